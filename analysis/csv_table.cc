@@ -1,0 +1,141 @@
+#include "analysis/csv_table.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "model/input_error.h"
+
+namespace exotwin {
+
+int CsvTable::Find(const std::string& name) const {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+namespace {
+
+std::string Trim(const std::string& s) {
+  size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
+  return s.substr(b, e - b);
+}
+
+std::string Where(const std::string& path, int line) { return path + ":" + std::to_string(line) + ": "; }
+
+}  // namespace
+
+CsvTable ReadCsv(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open file (" + std::strerror(errno) + ")");
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (content.empty()) throw InputError(path + ": file is empty, expected a CSV header row");
+  if (content.find('\0') != std::string::npos)
+    throw InputError(path + ": binary data (NUL byte), expected a text CSV file");
+
+  CsvTable t;
+  bool have_header = false;
+  size_t pos = 0;
+  int line_no = 0;
+  std::vector<double> row;
+  while (pos < content.size()) {
+    size_t end = content.find('\n', pos);
+    if (end == std::string::npos) end = content.size();
+    const std::string line = content.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    const std::string trimmed = Trim(line);
+    if (trimmed.empty() || trimmed[0] == '#') continue;
+    if (!have_header) {
+      std::stringstream ss(trimmed);
+      std::string name;
+      std::set<std::string> seen;
+      while (std::getline(ss, name, ',')) {
+        name = Trim(name);
+        if (name.empty())
+          throw InputError(Where(path, line_no) + "empty column name in the header row");
+        if (!seen.insert(name).second)
+          throw InputError(Where(path, line_no) + "duplicated column '" + name + "' in the header");
+        t.names.push_back(name);
+      }
+      if (trimmed.back() == ',') throw InputError(Where(path, line_no) + "header ends with ','");
+      t.columns.assign(t.names.size(), {});
+      have_header = true;
+      continue;
+    }
+    row.clear();
+    const char* p = trimmed.c_str();
+    const char* const stop = p + trimmed.size();
+    size_t field = 0;
+    while (true) {
+      while (p < stop && (*p == ' ' || *p == '\t')) ++p;
+      char* q = nullptr;
+      errno = 0;
+      const double v = std::strtod(p, &q);
+      const char* after = q;
+      while (after < stop && (*after == ' ' || *after == '\t')) ++after;
+      if (q == p || (after < stop && *after != ',')) {
+        const char* fe = p;
+        while (fe < stop && *fe != ',') ++fe;
+        const std::string col = field < t.names.size() ? t.names[field] : "#" + std::to_string(field + 1);
+        throw InputError(Where(path, line_no) + "column '" + col + "': '" + std::string(p, fe) +
+                         "' is not a number");
+      }
+      row.push_back(v);
+      ++field;
+      p = after;
+      if (p >= stop) break;
+      ++p;  // skip ','
+      if (p >= stop) throw InputError(Where(path, line_no) + "row ends with ','");
+    }
+    if (row.size() != t.names.size())
+      throw InputError(Where(path, line_no) + "expected " + std::to_string(t.names.size()) +
+                       " fields (as in the header), found " + std::to_string(row.size()));
+    for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
+    t.line_of_row.push_back(line_no);
+  }
+  if (!have_header) throw InputError(path + ": no header row (only comments or blank lines)");
+  return t;
+}
+
+void WriteFileAtomic(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
+    out << text;
+    out.flush();
+    if (!out) throw InputError(path + ": write failed (" + std::strerror(errno) + ")");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw InputError(path + ": cannot rename temporary file (" + std::strerror(errno) + ")");
+}
+
+void WriteCsv(const std::string& path, const std::vector<std::string>& names,
+              const std::vector<const std::vector<double>*>& columns,
+              const std::vector<std::string>& comments) {
+  std::string out;
+  for (const auto& c : comments) out += "# " + c + "\n";
+  for (size_t i = 0; i < names.size(); ++i) out += (i ? "," : "") + names[i];
+  out += "\n";
+  const size_t n = columns.empty() ? 0 : columns[0]->size();
+  out.reserve(out.size() + n * columns.size() * 24);
+  char buf[32];
+  for (size_t r = 0; r < n; ++r) {
+    for (size_t c = 0; c < columns.size(); ++c) {
+      const int len = std::snprintf(buf, sizeof(buf), "%.17g", (*columns[c])[r]);
+      if (c) out += ',';
+      out.append(buf, len);
+    }
+    out += '\n';
+  }
+  WriteFileAtomic(path, out);
+}
+
+}  // namespace exotwin

@@ -1,0 +1,153 @@
+#include "analysis/measured_data.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dsp/butterworth.h"
+#include "model/input_error.h"
+
+namespace exotwin {
+
+const std::vector<double>* MeasuredData::Column(const std::string& name) const {
+  const int i = table.Find(name);
+  return i < 0 ? nullptr : &table.columns[i];
+}
+
+namespace {
+
+bool IsKnownColumn(const std::string& n) {
+  static const char* kKnown[] = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "qd_hip", "qd_knee",
+                                 "qdd_hip", "qdd_knee", "cmd_hip", "cmd_knee"};
+  for (const char* k : kKnown)
+    if (n == k) return true;
+  return n.rfind("emg_", 0) == 0;
+}
+
+}  // namespace
+
+MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
+  MeasuredData d;
+  d.source = path;
+  d.table = ReadCsv(path);
+  const CsvTable& t = d.table;
+  for (const char* req : {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"})
+    if (t.Find(req) < 0)
+      throw InputError(path + ": missing required column '" + req +
+                       "' (expected t, q_hip, q_knee, tau_hip, tau_knee)");
+  if (t.rows() < min_samples)
+    throw InputError(path + ": " + std::to_string(t.rows()) + " samples, expected at least " +
+                     std::to_string(min_samples));
+  for (size_t c = 0; c < t.names.size(); ++c) {
+    const std::string& n = t.names[c];
+    if (!IsKnownColumn(n)) continue;
+    double limit = 1e6;
+    std::string unit;
+    if (n == "q_hip" || n == "q_knee") { limit = 2 * M_PI; unit = "rad"; }
+    if (n == "tau_hip" || n == "tau_knee" || n.rfind("cmd_", 0) == 0) { limit = 1000; unit = "N m"; }
+    if (n.rfind("emg_", 0) == 0) { limit = 100; unit = "V"; }
+    for (size_t r = 0; r < t.rows(); ++r) {
+      const double v = t.columns[c][r];
+      const std::string where = path + ":" + std::to_string(t.line_of_row[r]) + ": column '" + n + "': ";
+      if (!std::isfinite(v)) throw InputError(where + "value is not finite, expected a finite number");
+      if (std::abs(v) > limit)
+        throw InputError(where + "value " + std::to_string(v) + " out of range, expected |x| <= " +
+                         std::to_string(limit) + " " + unit);
+    }
+  }
+  const auto& tc = t.columns[t.Find("t")];
+  for (size_t r = 1; r < tc.size(); ++r)
+    if (!(tc[r] > tc[r - 1]))
+      throw InputError(path + ":" + std::to_string(t.line_of_row[r]) + ": column 't': " +
+                       std::to_string(tc[r]) + " not greater than the previous " +
+                       std::to_string(tc[r - 1]) + ", expected strictly increasing time");
+  d.t = tc;
+  d.q_hip = t.columns[t.Find("q_hip")];
+  d.q_knee = t.columns[t.Find("q_knee")];
+  d.tau_hip = t.columns[t.Find("tau_hip")];
+  d.tau_knee = t.columns[t.Find("tau_knee")];
+  return d;
+}
+
+std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<double>& y,
+                                const std::vector<double>& xq) {
+  std::vector<double> out(xq.size());
+  size_t j = 0;
+  for (size_t i = 0; i < xq.size(); ++i) {
+    const double v = xq[i];
+    if (v <= x.front()) { out[i] = y.front(); continue; }
+    if (v >= x.back()) { out[i] = y.back(); continue; }
+    if (j > 0 && x[j] > v) j = 0;
+    while (j + 1 < x.size() && x[j + 1] < v) ++j;
+    const double w = (v - x[j]) / (x[j + 1] - x[j]);
+    out[i] = y[j] + w * (y[j + 1] - y[j]);
+  }
+  return out;
+}
+
+Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
+  Kinematics k;
+  k.t = data.t;
+  k.q[0] = data.q_hip;
+  k.q[1] = data.q_knee;
+  const char* names[2] = {"hip", "knee"};
+  bool all_measured = true;
+  for (int j = 0; j < 2; ++j) {
+    const auto* qd = data.Column(std::string("qd_") + names[j]);
+    const auto* qdd = data.Column(std::string("qdd_") + names[j]);
+    if (qd && qdd) {
+      k.qd[j] = *qd;
+      k.qdd[j] = *qdd;
+    } else {
+      all_measured = false;
+    }
+  }
+  if (all_measured) {
+    k.derivative_source = "measured columns";
+    return k;
+  }
+
+  // Uniform grid check.
+  const size_t n = data.t.size();
+  std::vector<double> dts(n - 1);
+  for (size_t i = 0; i + 1 < n; ++i) dts[i] = data.t[i + 1] - data.t[i];
+  std::vector<double> sorted = dts;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double dt = sorted[sorted.size() / 2];
+  bool uniform = true;
+  for (double s : dts)
+    if (std::abs(s - dt) > 0.01 * dt) { uniform = false; break; }
+
+  std::vector<double> grid;
+  if (uniform) {
+    grid = data.t;
+  } else {
+    const size_t m = static_cast<size_t>(std::floor((data.t.back() - data.t.front()) / dt)) + 1;
+    grid.resize(m);
+    for (size_t i = 0; i < m; ++i) grid[i] = data.t.front() + dt * static_cast<double>(i);
+    k.resampled = true;
+  }
+  const double fs = 1.0 / dt;
+  if (!(cutoff_hz < 0.5 * fs))
+    throw InputError(data.source + ": sample period " + std::to_string(dt) +
+                     " s is too long for the 20 Hz derivative filter, expected a sample rate above " +
+                     std::to_string(2 * cutoff_hz) + " Hz");
+  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, fs, cutoff_hz);
+  for (int j = 0; j < 2; ++j) {
+    const auto* qd = data.Column(std::string("qd_") + names[j]);
+    const auto* qdd = data.Column(std::string("qdd_") + names[j]);
+    const std::vector<double> qg = uniform ? k.q[j] : Interpolate(data.t, k.q[j], grid);
+    const std::vector<double> qf = dsp::FiltFilt(sos, qg);
+    std::vector<double> v = dsp::Gradient(qf, dt);
+    std::vector<double> a = dsp::Gradient(v, dt);
+    if (!uniform) {
+      v = Interpolate(grid, v, data.t);
+      a = Interpolate(grid, a, data.t);
+    }
+    k.qd[j] = qd ? *qd : v;
+    k.qdd[j] = qdd ? *qdd : a;
+  }
+  k.derivative_source = "butterworth 20 Hz";
+  return k;
+}
+
+}  // namespace exotwin

@@ -1,0 +1,45 @@
+// The measured-data CSV of DESIGN.md (input of predict / diagnose / identify) and the kinematics
+// derived from it.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "analysis/csv_table.h"
+
+namespace exotwin {
+
+struct MeasuredData {
+  std::string source;  // file name, for messages
+  std::vector<double> t, q_hip, q_knee, tau_hip, tau_knee;
+  CsvTable table;  // every column as read (optional ones: qd_*, qdd_*, cmd_*, emg_*, ...)
+
+  size_t size() const { return t.size(); }
+  // Optional column by name; nullptr if absent.
+  const std::vector<double>* Column(const std::string& name) const;
+};
+
+// Reads and validates a measured-data CSV: required columns t, q_hip, q_knee, tau_hip, tau_knee;
+// strictly increasing t; finite values in every known column; angles within +-2 pi rad; torques
+// within +-1000 N m; at least `min_samples` rows. Throws InputError naming file, line and column.
+MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples = 20);
+
+// Joint kinematics on the measured time base.
+struct Kinematics {
+  std::vector<double> t;
+  std::vector<double> q[2], qd[2], qdd[2];  // [0] hip, [1] knee; rad, rad/s, rad/s^2
+  bool resampled = false;                    // the input was non-uniform and went through a grid
+  std::string derivative_source;             // "measured columns" or "butterworth 20 Hz"
+};
+
+// Uses qd_*/qdd_* columns when present, else derives them as in Hwang & Jeon sec. 3.2: the angle is
+// filtered by a zero-phase 2nd-order Butterworth low-pass at 20 Hz (forward-backward) and
+// differentiated by central differences. Non-uniform sampling (any step off the median by more than
+// 1 %) is handled by resampling the angles onto a uniform grid at the median step (linear
+// interpolation), differentiating there, and interpolating back onto the measured times.
+Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz = 20.0);
+
+// Linear interpolation of (x, y) at xq (x strictly increasing; clamped at the ends).
+std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<double>& y,
+                                const std::vector<double>& xq);
+
+}  // namespace exotwin

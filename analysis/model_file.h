@@ -1,0 +1,24 @@
+// MODEL.yaml (DESIGN.md "Model parameter file"): reading with strict validation, and writing.
+#pragma once
+#include <string>
+
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// Reads a model file. Throws InputError naming the file, the key (e.g. "human.J2" or
+// "effects[1].joint") and what was expected, for: unreadable or malformed YAML, unknown or missing
+// keys, wrong types, non-finite numbers, negative masses, values out of physical range
+// (|J| <= 50 kg m^2, |X|, |Y| <= 50 kg m, L1 in (0.1, 1.0) m), unknown passive model or effect.
+// Physical consistency (a realization exists) is checked when the twin is built (Plant::SetParams).
+LegParams ReadModelFile(const std::string& path);
+
+// Parses model YAML text; `source` names it in messages.
+LegParams ParseModelYaml(const std::string& text, const std::string& source);
+
+// Serializes params as MODEL.yaml text. `extra_yaml` (already formatted top-level YAML, e.g. an
+// `identification:` block) is appended verbatim; `header` lines become '# ' comments at the top.
+std::string ModelToYaml(const LegParams& params, const std::string& header = "",
+                        const std::string& extra_yaml = "");
+
+}  // namespace exotwin

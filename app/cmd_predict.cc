@@ -1,0 +1,50 @@
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+#include "analysis/csv_table.h"
+#include "analysis/measured_data.h"
+#include "analysis/model_file.h"
+#include "analysis/predict.h"
+#include "app/commands.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+
+std::string DefaultModelFor(bool has_human) {
+  return ShippedModelPath(has_human ? "leg_exowheel.xml" : "exowheel_exo_only.xml");
+}
+
+CommandRunner RegisterPredict(CLI::App& app) {
+  struct Opts {
+    std::string params, measured, out, mjcf;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand(
+      "predict", "Torque-sensor reading the twin predicts for measured kinematics (t,tau_hip,tau_knee)");
+  sub->add_option("--params", o->params, "MODEL.yaml (lumped parameters, passive model, effects)")->required();
+  sub->add_option("--measured", o->measured, "measured-data CSV (t, q_hip, q_knee, ...)")->required();
+  sub->add_option("--out", o->out, "output CSV of the prediction")->required();
+  sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    const LegParams params = ReadModelFile(o->params);
+    const MeasuredData data = ReadMeasuredCsv(o->measured);
+    Plant plant(o->mjcf.empty() ? DefaultModelFor(params.human.has_value()) : o->mjcf);
+    plant.SetParams(params);
+    const Kinematics kin = DeriveKinematics(data);
+    if (kin.resampled)
+      std::fprintf(stderr,
+                   "predict: %s is sampled non-uniformly; derivatives computed on a uniform grid at "
+                   "the median step and interpolated back\n",
+                   o->measured.c_str());
+    const Prediction p = PredictTorque(plant, kin);
+    WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&p.t, &p.tau_S[0], &p.tau_S[1]},
+             {"exotwin predict: torque-sensor reading tau_S = -tau_R (N m)",
+              "params: " + o->params + ", measured: " + o->measured + ", derivatives: " +
+                  kin.derivative_source});
+    return 0;
+  };
+}
+
+}  // namespace exotwin

@@ -1,0 +1,181 @@
+#include "dsp/butterworth.h"
+
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+#include <string>
+
+namespace exotwin::dsp {
+namespace {
+
+using cd = std::complex<double>;
+
+cd Bilinear(cd s, double fs) { return (2.0 * fs + s) / (2.0 * fs - s); }
+
+cd EvalCascade(const std::vector<Biquad>& sos, cd z) {
+  cd h = 1.0;
+  const cd zi = 1.0 / z;
+  for (const Biquad& s : sos)
+    h *= (s.b0 + s.b1 * zi + s.b2 * zi * zi) / (1.0 + s.a1 * zi + s.a2 * zi * zi);
+  return h;
+}
+
+}  // namespace
+
+std::vector<Biquad> DesignButterworth(int order, BandType type, double fs, double f_lo,
+                                      double f_hi) {
+  auto bad = [](const std::string& what) { throw std::invalid_argument("Butterworth: " + what); };
+  if (order < 1 || order > 12) bad("order must be in 1..12, got " + std::to_string(order));
+  if (!(fs > 0)) bad("sample rate must be > 0");
+  if (!(f_lo > 0 && f_lo < fs / 2)) bad("cut-off must be in (0, fs/2)");
+  if (type == BandType::kBandPass && !(f_hi > f_lo && f_hi < fs / 2))
+    bad("band-pass needs f_lo < f_hi < fs/2");
+
+  // Pre-warped analogue frequencies (rad/s).
+  const double w_lo = 2.0 * fs * std::tan(M_PI * f_lo / fs);
+  const double w_hi = type == BandType::kBandPass ? 2.0 * fs * std::tan(M_PI * f_hi / fs) : 0.0;
+
+  // Analogue prototype poles on the unit circle, left half plane.
+  std::vector<cd> proto;
+  for (int k = 0; k < order; ++k)
+    proto.push_back(std::polar(1.0, M_PI * (2.0 * k + order + 1) / (2.0 * order)));
+
+  std::vector<cd> poles;  // digital
+  double zero_at_plus1 = 0, zero_at_minus1 = 0;
+  for (const cd& p : proto) {
+    switch (type) {
+      case BandType::kLowPass:
+        poles.push_back(Bilinear(p * w_lo, fs));
+        zero_at_minus1 += 1;
+        break;
+      case BandType::kHighPass:
+        poles.push_back(Bilinear(w_lo / p, fs));
+        zero_at_plus1 += 1;
+        break;
+      case BandType::kBandPass: {
+        const double bw = w_hi - w_lo, w0sq = w_lo * w_hi;
+        const cd disc = std::sqrt(p * p * bw * bw - 4.0 * w0sq);
+        poles.push_back(Bilinear((p * bw + disc) / 2.0, fs));
+        poles.push_back(Bilinear((p * bw - disc) / 2.0, fs));
+        zero_at_plus1 += 1;
+        zero_at_minus1 += 1;
+        break;
+      }
+    }
+  }
+
+  // Pair poles: complex ones with their conjugates, real ones two by two.
+  std::vector<std::pair<cd, cd>> pairs;
+  std::vector<cd> reals;
+  for (const cd& p : poles) {
+    if (p.imag() > 1e-12) pairs.push_back({p, std::conj(p)});
+    else if (std::abs(p.imag()) <= 1e-12) reals.push_back(cd(p.real(), 0.0));
+  }
+  std::vector<Biquad> sos;
+  auto take_zero = [&](double& b1, double& b2, bool second) {
+    // Multiplies (1 - z0 z^-1) into the numerator polynomial [1, b1, b2].
+    double z0;
+    if (zero_at_plus1 >= zero_at_minus1 && zero_at_plus1 > 0) { z0 = 1.0; zero_at_plus1 -= 1; }
+    else if (zero_at_minus1 > 0) { z0 = -1.0; zero_at_minus1 -= 1; }
+    else return;
+    if (!second) b1 = -z0;
+    else { b2 = -z0 * b1; b1 = b1 - z0; }
+  };
+  for (auto& pr : pairs) {
+    Biquad s;
+    s.a1 = -2.0 * pr.first.real();
+    s.a2 = std::norm(pr.first);
+    double b1 = 0, b2 = 0;
+    take_zero(b1, b2, false);
+    take_zero(b1, b2, true);
+    s.b0 = 1.0; s.b1 = b1; s.b2 = b2;
+    sos.push_back(s);
+  }
+  for (size_t i = 0; i < reals.size(); i += 2) {
+    Biquad s;
+    double b1 = 0, b2 = 0;
+    if (i + 1 < reals.size()) {
+      s.a1 = -(reals[i].real() + reals[i + 1].real());
+      s.a2 = reals[i].real() * reals[i + 1].real();
+      take_zero(b1, b2, false);
+      take_zero(b1, b2, true);
+    } else {
+      s.a1 = -reals[i].real();
+      take_zero(b1, b2, false);
+    }
+    s.b0 = 1.0; s.b1 = b1; s.b2 = b2;
+    sos.push_back(s);
+  }
+
+  // Unit gain in the pass band.
+  double f_ref = 0.0;
+  if (type == BandType::kHighPass) f_ref = fs / 2.0;
+  if (type == BandType::kBandPass) f_ref = std::atan(std::sqrt(w_lo * w_hi) / (2.0 * fs)) * fs / M_PI;
+  const double gain = std::abs(EvalCascade(sos, std::polar(1.0, 2.0 * M_PI * f_ref / fs)));
+  sos[0].b0 /= gain; sos[0].b1 /= gain; sos[0].b2 /= gain;
+  return sos;
+}
+
+double MagnitudeResponse(const std::vector<Biquad>& sos, double fs, double f) {
+  return std::abs(EvalCascade(sos, std::polar(1.0, 2.0 * M_PI * f / fs)));
+}
+
+SosFilter::SosFilter(std::vector<Biquad> sos) : sos_(std::move(sos)), z_(sos_.size(), {0.0, 0.0}) {}
+
+double SosFilter::Step(double x) {
+  for (size_t i = 0; i < sos_.size(); ++i) {
+    const Biquad& s = sos_[i];
+    auto& z = z_[i];
+    const double y = s.b0 * x + z[0];
+    z[0] = s.b1 * x - s.a1 * y + z[1];
+    z[1] = s.b2 * x - s.a2 * y;
+    x = y;
+  }
+  return x;
+}
+
+void SosFilter::ResetSteady(double x) {
+  for (size_t i = 0; i < sos_.size(); ++i) {
+    const Biquad& s = sos_[i];
+    const double den = 1.0 + s.a1 + s.a2;
+    const double y = std::abs(den) > 1e-300 ? x * (s.b0 + s.b1 + s.b2) / den : 0.0;
+    z_[i][1] = s.b2 * x - s.a2 * y;
+    z_[i][0] = s.b1 * x - s.a1 * y + z_[i][1];
+    x = y;
+  }
+}
+
+void SosFilter::Reset() {
+  for (auto& z : z_) z = {0.0, 0.0};
+}
+
+std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {
+  const size_t n = x.size();
+  if (n == 0) return {};
+  size_t pad = 3 * (2 * sos.size() + 1);
+  if (pad >= n) pad = n - 1;
+  std::vector<double> ext;
+  ext.reserve(n + 2 * pad);
+  for (size_t i = pad; i >= 1; --i) ext.push_back(2.0 * x[0] - x[i]);
+  ext.insert(ext.end(), x.begin(), x.end());
+  for (size_t i = 1; i <= pad; ++i) ext.push_back(2.0 * x[n - 1] - x[n - 1 - i]);
+
+  SosFilter f(sos);
+  f.ResetSteady(ext.front());
+  for (double& v : ext) v = f.Step(v);
+  f.ResetSteady(ext.back());
+  for (auto it = ext.rbegin(); it != ext.rend(); ++it) *it = f.Step(*it);
+  return std::vector<double>(ext.begin() + pad, ext.begin() + pad + n);
+}
+
+std::vector<double> Gradient(const std::vector<double>& x, double dt) {
+  const size_t n = x.size();
+  std::vector<double> d(n, 0.0);
+  if (n < 2) return d;
+  d[0] = (x[1] - x[0]) / dt;
+  d[n - 1] = (x[n - 1] - x[n - 2]) / dt;
+  for (size_t i = 1; i + 1 < n; ++i) d[i] = (x[i + 1] - x[i - 1]) / (2.0 * dt);
+  return d;
+}
+
+}  // namespace exotwin::dsp

@@ -1,0 +1,50 @@
+// Butterworth filters as cascades of second-order sections (bilinear transform with pre-warping),
+// causal filtering for the real-time path and zero-phase forward-backward filtering for off-line use.
+#pragma once
+#include <array>
+#include <vector>
+
+namespace exotwin::dsp {
+
+// One second-order section, a0 normalised to 1: H(z) = (b0 + b1 z^-1 + b2 z^-2)/(1 + a1 z^-1 + a2 z^-2).
+struct Biquad {
+  double b0 = 1, b1 = 0, b2 = 0, a1 = 0, a2 = 0;
+};
+
+enum class BandType { kLowPass, kHighPass, kBandPass };
+
+// Design an order-N Butterworth filter. f_lo/f_hi in Hz (f_hi only for band-pass), fs sample rate, Hz.
+// Preconditions: N >= 1, 0 < f < fs/2 (throws std::invalid_argument otherwise). A band-pass of order N
+// has 2N poles (as scipy.signal.butter(N, [f_lo, f_hi], 'bandpass')).
+std::vector<Biquad> DesignButterworth(int order, BandType type, double fs, double f_lo,
+                                      double f_hi = 0.0);
+
+// Complex gain magnitude of the cascade at frequency f (Hz).
+double MagnitudeResponse(const std::vector<Biquad>& sos, double fs, double f);
+
+// Causal cascade filter with state (transposed direct form II); real-time safe after construction.
+class SosFilter {
+ public:
+  SosFilter() = default;
+  explicit SosFilter(std::vector<Biquad> sos);
+  // Filters one sample.
+  double Step(double x);
+  // Sets the internal state to the steady state for a constant input x (no start-up transient).
+  void ResetSteady(double x);
+  void Reset();
+
+ private:
+  std::vector<Biquad> sos_;
+  std::vector<std::array<double, 2>> z_;
+};
+
+// Zero-phase filtering (forward then backward), odd-reflection padding of 3*(2*sections+1) samples
+// and steady-state initial conditions, like scipy.signal.sosfiltfilt. Inputs shorter than the pad
+// length use the whole signal as the pad.
+std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x);
+
+// Numerical derivative with central differences (second order inside, one-sided at the ends).
+// dt > 0 uniform sample period. Size >= 2.
+std::vector<double> Gradient(const std::vector<double>& x, double dt);
+
+}  // namespace exotwin::dsp

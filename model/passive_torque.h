@@ -1,0 +1,23 @@
+// Passive elastic joint torque P(q) of eq. (1) and (12), rebuilt from Riener & Edrich 1999
+// (J. Biomech. 32:539-544) because the 2015 print of eq. (12) is garbled (see the .cc file).
+#pragma once
+#include <Eigen/Core>
+
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// Riener & Edrich 1999 hip moment (N m), positive in the direction of hip flexion.
+// H hip flexion, K knee flexion (both degrees, K >= 0 flexed).
+double RienerHipMoment(double H_deg, double K_deg);
+
+// Riener & Edrich 1999 knee moment (N m), positive in the direction of knee flexion.
+// A ankle plantarflexion, K knee flexion, H hip flexion (degrees).
+double RienerKneeMoment(double A_deg, double K_deg, double H_deg);
+
+// P(q) in this project's convention (q in rad, hip flexion positive, knee flexion negative), the term
+// that sits on the left of eq. (1) beside G: P = minus the passive moment along each generalized
+// coordinate. Ankle held at 0 (the lower leg is one rigid segment). N m. kNone gives zero.
+Eigen::Vector2d PassiveElasticTorque(PassiveModel model, const Eigen::Vector2d& q);
+
+}  // namespace exotwin

@@ -1,0 +1,38 @@
+// Identification regressors: the dynamics written linearly in the lumped parameters, eq. (18)-(21)
+// and Appendix A1-A4 of Hwang & Jeon 2015, with the signs re-derived (see regressors.cc).
+#pragma once
+#include <Eigen/Core>
+
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+using Matrix26 = Eigen::Matrix<double, 2, 6>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// Parameter vector order of the full regressor: [J1, J2, X1, X2, Y1, Y2].
+Vector6 ToVector(const LumpedParams& p);
+LumpedParams FromVector(const Vector6& v);
+
+// Full regressor Y(q, qd, qdd) with M qdd + V + G = Y * [J1 J2 X1 X2 Y1 Y2]^T, any state.
+Matrix26 FullRegressor(double L1, double g, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                       const Eigen::Vector2d& qdd);
+
+// One row of a step regressor: u* = w^T phi (eq. 18).
+struct StepRow {
+  double u_star = 0;
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+};
+
+// Step 1 (exo R2, hip fixed at 90 deg, knee y moving): phi = [J_R2, X_R2, Y_R2]. u = tau_R knee.
+StepRow Step1Row(double g, double y, double ydd, double u);
+// Step 2 (exo R1, knee fixed at -90 deg, hip y moving): phi = [J_R1, X_R1, Y_R1]; needs X_R2, Y_R2.
+StepRow Step2Row(double L1, double g, const LumpedParams& exo, double y, double ydd, double u);
+// Step 3 (human H2, hip at 90 deg): phi = [J_H2, X_H2, Y_H2]; exo known; P2 the passive torque.
+StepRow Step3Row(double g, const LumpedParams& exo, double y, double ydd, double u, double P2);
+// Step 4 (human H1, knee at -90 deg): phi = [J_H1, X_H1, Y_H1]; exo and the human's X_H2, Y_H2
+// (from step 3) known; P1 the passive torque.
+StepRow Step4Row(double L1, double g, const LumpedParams& exo, const LumpedParams& human_distal,
+                 double y, double ydd, double u, double P1);
+
+}  // namespace exotwin

@@ -1,0 +1,177 @@
+#include "sim/plant.h"
+
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "model/input_error.h"
+#include "model/passive_torque.h"
+
+namespace exotwin {
+
+SimulationError::SimulationError(double t, const std::string& cause)
+    : std::runtime_error("simulation diverged at t = " + std::to_string(t) + " s: " + cause),
+      time_(t) {}
+
+std::string ShippedModelPath(const std::string& file) {
+  return std::string(EXOTWIN_SOURCE_DIR) + "/models/" + file;
+}
+
+Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
+  char err[1000] = "";
+  m_ = mj_loadXML(mjcf_path.c_str(), nullptr, err, sizeof(err));
+  if (!m_) throw InputError(mjcf_path + ": cannot load MJCF model: " + err);
+  if (err[0]) {
+    mj_deleteModel(m_);
+    throw InputError(mjcf_path + ": MJCF model loaded with a warning (treated as an error): " + err);
+  }
+  d_ = mj_makeData(m_);
+  d_inv_ = mj_makeData(m_);
+  try {
+    exo_thigh_ = Body("exo_thigh", true);
+    exo_shank_ = Body("exo_shank", true);
+    human_thigh_ = Body("human_thigh", false);
+    human_shank_ = Body("human_shank", false);
+    if ((human_thigh_ < 0) != (human_shank_ < 0))
+      throw InputError(mjcf_path + ": needs both human_thigh and human_shank bodies or neither");
+    const int hip = mj_name2id(m_, mjOBJ_JOINT, "hip");
+    const int knee = mj_name2id(m_, mjOBJ_JOINT, "knee");
+    if (hip < 0 || knee < 0 || m_->jnt_type[hip] != mjJNT_HINGE || m_->jnt_type[knee] != mjJNT_HINGE ||
+        m_->nv != 2)
+      throw InputError(mjcf_path + ": expected exactly two hinge joints named 'hip' and 'knee'");
+    hip_dof_ = m_->jnt_dofadr[hip];
+    knee_dof_ = m_->jnt_dofadr[knee];
+    if (m_->nu != 2)
+      throw InputError(mjcf_path + ": expected two torque actuators (hip, knee), found " +
+                       std::to_string(m_->nu));
+  } catch (...) {
+    mj_deleteData(d_);
+    mj_deleteData(d_inv_);
+    mj_deleteModel(m_);
+    throw;
+  }
+  params_.L1 = -m_->body_pos[3 * exo_shank_ + 2];
+}
+
+Plant::~Plant() {
+  mj_deleteData(d_);
+  mj_deleteData(d_inv_);
+  mj_deleteModel(m_);
+}
+
+int Plant::Body(const char* name, bool required) const {
+  const int id = mj_name2id(m_, mjOBJ_BODY, name);
+  if (id < 0 && required) throw InputError(path_ + ": MJCF model has no body named '" + name + "'");
+  return id;
+}
+
+namespace {
+
+// Writes one segment (in its joint frame: x forward at q = 0, z along the link upwards) into a body.
+// Sagittal inertia about the hinge axis (y); the two others chosen so the triangle inequality holds.
+void WriteBody(mjModel* m, int body, const SegmentInertial& s) {
+  m->body_mass[body] = s.mass;
+  m->body_ipos[3 * body + 0] = s.b;
+  m->body_ipos[3 * body + 1] = 0.0;
+  m->body_ipos[3 * body + 2] = -s.a;
+  m->body_inertia[3 * body + 0] = s.Iz;        // about x (frontal axis)
+  m->body_inertia[3 * body + 1] = s.Iz;        // about y (hinge axis): the sagittal Iz
+  m->body_inertia[3 * body + 2] = 0.5 * s.Iz;  // about the long axis
+  m->body_iquat[4 * body + 0] = 1.0;
+  m->body_iquat[4 * body + 1] = m->body_iquat[4 * body + 2] = m->body_iquat[4 * body + 3] = 0.0;
+}
+
+}  // namespace
+
+void Plant::SetParams(const LegParams& params) {
+  if (!(params.L1 > 0.1 && params.L1 < 1.0))
+    throw InputError("L1: expected a thigh length in (0.1, 1.0) m, got " + std::to_string(params.L1));
+  if (params.human && human_thigh_ < 0)
+    throw InputError(path_ + ": the parameter set has a human: block but the model has no human bodies");
+  const SystemRealization exo = RealizeLumped(params.exo, params.L1, "exo");
+  SystemRealization human;
+  if (params.human) human = RealizeLumped(*params.human, params.L1, "human");
+
+  m_->opt.gravity[0] = m_->opt.gravity[1] = 0.0;
+  m_->opt.gravity[2] = -params.g;
+  m_->body_pos[3 * exo_shank_ + 2] = -params.L1;
+  WriteBody(m_, exo_thigh_, exo.thigh);
+  WriteBody(m_, exo_shank_, exo.lower_leg);
+  if (human_thigh_ >= 0) {
+    // Without a human the welded human bodies carry a negligible mass (MuJoCo needs mass > 0 only
+    // for bodies with joints; these have none).
+    SegmentInertial none{0.0, 0.0, 0.0, 0.0};
+    WriteBody(m_, human_thigh_, params.human ? human.thigh : none);
+    WriteBody(m_, human_shank_, params.human ? human.lower_leg : none);
+  }
+  mj_setConst(m_, d_);
+  params_ = params;
+  mj_forward(m_, d_);
+}
+
+Eigen::Vector2d Plant::InverseDynamics(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                                       const Eigen::Vector2d& qdd) {
+  mjData* d = d_inv_;
+  d->qpos[0] = q[0];
+  d->qpos[1] = q[1];
+  d->qvel[0] = qd[0];
+  d->qvel[1] = qd[1];
+  d->qacc[0] = qdd[0];
+  d->qacc[1] = qdd[1];
+  const int saved = m_->opt.disableflags;
+  m_->opt.disableflags |= mjDSBL_CONSTRAINT;  // rigid-body inverse dynamics, no limit forces
+  mj_inverse(m_, d);
+  m_->opt.disableflags = saved;
+  Eigen::Vector2d tau(d->qfrc_inverse[hip_dof_], d->qfrc_inverse[knee_dof_]);
+  if (params_.human) tau += PassiveElasticTorque(params_.passive, q);
+  return tau;
+}
+
+void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t) {
+  mj_resetData(m_, d_);
+  d_->qpos[0] = q[0];
+  d_->qpos[1] = q[1];
+  d_->qvel[0] = qd[0];
+  d_->qvel[1] = qd[1];
+  d_->time = t;
+  mj_forward(m_, d_);
+  CheckDivergence("reset");
+}
+
+void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
+  if (!std::isfinite(tau_R[0]) || !std::isfinite(tau_R[1]) || !std::isfinite(tau_ext[0]) ||
+      !std::isfinite(tau_ext[1]))
+    throw SimulationError(d_->time, "non-finite torque command");
+  Eigen::Vector2d applied = tau_ext;
+  if (params_.human) applied -= PassiveElasticTorque(params_.passive, q());
+  d_->qfrc_applied[hip_dof_] = applied[0];
+  d_->qfrc_applied[knee_dof_] = applied[1];
+  // Actuators are plain motors with gear 1: ctrl is the joint torque (clamped by ctrlrange).
+  d_->ctrl[0] = tau_R[0];
+  d_->ctrl[1] = tau_R[1];
+  mj_step(m_, d_);
+  CheckDivergence("step");
+}
+
+void Plant::CheckDivergence(const char* where) {
+  for (int i = 0; i < mjNWARNING; ++i) {
+    if (d_->warning[i].number > 0) {
+      static const char* kNames[mjNWARNING] = {"inertia",  "contact full", "constraint full",
+                                               "vgeom full", "bad qpos",   "bad qvel",
+                                               "bad qacc",   "bad ctrl"};
+      throw SimulationError(d_->time, std::string("MuJoCo warning '") + kNames[i] + "' in " + where);
+    }
+  }
+  for (int i = 0; i < m_->nq; ++i)
+    if (!std::isfinite(d_->qpos[i]) || !std::isfinite(d_->qvel[i]))
+      throw SimulationError(d_->time, std::string("non-finite state in ") + where);
+}
+
+Eigen::Vector2d Plant::q() const { return {d_->qpos[0], d_->qpos[1]}; }
+Eigen::Vector2d Plant::qd() const { return {d_->qvel[0], d_->qvel[1]}; }
+Eigen::Vector2d Plant::qdd() const { return {d_->qacc[0], d_->qacc[1]}; }
+double Plant::time() const { return d_->time; }
+double Plant::timestep() const { return m_->opt.timestep; }
+
+}  // namespace exotwin

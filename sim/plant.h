@@ -1,0 +1,81 @@
+// The MuJoCo plant of the two-joint leg + exoskeleton (models/leg_exowheel.xml or
+// models/exowheel_exo_only.xml) with the lumped parameters of a MODEL.yaml written into it.
+// Immutable-after-setup model, mutable data; every physics call checks for divergence.
+#pragma once
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "model/lumped_params.h"
+#include "sim/realization.h"
+
+struct mjModel_;
+struct mjData_;
+
+namespace exotwin {
+
+// Raised when the simulation diverges (NaN/inf state, MuJoCo warning). Carries the time and cause.
+class SimulationError : public std::runtime_error {
+ public:
+  SimulationError(double t, const std::string& cause);
+  double time() const { return time_; }
+
+ private:
+  double time_;
+};
+
+// Path of a model shipped in models/ (e.g. "leg_exowheel.xml").
+std::string ShippedModelPath(const std::string& file);
+
+class Plant {
+ public:
+  // Loads an MJCF file with bodies exo_thigh, exo_shank (+ human_thigh, human_shank) and hinges
+  // hip, knee. Throws InputError naming the file and MuJoCo's message if it cannot be used.
+  explicit Plant(const std::string& mjcf_path);
+  ~Plant();
+  Plant(const Plant&) = delete;
+  Plant& operator=(const Plant&) = delete;
+
+  // Writes L1, g and a consistent realization of params.exo / params.human into the model.
+  // Throws InputError if a system has no realization or the model lacks human bodies.
+  void SetParams(const LegParams& params);
+  const LegParams& params() const { return params_; }
+  bool has_human_bodies() const { return human_thigh_ >= 0; }
+
+  // Actuator torque tau_R (N m) for a relaxed subject: MuJoCo's inverse dynamics (mj_inverse, joint
+  // limits disabled) plus the passive elastic torque P(q). Does not change the simulation state.
+  Eigen::Vector2d InverseDynamics(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                                  const Eigen::Vector2d& qdd);
+
+  // Sets the state (rad, rad/s) and time (s) of the forward simulation; recomputes kinematics.
+  void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0);
+  // Advances one physics step (model timestep) with actuator torque tau_R (N m) and an extra joint
+  // torque tau_ext (N m, e.g. muscles or effects) acting on the link. Throws SimulationError on
+  // divergence. P(q) is applied automatically when params.human is set.
+  void Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext = Eigen::Vector2d::Zero());
+
+  Eigen::Vector2d q() const;
+  Eigen::Vector2d qd() const;
+  Eigen::Vector2d qdd() const;  // acceleration of the last step
+  double time() const;
+  double timestep() const;
+
+  const mjModel_* model() const { return m_; }
+  mjData_* data() { return d_; }
+
+ private:
+  void CheckDivergence(const char* where);
+  int Body(const char* name, bool required) const;
+
+  std::string path_;
+  mjModel_* m_ = nullptr;
+  mjData_* d_ = nullptr;
+  mjData_* d_inv_ = nullptr;  // scratch data for inverse dynamics
+  int exo_thigh_ = -1, exo_shank_ = -1, human_thigh_ = -1, human_shank_ = -1;
+  int hip_dof_ = -1, knee_dof_ = -1;
+  LegParams params_;
+};
+
+}  // namespace exotwin
