@@ -15,6 +15,13 @@ std::string DefaultModelFor(bool has_human) {
   return ShippedModelPath(has_human ? "leg_exowheel.xml" : "exowheel_exo_only.xml");
 }
 
+std::vector<CommandFactory>& CommandFactories() {
+  static std::vector<CommandFactory> factories;
+  return factories;
+}
+
+namespace {
+
 CommandRunner RegisterPredict(CLI::App& app) {
   struct Opts {
     std::string params, measured, out, mjcf;
@@ -47,4 +54,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
   };
 }
 
+const CommandRegistration kPredict(RegisterPredict);
+
+}  // namespace
 }  // namespace exotwin

@@ -3,6 +3,7 @@
 #pragma once
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -10,10 +11,15 @@ class App;
 
 namespace exotwin {
 
-using CommandRunner = std::function<int()>;
+using CommandRunner = std::function<int()>;  // returns -1 when its sub-command was not selected
+using CommandFactory = CommandRunner (*)(CLI::App& app);
 
-// Registers `predict` on `app`; the returned runner executes it after parsing.
-CommandRunner RegisterPredict(CLI::App& app);
+// Every app/cmd_*.cc registers its sub-command with a file-scope CommandRegistration; main() adds
+// them all (app/ is an object library, so no registration is dropped by the linker).
+std::vector<CommandFactory>& CommandFactories();
+struct CommandRegistration {
+  explicit CommandRegistration(CommandFactory f) { CommandFactories().push_back(f); }
+};
 
 // Chooses the shipped MJCF for a parameter set: with a human the leg + exo, else the exo alone.
 std::string DefaultModelFor(bool has_human);

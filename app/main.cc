@@ -12,7 +12,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"exotwin: digital twin of a leg in a rehabilitation exoskeleton"};
   app.require_subcommand(1);
-  std::vector<exotwin::CommandRunner> runners = {exotwin::RegisterPredict(app)};
+  std::vector<exotwin::CommandRunner> runners;
+  for (auto factory : exotwin::CommandFactories()) runners.push_back(factory(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
