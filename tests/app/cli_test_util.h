@@ -1,0 +1,48 @@
+// Helpers for tests that run the exotwin executable (path in EXOTWIN_BIN, set by CTest).
+#pragma once
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace exotwin::testing {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout + stderr
+};
+
+inline std::string ExotwinBin() {
+  const char* b = std::getenv("EXOTWIN_BIN");
+  return b ? b : std::string(EXOTWIN_SOURCE_DIR) + "/build/app/exotwin";
+}
+
+// Runs `exotwin <args>` through the shell, capturing stdout and stderr.
+inline RunResult RunExotwin(const std::string& args) {
+  RunResult r;
+  const std::string cmd = ExotwinBin() + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.output.append(buf, n);
+  const int st = pclose(p);
+  r.exit_code = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  return r;
+}
+
+// A fresh temporary directory for one test.
+inline std::string TempDir(const std::string& tag) {
+  std::string tmpl = "/tmp/exotwin_" + tag + "_XXXXXX";
+  char* d = mkdtemp(tmpl.data());
+  return d ? std::string(d) : std::string("/tmp");
+}
+
+inline void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+}  // namespace exotwin::testing

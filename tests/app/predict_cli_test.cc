@@ -1,0 +1,154 @@
+// `exotwin predict` through the command line: the contract of DESIGN.md, and bad input that must exit
+// 2 with a message naming the place and what was expected (one test per case).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "analysis/csv_table.h"
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::RunExotwin;
+using testing::TempDir;
+using testing::WriteText;
+
+const char kModel[] =
+    "L1: 0.41\n"
+    "exo:   {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
+    "human: {J1: 1.69, J2: 0.37, X1: 4.54, X2: 1.20, Y1: -0.16, Y2: 0.42}\n"
+    "passive: riener1999\n"
+    "effects: []\n";
+
+std::string GoodCsv(int n = 200, double dt = 0.001) {
+  std::ostringstream os;
+  os << "t,q_hip,q_knee,tau_hip,tau_knee\n";
+  for (int i = 0; i < n; ++i) {
+    const double t = i * dt;
+    os << t << "," << 0.3 + 0.1 * std::sin(2 * t) << "," << -0.7 + 0.2 * std::sin(3 * t) << ",-20,-5\n";
+  }
+  return os.str();
+}
+
+class PredictCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = TempDir("predict");
+    WriteText(dir_ + "/model.yaml", kModel);
+    WriteText(dir_ + "/data.csv", GoodCsv());
+  }
+  // Runs predict with a modified model and/or data file; returns the result.
+  testing::RunResult Predict(const std::string& model, const std::string& data,
+                             const std::string& extra = "") {
+    WriteText(dir_ + "/m.yaml", model);
+    WriteText(dir_ + "/d.csv", data);
+    return RunExotwin("predict --params " + dir_ + "/m.yaml --measured " + dir_ + "/d.csv --out " +
+                      dir_ + "/pred.csv " + extra);
+  }
+  void ExpectBadInput(const testing::RunResult& r, const std::string& must_contain) {
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(must_contain), std::string::npos)
+        << "message should contain '" << must_contain << "': " << r.output;
+  }
+  std::string dir_;
+};
+
+TEST_F(PredictCli, WritesPredictionWithContractColumns) {
+  const auto r = RunExotwin("predict --params " + dir_ + "/model.yaml --measured " + dir_ +
+                            "/data.csv --out " + dir_ + "/pred.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const CsvTable t = ReadCsv(dir_ + "/pred.csv");
+  ASSERT_EQ(t.names, (std::vector<std::string>{"t", "tau_hip", "tau_knee"}));
+  EXPECT_EQ(t.rows(), 200u);
+}
+
+TEST_F(PredictCli, MissingColumn) {
+  ExpectBadInput(Predict(kModel, "t,q_hip,q_knee,tau_hip\n0,0,0,0\n"), "missing required column 'tau_knee'");
+}
+TEST_F(PredictCli, NonIncreasingTime) {
+  std::string csv = GoodCsv();
+  csv += "0.1,0.3,-0.7,-20,-5\n";
+  ExpectBadInput(Predict(kModel, csv), "expected strictly increasing time");
+}
+TEST_F(PredictCli, NaNValue) {
+  std::string csv = GoodCsv(50);
+  csv += "0.5,nan,-0.7,-20,-5\n";
+  ExpectBadInput(Predict(kModel, csv), "column 'q_hip': value is not finite");
+}
+TEST_F(PredictCli, TooFewSamples) { ExpectBadInput(Predict(kModel, GoodCsv(5)), "expected at least"); }
+TEST_F(PredictCli, NotANumber) {
+  ExpectBadInput(Predict(kModel, GoodCsv(30) + "0.9,abc,-0.7,-20,-5\n"), "'abc' is not a number");
+}
+TEST_F(PredictCli, WrongFieldCount) {
+  ExpectBadInput(Predict(kModel, GoodCsv(30) + "0.9,0.2,-0.7\n"), "expected 5 fields");
+}
+TEST_F(PredictCli, EmptyCsv) { ExpectBadInput(Predict(kModel, ""), "file is empty"); }
+TEST_F(PredictCli, UnknownYamlKey) {
+  ExpectBadInput(Predict(std::string(kModel) + "colour: red\n", GoodCsv()), "colour: unknown key");
+}
+TEST_F(PredictCli, MissingYamlKey) {
+  ExpectBadInput(Predict("L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15}\n", GoodCsv()),
+                 "exo.Y2: missing");
+}
+TEST_F(PredictCli, WrongType) {
+  ExpectBadInput(Predict("L1: long\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.1}\n",
+                         GoodCsv()),
+                 "L1: 'long' is not a number");
+}
+TEST_F(PredictCli, NegativeMass) {
+  ExpectBadInput(
+      Predict("L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16, m2: -2}\n",
+              GoodCsv()),
+      "exo.m2: mass must be > 0 kg");
+}
+TEST_F(PredictCli, InconsistentParameterSet) {
+  // J1 = J2: no thigh inertia can be left for the lower leg's m2 L1^2 term.
+  ExpectBadInput(Predict("L1: 0.41\nexo: {J1: 0.74, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n",
+                         GoodCsv()),
+                 "exo: lumped parameters have no physically consistent realization");
+}
+TEST_F(PredictCli, UnreadableMjcf) {
+  WriteText(dir_ + "/bad.xml", "<mujoco><worldbody><body name='x'>");
+  ExpectBadInput(Predict(kModel, GoodCsv(), "--mjcf " + dir_ + "/bad.xml"), "cannot load MJCF model");
+}
+TEST_F(PredictCli, MjcfWithoutExpectedBodies) {
+  WriteText(dir_ + "/other.xml",
+            "<mujoco><worldbody><body name='b'><joint type='hinge'/><geom size='0.1'/></body>"
+            "</worldbody></mujoco>");
+  ExpectBadInput(Predict(kModel, GoodCsv(), "--mjcf " + dir_ + "/other.xml"), "no body named 'exo_thigh'");
+}
+TEST_F(PredictCli, PassiveWithoutHuman) {
+  ExpectBadInput(Predict("L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
+                         "passive: riener1999\n",
+                         GoodCsv()),
+                 "passive: acts on the human only");
+}
+TEST_F(PredictCli, MalformedYaml) {
+  ExpectBadInput(Predict("L1: [0.41\n", GoodCsv()), "malformed YAML");
+}
+TEST_F(PredictCli, MissingRequiredOption) {
+  const auto r = RunExotwin("predict --params " + dir_ + "/model.yaml");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+// Non-uniform sampling is resampled (and said on stderr); the prediction equals the one on the
+// uniformly sampled signal at the common times within the derivative filter's accuracy.
+TEST_F(PredictCli, NonUniformSamplingIsResampled) {
+  std::ostringstream os;
+  os << "t,q_hip,q_knee,tau_hip,tau_knee\n";
+  double t = 0;
+  for (int i = 0; i < 2000; ++i) {
+    os << t << "," << 0.3 + 0.1 * std::sin(2 * t) << "," << -0.7 + 0.2 * std::sin(3 * t) << ",0,0\n";
+    t += (i % 2) ? 0.0008 : 0.0012;
+  }
+  const auto r = Predict(kModel, os.str());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("non-uniformly"), std::string::npos);
+  const CsvTable p = ReadCsv(dir_ + "/pred.csv");
+  EXPECT_EQ(p.rows(), 2000u);
+}
+
+}  // namespace
+}  // namespace exotwin
