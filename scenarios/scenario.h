@@ -1,0 +1,96 @@
+// A scenario file (YAML): subject, device, protocol, hardware settings and faults, logs and checks.
+// See scenarios/README.md for the schema; scenarios/*.yaml are the shipped examples.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+enum class Device { kExowheel, kExowheelExoOnly, kHal3 };
+enum class TrajectoryKind { kGait, kExcitation, kHold };
+
+struct SubjectSpec {
+  std::string preset;          // "S1".."S10"
+  std::optional<uint64_t> random_seed;  // draw from the population with this seed
+  std::string params_file;     // or a MODEL.yaml
+  PassiveModel passive = PassiveModel::kRiener1999;
+};
+
+struct ProtocolSpec {
+  TrajectoryKind trajectory = TrajectoryKind::kGait;
+  double duration = 10.0;       // s per trial
+  int trials = 1;
+  double stride_period = 2.0;   // s (gait)
+  std::string moving_joint = "both";  // excitation: hip | knee | both
+  uint64_t excitation_seed = 1;
+  double ramp = 1.0;            // s: the controller ramps from the start pose to the trajectory
+};
+
+// One injected fault: `type` as in hwsim (sensor_stuck, sensor_stale, encoder_glitch, frame_drop,
+// frame_late, bus_off, command_loss, nan_measurement), on `joint` (hip/knee/all), from `at` (s) for
+// `duration` (s, <= 0 = until the end), with a type-specific `value`.
+struct FaultSpec {
+  std::string type;
+  std::string joint = "all";
+  double at = 0;
+  double duration = 0;
+  double value = 0;
+};
+
+struct CheckSpec {
+  std::string name;
+  std::string metric;
+  double limit = 0;
+  std::string op = "<=";  // "<=" (value must not exceed limit) or ">="
+};
+
+struct HardwareSpec {
+  double can_bitrate = 1e6;         // bit/s
+  double can_latency = 50e-6;       // s, per frame in the controller interface
+  double can_jitter = 10e-6;        // s, standard deviation
+  double can_drop_rate = 0;         // probability per frame
+  double torque_sensor_noise = 0.024;  // N m (0.02 % FS repeatability of the +-120 N m sensor)
+  double torque_sensor_offset[2] = {0, 0};  // N m
+  int encoder_bits = 19;            // counts per revolution = 2^bits
+  double motor_lag = 0.5e-3;        // s, current-loop time constant
+  double torque_limit = 120;        // N m, driver saturation
+  double watchdog = 0.02;           // s without a command -> driver cuts torque
+};
+
+struct ControllerSpec {
+  double rate_hz = 1000;
+  double kp[2] = {600, 400};   // N m/rad
+  double kd[2] = {30, 15};     // N m s/rad
+  bool feedforward = true;     // inverse-dynamics feed-forward from the controller's own model
+  double torque_limit = 100;   // N m, supervisor limit
+};
+
+struct Scenario {
+  std::string name;
+  std::string source;  // file path, for messages
+  SubjectSpec subject;
+  Device device = Device::kExowheel;
+  std::map<std::string, double> fixed_joints;  // joint -> angle (rad)
+  ProtocolSpec protocol;
+  HardwareSpec hardware;
+  ControllerSpec controller;
+  std::vector<FaultSpec> faults;
+  bool log_measured_csv = true;
+  double log_rate_hz = 1000;
+  std::vector<CheckSpec> checks;
+  uint64_t seed = 1;
+};
+
+// Reads and validates a scenario file. Throws InputError naming the file, the key and what was
+// expected (unknown keys, wrong types, out-of-range values, unknown names).
+Scenario ReadScenario(const std::string& path);
+Scenario ParseScenarioYaml(const std::string& text, const std::string& source);
+
+const char* DeviceName(Device d);
+
+}  // namespace exotwin
