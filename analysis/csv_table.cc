@@ -139,3 +139,52 @@ void WriteCsv(const std::string& path, const std::vector<std::string>& names,
 }
 
 }  // namespace exotwin
+
+#include <fcntl.h>
+#include <unistd.h>
+
+namespace exotwin {
+
+CsvStreamWriter::CsvStreamWriter(const std::string& path, const std::vector<std::string>& names,
+                                 const std::vector<std::string>& comments, size_t flush_rows)
+    : path_(path), columns_(names.size()), flush_rows_(flush_rows ? flush_rows : 1) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd_ < 0) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
+  for (const auto& c : comments) buffer_ += "# " + c + "\n";
+  for (size_t i = 0; i < names.size(); ++i) buffer_ += (i ? "," : "") + names[i];
+  buffer_ += "\n";
+  Flush();
+}
+
+CsvStreamWriter::~CsvStreamWriter() {
+  Flush();
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void CsvStreamWriter::Row(const double* values, size_t n) {
+  char buf[32];
+  for (size_t c = 0; c < columns_; ++c) {
+    const int len = std::snprintf(buf, sizeof(buf), "%.10g", c < n ? values[c] : 0.0);
+    if (c) buffer_ += ',';
+    buffer_.append(buf, len);
+  }
+  buffer_ += '\n';
+  ++rows_;
+  if (++pending_ >= flush_rows_) Flush();
+}
+
+void CsvStreamWriter::Flush() {
+  size_t off = 0;
+  while (off < buffer_.size() && fd_ >= 0) {
+    const ssize_t w = ::write(fd_, buffer_.data() + off, buffer_.size() - off);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      throw InputError(path_ + ": write failed (" + std::strerror(errno) + ")");
+    }
+    off += static_cast<size_t>(w);
+  }
+  buffer_.clear();
+  pending_ = 0;
+}
+
+}  // namespace exotwin

@@ -32,3 +32,28 @@ void WriteCsv(const std::string& path, const std::vector<std::string>& names,
 void WriteFileAtomic(const std::string& path, const std::string& text);
 
 }  // namespace exotwin
+
+namespace exotwin {
+
+// Streams rows to a CSV file as a run produces them, so that an abort loses at most the rows of the
+// last `flush_rows` (the buffer is written with one write(2) of whole lines, never a partial line).
+class CsvStreamWriter {
+ public:
+  // Opens (truncates) `path` and writes the comments and the header. Throws InputError if it cannot.
+  CsvStreamWriter(const std::string& path, const std::vector<std::string>& names,
+                  const std::vector<std::string>& comments = {}, size_t flush_rows = 100);
+  ~CsvStreamWriter();
+  CsvStreamWriter(const CsvStreamWriter&) = delete;
+  CsvStreamWriter& operator=(const CsvStreamWriter&) = delete;
+  // Appends one row (values.size() == number of columns).
+  void Row(const double* values, size_t n);
+  void Flush();
+  size_t rows() const { return rows_; }
+
+ private:
+  int fd_ = -1;
+  std::string path_, buffer_;
+  size_t columns_, flush_rows_, pending_ = 0, rows_ = 0;
+};
+
+}  // namespace exotwin
