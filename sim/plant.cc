@@ -7,6 +7,7 @@
 
 #include "model/input_error.h"
 #include "model/passive_torque.h"
+#include "sim/realizability.h"
 
 namespace exotwin {
 
@@ -82,6 +83,34 @@ void WriteBody(mjModel* m, int body, const SegmentInertial& s) {
   m->body_iquat[4 * body + 1] = m->body_iquat[4 * body + 2] = m->body_iquat[4 * body + 3] = 0.0;
 }
 
+// Realizes exo and human so that their sum is exactly params.Total(). When the human set alone has no
+// physical realization but the combined system has one (Table 4's S3: its m2 window is empty by
+// 0.1 kg), J1 is moved from the exoskeleton's thigh to the human's: just enough for a plausible human
+// thigh (m2 = 1.1 x its lower bound, thigh CoM at L1/2 with the inertia of a uniform rod). Only J1
+// moves and the sum is unchanged, so the joint torques are exactly those of the printed parameters.
+// Throws InputError when no such split exists.
+void SplitRealization(const LegParams& params, SystemRealization* exo, SystemRealization* human) {
+  LumpedParams h = *params.human, e = params.exo;
+  std::string why;
+  if (!IsRealizable(h, params.L1, &why) && h.J2 > 0) {
+    const double L1 = params.L1;
+    const double m2 = 1.1 * (h.X2 * h.X2 + h.Y2 * h.Y2) / h.J2;
+    const double mx = std::abs(h.X1 - m2 * L1);
+    const double m1 = std::max(2.0 * mx / L1, 1.0);
+    const double needed = h.J2 + m2 * L1 * L1 + (mx * mx + h.Y1 * h.Y1) / m1 + m1 * L1 * L1 / 12.0;
+    const double shift = needed - h.J1;
+    h.J1 += shift;
+    h.m1 = m1;
+    h.m2 = m2;
+    e.J1 -= shift;
+    if (!IsRealizable(e, L1, nullptr))
+      throw InputError("human: lumped parameters have no physically consistent realization (" + why +
+                       "), and the exoskeleton cannot lend the thigh inertia needed");
+  }
+  *human = RealizeLumped(h, params.L1, "human");
+  *exo = RealizeLumped(e, params.L1, "exo");
+}
+
 }  // namespace
 
 void Plant::SetParams(const LegParams& params) {
@@ -89,9 +118,12 @@ void Plant::SetParams(const LegParams& params) {
     throw InputError("L1: expected a thigh length in (0.1, 1.0) m, got " + std::to_string(params.L1));
   if (params.human && human_thigh_ < 0)
     throw InputError(path_ + ": the parameter set has a human: block but the model has no human bodies");
-  const SystemRealization exo = RealizeLumped(params.exo, params.L1, "exo");
-  SystemRealization human;
-  if (params.human) human = RealizeLumped(*params.human, params.L1, "human");
+  SystemRealization exo, human;
+  if (!params.human) {
+    exo = RealizeLumped(params.exo, params.L1, "exo");
+  } else {
+    SplitRealization(params, &exo, &human);
+  }
 
   m_->opt.gravity[0] = m_->opt.gravity[1] = 0.0;
   m_->opt.gravity[2] = -params.g;

@@ -11,6 +11,7 @@
 
 #include "model/leg_dynamics.h"
 #include "model/regressors.h"
+#include "model/input_error.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -91,6 +92,49 @@ TEST(MujocoVsClosedForm, ForwardDynamicsAgree) {
   const Eigen::Vector2d acc = MassMatrix(lp.Total(), lp.L1, q[1]).ldlt().solve(rhs);
   EXPECT_NEAR(plant.qdd()[0], acc[0], 1e-8 * (1 + acc.norm()));
   EXPECT_NEAR(plant.qdd()[1], acc[1], 1e-8 * (1 + acc.norm()));
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// Table 4's S3 has no realization of its own (empty m2 window); the plant lends thigh inertia from the
+// exoskeleton so that the sum, and hence every joint torque, is exactly the printed one.
+TEST(MujocoVsClosedForm, UnrealizableHumanIsSplitWithExactTotal) {
+  Plant plant(ShippedModelPath("leg_exowheel.xml"));
+  LegParams lp;
+  lp.L1 = 0.43;
+  lp.exo = {3.21, 0.77, 3.99, 1.78, 0.12, 0.18};
+  lp.human = LumpedParams{1.50, 0.40, 4.40, 1.50, -0.50, 0.42};
+  lp.passive = PassiveModel::kRiener1999;
+  ASSERT_NO_THROW(plant.SetParams(lp));
+  const Eigen::Vector2d q(0.3, -1.2), qd(1.0, -2.0), qdd(4.0, -6.0);
+  const Eigen::Vector2d mj = plant.InverseDynamics(q, qd, qdd);
+  const Eigen::Vector2d cf = ActuatorTorque(lp, q, qd, qdd);
+  EXPECT_NEAR(mj[0], cf[0], 1e-9 * cf.norm());
+  EXPECT_NEAR(mj[1], cf[1], 1e-9 * cf.norm());
+  // Every body physical.
+  for (int b = 1; b < plant.model()->nbody; ++b) {
+    if (std::string(mj_id2name(plant.model(), mjOBJ_BODY, b)) == "seat") continue;
+    EXPECT_GT(plant.model()->body_mass[b], 0.0);
+    EXPECT_GT(plant.model()->body_inertia[3 * b + 1], 0.0);
+  }
+}
+
+// A human set that even the combined system cannot realize is rejected with a clear error.
+TEST(MujocoVsClosedForm, RejectsUnrealizableSets) {
+  Plant plant(ShippedModelPath("leg_exowheel.xml"));
+  LegParams lp;
+  lp.L1 = 0.41;
+  lp.exo = {0.80, 0.74, 3.85, 1.74, 0.15, 0.16};
+  try {
+    plant.SetParams(lp);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no physically consistent realization"), std::string::npos);
+  }
 }
 
 }  // namespace
