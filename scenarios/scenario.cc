@@ -36,8 +36,12 @@ class Reader {
 
   void Keys(const YAML::Node& n, const std::string& key, const std::set<std::string>& allowed) const {
     if (!n.IsMap()) Fail(key, "expected a mapping" + Line(n));
+    std::set<std::string> seen;
     for (const auto& kv : n) {
-      const std::string k = kv.first.as<std::string>();
+      if (!kv.first.IsScalar())
+        Fail(key.empty() ? "(top level)" : key, "expected plain keys, found a non-scalar key" + Line(kv.first));
+      const std::string k = kv.first.Scalar();
+      if (!seen.insert(k).second) Fail(key.empty() ? k : key + "." + k, "duplicated key" + Line(kv.first));
       if (!allowed.count(k)) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -93,8 +97,7 @@ class Reader {
 };
 
 const std::set<std::string> kFaultTypes = {"sensor_stuck", "sensor_stale", "encoder_glitch", "frame_drop",
-                                           "frame_late",   "bus_off",      "command_loss",   "nan_measurement",
-                                           "sensor_offset_jump"};
+                                           "frame_late",   "bus_off",      "command_loss",   "nan_measurement"};
 
 }  // namespace
 

@@ -1,0 +1,54 @@
+// The scenario runner: builds the twin (plant + virtual hardware + the real controller) from a
+// scenario, runs it in lockstep, logs the measured data, computes metrics and evaluates the checks.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/lumped_params.h"
+#include "scenarios/scenario.h"
+
+namespace exotwin {
+
+struct RunOptions {
+  std::string out_dir = "out";
+  std::optional<uint64_t> seed;  // overrides the scenario's seed
+  std::string can_log;           // candump log of every frame on the bus ("" = none)
+  bool progress = false;         // progress bar on stderr
+  // Called once per logged sample with (t, q_true[2], tau_applied[2]) (e.g. a video renderer).
+  std::function<void(double, const double*, const double*)> on_sample;
+};
+
+struct CheckResult {
+  std::string name, metric, op;
+  double value = 0, limit = 0;
+  bool passed = false;
+};
+
+struct RunResult {
+  std::string scenario;
+  uint64_t seed = 0;
+  std::map<std::string, double> metrics;
+  std::vector<CheckResult> checks;
+  std::vector<std::string> files;  // written files
+  std::vector<std::string> events; // fault events "t=... type joint"
+  bool all_passed() const;
+};
+
+// The subject's parameters as the twin's ground truth (preset, population draw or MODEL.yaml),
+// with the scenario's passive model; exo alone for the exo-only device.
+LegParams ResolveSubject(const Scenario& s);
+
+// Runs every trial of the scenario; writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
+// encoder angles, torque-sensor readings, commands) and DIR/truth[_trialN].csv (plant state and applied
+// torque). Throws InputError on bad scenario content and SimulationError on divergence (the logs
+// written so far stay on disk).
+RunResult RunScenario(const Scenario& s, const RunOptions& opt);
+
+// Writes result.json (atomically).
+void WriteResultJson(const RunResult& r, const std::string& path);
+
+}  // namespace exotwin

@@ -1,0 +1,309 @@
+// Tests of controller/trajectory.h: analytic derivatives against finite differences, designed
+// exciting trajectories within their limits for many seeds, the hold / composition / fade-in
+// wrappers, and the Winter gait against angles computed directly from marker values.
+#include "controller/trajectory.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <memory>
+
+#include "model/input_error.h"
+
+namespace exotwin::controller {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Central differences of q and qd against the analytic qd and qdd.
+void ExpectDerivativesMatch(const std::function<JointSetpoint(double)>& f, double t0, double t1,
+                            double tol_rel) {
+  const double h = 1e-5;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = t0 + (t1 - t0) * i / 200.0;
+    const JointSetpoint p = f(t), m = f(t - h), pl = f(t + h);
+    const double qd_fd = (pl.q - m.q) / (2 * h);
+    const double qdd_fd = (pl.qd - m.qd) / (2 * h);
+    EXPECT_NEAR(p.qd, qd_fd, tol_rel * (1 + std::abs(p.qd))) << "t=" << t;
+    EXPECT_NEAR(p.qdd, qdd_fd, tol_rel * (1 + std::abs(p.qdd))) << "t=" << t;
+  }
+}
+
+TEST(FourierSeries, AnalyticDerivativesMatchFiniteDifferences) {
+  FourierSeries s(0.3, 0.1, {{3, 0.1, -0.05}, {7, 0.02, 0.03}, {15, -0.01, 0.004}});
+  ExpectDerivativesMatch([&](double t) { return s.Eval(t); }, 0.0, 10.0, 1e-6);
+  // Large t: phase reduction keeps the accuracy.
+  ExpectDerivativesMatch([&](double t) { return s.Eval(t); }, 1e5, 1e5 + 1.0, 1e-5);
+}
+
+TEST(FourierSeries, RejectsBadInput) {
+  EXPECT_THROW(FourierSeries(0, 0.0, {}), InputError);
+  EXPECT_THROW(FourierSeries(0, 0.1, {{0, 1, 1}}), InputError);
+  EXPECT_THROW(FourierSeries(NAN, 0.1, {}), InputError);
+}
+
+// Independent limit check: a grid finer than Design's and shifted by a non-commensurate offset.
+void ExpectWithinLimits(const HarmonicTrajectory& tr, const ExcitationSpec& spec) {
+  const int n = 60000;
+  const double period = tr.Period();
+  double qmin = 1e9, qmax = -1e9, qd = 0, qdd = 0;
+  for (int i = 0; i < n; ++i) {
+    const JointSetpoint p = tr.At((i + 0.3183) * period / n);
+    qmin = std::min(qmin, p.q);
+    qmax = std::max(qmax, p.q);
+    qd = std::max(qd, std::abs(p.qd));
+    qdd = std::max(qdd, std::abs(p.qdd));
+  }
+  EXPECT_GE(qmin, spec.q_min);
+  EXPECT_LE(qmax, spec.q_max);
+  EXPECT_LE(qd, spec.qd_max);
+  EXPECT_LE(qdd, spec.qdd_max);
+  // One limit is binding (fill = 0.98 of it, minus grid effects).
+  const double use = std::max({(qmax - qmin) / (spec.q_max - spec.q_min), qd / spec.qd_max,
+                               qdd / spec.qdd_max});
+  EXPECT_GT(use, 0.95);
+}
+
+TEST(HarmonicTrajectory, DesignRespectsPaperLimitsForManySeeds) {
+  for (const ExcitationSpec& spec : {ExcitationSpec::PaperHip(), ExcitationSpec::PaperKnee()}) {
+    for (uint64_t seed = 1; seed <= 60; ++seed) {
+      const HarmonicTrajectory tr = HarmonicTrajectory::Design(spec, seed);
+      SCOPED_TRACE(seed);
+      ExpectWithinLimits(tr, spec);
+      // All harmonics within the gait band 0.3-1.5 Hz.
+      for (const auto& term : tr.series().terms()) {
+        EXPECT_GE(term.k * tr.series().f0(), 0.3 - 1e-12);
+        EXPECT_LE(term.k * tr.series().f0(), 1.5 + 1e-12);
+      }
+      // Starts (and restarts every period) at rest.
+      const JointSetpoint s0 = tr.At(0.0), s1 = tr.At(tr.Period());
+      EXPECT_NEAR(s0.qd, 0.0, 1e-12);
+      EXPECT_NEAR(s0.qdd, 0.0, 1e-11);
+      EXPECT_NEAR(s1.q, s0.q, 1e-12);
+      EXPECT_DOUBLE_EQ(tr.StartPose(), s0.q);
+    }
+  }
+}
+
+TEST(HarmonicTrajectory, DerivativesAndOtherBasis) {
+  ExcitationSpec spec = ExcitationSpec::PaperKnee();
+  spec.f0_hz = 0.3;  // f0 = 0.3 Hz, k = 1..5: the other basis of the documented choice
+  spec.k_min = 1;
+  spec.k_max = 5;
+  const HarmonicTrajectory tr = HarmonicTrajectory::Design(spec, 7);
+  ExpectWithinLimits(tr, spec);
+  ExpectDerivativesMatch([&](double t) { return tr.At(t); }, 0.0, tr.Period(), 1e-6);
+}
+
+TEST(HarmonicTrajectory, SeededAndDeterministic) {
+  const auto spec = ExcitationSpec::PaperHip();
+  const HarmonicTrajectory a = HarmonicTrajectory::Design(spec, 123);
+  const HarmonicTrajectory b = HarmonicTrajectory::Design(spec, 123);
+  const HarmonicTrajectory c = HarmonicTrajectory::Design(spec, 124);
+  ASSERT_EQ(a.series().terms().size(), 13u);  // k = 3..15 at f0 = 0.1 Hz
+  bool differs = false;
+  for (size_t i = 0; i < a.series().terms().size(); ++i) {
+    EXPECT_EQ(a.series().terms()[i].a, b.series().terms()[i].a);  // bit-identical
+    EXPECT_EQ(a.series().terms()[i].b, b.series().terms()[i].b);
+    differs |= a.series().terms()[i].a != c.series().terms()[i].a;
+  }
+  EXPECT_TRUE(differs);
+  // std::mt19937_64 itself is fully specified: 10000th output of the default seed (C++ standard).
+  std::mt19937_64 rng;
+  rng.discard(9999);
+  EXPECT_EQ(rng(), 9981545732273789042ull);
+}
+
+TEST(HarmonicTrajectory, DesignRejectsBadSpecs) {
+  ExcitationSpec s = ExcitationSpec::PaperHip();
+  s.q_max = s.q_min;
+  EXPECT_THROW(HarmonicTrajectory::Design(s, 1), InputError);
+  s = ExcitationSpec::PaperHip();
+  s.qd_max = 0;
+  EXPECT_THROW(HarmonicTrajectory::Design(s, 1), InputError);
+  s = ExcitationSpec::PaperHip();
+  s.k_max = 20;  // 2 Hz, outside the gait band
+  EXPECT_THROW(HarmonicTrajectory::Design(s, 1), InputError);
+  s = ExcitationSpec::PaperHip();
+  s.fill = 1.5;
+  EXPECT_THROW(HarmonicTrajectory::Design(s, 1), InputError);
+}
+
+TEST(Composition, KneeSwingsWithHipHeldAt90Degrees) {
+  auto knee = std::make_shared<HarmonicTrajectory>(
+      HarmonicTrajectory::Design(ExcitationSpec::PaperKnee(), 3));
+  auto hip = std::make_shared<HoldTrajectory>(90 * kDeg);
+  JointwiseTrajectory leg(hip, knee);
+  for (double t : {0.0, 1.3, 7.7}) {
+    JointSetpoint h, k;
+    leg.Sample(t, &h, &k);
+    EXPECT_DOUBLE_EQ(h.q, M_PI / 2);
+    EXPECT_EQ(h.qd, 0.0);
+    EXPECT_EQ(h.qdd, 0.0);
+    EXPECT_DOUBLE_EQ(k.q, knee->At(t).q);
+  }
+  EXPECT_THROW(JointwiseTrajectory(hip, nullptr), InputError);
+  EXPECT_THROW(HoldTrajectory(NAN), InputError);
+}
+
+TEST(FadeIn, StartsAtRestAndJoinsTheInnerTrajectory) {
+  auto gait = std::make_shared<GaitTrajectory>(
+      GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath()));
+  const double T = 2.0;
+  FadeInTrajectory f(gait, T);
+  JointSetpoint h, k, gh, gk;
+  gait->Sample(0.0, &gh, &gk);
+  for (double t : {-1.0, 0.0}) {
+    f.Sample(t, &h, &k);
+    EXPECT_DOUBLE_EQ(h.q, gh.q);
+    EXPECT_DOUBLE_EQ(k.q, gk.q);
+    EXPECT_EQ(h.qd, 0.0);
+    EXPECT_EQ(k.qdd, 0.0);
+  }
+  for (double t : {T, T + 0.37, 5.0}) {
+    f.Sample(t, &h, &k);
+    gait->Sample(t, &gh, &gk);
+    EXPECT_DOUBLE_EQ(h.q, gh.q);
+    EXPECT_DOUBLE_EQ(k.qd, gk.qd);
+  }
+  // Continuity of q, qd, qdd at the end of the fade and analytic derivatives during it.
+  f.Sample(T - 1e-9, &h, &k);
+  gait->Sample(T, &gh, &gk);
+  EXPECT_NEAR(h.q, gh.q, 1e-8);
+  EXPECT_NEAR(h.qd, gh.qd, 1e-7);
+  EXPECT_NEAR(k.qdd, gk.qdd, 1e-6);
+  for (int joint = 0; joint < 2; ++joint)
+    ExpectDerivativesMatch(
+        [&](double t) {
+          JointSetpoint a, b;
+          f.Sample(t, &a, &b);
+          return joint == 0 ? a : b;
+        },
+        0.01, T - 0.01, 1e-5);
+  EXPECT_THROW(FadeInTrajectory(gait, 0.0), InputError);
+}
+
+// ---------------------------------------------------------------- gait
+
+TEST(GaitTrajectory, WinterStrideDetectedAndFitted) {
+  const GaitTrajectory g = GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath());
+  // Right heel contacts at frames 28 and 97 of Winter's table: 69 frames of 1.501/105 s.
+  EXPECT_NEAR(g.data_stride_period_s(), 69 * 1.501 / 105, 0.015);
+  std::printf("Winter stride %.4f s, fit rms hip %.2f deg, knee %.2f deg\n", g.data_stride_period_s(),
+              g.fit_rms_hip() / kDeg, g.fit_rms_knee() / kDeg);
+  EXPECT_LT(g.fit_rms_hip(), 1.5 * kDeg);
+  EXPECT_LT(g.fit_rms_knee(), 1.5 * kDeg);
+}
+
+TEST(GaitTrajectory, RangesAreWintersNormalGait) {
+  const GaitTrajectory g = GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath());
+  double hmin = 1e9, hmax = -1e9, kmin = 1e9, kmax = -1e9, hqd = 0, kqd = 0;
+  for (int i = 0; i < 4000; ++i) {
+    JointSetpoint h, k;
+    g.Sample(i * 2.0 / 4000, &h, &k);
+    hmin = std::min(hmin, h.q);
+    hmax = std::max(hmax, h.q);
+    kmin = std::min(kmin, k.q);
+    kmax = std::max(kmax, k.q);
+    hqd = std::max(hqd, std::abs(h.qd));
+    kqd = std::max(kqd, std::abs(k.qd));
+  }
+  std::printf("hip %.1f..%.1f deg, knee %.1f..%.1f deg, max speed hip %.0f knee %.0f deg/s\n",
+              hmin / kDeg, hmax / kDeg, kmin / kDeg, kmax / kDeg, hqd / kDeg, kqd / kDeg);
+  // Thigh angle roughly -10..+25 deg (here -17..26), knee flexion roughly 0..65 deg.
+  EXPECT_GT(hmin, -22 * kDeg);
+  EXPECT_LT(hmin, -8 * kDeg);
+  EXPECT_GT(hmax, 20 * kDeg);
+  EXPECT_LT(hmax, 30 * kDeg);
+  EXPECT_GT(kmin, -70 * kDeg);
+  EXPECT_LT(kmin, -55 * kDeg);
+  EXPECT_GT(kmax, -5 * kDeg);
+  EXPECT_LT(kmax, 5 * kDeg);
+  // Winter's ~1 s natural stride slowed to 2 s halves the speeds: hip ~120, knee ~200 deg/s.
+  EXPECT_LT(hqd, 150 * kDeg);
+  EXPECT_LT(kqd, 250 * kDeg);
+}
+
+TEST(GaitTrajectory, MatchesDirectMarkerComputationAtFrames) {
+  const GaitTrajectory g = GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath());
+  // Marker rows copied from data/WinterTableA1.txt: time, hip x y, knee x y, ankle x y (cm).
+  struct Row { double t, hx, hy, kx, ky, ax, ay; };
+  const Row rows[] = {
+      {0.129, 62.78, 82.01, 73.22, 51.73, 48.15, 21.06},     // frame 10, swing
+      {0.386, 101.53, 79.34, 112.34, 50.46, 124.94, 10.63},  // frame 28, heel contact
+      {0.701, 142.02, 82.65, 140.11, 51.09, 130.56, 9.99},   // frame 50, late stance
+      {1.072, 196.42, 80.10, 202.66, 49.31, 172.50, 23.61},  // frame 76, swing
+  };
+  for (const Row& r : rows) {
+    // Direct definition: thigh from the downward vertical, knee = shank - thigh.
+    const double thigh = std::atan2(r.kx - r.hx, r.hy - r.ky);
+    const double knee = std::atan2(r.ax - r.kx, r.ky - r.ay) - thigh;
+    const double t_out = (r.t - 0.386) * 2.0 / g.data_stride_period_s();
+    JointSetpoint h, k;
+    g.Sample(t_out, &h, &k);
+    SCOPED_TRACE(r.t);
+    EXPECT_NEAR(h.q, thigh, 2.5 * kDeg);
+    EXPECT_NEAR(k.q, knee, 2.5 * kDeg);
+  }
+  // Signs at known events: heel contact hip flexed ~20 deg, knee nearly straight; swing knee flexed.
+  JointSetpoint h, k;
+  g.Sample(0.0, &h, &k);
+  EXPECT_NEAR(h.q, 20 * kDeg, 3 * kDeg);
+  EXPECT_NEAR(k.q, 0.0, 5 * kDeg);
+}
+
+TEST(GaitTrajectory, PeriodicDerivativesAndOptions) {
+  GaitSpec spec;
+  spec.stride_period_s = 2.5;
+  spec.harmonics = 8;
+  spec.amplitude_scale = 0.5;
+  spec.knee_offset = -5 * kDeg;
+  const GaitTrajectory g = GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), spec);
+  GaitSpec ref_spec;
+  ref_spec.harmonics = 8;
+  const GaitTrajectory ref = GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), ref_spec);
+  for (double t : {0.0, 0.4, 1.9}) {
+    JointSetpoint h0, k0, h1, k1, hr, kr;
+    g.Sample(t, &h0, &k0);
+    g.Sample(t + 2.5, &h1, &k1);
+    EXPECT_NEAR(h0.q, h1.q, 1e-12);
+    EXPECT_NEAR(k0.qd, k1.qd, 1e-11);
+    // Half the excursion about the stride mean, time-scaled, offset.
+    ref.Sample(t * 2.0 / 2.5, &hr, &kr);
+    EXPECT_NEAR(h0.q - g.hip().c0(), 0.5 * (hr.q - ref.hip().c0()), 1e-12);
+    EXPECT_NEAR(g.knee().c0(), ref.knee().c0() - 5 * kDeg, 1e-12);
+  }
+  for (int joint = 0; joint < 2; ++joint)
+    ExpectDerivativesMatch(
+        [&](double t) {
+          JointSetpoint a, b;
+          g.Sample(t, &a, &b);
+          return joint == 0 ? a : b;
+        },
+        0.0, 2.5, 1e-6);
+}
+
+TEST(GaitTrajectory, BadFilesAreInputErrors) {
+  EXPECT_THROW(GaitTrajectory::FromWinterFile("/nonexistent/winter.txt"), InputError);
+  const std::string path = ::testing::TempDir() + "/winter_bad.txt";
+  {
+    std::ofstream out(path);
+    out << "'FRAME' 'TIME'\n1 0 1 2 3 4 5 6 7\n";
+  }
+  try {
+    GaitTrajectory::FromWinterFile(path);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":2:"), std::string::npos) << e.what();
+  }
+  GaitSpec spec;
+  spec.stride_period_s = -1;
+  EXPECT_THROW(GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), spec), InputError);
+}
+
+}  // namespace
+}  // namespace exotwin::controller
