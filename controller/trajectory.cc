@@ -41,6 +41,7 @@ FourierSeries::FourierSeries(double c0, double f0, std::vector<Term> terms)
     if (t.k < 1) throw InputError("FourierSeries: harmonic number must be >= 1");
     if (!Finite(t.a) || !Finite(t.b)) throw InputError("FourierSeries: coefficients must be finite");
   }
+  std::stable_sort(terms_.begin(), terms_.end(), [](const Term& x, const Term& y) { return x.k < y.k; });
 }
 
 JointSetpoint FourierSeries::Eval(double t) const {
@@ -49,12 +50,22 @@ JointSetpoint FourierSeries::Eval(double t) const {
   const double phase = kTwoPi * (cycles - std::floor(cycles));
   const double w0 = kTwoPi * f0_;
   JointSetpoint out{c0_, 0.0, 0.0};
+  // sin/cos of k * phase by the angle-addition recurrence from one sincos (terms_ is sorted by k at
+  // construction); the rounding error grows like k eps, below 1e-14 for the k <= 20 used here.
+  const double s1 = std::sin(phase), c1 = std::cos(phase);
+  double sk = 0.0, ck = 1.0;  // k = 0
+  int k = 0;
   for (const Term& term : terms_) {
+    while (k < term.k) {
+      const double sn = sk * c1 + ck * s1;
+      ck = ck * c1 - sk * s1;
+      sk = sn;
+      ++k;
+    }
     const double w = term.k * w0;
-    const double s = std::sin(term.k * phase), c = std::cos(term.k * phase);
-    out.q += term.a * s + term.b * c;
-    out.qd += w * (term.a * c - term.b * s);
-    out.qdd -= w * w * (term.a * s + term.b * c);
+    out.q += term.a * sk + term.b * ck;
+    out.qd += w * (term.a * ck - term.b * sk);
+    out.qdd -= w * w * (term.a * sk + term.b * ck);
   }
   return out;
 }

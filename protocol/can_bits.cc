@@ -61,9 +61,44 @@ int CanStuffBitCount(const std::vector<bool>& bits) {
   return stuff;
 }
 
+// Same bit stream as CanStuffRegion + CanStuffBitCount, on a stack buffer: this runs for every frame
+// of the virtual bus (5 per millisecond), so it must not allocate. tests/protocol/can_bits_test.cc
+// checks both paths agree on random frames.
 int CanFrameBits(const CanFrame& frame) {
-  const std::vector<bool> region = CanStuffRegion(frame);
-  return static_cast<int>(region.size()) + CanStuffBitCount(region) + kCanTrailerBits + kCanIfsBits;
+  const int dlc = std::min<int>(frame.dlc, 8);
+  uint8_t bits[34 + 64];
+  int n = 0;
+  auto push = [&](uint32_t value, int k) {
+    for (int i = k - 1; i >= 0; --i) bits[n++] = static_cast<uint8_t>((value >> i) & 1u);
+  };
+  push(0, 1);                 // SOF
+  push(frame.id & 0x7FF, 11); // identifier
+  push(0, 3);                 // RTR, IDE, r0
+  push(frame.dlc & 0xF, 4);   // DLC
+  for (int i = 0; i < dlc; ++i) push(frame.data[i], 8);
+  uint16_t crc = 0;
+  for (int i = 0; i < n; ++i) {
+    const bool top = ((crc >> 14) & 1u) != 0;
+    crc = static_cast<uint16_t>((crc << 1) & 0x7FFF);
+    if (top != (bits[i] != 0)) crc ^= 0x4599;
+  }
+  push(crc, 15);
+  int stuff = 0, run = 0;
+  uint8_t last = 0;
+  for (int i = 0; i < n; ++i) {
+    if (run > 0 && bits[i] == last) {
+      ++run;
+    } else {
+      last = bits[i];
+      run = 1;
+    }
+    if (run == 5) {
+      ++stuff;
+      last = static_cast<uint8_t>(!last);
+      run = 1;
+    }
+  }
+  return n + stuff + kCanTrailerBits + kCanIfsBits;
 }
 
 int CanFrameBitsWorstCase(int dlc) {

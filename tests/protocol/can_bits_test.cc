@@ -109,3 +109,23 @@ TEST(CanFrameBits, WorstCaseFormulaOfDavisEtAl) {
 
 }  // namespace
 }  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// The allocation-free CanFrameBits and the vector-based region + stuff count agree on random frames.
+TEST(CanFrameBits, FastPathAgreesWithBitStream) {
+  uint64_t x = 88172645463325252ull;  // xorshift64
+  auto next = [&]() { x ^= x << 13; x ^= x >> 7; x ^= x << 17; return x; };
+  for (int k = 0; k < 5000; ++k) {
+    CanFrame f;
+    f.id = static_cast<uint16_t>(next() & 0x7FF);
+    f.dlc = static_cast<uint8_t>(next() % 9);
+    for (int i = 0; i < f.dlc; ++i) f.data[i] = static_cast<uint8_t>((k % 3 == 0) ? (next() & 1 ? 0 : 0xFF) : next());
+    const std::vector<bool> region = CanStuffRegion(f);
+    EXPECT_EQ(CanFrameBits(f), static_cast<int>(region.size()) + CanStuffBitCount(region) + kCanTrailerBits + kCanIfsBits);
+  }
+}
+
+}  // namespace
+}  // namespace exotwin

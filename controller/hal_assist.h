@@ -1,0 +1,152 @@
+// HAL assist control of Hayashi, Kawamoto & Sankai ("Control method of robot suit HAL working as
+// operator's muscle using biological and dynamical information"), issue 6 item 6. One knee joint in
+// HAL's convention: th = 0 lower leg hanging, positive = extension (th = th2 + pi/2 seated).
+//   muscle torque estimate  mu^ = (a_e E_e + b_e) - (a_f E_f + b_f)          eq. (2)
+//   tau_mu = alpha_mu mu^                                                   eq. (3)
+//   one-link model  I thdd + (D + R) thd + K th + Mgl sin th = tau + mu      eq. (4)
+//   tau_zeta = alpha_zeta (-D thd - K th)                                   eq. (5)
+//   tau = tau_zeta + tau_mu + tau_c                                         eq. (6)
+//   on-line D, K: delta-operator model + recursive weighted least squares    eq. (8)-(13)
+//   passive parameters identified first                                     eq. (14)-(15)
+//   state observer with adaptive gains                                      eq. (16)-(17)
+// Units: N m, rad, rad/s, s; E in V (amplified RMS envelope, eq. 1).
+#pragma once
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace exotwin {
+
+// Straight line y = a x + b.
+struct LinearFit {
+  double a = 0, b = 0;
+};
+// Eq. (2) calibration for one muscle group: least squares of the produced torque tau (N m, >= 0,
+// against HAL's reference torque) on its RMS envelope E (V). Same length >= 2, E not constant.
+LinearFit FitEmgToTorque(const std::vector<double>& E, const std::vector<double>& tau);
+
+struct HalEmgCoefficients {
+  LinearFit extensor, flexor;  // a in N m/V, b in N m
+};
+// Eq. (2): mu^ = (a_e E_e + b_e) - (a_f E_f + b_f), N m (positive = extension).
+double EstimateMuscleTorque(const HalEmgCoefficients& c, double E_e, double E_f);
+
+// Passive one-link parameters of eq. (14)/(15): I thdd + B thd + Mgl sin th = tau.
+struct OneLinkPassive {
+  double I = 0;    // kg m^2
+  double B = 0;    // N m s/rad (D + R for eq. 14, R for eq. 15)
+  double mgl = 0;  // N m
+};
+// Least squares of eq. (14)/(15) from a relaxed record: th (rad) and tau (N m) every dt (s);
+// th smoothed by a zero-phase 2nd-order low-pass at fc (Hz) and differentiated centrally.
+// Precondition: same length >= 16; th excites inertia, damping and gravity (a swing).
+OneLinkPassive IdentifyOneLinkPassive(const std::vector<double>& th, const std::vector<double>& tau,
+                                      double dt, double fc = 20.0);
+
+// On-line estimation of the operator's viscosity D and stiffness K, eq. (8)-(13).
+struct ViscoelasticRlsConfig {
+  double dt = 1e-3;     // sample period T_d, s
+  double rho = 0.999;   // forgetting factor (0 << rho < 1), memory ~ dt/(1 - rho) = 1 s
+  double p0 = 1e6;      // P(0) = p0 I (beta of eq. 13)
+  // Anti-windup (our addition): with rho < 1, P grows as rho^-k in unexcited directions (operator at
+  // rest) until it overflows; trace(P) is capped at p_max by uniform scaling.
+  double p_max = 1e9;
+  // E(delta) = delta^2 + e1 delta + e2, the state-variable filter of eq. (11). The paper gives no
+  // values; we use a double pole at -pf: e1 = 2 pf, e2 = pf^2, pf = 20 rad/s (above the 0.5 Hz
+  // swing and the leg's natural frequency, below the noise).
+  double pf = 20.0;
+  // Known passive parameters (eq. 14-15) used to split D' = D + R and K' = K + G(th) (eq. 8), and
+  // the initial estimate.
+  double R = 0.0;       // actuator viscosity, N m s/rad
+  double mgl = 0.0;     // M g l of leg + exoskeleton, N m
+  double I0 = 0.3, D0 = 1.0, K0 = 5.0;  // initial I (kg m^2), D, K (operator)
+  // false: the paper's eq. (8), K' = K + G(th) estimated as one slowly varying parameter (G varies
+  // with th along the swing, so K^ carries a ripple of the order of mgl (1 - sin th / th)).
+  // true (our extension): the known gravity moment is moved into the input, u - mgl sin th, so the
+  // RLS estimates K' = K directly.
+  bool gravity_in_input = false;
+};
+
+class ViscoelasticRls {
+ public:
+  explicit ViscoelasticRls(const ViscoelasticRlsConfig& cfg);
+  // One sample: measured angle th(k) (rad) and input u(k) = tau + mu + sigma (N m), eq. (9).
+  // Updates X^ (eq. 13) with the regressor phi(k) built from data up to k-1, then the filters.
+  void Step(double th, double u);
+  double I() const;        // kg m^2, from X4 = 1/I
+  double Dprime() const;   // D' = D + R, N m s/rad
+  double Kprime() const;   // K' = K + G(th), N m/rad
+  double D() const { return Dprime() - cfg_.R; }
+  double K() const;        // K' - G(th_last), eq. (8)
+  const Eigen::Vector4d& X() const { return X_; }
+  double last_error() const { return err_; }  // e(k) of eq. (12), rad
+
+ private:
+  ViscoelasticRlsConfig cfg_;
+  double e1_, e2_;
+  Eigen::Vector4d X_;
+  Eigen::Matrix4d P_;
+  double s1t_ = 0, s2t_ = 0, s1u_ = 0, s2u_ = 0;  // filter states of th and u
+  double th_last_ = 0, err_ = 0;
+};
+
+// G(th) of eq. (8): Mgl sin(th)/th, Mgl at th = 0.
+double GravityStiffness(double mgl, double th);
+
+// State observer of eq. (16) with the adaptive gains of eq. (17). Poles of the error dynamics
+// fixed at -lambda1, -lambda2 (1/s, positive) whatever the current I, D', K'. Eq. (17) as printed
+// (g1 = l1 - l2 - D'/I, g2 = l1 l2 - g1 D'/I) is garbled; pole placement for A = [0 1; -K'/I -D'/I],
+// C = [1 0] gives g1 = l1 + l2 - D'/I, g2 = l1 l2 - K'/I - g1 D'/I, which we use.
+class AdaptiveObserver {
+ public:
+  // dt: s; lambda1, lambda2 > 0 (default time constants ~ 17 / 13 ms, below a 40 ms EMD).
+  explicit AdaptiveObserver(double dt = 1e-3, double lambda1 = 60.0, double lambda2 = 80.0);
+  // One step with measured th (rad), input u (N m) and the current model I, D', K'.
+  void Step(double th, double u, double I, double Dp, double Kp);
+  double theta() const { return x1_; }
+  double velocity() const { return x2_; }
+  void Reset(double th, double thd = 0) { x1_ = th, x2_ = thd; }
+
+ private:
+  double dt_, l1_, l2_;
+  double x1_ = 0, x2_ = 0;
+};
+
+// Configuration of the whole assist law.
+struct HalAssistConfig {
+  double dt = 1e-3;
+  double alpha_mu = 1.0;    // eq. (3); Hayashi's experiment 2: 1.0
+  double alpha_zeta = 0.5;  // eq. (5); experiment 2: 0.5
+  HalEmgCoefficients emg;
+  ViscoelasticRlsConfig rls;
+  double lambda1 = 60.0, lambda2 = 80.0;
+  double tau_max = 60.0;  // actuator limit, N m (models/hal3_knee.xml ctrlrange)
+};
+
+// Torques of one control step, N m.
+struct HalAssistOutput {
+  double tau = 0, tau_mu = 0, tau_zeta = 0, tau_c = 0, mu_hat = 0;
+  double D = 0, K = 0, thd_hat = 0;
+};
+
+// The controller of eq. (6). Each Step: mu^ from the envelopes (eq. 2), tau_mu (eq. 3); the RLS is
+// fed the previous step's applied torque plus mu^ (eq. 9: u = tau + mu, sigma = 0 seated); the
+// observer gives thd^; tau_zeta from the current D^, K^ (eq. 5, D^, K^ clamped >= 0); tau_c is the
+// caller's compensation of HAL's own impedance (controller/virtual_impedance.h), or 0 (Exp. 1 uses
+// tau_c alone: set alpha_mu = alpha_zeta = 0).
+class HalAssistController {
+ public:
+  explicit HalAssistController(const HalAssistConfig& cfg);
+  HalAssistOutput Step(double th, double E_e, double E_f, double tau_c = 0.0);
+  const ViscoelasticRls& rls() const { return rls_; }
+  const AdaptiveObserver& observer() const { return obs_; }
+
+ private:
+  HalAssistConfig cfg_;
+  ViscoelasticRls rls_;
+  AdaptiveObserver obs_;
+  double tau_prev_ = 0;
+  bool started_ = false;
+};
+
+}  // namespace exotwin
