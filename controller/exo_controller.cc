@@ -24,6 +24,12 @@ void ExoController::Tick(double t) {
   CanStatus st;
   while ((st = bus_->Receive(&f)) != CanStatus::kNoFrame) {
     if (st != CanStatus::kOk) continue;
+    msg::EmgSamples e;
+    if (msg::Decode(f, &e)) {
+      for (int c = 0; c < msg::kEmgChannels; ++c) tel_.emg[c] = e.volts[c];
+      ++tel_.emg_samples;
+      continue;
+    }
     msg::JointStatus s;
     if (!msg::Decode(f, &s)) continue;
     const int j = static_cast<int>(s.joint);

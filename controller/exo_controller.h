@@ -33,6 +33,8 @@ struct ControllerTelemetry {
   double tau_cmd[2] = {0, 0};     // torque sent to the modules, N m
   double age[2] = {0, 0};         // s since the latest status frame per joint
   SafetyOutput safety;
+  double emg[5] = {0, 0, 0, 0, 0};  // latest EMG sample after the amplifier, V (GMAX, VM, RF, ST, GAS)
+  uint32_t emg_samples = 0;          // EMG frames received
   uint32_t frames_received = 0, frames_sent = 0, send_failures = 0;
   bool have_status[2] = {false, false};
 };

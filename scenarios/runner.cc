@@ -18,7 +18,10 @@
 #include "hwsim/virtual_can_bus.h"
 #include "model/input_error.h"
 #include "protocol/candump.h"
+#include "hwsim/emg_amplifier.h"
 #include "sim/anthropometry.h"
+#include "sim/muscles.h"
+#include "sim/synthetic_emg.h"
 #include "sim/plant.h"
 #include "sim/subjects.h"
 
@@ -147,6 +150,28 @@ controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegPar
   return c;
 }
 
+// The subject's behaviour for the trial (relaxed unless the scenario's human block says otherwise).
+std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams& mp,
+                                          const std::shared_ptr<const LegTrajectory>& trajectory,
+                                          uint64_t seed) {
+  const HumanSpec& h = s.human;
+  if (h.behaviour == "isometric_hip" || h.behaviour == "isometric_knee")
+    return std::make_unique<ContractionProgramme>(
+        IsometricProgramme(h.behaviour == "isometric_hip" ? 0 : 1, h.contractions, 0.2, 0.8, 0.1, seed));
+  if (h.behaviour == "exaggerated_gait") {
+    IntendedMotion base = [trajectory](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+      controller::JointSetpoint a, b;
+      trajectory->Sample(t, &a, &b);
+      q = {a.q, b.q};
+      qd = {a.qd, b.qd};
+      qdd = {a.qdd, b.qdd};
+    };
+    // Mean posture of the gait pattern (Winter, fitted): about 5 deg hip, -25 deg knee.
+    return std::make_unique<ExaggeratedGait>(mp, base, Eigen::Vector2d(0.09, -0.45), h.gain, h.active_from);
+  }
+  return std::make_unique<RelaxedBehaviour>();
+}
+
 struct FaultSwitch {
   FaultSpec spec;
   bool active = false;
@@ -248,7 +273,8 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
       g.t += trial_epoch;  // trials follow each other in one log
       can_log->Write(g);
     });
-    hwsim::VirtualCanBus::Endpoint* ctrl_ep = bus.AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee});
+    hwsim::VirtualCanBus::Endpoint* ctrl_ep = bus.AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee, msg::kIdEmgSamples});
+    CanBus* emg_ep = bus.AddNode("emg_amplifier", {0x7FF});  // sends only
     CanBus* hip_ep = bus.AddNode("hip_module", {msg::kIdJointCommandHip});
     CanBus* knee_ep = bus.AddNode("knee_module", {msg::kIdJointCommandKnee});
 
@@ -266,6 +292,16 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     hwsim::JointModule* modules[2] = {&hip, &knee};
     controller::ExoController ctrl(ControllerConfig(s, truth), trajectory, ctrl_ep);
 
+    // The human: muscles (ground truth alpha, beta, gamma), behaviour, surface EMG -> amplifier.
+    const bool human = truth.human.has_value();
+    const bool emg_on = human && s.human.emg;
+    const MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
+    MuscleModel muscles(mp, dt);
+    std::unique_ptr<Behaviour> behaviour = BuildBehaviour(s, mp, trajectory, seed + 3);
+    SyntheticEmg emg(DefaultSyntheticEmgConfig(), seed + 4);
+    hwsim::EmgAmplifier amplifier;
+    uint8_t emg_counter = 0;
+
     std::vector<FaultSwitch> faults;
     for (const FaultSpec& f : s.faults) faults.push_back({f, false});
 
@@ -277,12 +313,16 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     if (s.log_measured_csv) {
       measured = std::make_unique<CsvStreamWriter>(
           opt.out_dir + "/measured" + suffix + ".csv",
-          std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "cmd_hip", "cmd_knee",
-                                   "ref_hip", "ref_knee", "state"},
+          emg_on ? std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "cmd_hip", "cmd_knee",
+                                            "ref_hip", "ref_knee", "state", "emg_GMAX", "emg_VM", "emg_RF",
+                                            "emg_ST", "emg_GAS"}
+                 : std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "cmd_hip", "cmd_knee",
+                                            "ref_hip", "ref_knee", "state"},
           comments);
       truth_log = std::make_unique<CsvStreamWriter>(
           opt.out_dir + "/truth" + suffix + ".csv",
-          std::vector<std::string>{"t", "q_hip", "q_knee", "qd_hip", "qd_knee", "tau_R_hip", "tau_R_knee"},
+          std::vector<std::string>{"t", "q_hip", "q_knee", "qd_hip", "qd_knee", "tau_R_hip", "tau_R_knee",
+                                   "tau_M_hip", "tau_M_knee"},
           comments);
       result.files.push_back("measured" + suffix + ".csv");
       result.files.push_back("truth" + suffix + ".csv");
@@ -308,11 +348,26 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
       }
       bus.AdvanceTo(t + dt * 0.999);
       for (int j = 0; j < 2; ++j) tau[j] = modules[j]->Applied(t + dt, dt);
-      plant.Step({tau[0], tau[1]});
+      Eigen::Vector2d tau_M = Eigen::Vector2d::Zero();
+      if (human) {
+        muscles.Step(behaviour->Excitation(t, plant.q(), plant.qd()));
+        tau_M = muscles.Torques(plant.q(), plant.qd()).total();
+      }
+      plant.Step({tau[0], tau[1]}, tau_M);
       t = plant.time();
       const Eigen::Vector2d q = plant.q();
       hip.Sample(t, q[0], tau[0]);
       knee.Sample(t, q[1], tau[1]);
+      if (emg_on) {  // the amplifier samples the electrodes at 1 kHz and sends one frame
+        const MuscleVec v = emg.Sample(muscles.electrical_activation());
+        std::array<double, 5> in{};
+        for (int c = 0; c < 5; ++c) in[c] = v[c];
+        msg::EmgSamples es;
+        const auto out = amplifier.Sample(in);
+        for (int c = 0; c < 5; ++c) es.volts[c] = out[c];
+        es.counter = emg_counter++ & 0x0F;
+        emg_ep->Send(msg::Encode(es));
+      }
 
       const auto& tel = ctrl.telemetry();
       const bool after_ramp = t >= s.protocol.ramp;
@@ -334,11 +389,12 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
         if (measured) {
           const double row[] = {t, tel.est[0].q, tel.est[1].q, tel.tau_sensor[0], tel.tau_sensor[1],
                                 tel.tau_cmd[0], tel.tau_cmd[1], tel.ref[0].q, tel.ref[1].q,
-                                static_cast<double>(tel.safety.state)};
-          measured->Row(row, 10);
+                                static_cast<double>(tel.safety.state), tel.emg[0], tel.emg[1], tel.emg[2],
+                                tel.emg[3], tel.emg[4]};
+          measured->Row(row, emg_on ? 15 : 10);
           const Eigen::Vector2d qd = plant.qd();
-          const double trow[] = {t, q[0], q[1], qd[0], qd[1], tau[0], tau[1]};
-          truth_log->Row(trow, 7);
+          const double trow[] = {t, q[0], q[1], qd[0], qd[1], tau[0], tau[1], tau_M[0], tau_M[1]};
+          truth_log->Row(trow, 9);
         }
         if (opt.on_sample) {
           const double qa[2] = {q[0], q[1]};

@@ -99,6 +99,29 @@ class Reader {
 const std::set<std::string> kFaultTypes = {"sensor_stuck", "sensor_stale", "encoder_glitch", "frame_drop",
                                            "frame_late",   "bus_off",      "command_loss",   "nan_measurement"};
 
+void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
+  if (s.device != Device::kHal3) r.Fail("hal", "only allowed with device: hal3");
+  r.Keys(n, "hal", {"mode", "alpha_mu", "alpha_zeta", "virtual_viscosity", "sweep_viscosity", "swing_freq",
+                    "cc_up", "cc_down", "settle", "rls_gravity_in_input"});
+  HalSpec& h = s.hal;
+  if (n["mode"]) h.mode = r.Str(n["mode"], "hal.mode", {"none", "impedance", "assist"});
+  if (n["alpha_mu"]) h.alpha_mu = r.Num(n["alpha_mu"], "hal.alpha_mu", 0, 5);
+  if (n["alpha_zeta"]) h.alpha_zeta = r.Num(n["alpha_zeta"], "hal.alpha_zeta", 0, 5);
+  if (n["virtual_viscosity"]) h.virtual_viscosity = r.Num(n["virtual_viscosity"], "hal.virtual_viscosity", -5, 20);
+  if (n["sweep_viscosity"]) {
+    const YAML::Node v = n["sweep_viscosity"];
+    if (!v.IsSequence() || v.size() < 2 || v.size() > 50)
+      r.Fail("hal.sweep_viscosity", "expected a list of 2..50 viscosities (N m s/rad)" + Reader::Line(v));
+    for (size_t i = 0; i < v.size(); ++i)
+      h.sweep_viscosity.push_back(r.Num(v[i], "hal.sweep_viscosity[" + std::to_string(i) + "]", -5, 20));
+  }
+  if (n["swing_freq"]) h.swing_freq = r.Num(n["swing_freq"], "hal.swing_freq", 0.1, 2);
+  if (n["cc_up"]) h.cc_up = r.Num(n["cc_up"], "hal.cc_up", 0, 1);
+  if (n["cc_down"]) h.cc_down = r.Num(n["cc_down"], "hal.cc_down", 0, 1);
+  if (n["settle"]) h.settle = r.Num(n["settle"], "hal.settle", 0, 3600);
+  if (n["rls_gravity_in_input"]) h.rls_gravity_in_input = r.Bool(n["rls_gravity_in_input"], "hal.rls_gravity_in_input");
+}
+
 }  // namespace
 
 Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
@@ -111,8 +134,8 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   }
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
   if (!root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
-  r.Keys(root, "", {"name", "description", "seed", "subject", "device", "fixed_joints", "protocol", "hardware",
-                    "controller", "faults", "logs", "checks"});
+  r.Keys(root, "", {"name", "description", "seed", "subject", "human", "device", "fixed_joints", "protocol",
+                    "hardware", "controller", "faults", "logs", "checks", "hal"});
   Scenario s;
   s.source = source;
   if (!root["name"]) r.Fail("name", "missing, expected the scenario's name");
@@ -140,6 +163,22 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   } else if (s.device != Device::kExowheelExoOnly) {
     r.Fail("subject", "missing, expected {preset: S1} or {random_seed: N} or {params: FILE}");
   }
+
+  if (root["human"]) {
+    const YAML::Node n = root["human"];
+    r.Keys(n, "human", {"behaviour", "active_from", "gain", "contractions", "emg", "muscle_seed"});
+    HumanSpec& h = s.human;
+    if (n["behaviour"])
+      h.behaviour = r.Str(n["behaviour"], "human.behaviour",
+                          {"relaxed", "exaggerated_gait", "isometric_hip", "isometric_knee"});
+    if (n["active_from"]) h.active_from = r.Num(n["active_from"], "human.active_from", 0, 3600);
+    if (n["gain"]) h.gain = r.Num(n["gain"], "human.gain", 0.5, 3);
+    if (n["contractions"]) h.contractions = static_cast<int>(r.Num(n["contractions"], "human.contractions", 1, 100));
+    if (n["emg"]) h.emg = r.Bool(n["emg"], "human.emg");
+    if (n["muscle_seed"]) h.muscle_seed = static_cast<uint64_t>(r.Num(n["muscle_seed"], "human.muscle_seed", 0, 1e15));
+  }
+
+  if (root["hal"]) ParseHal(r, root["hal"], s);
 
   if (root["fixed_joints"]) {
     const YAML::Node n = root["fixed_joints"];

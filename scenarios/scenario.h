@@ -42,6 +42,30 @@ struct FaultSpec {
   double value = 0;
 };
 
+// The subject's behaviour and EMG (EXOwheel devices with a subject).
+struct HumanSpec {
+  std::string behaviour = "relaxed";  // relaxed | exaggerated_gait | isometric_hip | isometric_knee
+  double active_from = 5.0;           // s: exaggerated gait starts here (relaxed before, as Fig. 9)
+  double gain = 1.3;                  // exaggerated gait: amplification of the pattern
+  int contractions = 6;               // isometric programmes: number of contractions
+  bool emg = true;                    // EMG electrodes + amplifier node on the bus
+  uint64_t muscle_seed = 1;           // ground-truth alpha, beta, gamma drawn from Tables 6-7
+};
+
+// HAL-3 settings (device: hal3 only; scenarios/hal_runner.h). The operator performs Hayashi's seated
+// 0.5 Hz knee swing (targets +1.0 / -0.3 rad) with co-contraction cc_down in swing-down.
+struct HalSpec {
+  std::string mode = "impedance";   // none | impedance (tau_c only: Hayashi exp. 1, Lee & Sankai) | assist (exp. 2)
+  double alpha_mu = 1.0;            // Hayashi eq. (3)
+  double alpha_zeta = 0.5;          // Hayashi eq. (5)
+  double virtual_viscosity = 0.0;   // B_v of tau_c, N m s/rad (Lee & Sankai; 0 = Hayashi's tau_c)
+  std::vector<double> sweep_viscosity;  // non-empty: one run per B_v (replaces protocol.trials)
+  double swing_freq = 0.5;          // Hz
+  double cc_up = 0.0, cc_down = 0.05;  // co-contraction drive (fraction of MVC) outside / in swing-down
+  double settle = 4.0;              // s at the start excluded from the metrics
+  bool rls_gravity_in_input = true; // ViscoelasticRlsConfig::gravity_in_input
+};
+
 struct CheckSpec {
   std::string name;
   std::string metric;
@@ -74,6 +98,8 @@ struct Scenario {
   std::string name;
   std::string source;  // file path, for messages
   SubjectSpec subject;
+  HumanSpec human;
+  HalSpec hal;
   Device device = Device::kExowheel;
   std::map<std::string, double> fixed_joints;  // joint -> angle (rad)
   ProtocolSpec protocol;

@@ -1,0 +1,49 @@
+// Writes BGR frames to an MP4 file through OpenCV's FFmpeg backend on a worker thread (encoding
+// overlaps with rendering). The file appears atomically: frames go to PATH-without-.mp4 + ".tmp.mp4",
+// renamed to PATH by Close(); a writer destroyed without Close() removes the temporary file.
+#pragma once
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace exotwin {
+
+class Mp4Writer {
+ public:
+  // Opens the encoder: FourCC `codec` first (e.g. "avc1" = H.264), then "mp4v" with a warning on
+  // stderr. fps > 0; size in px. Throws InputError if PATH's folder does not exist, runtime_error if
+  // no codec opens.
+  Mp4Writer(const std::string& path, double fps, cv::Size size, const std::string& codec = "avc1");
+  ~Mp4Writer();
+  Mp4Writer(const Mp4Writer&) = delete;
+  Mp4Writer& operator=(const Mp4Writer&) = delete;
+
+  // Queues a copy of a BGR CV_8UC3 frame of the writer's size; blocks while 4 frames are queued.
+  void Write(const cv::Mat& frame);
+  // Flushes the queue, closes the file and renames it to PATH. Idempotent.
+  void Close();
+
+  const std::string& codec() const { return codec_; }  // FourCC actually used
+  long frames() const { return frames_; }               // frames queued so far
+  const std::string& path() const { return path_; }
+
+ private:
+  void Run();
+
+  std::string path_, tmp_path_, codec_;
+  cv::Size size_;
+  cv::VideoWriter writer_;
+  std::thread worker_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<cv::Mat> queue_;
+  bool stop_ = false, closed_ = false;
+  long frames_ = 0;
+};
+
+}  // namespace exotwin
