@@ -1,8 +1,12 @@
 #include "analysis/effects.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "dsp/butterworth.h"
 #include "model/input_error.h"
+#include "model/leg_dynamics.h"
+#include "model/passive_torque.h"
 
 namespace exotwin {
 
@@ -19,11 +23,80 @@ std::vector<double> Delayed(const std::vector<double>& t, const std::vector<doub
   return Interpolate(t, x, tq);
 }
 
+double MedianStep(const std::vector<double>& t) {
+  std::vector<double> d(t.size() - 1);
+  for (size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+Eigen::Vector2d At(const std::vector<double> v[2], size_t i) { return {v[0][i], v[1][i]}; }
+
 }  // namespace
+
+std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg) {
+  if (t.size() < 2 || emg.size() != t.size())
+    throw InputError("EMG envelope: expected an EMG column with one value per sample");
+  const double fs = 1.0 / MedianStep(t);
+  if (!(fs > 40.0))
+    throw InputError("EMG envelope: sample rate " + std::to_string(fs) +
+                     " Hz, expected above 40 Hz for the 20 Hz high-pass");
+  static thread_local double cached_fs = -1;
+  static thread_local std::vector<dsp::Biquad> hp, lp;
+  if (fs != cached_fs) {
+    hp = dsp::DesignButterworth(2, dsp::BandType::kHighPass, fs, 20.0);
+    lp = dsp::DesignButterworth(4, dsp::BandType::kLowPass, fs, 2.0);
+    cached_fs = fs;
+  }
+  // Odd reflection of up to 1 s at both ends before filtering keeps the start-up transients of
+  // the 2 Hz low-pass out of the record.
+  const size_t n = emg.size(), pad = std::min(n - 1, static_cast<size_t>(fs));
+  auto padded = [&](const std::vector<double>& x) {
+    std::vector<double> y;
+    y.reserve(n + 2 * pad);
+    for (size_t k = pad; k >= 1; --k) y.push_back(2 * x[0] - x[k]);
+    y.insert(y.end(), x.begin(), x.end());
+    for (size_t k = 1; k <= pad; ++k) y.push_back(2 * x[n - 1] - x[n - 1 - k]);
+    return y;
+  };
+  std::vector<double> x = dsp::FiltFilt(hp, padded(emg));
+  x = std::vector<double>(x.begin() + pad, x.begin() + pad + n);
+  for (double& v : x) v = std::abs(v);
+  x = dsp::FiltFilt(lp, padded(x));
+  return std::vector<double>(x.begin() + pad, x.begin() + pad + n);
+}
+
+Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
+                                    const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
+  if (!params.human) return ActuatorTorque(params, q, qd, qdd);
+  return RigidInverseDynamics(*params.human, params.L1, params.g, q, qd, qdd) +
+         PassiveElasticTorque(params.passive, q);
+}
+
+Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
+                               const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
+  // Newton on f(x) = x - q_j + tau_C,j(x)/k with a central-difference slope (1e-6 rad).
+  Eigen::Vector2d qc = q;
+  for (int it = 0; it < 6; ++it) {
+    const double f = qc[j] - q[j] + CompliantPartTorque(params, qc, qd, qdd)[j] / k;
+    Eigen::Vector2d a = qc, b = qc;
+    a[j] += 1e-6;
+    b[j] -= 1e-6;
+    const double slope = 1.0 + (CompliantPartTorque(params, a, qd, qdd)[j] -
+                                CompliantPartTorque(params, b, qd, qdd)[j]) / (2e-6 * k);
+    const double step = f / std::max(slope, 0.1);  // a slope <= 0 would be a buckling strap
+    qc[j] -= step;
+    if (std::abs(step) < 1e-12) break;
+  }
+  return qc;
+}
 
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
                   std::vector<double> tau_S[2]) {
   const size_t n = kin.t.size();
+  LegParams rigid = params;
+  rigid.effects.clear();
+  const std::vector<double> tau_rigid[2] = {tau_R[0], tau_R[1]};
   for (const Effect& e : params.effects) {
     const int j = EffectJoint(e);
     auto& tr = tau_R[j];
@@ -49,6 +122,40 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
         tau_R[0][i] += dG;
         if (j == 1) tau_R[1][i] += dG;
       }
+    } else if (e.name == "backlash") {
+      for (size_t i = 0; i < n; ++i) {
+        const Eigen::Vector2d q = At(kin.q, i), qd = At(kin.qd, i), qdd = At(kin.qdd, i);
+        Eigen::Vector2d ql = q;
+        ql[j] -= 0.5 * e.value * std::tanh(tau_rigid[j][i] / kBacklashTorqueWidth);
+        const Eigen::Vector2d d = ActuatorTorque(rigid, ql, qd, qdd) - ActuatorTorque(rigid, q, qd, qdd);
+        tau_R[0][i] += d[0];
+        tau_R[1][i] += d[1];
+      }
+    } else if (e.name == "series_compliance") {
+      for (size_t i = 0; i < n; ++i) {
+        const Eigen::Vector2d q = At(kin.q, i), qd = At(kin.qd, i), qdd = At(kin.qdd, i);
+        const Eigen::Vector2d qc = CompliantAngle(rigid, j, e.value, q, qd, qdd);
+        const Eigen::Vector2d d =
+            CompliantPartTorque(rigid, qc, qd, qdd) - CompliantPartTorque(rigid, q, qd, qdd);
+        tau_R[0][i] += d[0];
+        tau_R[1][i] += d[1];
+      }
+    } else if (e.name == "muscle_activity") {
+      bool any = false;
+      for (const auto& f : e.fields) {
+        if (f.first.rfind("w_", 0) != 0) continue;
+        const std::string ch = f.first.substr(2);
+        const auto it = kin.emg.find(ch);
+        if (it == kin.emg.end())
+          throw InputError("effect muscle_activity (" + e.joint + "): weight for channel '" + ch +
+                           "' but the measured data have no column 'emg_" + ch + "'");
+        const std::vector<double> env = EmgEnvelope(kin.t, it->second);
+        for (size_t i = 0; i < n; ++i) tr[i] += e.value * f.second * env[i];
+        any = true;
+      }
+      if (!any)
+        throw InputError("effect muscle_activity (" + e.joint +
+                         "): expected weights {channel: N m per V} for at least one EMG channel");
     }
   }
   for (int j = 0; j < 2; ++j) {
@@ -63,8 +170,6 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
       for (double& v : tau_S[j]) v *= 1.0 + e.value;
     } else if (e.name == "sensor_delay") {
       tau_S[j] = Delayed(kin.t, tau_S[j], e.value);
-    } else if (e.name == "backlash" || e.name == "series_compliance" || e.name == "muscle_activity") {
-      throw InputError("effect '" + e.name + "' is not supported by this build's predict");
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "dsp/butterworth.h"
 #include "model/input_error.h"
@@ -21,6 +22,13 @@ bool IsKnownColumn(const std::string& n) {
   for (const char* k : kKnown)
     if (n == k) return true;
   return n.rfind("emg_", 0) == 0;
+}
+
+// %g (std::to_string prints 1e300 as 301 digits).
+std::string Short(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
 }
 
 }  // namespace
@@ -50,7 +58,7 @@ MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
       const std::string where = path + ":" + std::to_string(t.line_of_row[r]) + ": column '" + n + "': ";
       if (!std::isfinite(v)) throw InputError(where + "value is not finite, expected a finite number");
       if (std::abs(v) > limit)
-        throw InputError(where + "value " + std::to_string(v) + " out of range, expected |x| <= " +
+        throw InputError(where + "value " + Short(v) + " out of range, expected |x| <= " +
                          std::to_string(limit) + " " + unit);
     }
   }
@@ -89,6 +97,9 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
   k.t = data.t;
   k.q[0] = data.q_hip;
   k.q[1] = data.q_knee;
+  for (size_t c = 0; c < data.table.names.size(); ++c)
+    if (data.table.names[c].rfind("emg_", 0) == 0 && data.table.names[c].size() > 4)
+      k.emg[data.table.names[c].substr(4)] = data.table.columns[c];
   const char* names[2] = {"hip", "knee"};
   bool all_measured = true;
   for (int j = 0; j < 2; ++j) {
@@ -113,6 +124,9 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
   std::vector<double> sorted = dts;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const double dt = sorted[sorted.size() / 2];
+  if (!(dt >= 1e-6))
+    throw InputError(data.source + ": column 't': median sample period " + Short(dt) +
+                     " s, expected at least 1e-6 s (a sample rate up to 1 MHz)");
   bool uniform = true;
   for (double s : dts)
     if (std::abs(s - dt) > 0.01 * dt) { uniform = false; break; }
@@ -121,7 +135,14 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
   if (uniform) {
     grid = data.t;
   } else {
-    const size_t m = static_cast<size_t>(std::floor((data.t.back() - data.t.front()) / dt)) + 1;
+    const double span = data.t.back() - data.t.front();
+    const double points = std::floor(span / dt) + 1;
+    if (!(points <= std::max(100.0 * static_cast<double>(n), 1e6)))
+      throw InputError(data.source + ": column 't': sampling too irregular to resample (median step " +
+                       Short(dt) + " s over " + Short(span) + " s needs " + Short(points) +
+                       " grid points for " + std::to_string(n) +
+                       " samples), expected roughly uniform sampling without long gaps");
+    const size_t m = static_cast<size_t>(points);
     grid.resize(m);
     for (size_t i = 0; i < m; ++i) grid[i] = data.t.front() + dt * static_cast<double>(i);
     k.resampled = true;

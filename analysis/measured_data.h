@@ -1,6 +1,7 @@
 // The measured-data CSV of DESIGN.md (input of predict / diagnose / identify) and the kinematics
 // derived from it.
 #pragma once
+#include <map>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,7 @@ struct Kinematics {
   std::vector<double> q[2], qd[2], qdd[2];  // [0] hip, [1] knee; rad, rad/s, rad/s^2
   bool resampled = false;                    // the input was non-uniform and went through a grid
   std::string derivative_source;             // "measured columns" or "butterworth 20 Hz"
+  std::map<std::string, std::vector<double>> emg;  // emg_<channel> columns (V) by channel, e.g. "VM"
 };
 
 // Uses qd_*/qdd_* columns when present, else derives them as in Hwang & Jeon sec. 3.2: the angle is

@@ -45,8 +45,12 @@ double Number(const Ctx& c, const YAML::Node& n, const std::string& key, double 
 void CheckKeys(const Ctx& c, const YAML::Node& map, const std::string& key,
                const std::set<std::string>& allowed) {
   if (!map.IsMap()) c.Fail(key, "expected a mapping" + Mark(map));
+  std::set<std::string> seen;
   for (const auto& kv : map) {
-    const std::string k = kv.first.as<std::string>();
+    if (!kv.first.IsScalar())
+      c.Fail(key.empty() ? "(top level)" : key, "expected plain keys, found a non-scalar key" + Mark(kv.first));
+    const std::string k = kv.first.Scalar();
+    if (!seen.insert(k).second) c.Fail(key.empty() ? k : key + "." + k, "duplicated key" + Mark(kv.first));
     if (!allowed.count(k)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -139,9 +143,13 @@ Effect ReadEffect(const Ctx& c, const YAML::Node& n, const std::string& key) {
   }
   if (e.name == "muscle_activity" && n["weights"]) {
     if (!n["weights"].IsMap()) c.Fail(key + ".weights", "expected a mapping channel: N m per V");
-    for (const auto& kv : n["weights"])
-      e.fields["w_" + kv.first.as<std::string>()] =
-          Number(c, kv.second, key + ".weights." + kv.first.as<std::string>(), -1e6, 1e6, "");
+    for (const auto& kv : n["weights"]) {
+      const std::string ch = kv.first.IsScalar() ? kv.first.Scalar() : "";
+      const char* kIdent = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_";
+      if (ch.empty() || ch.find_first_not_of(kIdent) != std::string::npos)
+        c.Fail(key + ".weights", "expected EMG channel names (letters, digits, '_') as keys" + Mark(kv.first));
+      e.fields["w_" + ch] = Number(c, kv.second, key + ".weights." + ch, -1e6, 1e6, "");
+    }
   }
   return e;
 }

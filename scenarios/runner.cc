@@ -18,6 +18,9 @@
 #include "hwsim/virtual_can_bus.h"
 #include "model/input_error.h"
 #include "protocol/candump.h"
+#include "renders/video_renderer.h"
+#include "dsp/butterworth.h"
+#include "model/leg_dynamics.h"
 #include "hwsim/emg_amplifier.h"
 #include "sim/anthropometry.h"
 #include "sim/muscles.h"
@@ -329,6 +332,15 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     }
 
     plant.Reset({h0.q, k0.q}, {h0.qd, k0.qd}, 0.0);
+    std::unique_ptr<VideoRenderer> video;
+    std::vector<dsp::SosFilter> envelope;
+    const controller::ExoControllerConfig ctrl_cfg = ControllerConfig(s, truth);
+    if (!opt.video_path.empty() && trial == 0) {
+      RenderOptions ro;
+      video = std::make_unique<VideoRenderer>(plant.model(), opt.video_path, ro);
+      envelope.assign(5, dsp::SosFilter(dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, 3.0)));
+    }
+    size_t events_seen = result.events.size();
     double tau[2] = {0, 0};
     const long n_steps = std::lround(s.protocol.duration / dt);
     const long log_every = std::max(1L, std::lround(1.0 / (s.log_rate_hz * dt)));
@@ -396,6 +408,24 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
           const double trow[] = {t, q[0], q[1], qd[0], qd[1], tau[0], tau[1], tau_M[0], tau_M[1]};
           truth_log->Row(trow, 9);
         }
+        if (video) {
+          OverlaySample os;
+          os.t = t;
+          os.q_hip = q[0];
+          os.q_knee = q[1];
+          // The twin's estimate: the controller's own model on its estimated state.
+          const Eigen::Vector2d est =
+              -ActuatorTorque(ctrl_cfg.model, {tel.est[0].q, tel.est[1].q}, {tel.est[0].qd, tel.est[1].qd},
+                              {tel.est[0].qdd, tel.est[1].qdd});
+          for (int j = 0; j < 2; ++j) {
+            os.tau_meas[j] = std::isfinite(tel.tau_sensor[j]) ? tel.tau_sensor[j] : 0.0;
+            os.tau_est[j] = est[j];
+          }
+          if (emg_on)
+            for (int c = 0; c < 5; ++c) os.emg.push_back(envelope[c].Step(std::abs(tel.emg[c])));
+          if (result.events.size() > events_seen) os.event = result.events[events_seen++];
+          video->AddSample(plant.data(), os);
+        }
         if (opt.on_sample) {
           const double qa[2] = {q[0], q[1]};
           opt.on_sample(t, qa, tau);
@@ -407,6 +437,10 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
         std::fprintf(stderr, "\r%s: trial %d/%d  %5.1f%%  sim %.1f s  eta %.0f s   ", s.name.c_str(), trial + 1,
                      s.protocol.trials, 100 * frac, t, frac > 0 ? el * (1 - frac) / frac : 0.0);
       }
+    }
+    if (video) {
+      video->Finish(t);
+      result.files.push_back(opt.video_path);
     }
     final_state = std::max(final_state, static_cast<int>(ctrl.state()));
     const hwsim::CanBusStatistics st = bus.Statistics();

@@ -18,6 +18,7 @@ struct RunOptions {
   std::optional<uint64_t> seed;  // overrides the scenario's seed
   std::string can_log;           // candump log of every frame on the bus ("" = none)
   bool progress = false;         // progress bar on stderr
+  std::string video_path;        // MP4 of the first trial (side view + overlays); "" = none
   // Called once per logged sample with (t, q_true[2], tau_applied[2]) (e.g. a video renderer).
   std::function<void(double, const double*, const double*)> on_sample;
 };

@@ -1,0 +1,181 @@
+#include "analysis/diagnose_columns.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "analysis/effects.h"
+#include "dsp/butterworth.h"
+#include "model/leg_dynamics.h"
+
+namespace exotwin {
+
+std::string Candidate::Label() const {
+  return name + (axis.empty() ? "" : "." + axis) + (joint == 0 ? "(hip)" : "(knee)");
+}
+
+namespace {
+
+double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+// Appends one column given as (hip row value, knee row value) per fit row.
+template <class F>
+int AddColumn(ColumnBank& b, const double w[2], F f) {
+  const size_t m = b.sample.size();
+  const int c = b.used++;
+  if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);
+  for (size_t k = 0; k < m; ++k) {
+    const Eigen::Vector2d v = f(b.sample[k]);
+    b.X(k, c) = w[0] * v[0];
+    b.X(m + k, c) = w[1] * v[1];
+  }
+  return c;
+}
+
+Eigen::Vector2d Row(int j, double v) { return j == 0 ? Eigen::Vector2d(v, 0) : Eigen::Vector2d(0, v); }
+
+}  // namespace
+
+ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
+                        const std::vector<double> tau_R[2], const std::vector<double> tau_S[2],
+                        const std::vector<double> resid[2], const double w[2], size_t split,
+                        size_t max_rows) {
+  ColumnBank b;
+  const size_t n = kin.t.size();
+  const size_t stride = std::max<size_t>(1, (n + max_rows - 1) / max_rows);
+  for (size_t i = 0; i < n; i += stride) {
+    b.sample.push_back(i);
+    b.train.push_back(i < split);
+  }
+  const size_t m = b.sample.size();
+  b.X.resize(2 * m, 0);
+  b.r.resize(2 * m);
+  for (size_t k = 0; k < m; ++k) {
+    b.r[k] = w[0] * resid[0][b.sample[k]];
+    b.r[m + k] = w[1] * resid[1][b.sample[k]];
+  }
+  LegParams rigid = params;
+  rigid.effects.clear();
+  auto Q = [&](size_t i) { return Eigen::Vector2d(kin.q[0][i], kin.q[1][i]); };
+  auto QD = [&](size_t i) { return Eigen::Vector2d(kin.qd[0][i], kin.qd[1][i]); };
+  auto QDD = [&](size_t i) { return Eigen::Vector2d(kin.qdd[0][i], kin.qdd[1][i]); };
+  // Time derivative of the predicted reading (for the delay), on the full record.
+  std::vector<double> dS[2];
+  for (int j = 0; j < 2; ++j) {
+    dS[j].resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
+      dS[j][i] = (tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]);
+    }
+  }
+  const double g = params.g;
+  std::vector<std::vector<double>> envelopes;
+  b.X.resize(2 * m, 40);
+  for (int j = 0; j < 2; ++j) {
+    auto add = [&](const std::string& name, std::vector<int> cols, const std::string& axis = "") {
+      Candidate c;
+      c.name = name, c.joint = j, c.cols = std::move(cols), c.axis = axis;
+      b.candidates.push_back(c);
+      return &b.candidates.back();
+    };
+    const int off = AddColumn(b, w, [&](size_t) { return Row(j, 1.0); });
+    add("coulomb_friction", {AddColumn(b, w, [&](size_t i) { return Row(j, -Sign(kin.qd[j][i])); })});
+    add("viscous_friction", {AddColumn(b, w, [&](size_t i) { return Row(j, -kin.qd[j][i]); })});
+    add("inertia_error", {AddColumn(b, w, [&](size_t i) { return Row(j, -kin.qdd[j][i]); })});
+    for (const char* axis : {"X", "Y"}) {
+      const bool is_x = axis[0] == 'X';
+      add("gravity_error", {AddColumn(b, w, [&](size_t i) {
+            const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
+            const double v = -g * (is_x ? std::sin(ang) : std::cos(ang));
+            return Eigen::Vector2d(v, j == 1 ? v : 0.0);
+          })}, axis);
+    }
+    add("joint_stiffness", {AddColumn(b, w, [&](size_t i) { return Row(j, -kin.q[j][i]); }), off});
+    // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b).
+    add("backlash", {AddColumn(b, w, [&](size_t i) {
+          Eigen::Vector2d qa = Q(i), qb = Q(i);
+          qa[j] += 1e-5, qb[j] -= 1e-5;
+          const Eigen::Vector2d d = (ActuatorTorque(rigid, qa, QD(i), QDD(i)) -
+                                     ActuatorTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
+          return Eigen::Vector2d(0.5 * std::tanh(tau_R[j][i] / kBacklashTorqueWidth) * d);
+        })});
+    // Straps: Delta tau_S = (1/k) dtau_C/dq_j tau_C,j (first order in 1/k).
+    add("series_compliance", {AddColumn(b, w, [&](size_t i) {
+          Eigen::Vector2d qa = Q(i), qb = Q(i);
+          qa[j] += 1e-5, qb[j] -= 1e-5;
+          const Eigen::Vector2d d = (CompliantPartTorque(rigid, qa, QD(i), QDD(i)) -
+                                     CompliantPartTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
+          return Eigen::Vector2d(d * CompliantPartTorque(rigid, Q(i), QD(i), QDD(i))[j]);
+        })});
+    add("sensor_offset", {off});
+    add("sensor_gain", {AddColumn(b, w, [&](size_t i) { return Row(j, tau_S[j][i]); })});
+    add("sensor_delay", {AddColumn(b, w, [&](size_t i) { return Row(j, -dS[j][i]); })});
+    if (!kin.emg.empty()) {
+      std::vector<int> cols;
+      std::vector<std::string> chans;
+      for (const auto& ch : kin.emg) {
+        if (j == 0) envelopes.push_back(EmgEnvelope(kin.t, ch.second));
+        const std::vector<double>& env = envelopes[chans.size()];
+        cols.push_back(AddColumn(b, w, [&](size_t i) { return Row(j, -env[i]); }));
+        chans.push_back(ch.first);
+      }
+      add("muscle_activity", cols)->channels = chans;
+    }
+  }
+  b.X.conservativeResize(Eigen::NoChange, b.used);
+  return b;
+}
+
+void AddRippleCandidates(ColumnBank& b, const Kinematics& kin, const Eigen::VectorXd& target) {
+  const size_t m = b.sample.size();
+  for (int j = 0; j < 2; ++j) {
+    // The search uses at most ~8000 fitting rows (every step-th).
+    const size_t step = std::max<size_t>(1, m / 8000);
+    auto sse = [&](double f) {
+      double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
+      for (size_t k = 0; k < m; k += step) {
+        if (!b.train[k]) continue;
+        const double x = 2 * M_PI * f * kin.q[j][b.sample[k]];
+        const double s = std::sin(x), c = std::cos(x), y = target[j * m + k];
+        ss += s * s, sc += s * c, cc += c * c, ys += y * s, yc += y * c, yy += y * y;
+      }
+      const double det = ss * cc - sc * sc;
+      if (det <= 1e-12 * (ss * cc + 1e-300)) return yy;
+      const double a = (ys * cc - yc * sc) / det, c2 = (yc * ss - ys * sc) / det;
+      return yy - a * ys - c2 * yc;
+    };
+    double best_f = 1.0, best = sse(1.0);
+    for (double f = 1.0; f <= 10.0 + 1e-9; f += 0.1) {
+      const double v = sse(f);
+      if (v < best) best = v, best_f = f;
+    }
+    double lo = best_f - 0.1, hi = best_f + 0.1;
+    const double gr = 0.5 * (std::sqrt(5.0) - 1);
+    for (int it = 0; it < 24; ++it) {
+      const double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo);
+      if (sse(x1) < sse(x2)) hi = x2; else lo = x1;
+    }
+    const double f = 0.5 * (lo + hi);
+    // Weight of joint j rows: the offset column of joint j holds exactly w_j there.
+    const int off = [&] {
+      for (const auto& c : b.candidates)
+        if (c.name == "sensor_offset" && c.joint == j) return c.cols[0];
+      return -1;
+    }();
+    const double w = b.X(j * m, off);
+    const int c0 = static_cast<int>(b.X.cols());
+    b.X.conservativeResize(Eigen::NoChange, c0 + 2);
+    b.used = c0 + 2;
+    b.X.col(c0).setZero();
+    b.X.col(c0 + 1).setZero();
+    for (size_t k = 0; k < m; ++k) {
+      const double x = 2 * M_PI * f * kin.q[j][b.sample[k]];
+      b.X(j * m + k, c0) = -w * std::sin(x);
+      b.X(j * m + k, c0 + 1) = -w * std::cos(x);
+    }
+    Candidate c;
+    c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
+    b.candidates.push_back(c);
+  }
+}
+
+}  // namespace exotwin

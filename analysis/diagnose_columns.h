@@ -1,0 +1,46 @@
+// Candidate explanations of a twin residual as columns of a linear model (first order in each
+// effect of DESIGN.md "Effects"); used by Diagnose (diagnose.h).
+#pragma once
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "analysis/measured_data.h"
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// One candidate effect: the columns (indices into ColumnBank::X) whose coefficients give its value.
+struct Candidate {
+  std::string name, axis;  // axis: gravity_error only
+  int joint = 0;           // 0 hip, 1 knee
+  std::vector<int> cols;
+  double ripple_f = 0;                // torque_ripple: cycles per rad found by search
+  std::vector<std::string> channels;  // muscle_activity: EMG channel of each column
+  std::string Label() const;          // e.g. "gravity_error.Y(knee)"
+};
+
+// Columns on the fit rows. Row layout: X has 2 m rows, hip rows 0..m-1 then knee rows m..2m-1;
+// rows are weighted by 1/noise of their joint (so the stacked least squares are balanced).
+struct ColumnBank {
+  std::vector<size_t> sample;  // m sample indices of the fit rows
+  std::vector<bool> train;     // m flags: row in the fitting part
+  Eigen::MatrixXd X;           // 2m x columns (weighted)
+  Eigen::VectorXd r;           // 2m weighted residual
+  std::vector<Candidate> candidates;
+  int used = 0;                // columns in use (X may be over-allocated while building)
+};
+
+// Builds every candidate for both joints. tau_R, tau_S: the twin's prediction (N m) on all samples;
+// resid[j]: measured - predicted tau_S; w[j]: row weights (1/N m); split: first held-out sample.
+ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
+                        const std::vector<double> tau_R[2], const std::vector<double> tau_S[2],
+                        const std::vector<double> resid[2], const double w[2], size_t split,
+                        size_t max_rows);
+
+// Adds the torque_ripple candidates (sin/cos of 2 pi f q_j) with f (1 .. 10 cycles/rad) found by
+// grid + golden search on `target` (2m weighted rows, e.g. the residual of all other columns).
+void AddRippleCandidates(ColumnBank& bank, const Kinematics& kin, const Eigen::VectorXd& target);
+
+}  // namespace exotwin

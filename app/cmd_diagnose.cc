@@ -1,0 +1,50 @@
+// `exotwin diagnose`: name what the twin gets wrong on measured data, extend it, measure the gain.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+#include "analysis/diagnose.h"
+#include "analysis/measured_data.h"
+#include "analysis/model_file.h"
+#include "app/commands.h"
+
+namespace exotwin {
+namespace {
+
+CommandRunner RegisterDiagnose(CLI::App& app) {
+  struct Opts {
+    std::string params, measured, out, mjcf;
+    double holdout = 0.3;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand(
+      "diagnose", "Where twin and measured data disagree, the cause, the extended model and its gain");
+  sub->add_option("--params", o->params, "MODEL.yaml of the twin")->required();
+  sub->add_option("--measured", o->measured, "measured-data CSV")->required();
+  sub->add_option("--out", o->out, "output folder (diagnosis.json, extended.yaml, report.html)")->required();
+  sub->add_option("--holdout", o->holdout, "held-out fraction at the end of the record (default 0.3)");
+  sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    const LegParams params = ReadModelFile(o->params);
+    const MeasuredData data = ReadMeasuredCsv(o->measured);
+    DiagnoseOptions opt;
+    opt.holdout_fraction = o->holdout;
+    opt.mjcf = o->mjcf;
+    const Diagnosis d = Diagnose(params, data, opt);
+    WriteDiagnosis(d, o->out, o->params, o->measured);
+    for (const auto& e : d.effects)
+      std::printf("diagnose: %s (%s) = %g %s [%g, %g]\n", e.effect.name.c_str(), e.effect.joint.c_str(),
+                  e.effect.value, e.effect.unit.c_str(), e.ci_lo, e.ci_hi);
+    if (d.effects.empty()) std::printf("diagnose: no effect named\n");
+    std::printf("diagnose: held-out rmse hip %.4f -> %.4f N m, knee %.4f -> %.4f N m; report %s/report.html\n",
+                d.joints[0].rmse_before, d.joints[0].rmse_after, d.joints[1].rmse_before,
+                d.joints[1].rmse_after, o->out.c_str());
+    return 0;
+  };
+}
+
+const CommandRegistration kDiagnose(RegisterDiagnose);
+
+}  // namespace
+}  // namespace exotwin
