@@ -11,9 +11,10 @@ namespace {
 
 // Prints the checks as a table; returns 0 when all passed, 1 otherwise.
 int Report(const RunResult& r, const std::string& out_dir) {
+  const auto samples = r.metrics.find("samples");
   std::printf("scenario %s (seed %llu): %zu samples, results in %s/result.json\n", r.scenario.c_str(),
-              static_cast<unsigned long long>(r.seed), static_cast<size_t>(r.metrics.at("samples")),
-              out_dir.c_str());
+              static_cast<unsigned long long>(r.seed),
+              samples == r.metrics.end() ? size_t{0} : static_cast<size_t>(samples->second), out_dir.c_str());
   for (const CheckResult& c : r.checks)
     std::printf("  %-4s %-32s %12.5g %s %-10.5g (%s)\n", c.passed ? "ok" : "FAIL", c.name.c_str(), c.value,
                 c.op.c_str(), c.limit, c.metric.c_str());

@@ -1,5 +1,7 @@
 #include "scenarios/runner.h"
 
+#include "scenarios/hal_runner.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -53,8 +55,6 @@ LegParams ResolveSubject(const Scenario& s) {
   } else if (s.subject.params_file.empty()) {
     p.passive = s.subject.passive;
   }
-  if (s.device == Device::kHal3)
-    throw InputError(s.source + ": device: hal3 scenarios are not supported by this runner yet");
   return p;
 }
 
@@ -231,6 +231,7 @@ struct Accum {
 }  // namespace
 
 RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
+  if (s.device == Device::kHal3) return RunHalScenario(s, opt);
   RunResult result;
   result.scenario = s.name;
   result.seed = opt.seed ? *opt.seed : s.seed;

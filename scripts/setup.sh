@@ -13,6 +13,7 @@ PKGS=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   can-utils                           # log2asc for the candump round-trip test
+  parallel                            # GNU parallel: the sweep split-and-merge test (tests/cli)
 )
 
 missing=()

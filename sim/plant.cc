@@ -1,9 +1,11 @@
 #include "sim/plant.h"
 
+#include <mujoco/mjxmacro.h>
 #include <mujoco/mujoco.h>
 
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "model/input_error.h"
 #include "model/passive_torque.h"
@@ -15,6 +17,44 @@ SimulationError::SimulationError(double t, const std::string& cause)
     : std::runtime_error("simulation diverged at t = " + std::to_string(t) + " s: " + cause),
       time_(t) {}
 
+namespace {
+
+// The first real number of the model (options and every mjtNum array) that is not finite or is
+// huge (|x| > 1e9, beyond any physical value in SI units here), as "field[i] = value"; "" if none.
+// MuJoCo loads such models (armature="inf", gear="1e300") without complaint, and the twin then
+// computes inf or nonsense silently.
+std::string FirstBadModelValue(const mjModel* m) {
+  auto bad = [](double v) { return !std::isfinite(v) || std::abs(v) > 1e9; };
+  auto say = [](const char* name, long i, double v) {
+    std::ostringstream os;
+    os << name << "[" << i << "] = " << v;
+    return os.str();
+  };
+#define X(type, name)                                                \
+  if (bad(m->opt.name)) return say("option." #name, 0, m->opt.name);
+  MJOPTION_FLOATS
+#undef X
+#define X(name, n)                                                   \
+  for (long i = 0; i < (n); ++i)                                     \
+    if (bad(m->opt.name[i])) return say("option." #name, i, m->opt.name[i]);
+  MJOPTION_VECTORS
+#undef X
+  MJMODEL_POINTERS_PREAMBLE(m)
+#define X(type, name, nr, nc)                                        \
+  if constexpr (std::is_same_v<type, mjtNum>) {                      \
+    for (long i = 0; i < static_cast<long>(m->nr) * (nc); ++i)       \
+      if (bad(m->name[i])) return say(#name, i, m->name[i]);         \
+  }
+  MJMODEL_POINTERS
+#undef X
+  (void)nuser_body, (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
+  (void)nuser_tendon, (void)nuser_actuator, (void)nuser_sensor, (void)nq, (void)nv, (void)na, (void)nu;
+  (void)nmocap;
+  return "";
+}
+
+}  // namespace
+
 std::string ShippedModelPath(const std::string& file) {
   return std::string(EXOTWIN_SOURCE_DIR) + "/models/" + file;
 }
@@ -23,6 +63,12 @@ Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
   char err[1000] = "";
   m_ = mj_loadXML(mjcf_path.c_str(), nullptr, err, sizeof(err));
   if (!m_) throw InputError(mjcf_path + ": cannot load MJCF model: " + err);
+  const std::string bad_value = FirstBadModelValue(m_);
+  if (!bad_value.empty()) {
+    mj_deleteModel(m_);
+    throw InputError(mjcf_path + ": MJCF model value " + bad_value +
+                     ", expected a finite number of magnitude at most 1e9");
+  }
   if (err[0]) {
     mj_deleteModel(m_);
     throw InputError(mjcf_path + ": MJCF model loaded with a warning (treated as an error): " + err);
@@ -46,6 +92,18 @@ Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
     if (m_->nu != 2)
       throw InputError(mjcf_path + ": expected two torque actuators (hip, knee), found " +
                        std::to_string(m_->nu));
+    // Step() writes the joint torques into ctrl[0] (hip) and ctrl[1] (knee): plain motors, gear 1.
+    for (int i = 0; i < 2; ++i) {
+      const int joint = i == 0 ? hip : knee;
+      if (m_->actuator_trntype[i] != mjTRN_JOINT || m_->actuator_trnid[2 * i] != joint ||
+          m_->actuator_gear[6 * i] != 1.0 || m_->actuator_gaintype[i] != mjGAIN_FIXED ||
+          m_->actuator_gainprm[mjNGAIN * i] != 1.0 || m_->actuator_biastype[i] != mjBIAS_NONE) {
+        const char* name = mj_id2name(m_, mjOBJ_ACTUATOR, i);
+        throw InputError(mjcf_path + ": actuator " + std::to_string(i) + " ('" + (name ? name : "") +
+                         "'): expected a <motor> on joint '" + (i == 0 ? "hip" : "knee") +
+                         "' with gear 1 (ctrl is the joint torque in N m)");
+      }
+    }
   } catch (...) {
     mj_deleteData(d_);
     mj_deleteData(d_inv_);
@@ -128,6 +186,14 @@ void Plant::SetParams(const LegParams& params) {
   m_->opt.gravity[0] = m_->opt.gravity[1] = 0.0;
   m_->opt.gravity[2] = -params.g;
   m_->body_pos[3 * exo_shank_ + 2] = -params.L1;
+  // Visual only: stretch the thigh geoms to the new L1 (centred at mid-thigh, half-length L1/2).
+  for (const char* g : {"human_thigh_geom", "exo_thigh_bar"}) {
+    const int id = mj_name2id(m_, mjOBJ_GEOM, g);
+    if (id < 0) continue;
+    m_->geom_pos[3 * id + 2] = -0.5 * params.L1;
+    const int axis = m_->geom_type[id] == mjGEOM_BOX ? 2 : 1;  // box half-height / capsule half-length
+    m_->geom_size[3 * id + axis] = 0.5 * params.L1;
+  }
   WriteBody(m_, exo_thigh_, exo.thigh);
   WriteBody(m_, exo_shank_, exo.lower_leg);
   if (human_thigh_ >= 0) {

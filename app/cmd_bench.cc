@@ -1,0 +1,84 @@
+// `exotwin bench [--out FILE.json] [--repeat R] [--quick] [--only NAME,...]`: speed of the twin, as
+// JSON (stdout, and FILE.json): closed loop vs bare mj_step, render + encode fps, identification and
+// diagnosis throughput, sweep speed-up on 2 worker processes; each with the ratio against its
+// baseline measured in the same run (app/bench_probes.h). Exit 0, 2 on bad options.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "analysis/csv_table.h"
+#include "app/bench_probes.h"
+#include "app/commands.h"
+#include "model/input_error.h"
+
+namespace exotwin {
+namespace {
+
+CommandRunner RegisterBench(CLI::App& app) {
+  struct Opts {
+    std::string out, only;
+    int repeat = 3;
+    bool quick = false;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand("bench", "Benchmark the twin (closed loop, render, identification, diagnosis, sweep)");
+  sub->add_option("--out", o->out, "write the JSON here too");
+  sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
+  sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
+  sub->add_option("--only", o->only, "comma-separated subset: closed_loop,render,identification,diagnosis,sweep");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
+    const std::vector<std::string> all = {"closed_loop", "render", "identification", "diagnosis", "sweep"};
+    std::vector<std::string> selected;
+    if (o->only.empty()) selected = all;
+    else {
+      size_t start = 0;
+      while (start <= o->only.size()) {
+        const size_t end = std::min(o->only.find(',', start), o->only.size());
+        const std::string name = o->only.substr(start, end - start);
+        if (std::find(all.begin(), all.end(), name) == all.end())
+          throw InputError("--only: unknown probe '" + name +
+                           "', expected a comma-separated subset of closed_loop,render,identification,diagnosis,sweep");
+        selected.push_back(name);
+        start = end + 1;
+      }
+    }
+    BenchConfig c;
+    c.repeat = o->repeat;
+    c.quick = o->quick;
+    std::string tmpl = (std::filesystem::temp_directory_path() / "exotwin_bench_XXXXXX").string();
+    if (!mkdtemp(tmpl.data())) throw std::runtime_error("bench: cannot create a temporary folder");
+    c.scratch = tmpl;
+
+    nlohmann::ordered_json j;
+    double load[3] = {0, 0, 0};
+    getloadavg(load, 3);
+    j["machine"] = {{"cores", std::thread::hardware_concurrency()}, {"load_avg_1min", load[0]}};
+    j["quick"] = o->quick;
+    j["repeat"] = o->repeat;
+    for (const std::string& name : selected) {
+      std::fprintf(stderr, "bench: %s...\n", name.c_str());
+      if (name == "closed_loop") j[name] = BenchClosedLoop(c);
+      if (name == "render") j[name] = BenchRender(c);
+      if (name == "identification") j[name] = BenchIdentification(c);
+      if (name == "diagnosis") j[name] = BenchDiagnosis(c);
+      if (name == "sweep") j[name] = BenchSweep(c);
+    }
+    std::filesystem::remove_all(c.scratch);
+    const std::string text = j.dump(2) + "\n";
+    std::fputs(text.c_str(), stdout);
+    if (!o->out.empty()) WriteFileAtomic(o->out, text);
+    return 0;
+  };
+}
+
+const CommandRegistration kBench(RegisterBench);
+
+}  // namespace
+}  // namespace exotwin

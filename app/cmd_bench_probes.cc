@@ -1,0 +1,271 @@
+// The probes of `exotwin bench` (app/bench_probes.h). Optional layers are detected at compile time:
+// a probe whose library is not in the build reports {"status": "unavailable"}.
+#include <mujoco/mujoco.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+
+#include "app/bench_probes.h"
+#include "scenarios/fork_pool.h"
+#include "scenarios/runner.h"
+#include "scenarios/scenario_job.h"
+#include "scenarios/sweep_plan.h"
+#include "sim/plant.h"
+#include "sim/subjects.h"
+
+#if __has_include("renders/video_renderer.h")
+#define EXOTWIN_BENCH_RENDER 1
+#include "renders/video_renderer.h"
+#endif
+#if __has_include("analysis/identification.h") && __has_include("analysis/identification_data.h")
+#define EXOTWIN_BENCH_IDENTIFY 1
+#include "analysis/identification.h"
+#include "analysis/identification_data.h"
+#endif
+#if __has_include("analysis/diagnose.h") && __has_include("analysis/generate.h")
+#define EXOTWIN_BENCH_DIAGNOSE 1
+#include "analysis/diagnose.h"
+#include "analysis/generate.h"
+#include "analysis/model_file.h"
+#endif
+
+namespace exotwin {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+// Best wall time (s) of `repeat` calls of f.
+double BestOf(int repeat, const std::function<void()>& f) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < std::max(1, repeat); ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
+Scenario GaitScenario(double duration) {
+  Scenario s = ReadScenario(std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/gait_2kmh.yaml");
+  s.protocol.duration = duration;
+  s.protocol.ramp = std::min(s.protocol.ramp, duration / 4);
+  s.log_measured_csv = false;
+  return s;
+}
+
+// CPU time (s, user + system) of the terminated, waited-for children of this process so far.
+double ChildrenCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// CPU time (s) of this process itself so far.
+double SelfCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+json Unavailable(const std::string& why) { return json{{"status", "unavailable"}, {"reason", why}}; }
+
+}  // namespace
+
+json BenchClosedLoop(const BenchConfig& c) {
+  const double duration = c.quick ? 2.0 : 10.0;
+  Plant plant(ShippedModelPath("leg_exowheel.xml"));
+  plant.SetParams(SubjectLegParams(PresetSubject("S1")));
+  mjModel* m = const_cast<mjModel*>(plant.model());
+  mjData* d = plant.data();
+  const long n = std::lround(duration / m->opt.timestep);
+  const double bare = BestOf(c.repeat, [&] {
+    mj_resetData(m, d);
+    d->qpos[0] = 0.3;
+    d->qpos[1] = -0.5;
+    for (long i = 0; i < n; ++i) {
+      d->ctrl[0] = 20.0;
+      d->ctrl[1] = 5.0;
+      mj_step(m, d);
+    }
+  });
+  const Scenario s = GaitScenario(duration);
+  RunOptions o;
+  o.out_dir = c.scratch + "/closed_loop";
+  const double closed = BestOf(c.repeat, [&] { RunScenario(s, o); });
+  return json{{"status", "ok"},
+              {"steps", n},
+              {"bare_mj_step_s", bare},
+              {"closed_loop_s", closed},
+              {"bare_steps_per_s", n / bare},
+              {"closed_loop_steps_per_s", n / closed},
+              {"closed_loop_x_realtime", duration / closed},
+              {"ratio_closed_loop_to_bare", closed / bare}};
+}
+
+json BenchRender(const BenchConfig& c) {
+#ifdef EXOTWIN_BENCH_RENDER
+  const double seconds = c.quick ? 1.0 : 3.0;
+  Plant plant(ShippedModelPath("leg_exowheel.xml"));
+  auto video = [&](bool overlays) {
+    RenderOptions opt;
+    opt.overlays = overlays;
+    opt.emg_names = {"VM", "RF", "ST"};
+    long frames = 0;
+    const std::string path = c.scratch + "/bench.mp4";
+    const double t = BestOf(c.quick ? 1 : std::min(c.repeat, 2), [&] {
+      VideoRenderer v(plant.model(), path, opt);
+      for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) {
+        OverlaySample s;
+        s.t = i * 1e-3;
+        s.q_hip = 0.6 + 0.5 * std::sin(2 * M_PI * 0.8 * s.t);
+        s.q_knee = -0.9 + 0.6 * std::sin(2 * M_PI * 1.1 * s.t);
+        s.tau_meas[0] = -20 + 5 * std::sin(3 * s.t), s.tau_meas[1] = 4 * std::cos(2 * s.t);
+        s.tau_est[0] = s.tau_meas[0] + 1, s.tau_est[1] = s.tau_meas[1] - 0.5;
+        s.emg = {0.1 + 0.05 * std::sin(s.t), 0.2, 0.05};
+        if (i == 500) s.event = "knee torque sensor: stuck reading";
+        v.AddSample(s);
+      }
+      v.Finish(seconds);
+      frames = v.frames();
+    });
+    return std::make_pair(t, frames);
+  };
+  try {
+    const auto [t_ov, frames] = video(true);
+    const auto [t_plain, frames_plain] = video(false);
+    const double fps = frames / t_ov, fps_plain = frames_plain / t_plain;
+    return json{{"status", "ok"},
+                {"width", 1280},
+                {"height", 720},
+                {"frames", frames},
+                {"video_fps", 30.0},
+                {"overlays_s", t_ov},
+                {"no_overlays_s", t_plain},
+                {"fps_with_overlays", fps},
+                {"fps_without_overlays", fps_plain},
+                {"x_realtime_with_overlays", fps / 30.0},
+                {"ratio_overlays_to_plain", t_ov / t_plain}};
+  } catch (const std::exception& e) {
+    return Unavailable(std::string("renderer failed: ") + e.what());
+  }
+#else
+  (void)c;
+  return Unavailable("renders/ is not part of this build");
+#endif
+}
+
+json BenchIdentification(const BenchConfig& c) {
+#ifdef EXOTWIN_BENCH_IDENTIFY
+  LegParams truth;
+  truth.L1 = 0.41;
+  truth.exo = {3.02, 0.74, 3.85, 1.74, 0.15, 0.16};
+  truth.human = LumpedParams{1.69, 0.37, 4.54, 1.20, -0.16, 0.42};
+  truth.passive = PassiveModel::kRiener1999;
+  ProtocolOptions po;
+  po.trial_s = 20;
+  po.trials = c.quick ? 1 : 2;
+  po.emg_rms = 0.05;
+  const auto t_sim0 = std::chrono::steady_clock::now();
+  const std::vector<MeasuredData> files = SimulateProtocol(truth, po).All();
+  const double t_sim = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_sim0).count();
+  LegParams known = truth;
+  known.human.reset();
+  size_t samples = 0;
+  for (const auto& f : files) samples += f.size();
+  const double data_s = 2.0 * po.trials * po.trial_s;
+  const double t = BestOf(c.repeat, [&] { Identify(files, &known, 0); });
+  return json{{"status", "ok"},
+              {"steps", "3-4 (human, known exo)"},
+              {"data_s", data_s},
+              {"samples", samples},
+              {"identify_s", t},
+              {"samples_per_s", samples / t},
+              {"x_realtime", data_s / t},
+              {"simulate_data_s", t_sim},
+              {"ratio_identify_to_simulation", t / t_sim}};
+#else
+  (void)c;
+  return Unavailable("analysis/identification.h is not part of this build");
+#endif
+}
+
+json BenchDiagnosis(const BenchConfig& c) {
+#ifdef EXOTWIN_BENCH_DIAGNOSE
+  GenerateOptions g;
+  g.seed = 2024;
+  g.duration = c.quick ? 20 : 60;
+  g.rate = 1000;
+  g.effects = 1;
+  g.allowed = {"coulomb_friction"};
+  const LegParams base = ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml");
+  const auto t_gen0 = std::chrono::steady_clock::now();
+  const GeneratedData data = GenerateMeasured(base, g);
+  const double t_gen = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_gen0).count();
+  const double t = BestOf(std::min(c.repeat, 2), [&] { Diagnose(base, data.data); });
+  return json{{"status", "ok"},
+              {"data_s", g.duration},
+              {"samples", data.data.size()},
+              {"hidden_effect", "coulomb_friction"},
+              {"diagnose_s", t},
+              {"samples_per_s", data.data.size() / t},
+              {"x_realtime", g.duration / t},
+              {"generate_data_s", t_gen},
+              {"ratio_diagnose_to_generation", t / t_gen}};
+#else
+  (void)c;
+  return Unavailable("analysis/diagnose.h is not part of this build");
+#endif
+}
+
+json BenchSweep(const BenchConfig& c) {
+  const int subjects = c.quick ? 2 : 8;
+  const Scenario base = GaitScenario(c.quick ? 2.0 : 20.0);
+  auto run = [&](int workers) {
+    const auto outcomes = RunForked(subjects, workers, [&](size_t i) {
+      RunOptions o;
+      o.out_dir = c.scratch + "/sweep_j" + std::to_string(workers) + "/subject_" + std::to_string(i);
+      return RunScenarioJob(WithPopulationSubject(base, 1, static_cast<int>(i)), o);
+    });
+    for (const JobOutcome& o : outcomes)
+      if (o.exit_code != kJobOk && o.exit_code != kJobCheckFailed)
+        throw std::runtime_error("bench sweep: a run failed (exit " + std::to_string(o.exit_code) + ")");
+  };
+  // Wall and CPU time of the fastest of `repeat` calls: cpu / wall = the cores the pool actually got.
+  struct Timing {
+    double wall = std::numeric_limits<double>::infinity(), children = 0, self = 0;
+  };
+  auto timed = [&](int workers) {
+    Timing best;
+    for (int i = 0; i < std::max(1, c.repeat); ++i) {
+      const double c0 = ChildrenCpuSeconds(), p0 = SelfCpuSeconds();
+      const auto t0 = std::chrono::steady_clock::now();
+      run(workers);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (wall < best.wall) best = {wall, ChildrenCpuSeconds() - c0, SelfCpuSeconds() - p0};
+    }
+    return best;
+  };
+  const Timing j1 = timed(1), j2 = timed(2);
+  const double t1 = j1.wall, t2 = j2.wall, cpu1 = j1.children, cpu2 = j2.children, parent1 = j1.self;
+  // The parent's own work (fork, wait, reading results) is the serial part of a sweep; with it,
+  // Amdahl's law bounds the speed-up 2 idle cores would give (memory bandwidth not modelled).
+  const double serial = parent1 / std::max(1e-12, parent1 + cpu1);
+  return json{{"status", "ok"},
+              {"runs", subjects},
+              {"sim_s_per_run", base.protocol.duration},
+              {"jobs1_s", t1},
+              {"jobs2_s", t2},
+              {"speedup_2_jobs", t1 / t2},
+              {"target_speedup", 1.8},
+              {"cores_used_jobs1", cpu1 / t1},
+              {"cores_used_jobs2", cpu2 / t2},
+              {"serial_fraction", serial},
+              {"amdahl_speedup_2_idle_cores", 1.0 / (serial + (1.0 - serial) / 2.0)}};
+}
+
+}  // namespace exotwin

@@ -1,0 +1,145 @@
+// `exotwin identify --measured A.csv --measured B.csv [--known MODEL.yaml] --out MODEL.yaml`
+// (DESIGN.md): least-squares identification of the exoskeleton (steps 1-2) or, with --known, of the
+// subject (steps 3-4), Hwang & Jeon 2015 sec. 3.2. --measured takes files or folders (every *.csv
+// inside with the measured-data columns; others are skipped with a note), in any order.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+
+#include "analysis/csv_table.h"
+#include "analysis/identification.h"
+#include "analysis/measured_data.h"
+#include "analysis/model_file.h"
+#include "app/commands.h"
+#include "model/input_error.h"
+#include "sim/realizability.h"
+
+namespace exotwin {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Reads one --measured argument: a CSV file, or a folder of CSVs (sorted by name).
+void ReadMeasuredArg(const std::string& arg, std::vector<MeasuredData>* out) {
+  std::error_code ec;
+  if (!fs::is_directory(arg, ec)) {
+    out->push_back(ReadMeasuredCsv(arg));
+    return;
+  }
+  std::vector<std::string> csvs;
+  for (const auto& e : fs::directory_iterator(arg, ec))
+    if (e.is_regular_file() && e.path().extension() == ".csv") csvs.push_back(e.path().string());
+  std::sort(csvs.begin(), csvs.end());
+  size_t used = 0;
+  for (const std::string& f : csvs) {
+    try {
+      out->push_back(ReadMeasuredCsv(f));
+      ++used;
+    } catch (const InputError& e) {
+      if (std::string(e.what()).find("missing required column") == std::string::npos) throw;
+      std::fprintf(stderr, "identify: note: skipping %s (not a measured-data CSV)\n", f.c_str());
+    }
+  }
+  if (used == 0)
+    throw InputError(arg + ": folder holds no measured-data CSV, expected *.csv files with columns "
+                           "t, q_hip, q_knee, tau_hip, tau_knee");
+}
+
+// "--emg-threshold VM=0.2" or "--emg-threshold 0.2" (every channel).
+void ParseThreshold(const std::string& s, std::map<std::string, double>* th) {
+  const size_t eq = s.find('=');
+  const std::string name = eq == std::string::npos ? "*" : s.substr(0, eq);
+  const std::string val = eq == std::string::npos ? s : s.substr(eq + 1);
+  char* end = nullptr;
+  const double v = std::strtod(val.c_str(), &end);
+  if (val.empty() || *end != '\0' || !(v > 0) || !std::isfinite(v))
+    throw InputError("--emg-threshold '" + s + "': expected CHANNEL=VOLTS or VOLTS with a positive value");
+  (*th)[name] = v;
+}
+
+CommandRunner RegisterIdentify(CLI::App& app) {
+  struct Opts {
+    std::vector<std::string> measured, thresholds;
+    std::string known, out, passive = "riener1999";
+    double L1 = 0.0, emg_reference = 2.0, emg_envelope = 0.0, trim = 0.1;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand(
+      "identify", "Least-squares identification of the lumped parameters (Hwang & Jeon 2015, steps 1-4)");
+  sub->add_option("--measured", o->measured,
+                  "measured-data CSV or folder of CSVs: the knee-swing and hip-swing recordings, any order")
+      ->required();
+  sub->add_option("--known", o->known, "MODEL.yaml holding the exoskeleton (exo:); identifies the human");
+  sub->add_option("--out", o->out, "MODEL.yaml to write")->required();
+  sub->add_option("--L1", o->L1, "thigh length, m (default: from --known, else 0.41)");
+  sub->add_option("--passive", o->passive, "passive elastic model subtracted in steps 3-4")
+      ->check(CLI::IsMember({"none", "riener1999"}));
+  sub->add_option("--emg-reference", o->emg_reference,
+                  "s of relaxed EMG at the start of each file for the eq. (13) threshold (default 2)");
+  sub->add_option("--emg-threshold", o->thresholds,
+                  "eq. (13) threshold instead of the reference: CHANNEL=V (e.g. VM=0.3) or V for all");
+  sub->add_option("--emg-envelope", o->emg_envelope,
+                  "s, moving average of the rectified EMG before thresholding (default 0: per sample)");
+  sub->add_option("--trim", o->trim, "s dropped at both ends of every file (default 0.1)");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    IdentificationOptions opt;
+    opt.passive = o->passive == "none" ? PassiveModel::kNone : PassiveModel::kRiener1999;
+    opt.trim_s = o->trim;
+    opt.selection.reference_s = o->emg_reference;
+    opt.selection.envelope_s = o->emg_envelope;
+    for (const std::string& t : o->thresholds) ParseThreshold(t, &opt.selection.thresholds);
+    if (!(o->trim >= 0)) throw InputError("--trim: expected a time >= 0 s");
+    if (!(o->emg_reference > 0)) throw InputError("--emg-reference: expected a time > 0 s");
+    if (!(o->emg_envelope >= 0)) throw InputError("--emg-envelope: expected a time >= 0 s");
+    if (o->L1 != 0.0 && !(o->L1 > 0.1 && o->L1 < 1.0))
+      throw InputError("--L1: expected a thigh length in (0.1, 1.0) m, got " + std::to_string(o->L1));
+
+    LegParams known;
+    if (!o->known.empty()) {
+      known = ReadModelFile(o->known);
+      if (o->L1 != 0.0 && std::abs(o->L1 - known.L1) > 1e-12)
+        throw InputError("--L1 " + std::to_string(o->L1) + " differs from L1 = " +
+                         std::to_string(known.L1) + " in " + o->known + ", expected one thigh length");
+      if (known.human)
+        std::fprintf(stderr, "identify: note: the human: block of %s is replaced by the identified one\n",
+                     o->known.c_str());
+      if (!known.effects.empty())
+        std::fprintf(stderr, "identify: note: the effects of %s are not used and not copied\n",
+                     o->known.c_str());
+    }
+    std::vector<MeasuredData> files;
+    for (const std::string& m : o->measured) ReadMeasuredArg(m, &files);
+    const double L1 = o->L1 != 0.0 ? o->L1 : 0.41;
+    const IdentificationResult r = Identify(files, o->known.empty() ? nullptr : &known, L1, opt);
+
+    std::string header = "exotwin identify: Hwang & Jeon 2015 ";
+    header += o->known.empty() ? "steps 1-2 (exoskeleton alone)" : "steps 3-4 (subject; exo from " + o->known + ")";
+    if (o->known.empty() && o->L1 == 0.0) header += "\nL1 = 0.41 m assumed (give --L1 for this rig)";
+    std::string why;
+    const LumpedParams& id = r.params.human ? *r.params.human : r.params.exo;
+    if (!IsRealizable(id, r.params.L1, &why)) {
+      std::fprintf(stderr, "identify: warning: identified %s parameters have no physically consistent "
+                   "realization (%s); predict will refuse them\n",
+                   r.params.human ? "human" : "exo", why.c_str());
+      header += "\nwarning: no physically consistent realization: " + why;
+    }
+    for (const StepEstimate& s : r.steps)
+      std::fprintf(stderr, "identify: step %d (%s): %zu of %zu samples, condition number %.2f, "
+                   "residual RMS %.4f N m\n",
+                   s.step, s.segment.c_str(), s.samples_used, s.samples_total, s.condition_number,
+                   s.residual_rms);
+    WriteFileAtomic(o->out, ModelToYaml(r.params, header, IdentificationYaml(r, opt)));
+    return 0;
+  };
+}
+
+const CommandRegistration kIdentify(RegisterIdentify);
+
+}  // namespace
+}  // namespace exotwin

@@ -1,0 +1,99 @@
+// `exotwin regress [--suite DIR] [--baselines DIR] [--update] [--out DIR] [--jobs J] [--all]`:
+// the controller-regression gate. Runs every scenario of the suite (one process each, J at a time),
+// compares its deterministic metrics with DIR/baselines/<name>.json, prints what moved, writes
+// OUT/regress.json; exit 1 on a regression, a failed check, a failed run or a missing baseline.
+// --update rewrites the baselines from this run (keeping tolerance overrides) and exits 0 unless a
+// run failed.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "analysis/csv_table.h"
+#include "app/commands.h"
+#include "model/input_error.h"
+#include "scenarios/fork_pool.h"
+#include "scenarios/progress_bar.h"
+#include "scenarios/regress.h"
+
+namespace exotwin {
+namespace {
+
+CommandRunner RegisterRegress(CLI::App& app) {
+  struct Opts {
+    std::string suite = std::string(EXOTWIN_SOURCE_DIR) + "/scenarios", baselines, out = "out/regress";
+    bool update = false, all = false;
+    int jobs = 0;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand("regress", "Controller regression: run the scenario suite, compare with baselines");
+  sub->add_option("--suite", o->suite, "folder of scenario YAML files (recursive; default: the shipped scenarios/)");
+  sub->add_option("--baselines", o->baselines, "folder of baseline JSON files (default: SUITE/baselines)");
+  sub->add_flag("--update", o->update, "rewrite the baselines from this run");
+  sub->add_option("--out", o->out, "output folder (one sub-folder per scenario, regress.json)");
+  sub->add_option("--jobs,-j", o->jobs, "scenarios run in parallel (default: number of cores)");
+  sub->add_flag("--all", o->all, "print every metric, not only those that moved");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    if (o->jobs < 0) throw InputError("--jobs: expected >= 1 (or 0 for the number of cores), got " + std::to_string(o->jobs));
+    const std::vector<SuiteEntry> suite = ListSuite(o->suite);
+    const std::string baselines = o->baselines.empty() ? o->suite + "/baselines" : o->baselines;
+    std::filesystem::create_directories(o->out);
+    auto dir_of = [&](size_t i) { return o->out + "/" + suite[i].scenario.name; };
+
+    ProgressBar bar(suite.size(), "regress");
+    size_t done = 0, failed = 0;
+    const auto outcomes = RunForked(
+        suite.size(), o->jobs > 0 ? o->jobs : DefaultWorkers(),
+        [&](size_t i) {
+          RunOptions opt;
+          opt.out_dir = dir_of(i);
+          return RunScenarioJob(suite[i].scenario, opt);
+        },
+        [&](size_t, const JobOutcome& r) {
+          ++done;
+          failed += r.exit_code != 0;
+          bar.Update(done, failed);
+        });
+    bar.Finish();
+
+    std::vector<ScenarioRegression> results;
+    bool input_error = false, run_failed = false;
+    for (size_t i = 0; i < suite.size(); ++i) {
+      const JobRun run = ReadJobRun(dir_of(i), outcomes[i]);
+      if (run.status == "input_error") {
+        std::fprintf(stderr, "exotwin: error: %s\n", run.error.c_str());
+        input_error = true;
+      }
+      run_failed |= !run.completed();
+      results.push_back(EvaluateRegression(suite[i], run, baselines));
+    }
+    if (input_error) return 2;
+
+    if (o->update) {
+      for (size_t i = 0; i < suite.size(); ++i) {
+        if (!results[i].run.completed()) continue;
+        const std::string path = results[i].baseline_path;
+        std::optional<Baseline> prev;
+        if (std::filesystem::exists(path)) prev = ReadBaseline(path);
+        WriteBaseline(BaselineFromRun(suite[i], results[i].run, prev ? &*prev : nullptr), path);
+        std::printf("%-30s baseline written: %s%s\n", results[i].name.c_str(), path.c_str(),
+                    results[i].failed_checks.empty() ? "" : " (note: a check failed in this run)");
+      }
+      WriteFileAtomic(o->out + "/regress.json", RegressionJson(results));
+      return run_failed ? 1 : 0;
+    }
+
+    std::fputs(FormatRegressionReport(results, o->all).c_str(), stdout);
+    WriteFileAtomic(o->out + "/regress.json", RegressionJson(results));
+    for (const auto& r : results)
+      if (r.failed()) return 1;
+    return 0;
+  };
+}
+
+const CommandRegistration kRegress(RegisterRegress);
+
+}  // namespace
+}  // namespace exotwin

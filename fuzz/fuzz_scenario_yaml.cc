@@ -1,0 +1,15 @@
+// libFuzzer target: the scenario YAML parser (ParseScenarioYaml).
+// Contract: any input either parses or throws InputError.
+#include <cstdint>
+#include <string>
+
+#include "model/input_error.h"
+#include "scenarios/scenario.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  try {
+    exotwin::ParseScenarioYaml(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml");
+  } catch (const exotwin::InputError&) {
+  }
+  return 0;
+}

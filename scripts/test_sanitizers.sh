@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Builds the project with AddressSanitizer + UndefinedBehaviorSanitizer into build-asan and runs the
+# test suite there. Any sanitizer report fails the test that triggered it (UBSan does not recover).
+# Usage: scripts/test_sanitizers.sh [extra ctest args]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+JOBS="${JOBS:-$(nproc)}"
+cmake -S . -B build-asan -DEXOTWIN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build-asan -j"$JOBS"
+
+# halt_on_error: the first report ends the process with a non-zero code, so the test fails.
+# detect_leaks: leaks are bugs too (LeakSanitizer).
+export ASAN_OPTIONS="${ASAN_OPTIONS:-halt_on_error=1:detect_leaks=1:abort_on_error=0:strict_string_checks=1}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
+
+# Tests excluded under the sanitizers, with the reason (keep this list short):
+EXCLUDE=""
+start=$(date +%s)
+ctest --test-dir build-asan --output-on-failure -j"$JOBS" ${EXCLUDE:+-E "$EXCLUDE"} "$@"
+echo "test_sanitizers: suite took $(( $(date +%s) - start )) s under ASan+UBSan"

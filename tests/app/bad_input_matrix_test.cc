@@ -1,0 +1,279 @@
+// The bad-input matrix of issue 8: one test per case of bad input over MJCF models, MODEL.yaml
+// parameter files, measured-data CSV and scenario YAML (truncated files, wrong types, units out of
+// range, NaN and inf, empty files, huge values, duplicated keys/columns, binary junk). Each goes
+// through the command line (`exotwin predict` for MJCF / parameters / CSV, `exotwin run` for
+// scenarios) and must exit 2 with a message naming the place (file, line or field) and what was
+// expected. Complements tests/app/predict_cli_test.cc (whose cases are not repeated here).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::RunExotwin;
+using testing::TempDir;
+using testing::WriteText;
+
+const char kModel[] =
+    "L1: 0.41\n"
+    "exo:   {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
+    "human: {J1: 1.69, J2: 0.37, X1: 4.54, X2: 1.20, Y1: -0.16, Y2: 0.42}\n"
+    "passive: riener1999\n"
+    "effects: []\n";
+const char kExo[] = "exo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n";
+
+// A valid scenario that runs in a blink; cases append or replace lines.
+const char kScenarioHead[] = "name: bad_input\ndevice: exowheel\n";
+const char kScenarioSubject[] = "subject: {preset: S1}\n";
+const char kScenarioProtocol[] = "protocol: {trajectory: hold, duration: 0.05, ramp: 0}\n";
+
+// 200 rows at 1 kHz; data row i is on line i + 2.
+std::string GoodCsv(int n = 200, const std::string& extra_header = "", const std::string& extra = "") {
+  std::ostringstream os;
+  os << "t,q_hip,q_knee,tau_hip,tau_knee" << extra_header << "\n";
+  for (int i = 0; i < n; ++i) {
+    const double t = i * 0.001;
+    os << t << "," << 0.3 + 0.1 * std::sin(2 * t) << "," << -0.7 + 0.2 * std::sin(3 * t) << ",-20,-5" << extra
+       << "\n";
+  }
+  return os.str();
+}
+// GoodCsv with data row `row` (0-based) replaced.
+std::string CsvWithRow(int row, const std::string& line) {
+  std::istringstream in(GoodCsv());
+  std::string out, l;
+  for (int i = -1; std::getline(in, l); ++i) out += (i == row ? line : l) + "\n";
+  return out;
+}
+
+std::string ShippedMjcf() {
+  std::ifstream in(std::string(EXOTWIN_SOURCE_DIR) + "/models/leg_exowheel.xml", std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+std::string MjcfReplace(const std::string& from, const std::string& to) {
+  std::string x = ShippedMjcf();
+  const size_t p = x.find(from);
+  if (p == std::string::npos) return "<!-- pattern not found: " + from + " -->";
+  return x.replace(p, from.size(), to);
+}
+
+std::string Junk(size_t n, bool with_nul, unsigned seed) {
+  std::string s(n, '\0');
+  unsigned x = seed;
+  for (auto& c : s) {
+    x = x * 1103515245u + 12345u;
+    c = static_cast<char>(0x80 | ((x >> 16) & 0x7F));  // high bytes: invalid UTF-8, no NUL
+  }
+  if (with_nul) s[n / 2] = '\0';
+  return s;
+}
+
+enum class Kind { kParams, kCsv, kMjcf, kScenario };
+
+struct Case {
+  std::string name;
+  Kind kind;
+  std::string content;   // the bad file's content (the other inputs are valid)
+  std::string place;     // must appear in the message: file/line/column or field
+  std::string expected;  // must appear in the message: what was expected
+  std::string args = {};  // replaces the bad file's path on the command line when not empty
+};
+
+std::vector<Case> Cases() {
+  const std::string S = std::string(kScenarioHead) + kScenarioSubject + kScenarioProtocol;
+  std::vector<Case> c = {
+      // ---- MJCF (predict --mjcf) ----
+      {"MjcfEmptyFile", Kind::kMjcf, "", "x.xml: cannot load MJCF model", "XML_ERROR_EMPTY_DOCUMENT"},
+      {"MjcfTruncated", Kind::kMjcf, ShippedMjcf().substr(0, 1900), "x.xml: cannot load MJCF model", "XML_ERROR_PARSING"},
+      {"MjcfBinaryJunk", Kind::kMjcf, Junk(512, true, 1), "x.xml: cannot load MJCF model", "XML parse error"},
+      {"MjcfMissingFile", Kind::kMjcf, "", "nonexistent.xml: cannot load MJCF model", "XML_ERROR_FILE_NOT_FOUND", "/nonexistent.xml"},
+      {"MjcfWrongAttributeType", Kind::kMjcf, MjcfReplace("timestep=\"0.001\"", "timestep=\"fast\""),
+       "x.xml: cannot load MJCF model", "problem reading attribute 'timestep'"},
+      {"MjcfNaNDamping", Kind::kMjcf, MjcfReplace("damping=\"0\"", "damping=\"nan\""),
+       "x.xml: MJCF model value dof_damping[0] = nan", "expected a finite number"},
+      {"MjcfInfArmature", Kind::kMjcf, MjcfReplace("damping=\"0\"", "damping=\"0\" armature=\"inf\""),
+       "x.xml: MJCF model value dof_armature[0] = inf", "expected a finite number"},
+      {"MjcfHugeGear", Kind::kMjcf, MjcfReplace("joint=\"hip\" gear=\"1\"", "joint=\"hip\" gear=\"1e300\""),
+       "x.xml: MJCF model value actuator_gear[0] = 1e+300", "of magnitude at most 1e9"},
+      {"MjcfGearNotOne", Kind::kMjcf, MjcfReplace("joint=\"knee\" gear=\"1\"", "joint=\"knee\" gear=\"2\""),
+       "x.xml: actuator 1 ('knee_motor')", "expected a <motor> on joint 'knee' with gear 1"},
+      {"MjcfActuatorsSwapped", Kind::kMjcf,
+       MjcfReplace("name=\"hip_motor\" joint=\"hip\"", "name=\"hip_motor\" joint=\"knee\""),
+       "x.xml: actuator 0 ('hip_motor')", "expected a <motor> on joint 'hip'"},
+      {"MjcfNoActuators", Kind::kMjcf,
+       MjcfReplace("<motor name=\"hip_motor\" joint=\"hip\" gear=\"1\" ctrlrange=\"-150 150\"/>", ""), "x.xml",
+       "expected two torque actuators (hip, knee), found 1"},
+      // ---- MODEL.yaml (predict --params) ----
+      {"ParamsEmptyFile", Kind::kParams, "", "m.yaml: empty model file", "expected L1 and exo:"},
+      {"ParamsTruncated", Kind::kParams, std::string(kModel).substr(0, 40), "m.yaml: line", "malformed YAML"},
+      {"ParamsBinaryJunkWithNul", Kind::kParams, Junk(300, true, 2), "m.yaml: binary data", "expected a YAML text"},
+      {"ParamsBinaryJunk", Kind::kParams, Junk(300, false, 3), "m.yaml", "expected a YAML mapping"},
+      {"ParamsNaN", Kind::kParams, std::string("L1: .nan\n") + kExo, "m.yaml: L1", "expected a finite number"},
+      {"ParamsInf", Kind::kParams, std::string("L1: 0.41\nexo: {J1: .inf, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"),
+       "m.yaml: exo.J1", "expected a finite number"},
+      {"ParamsLengthOutOfRange", Kind::kParams, std::string("L1: 4.1\n") + kExo, "m.yaml: L1",
+       "expected 0.1 .. 1 m"},
+      {"ParamsHugeValue", Kind::kParams,
+       "L1: 0.41\nexo: {J1: 1e300, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n", "m.yaml: exo.J1",
+       "expected 0 .. 50 kg m^2"},
+      {"ParamsOverflowingNumber", Kind::kParams,
+       "L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 1e999, X2: 1.74, Y1: 0.15, Y2: 0.16}\n", "m.yaml: exo.X1",
+       "is not a number"},
+      {"ParamsNegativeGravity", Kind::kParams, std::string("L1: 0.41\ng: -9.81\n") + kExo, "m.yaml: g",
+       "expected 0 .. 20 m/s^2"},
+      {"ParamsDuplicatedKey", Kind::kParams, std::string("L1: 0.41\nL1: 0.45\n") + kExo, "m.yaml: L1",
+       "duplicated key"},
+      {"ParamsBlockWrongType", Kind::kParams, "L1: 0.41\nexo: [3.02, 0.74, 3.85, 1.74, 0.15, 0.16]\n",
+       "m.yaml: exo", "expected a mapping"},
+      {"ParamsNonScalarKey", Kind::kParams, std::string("L1: 0.41\n") + kExo + "? [a, b]\n: 1\n", "m.yaml",
+       "expected plain keys"},
+      {"ParamsUnknownPassive", Kind::kParams, std::string(kModel).replace(std::string(kModel).find("riener1999"), 10, "hill"),
+       "m.yaml: passive", "expected 'none' or 'riener1999'"},
+      {"ParamsEffectsNotAList", Kind::kParams, std::string("L1: 0.41\n") + kExo + "effects: 3\n",
+       "m.yaml: effects", "expected a list"},
+      {"ParamsUnknownEffect", Kind::kParams,
+       std::string("L1: 0.41\n") + kExo + "effects:\n  - {name: warp_drive, joint: knee, value: 1}\n",
+       "m.yaml: effects[0].name", "expected one of"},
+      {"ParamsEffectWrongJoint", Kind::kParams,
+       std::string("L1: 0.41\n") + kExo + "effects:\n  - {name: backlash, joint: ankle, value: 0.01}\n",
+       "m.yaml: effects[0].joint", "expected 'hip' or 'knee'"},
+      {"ParamsEffectOutOfRange", Kind::kParams,
+       std::string("L1: 0.41\n") + kExo + "effects:\n  - {name: backlash, joint: knee, value: 2}\n",
+       "m.yaml: effects[0].value", "expected 0 .. 0.5 rad"},
+      {"ParamsEffectWrongUnit", Kind::kParams,
+       std::string("L1: 0.41\n") + kExo + "effects:\n  - {name: coulomb_friction, joint: knee, value: 1, unit: kg}\n",
+       "m.yaml: effects[0].unit", "expected 'N m'"},
+      {"ParamsEffectMissingField", Kind::kParams,
+       std::string("L1: 0.41\n") + kExo + "effects:\n  - {name: joint_stiffness, joint: knee, value: 5}\n",
+       "m.yaml: effects[0].q0", "missing, required by joint_stiffness"},
+      {"ParamsMissingFile", Kind::kParams, "", "nonexistent.yaml", "cannot open model file", "/nonexistent.yaml"},
+      // ---- measured CSV (predict --measured) ----
+      {"CsvTruncatedHeader", Kind::kCsv, "t,q_hip,q_kn", "d.csv", "missing required column 'q_knee'"},
+      {"CsvTruncatedLastRow", Kind::kCsv, GoodCsv().substr(0, GoodCsv().size() - 12), "d.csv:201",
+       "expected 5 fields"},
+      {"CsvDuplicatedColumn", Kind::kCsv, "t,q_hip,q_knee,q_hip,tau_hip,tau_knee\n0,0,0,0,0,0\n", "d.csv:1",
+       "duplicated column 'q_hip'"},
+      {"CsvBinaryJunkWithNul", Kind::kCsv, Junk(400, true, 4), "d.csv: binary data", "expected a text CSV file"},
+      {"CsvBinaryJunk", Kind::kCsv, Junk(400, false, 5), "d.csv", "missing required column 't'"},
+      {"CsvInfTorque", Kind::kCsv, CsvWithRow(50, "0.05,0.3,-0.7,inf,-5"), "d.csv:52: column 'tau_hip'",
+       "expected a finite number"},
+      {"CsvNegativeInfTime", Kind::kCsv, CsvWithRow(0, "-inf,0.3,-0.7,-20,-5"), "d.csv:2: column 't'",
+       "expected a finite number"},
+      {"CsvOverflowingNumber", Kind::kCsv, CsvWithRow(10, "0.01,1e999,-0.7,-20,-5"), "d.csv:12: column 'q_hip'",
+       "expected a finite number"},
+      {"CsvAngleOutOfRange", Kind::kCsv, CsvWithRow(20, "0.02,0.3,-7.5,-20,-5"), "d.csv:22: column 'q_knee'",
+       "expected |x| <= 6.28"},
+      {"CsvHugeTorque", Kind::kCsv, CsvWithRow(30, "0.03,0.3,-0.7,1e300,-5"), "d.csv:32: column 'tau_hip'",
+       "expected |x| <= 1000"},
+      {"CsvEmgOutOfRange", Kind::kCsv, GoodCsv(200, ",emg_VM", ",250"), "d.csv:2: column 'emg_VM'",
+       "expected |x| <= 100"},
+      {"CsvEmptyField", Kind::kCsv, CsvWithRow(40, "0.04,,-0.7,-20,-5"), "d.csv:42: column 'q_hip'",
+       "is not a number"},
+      {"CsvHeaderOnly", Kind::kCsv, "t,q_hip,q_knee,tau_hip,tau_knee\n", "d.csv", "expected at least 20"},
+      {"CsvOnlyComments", Kind::kCsv, "# nothing measured\n\n# still nothing\n", "d.csv", "no header row"},
+      {"CsvEmptyColumnName", Kind::kCsv, "t,,q_hip,q_knee,tau_hip,tau_knee\n", "d.csv:1", "empty column name"},
+      {"CsvRowEndsWithComma", Kind::kCsv, CsvWithRow(60, "0.06,0.3,-0.7,-20,-5,"), "d.csv:62",
+       "row ends with ','"},
+      {"CsvSampledTooSlowly", Kind::kCsv, "", "d.csv", "expected a sample rate above 40"},
+      {"CsvSamplingGap", Kind::kCsv, "", "d.csv: column 't'", "expected roughly uniform sampling"},
+      {"CsvMissingFile", Kind::kCsv, "", "nonexistent.csv", "cannot open file", "/nonexistent.csv"},
+      // ---- scenario YAML (run) ----
+      {"ScenarioEmptyFile", Kind::kScenario, "", "s.yaml: empty scenario file", ""},
+      {"ScenarioTruncated", Kind::kScenario, S.substr(0, 45), "s.yaml: line", "malformed YAML"},
+      {"ScenarioBinaryJunkWithNul", Kind::kScenario, Junk(300, true, 6), "s.yaml: binary data",
+       "expected a YAML text file"},
+      {"ScenarioBinaryJunk", Kind::kScenario, Junk(300, false, 7), "s.yaml", "expected a YAML mapping"},
+      {"ScenarioWrongType", Kind::kScenario,
+       std::string(kScenarioHead) + kScenarioSubject + "protocol: {trajectory: hold, duration: long}\n",
+       "s.yaml: protocol.duration", "'long' is not a number"},
+      {"ScenarioNaN", Kind::kScenario,
+       std::string(kScenarioHead) + kScenarioSubject + "protocol: {trajectory: hold, duration: .nan}\n",
+       "s.yaml: protocol.duration", "expected 0.01 .. 3600"},
+      {"ScenarioInf", Kind::kScenario, S + "hardware: {can_latency: .inf}\n", "s.yaml: hardware.can_latency",
+       "expected 0 .. 0.1"},
+      {"ScenarioHugeValue", Kind::kScenario, S + "controller: {kp: [1e300, 400]}\n", "s.yaml: controller.kp[0]",
+       "expected 0 .. 100000"},
+      {"ScenarioUnitOutOfRange", Kind::kScenario, S + "hardware: {can_bitrate: 5e7}\n",
+       "s.yaml: hardware.can_bitrate", "expected 10000 .. 1e+06"},
+      {"ScenarioAngleOutOfRange", Kind::kScenario, S + "fixed_joints: {hip: 90}\n", "s.yaml: fixed_joints.hip",
+       "expected -2.5 .. 2.5"},
+      {"ScenarioDuplicatedKey", Kind::kScenario, S + "device: hal3\n", "s.yaml: device", "duplicated key"},
+      {"ScenarioPairWrongType", Kind::kScenario, S + "controller: {kd: 30}\n", "s.yaml: controller.kd",
+       "expected [hip, knee]"},
+      {"ScenarioBoolWrongType", Kind::kScenario, S + "controller: {feedforward: maybe}\n",
+       "s.yaml: controller.feedforward", "is not true/false"},
+      {"ScenarioUnknownFault", Kind::kScenario, S + "faults:\n  - {type: meltdown, at: 0.01}\n",
+       "s.yaml: faults[0].type", "is not one of"},
+      {"ScenarioUnknownPreset", Kind::kScenario, std::string(kScenarioHead) + "subject: {preset: S99}\n" +
+       kScenarioProtocol, "subject: unknown preset 'S99'", "expected one of"},
+      {"ScenarioMissingParamsFile", Kind::kScenario,
+       std::string(kScenarioHead) + "subject: {params: /nonexistent/model.yaml}\n" + kScenarioProtocol,
+       "/nonexistent/model.yaml", "cannot open model file"},
+      {"ScenarioNonScalarKey", Kind::kScenario, S + "? {a: b}\n: c\n", "s.yaml", "expected plain keys"},
+      {"ScenarioMissingFile", Kind::kScenario, "", "nonexistent.yaml", "cannot open scenario file",
+       "/nonexistent.yaml"},
+  };
+  // Cases whose content is easier to build in code.
+  for (auto& k : c) {
+    if (k.name == "CsvSampledTooSlowly") {  // 1 Hz: nothing left below the 20 Hz derivative filter
+      std::ostringstream os;
+      os << "t,q_hip,q_knee,tau_hip,tau_knee\n";
+      for (int i = 0; i < 30; ++i) os << i << ",0.3,-0.7,-20,-5\n";
+      k.content = os.str();
+    } else if (k.name == "CsvSamplingGap") {  // 1 kHz, then one sample a day later
+      k.content = GoodCsv() + "86400,0.3,-0.7,-20,-5\n";
+    }
+  }
+  return c;
+}
+
+class BadInputMatrix : public ::testing::TestWithParam<Case> {};
+
+TEST_P(BadInputMatrix, ExitsTwoNamingPlaceAndExpectation) {
+  const Case& k = GetParam();
+  const std::string dir = TempDir("badinput");
+  std::string bad = dir + (k.kind == Kind::kParams ? "/m.yaml"
+                           : k.kind == Kind::kCsv  ? "/d.csv"
+                           : k.kind == Kind::kMjcf ? "/x.xml"
+                                                   : "/s.yaml");
+  WriteText(bad, k.content);
+  if (!k.args.empty()) bad = dir + k.args;  // a path that does not exist
+  WriteText(dir + "/m_ok.yaml", kModel);
+  WriteText(dir + "/d_ok.csv", GoodCsv());
+  std::string args;
+  switch (k.kind) {
+    case Kind::kParams: args = "predict --params " + bad + " --measured " + dir + "/d_ok.csv"; break;
+    case Kind::kCsv: args = "predict --params " + dir + "/m_ok.yaml --measured " + bad; break;
+    case Kind::kMjcf:
+      args = "predict --params " + dir + "/m_ok.yaml --measured " + dir + "/d_ok.csv --mjcf " + bad;
+      break;
+    case Kind::kScenario: args = "run " + bad; break;
+  }
+  args += k.kind == Kind::kScenario ? " --out " + dir + "/run" : " --out " + dir + "/pred.csv";
+  const auto r = RunExotwin(args);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("exotwin: error: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(k.place), std::string::npos) << "message should name '" << k.place << "': " << r.output;
+  EXPECT_NE(r.output.find(k.expected), std::string::npos)
+      << "message should say what was expected ('" << k.expected << "'): " << r.output;
+  // Never a partial result.
+  EXPECT_FALSE(std::ifstream(dir + "/pred.csv").good());
+  EXPECT_FALSE(std::ifstream(dir + "/run/result.json").good());
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, BadInputMatrix, ::testing::ValuesIn(Cases()),
+                         [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
+
+TEST(BadInputMatrixSize, AtLeastThirtyCases) { EXPECT_GE(Cases().size(), 30u); }
+
+}  // namespace
+}  // namespace exotwin

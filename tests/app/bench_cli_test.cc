@@ -1,0 +1,34 @@
+// `exotwin bench`: JSON with each probe's timing and its ratio against the in-run baseline.
+// Quick sizes, closed loop and sweep only (render, identification and diagnosis have their own benches).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin::testing {
+namespace {
+
+TEST(BenchCli, QuickJsonHasRatios) {
+  const std::string dir = TempDir("bench");
+  const RunResult r = RunExotwin("bench --quick --repeat 1 --only closed_loop,sweep --out " + dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream f(dir + "/b.json");
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["closed_loop"]["status"], "ok");
+  EXPECT_GT(j["closed_loop"]["ratio_closed_loop_to_bare"].get<double>(), 1.0);
+  EXPECT_EQ(j["closed_loop"]["steps"], 2000);
+  EXPECT_GT(j["sweep"]["speedup_2_jobs"].get<double>(), 0.0);
+  EXPECT_FALSE(j.contains("render"));
+}
+
+TEST(BenchCli, UnknownProbeExits2) {
+  const RunResult r = RunExotwin("bench --only warp_drive");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("warp_drive"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace exotwin::testing

@@ -1,0 +1,132 @@
+// `exotwin identify` through the command line (DESIGN.md): exo alone, then the subject with --known,
+// files in any order or a folder; bad input exits 2 naming the file and what was expected.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+
+#include "analysis/identification_data.h"
+#include "analysis/model_file.h"
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::RunExotwin;
+
+LegParams Truth() {
+  LegParams p;
+  p.L1 = 0.41;
+  p.exo = {3.02, 0.74, 3.85, 1.74, 0.15, 0.16};
+  p.human = LumpedParams{1.69, 0.37, 4.54, 1.20, -0.16, 0.42};
+  p.passive = PassiveModel::kRiener1999;
+  return p;
+}
+
+class IdentifyCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(testing::TempDir("identify"));
+    ProtocolOptions o;
+    o.trials = 2;
+    o.trial_s = 15;
+    LegParams exo = Truth();
+    exo.human.reset();
+    exo.passive = PassiveModel::kNone;
+    std::system(("mkdir -p " + *dir_ + "/exo " + *dir_ + "/human").c_str());
+    WriteProtocolCsv(SimulateProtocol(exo, o), *dir_ + "/exo");
+    o.seed = 2;
+    o.emg_rms = 0.05;  // relaxed EMG: eq. (13) runs on the amplifier noise
+    WriteProtocolCsv(SimulateProtocol(Truth(), o), *dir_ + "/human");
+    testing::WriteText(*dir_ + "/human/notes.csv", "a,b\n1,2\n");  // not measured data: skipped
+  }
+  static std::string* dir_;
+  std::string D() const { return *dir_; }
+  void ExpectBadInput(const testing::RunResult& r, const std::string& must_contain) {
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(must_contain), std::string::npos)
+        << "message should contain '" << must_contain << "': " << r.output;
+  }
+};
+std::string* IdentifyCli::dir_ = nullptr;
+
+TEST_F(IdentifyCli, ExoThenHumanWithKnown) {
+  // Hip file first: the order does not matter.
+  const auto r1 = RunExotwin("identify --measured " + D() + "/exo/hip_1.csv --measured " + D() +
+                             "/exo/knee_1.csv --measured " + D() + "/exo/hip_2.csv --measured " + D() +
+                             "/exo/knee_2.csv --L1 0.41 --out " + D() + "/exo.yaml");
+  ASSERT_EQ(r1.exit_code, 0) << r1.output;
+  const LegParams e = ReadModelFile(D() + "/exo.yaml");
+  EXPECT_FALSE(e.human.has_value());
+  EXPECT_NEAR(e.exo.J1, 3.02, 0.02 * 3.02);
+  EXPECT_NEAR(e.exo.X2, 1.74, 0.02 * 1.74);
+  EXPECT_NEAR(e.exo.Y2, 0.16, 0.01);
+
+  const auto r2 = RunExotwin("identify --measured " + D() + "/human --known " + D() + "/exo.yaml --out " +
+                             D() + "/full.yaml");
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  EXPECT_NE(r2.output.find("skipping"), std::string::npos) << r2.output;
+  const LegParams h = ReadModelFile(D() + "/full.yaml");
+  ASSERT_TRUE(h.human.has_value());
+  EXPECT_EQ(h.passive, PassiveModel::kRiener1999);
+  EXPECT_DOUBLE_EQ(h.exo.J1, e.exo.J1);
+  EXPECT_NEAR(h.human->J1, 1.69, 0.02 * 1.69);
+  EXPECT_NEAR(h.human->J2, 0.37, 0.02 * 0.37);
+  EXPECT_NEAR(h.human->X1, 4.54, 0.02 * 4.54);
+  EXPECT_NEAR(h.human->Y1, -0.16, 0.01);
+  EXPECT_NEAR(h.human->Y2, 0.42, 0.01);
+  std::ifstream in(D() + "/full.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* key : {"identification:", "segment: H2", "segment: H1", "std_error:",
+                          "condition_number:", "passive_selection:"})
+    EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
+}
+
+TEST_F(IdentifyCli, FileFittingNeitherConfiguration) {
+  std::string csv = "t,q_hip,q_knee,tau_hip,tau_knee\n";
+  for (int i = 0; i < 500; ++i) {
+    const double t = i * 1e-3;
+    csv += std::to_string(t) + "," + std::to_string(0.5 + 0.3 * std::sin(20 * t)) + "," +
+           std::to_string(-0.8 + 0.4 * std::sin(13 * t)) + ",1,1\n";
+  }
+  testing::WriteText(D() + "/both.csv", csv);
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/both.csv --measured " + D() +
+                            "/exo/hip_1.csv --out " + D() + "/x.yaml"),
+                 "both.csv: fits neither identification configuration: hip ");
+}
+
+TEST_F(IdentifyCli, MissingConfiguration) {
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/exo/knee_1.csv --measured " + D() +
+                            "/exo/knee_2.csv --out " + D() + "/x.yaml"),
+                 "no hip swing (knee held) recording");
+}
+
+TEST_F(IdentifyCli, MissingFile) {
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/nope.csv --measured " + D() +
+                            "/exo/knee_2.csv --out " + D() + "/x.yaml"),
+                 "nope.csv: cannot open file");
+}
+
+TEST_F(IdentifyCli, KnownWithoutExo) {
+  testing::WriteText(D() + "/bad.yaml", "L1: 0.41\n");
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/human --known " + D() + "/bad.yaml --out " +
+                            D() + "/x.yaml"),
+                 "exo");
+}
+
+TEST_F(IdentifyCli, BadPassiveOption) {
+  const auto r = RunExotwin("identify --measured " + D() + "/human --known " + D() +
+                            "/exo.yaml --passive bogus --out " + D() + "/x.yaml");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST_F(IdentifyCli, BadEmgThreshold) {
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/exo --emg-threshold VM=abc --out " + D() +
+                            "/x.yaml"),
+                 "--emg-threshold 'VM=abc'");
+}
+
+}  // namespace
+}  // namespace exotwin

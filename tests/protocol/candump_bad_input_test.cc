@@ -1,0 +1,67 @@
+// Candump logs in the bad-input matrix of issue 8 (no subcommand reads a candump log yet, so the
+// reader is tested directly): each case throws InputError naming file and line and what was
+// expected. Complements tests/protocol/candump_test.cc (malformed-line cases are not repeated here).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "model/input_error.h"
+#include "protocol/candump.h"
+
+namespace exotwin {
+namespace {
+
+std::string WriteLog(const std::string& tag, const std::string& content) {
+  const std::string path = "/tmp/exotwin_candump_bad_" + tag + "_" + std::to_string(getpid()) + ".log";
+  std::ofstream(path, std::ios::binary) << content;
+  return path;
+}
+
+void ExpectBad(const std::string& tag, const std::string& content, const std::string& place_suffix,
+               const std::string& expected) {
+  const std::string path = WriteLog(tag, content);
+  try {
+    CandumpReader::ReadAll(path);
+    ADD_FAILURE() << tag << ": accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(path + place_suffix), std::string::npos) << msg;
+    EXPECT_NE(msg.find(expected), std::string::npos) << msg;
+    EXPECT_NE(msg.find("expected '(sec.usec) can0 ID#DATA'"), std::string::npos) << msg;
+  }
+  std::remove(path.c_str());
+}
+
+const char kGood[] = "(1700000000.000000) can0 101#0102\n(1700000000.001000) can0 102#03\n";
+
+TEST(CandumpBadInput, TruncatedLastLine) {
+  ExpectBad("truncated", std::string(kGood) + "(1700000000.00", ":3:", "missing ')' after the time stamp");
+}
+TEST(CandumpBadInput, BinaryJunkWithNul) {
+  ExpectBad("junk_nul", std::string("\x01\x02\0\xff\xfe junk\n", 11), ":1:", "missing '(' time stamp");
+}
+TEST(CandumpBadInput, BinaryJunkHighBytes) {
+  ExpectBad("junk_high", std::string(kGood) + "(\xc3\x28\xa0\xa1.\xe2\x82) can0 1#\n", ":3:",
+            "time stamp is not sec.usec");
+}
+TEST(CandumpBadInput, HugeTimeStamp) {
+  ExpectBad("huge_stamp", "(99999999999999999999999.000001) can0 123#00\n", ":1:", "time stamp out of range");
+}
+TEST(CandumpBadInput, TooManyDecimals) {
+  ExpectBad("decimals", "(1700000000.0000000001) can0 123#00\n", ":1:", "more than 9 decimals");
+}
+TEST(CandumpBadInput, DataNotHexadecimal) {
+  ExpectBad("data_hex", std::string(kGood) + "(1700000000.002000) can0 103#0Z\n", ":3:", "data is not hexadecimal");
+}
+TEST(CandumpBadInput, EmptyFileIsAnEmptyLog) {
+  const std::string path = WriteLog("empty", "");
+  EXPECT_TRUE(CandumpReader::ReadAll(path).empty());
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace exotwin
