@@ -367,7 +367,7 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
         tau_M = muscles.Torques(plant.q(), plant.qd()).total();
       }
       plant.Step({tau[0], tau[1]}, tau_M);
-      t = plant.time();
+      t = static_cast<double>(k + 1) * dt;  // exact grid (plant.time() accumulates rounding)
       const Eigen::Vector2d q = plant.q();
       hip.Sample(t, q[0], tau[0]);
       knee.Sample(t, q[1], tau[1]);
