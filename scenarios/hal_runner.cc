@@ -315,22 +315,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   m["runs"] = runs;
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  for (const CheckSpec& c : s.checks) {
-    CheckResult r;
-    r.name = c.name;
-    r.metric = c.metric;
-    r.op = c.op;
-    r.limit = c.limit;
-    auto it = m.find(c.metric);
-    if (it == m.end()) {
-      std::string list;
-      for (const auto& kv : m) list += (list.empty() ? "" : ", ") + kv.first;
-      throw InputError(s.source + ": checks: unknown metric '" + c.metric + "', expected one of: " + list);
-    }
-    r.value = it->second;
-    r.passed = c.op == "<=" ? r.value <= c.limit : r.value >= c.limit;
-    result.checks.push_back(r);
-  }
+  result.checks = EvaluateChecks(s, m);
   WriteResultJson(result, opt.out_dir + "/result.json");
   return result;
 }

@@ -475,6 +475,13 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
   m["final_state"] = final_state;
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
+  result.checks = EvaluateChecks(s, m);
+  WriteResultJson(result, opt.out_dir + "/result.json");
+  return result;
+}
+
+std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::string, double>& m) {
+  std::vector<CheckResult> out;
   for (const CheckSpec& c : s.checks) {
     CheckResult r;
     r.name = c.name;
@@ -489,10 +496,9 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     }
     r.value = it->second;
     r.passed = c.op == "<=" ? r.value <= c.limit : r.value >= c.limit;
-    result.checks.push_back(r);
+    out.push_back(r);
   }
-  WriteResultJson(result, opt.out_dir + "/result.json");
-  return result;
+  return out;
 }
 
 void WriteResultJson(const RunResult& r, const std::string& path) {

@@ -49,6 +49,9 @@ LegParams ResolveSubject(const Scenario& s);
 // written so far stay on disk).
 RunResult RunScenario(const Scenario& s, const RunOptions& opt);
 
+// Evaluates the scenario's checks on the metrics. Throws InputError for a metric that does not exist.
+std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::string, double>& metrics);
+
 // Writes result.json (atomically).
 void WriteResultJson(const RunResult& r, const std::string& path);
 
