@@ -13,6 +13,7 @@ PKGS=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   can-utils                           # log2asc for the candump round-trip test
+  clang libclang-rt-14-dev            # libFuzzer targets in fuzz/ (-DEXOTWIN_FUZZ=ON, -fsanitize=fuzzer)
   parallel                            # GNU parallel: the sweep split-and-merge test (tests/cli)
 )
 

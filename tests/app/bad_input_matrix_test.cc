@@ -88,6 +88,9 @@ struct Case {
   std::string args = {};  // replaces the bad file's path on the command line when not empty
 };
 
+// gtest prints a parameter in test names and failures: the case name, not its bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 std::vector<Case> Cases() {
   const std::string S = std::string(kScenarioHead) + kScenarioSubject + kScenarioProtocol;
   std::vector<Case> c = {
