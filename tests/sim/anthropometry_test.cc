@@ -13,30 +13,10 @@
 
 #include "model/input_error.h"
 
+#include "tests/data_rows.h"
+
 namespace exotwin {
 namespace {
-
-// Rows of a data/ CSV (comment lines and the header skipped), split on commas.
-std::vector<std::vector<std::string>> ReadCsv(const std::string& file) {
-  std::ifstream in(std::string(EXOTWIN_SOURCE_DIR) + "/data/" + file);
-  EXPECT_TRUE(in.good()) << file;
-  std::vector<std::vector<std::string>> rows;
-  std::string line;
-  bool header = true;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (header) {
-      header = false;
-      continue;
-    }
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
-}
 
 TEST(Anthropometry, Eq11DeLevaTable1ByHandForS1) {
   // S1: W = 75.2 kg, L1 = 0.41 m, L2 = 0.53 m; Table 1 De Leva: thigh 14.2/45.5/32.9,
@@ -91,8 +71,8 @@ TEST(Anthropometry, Table4RuleDempsterByHandForS1) {
 
 // Mean relative error (computed / printed - 1) of J_H1, J_H2, X_H1, X_H2 over S1..S10.
 std::vector<double> MeanRelErrors(bool table4_rule, AnthropometricModel m, int first_col) {
-  const auto t2 = ReadCsv("hwang2015_table2_subjects.csv");
-  const auto t4 = ReadCsv("hwang2015_table4_human_identified.csv");
+  const auto t2 = ReadDataRows("hwang2015_table2_subjects.csv");
+  const auto t4 = ReadDataRows("hwang2015_table4_human_identified.csv");
   EXPECT_EQ(t2.size(), 10u);
   EXPECT_EQ(t4.size(), 10u);
   std::vector<double> err(4, 0.0);

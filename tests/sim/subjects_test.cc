@@ -16,29 +16,10 @@
 #include "sim/paper_tables.h"
 #include "sim/realizability.h"
 
+#include "tests/data_rows.h"
+
 namespace exotwin {
 namespace {
-
-std::vector<std::vector<std::string>> ReadCsv(const std::string& file) {
-  std::ifstream in(std::string(EXOTWIN_SOURCE_DIR) + "/data/" + file);
-  EXPECT_TRUE(in.good()) << file;
-  std::vector<std::vector<std::string>> rows;
-  std::string line;
-  bool header = true;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (header) {
-      header = false;
-      continue;
-    }
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
-}
 
 double D(const std::string& s) { return std::stod(s); }
 
@@ -53,9 +34,9 @@ void ExpectParams(const LumpedParams& p, const std::vector<std::string>& row, in
 }
 
 TEST(Subjects, PresetsMatchTheCsvTables) {
-  const auto t2 = ReadCsv("hwang2015_table2_subjects.csv");
-  const auto t3 = ReadCsv("hwang2015_table3_exo_identified.csv");
-  const auto t4 = ReadCsv("hwang2015_table4_human_identified.csv");
+  const auto t2 = ReadDataRows("hwang2015_table2_subjects.csv");
+  const auto t3 = ReadDataRows("hwang2015_table3_exo_identified.csv");
+  const auto t4 = ReadDataRows("hwang2015_table4_human_identified.csv");
   ASSERT_EQ(t2.size(), 10u);
   ASSERT_EQ(t3.size(), 10u);
   ASSERT_EQ(t4.size(), 10u);
@@ -82,9 +63,9 @@ TEST(Subjects, PresetsMatchTheCsvTables) {
 }
 
 TEST(Subjects, EmbeddedTablesMatchTheCsvs) {
-  const auto t2 = ReadCsv("hwang2015_table2_subjects.csv");
-  const auto t4 = ReadCsv("hwang2015_table4_human_identified.csv");
-  const auto t5 = ReadCsv("hwang2015_table5_rmse.csv");
+  const auto t2 = ReadDataRows("hwang2015_table2_subjects.csv");
+  const auto t4 = ReadDataRows("hwang2015_table4_human_identified.csv");
+  const auto t5 = ReadDataRows("hwang2015_table5_rmse.csv");
   ASSERT_EQ(t5.size(), 10u);
   for (int i = 0; i < 10; ++i) {
     EXPECT_DOUBLE_EQ(PaperTable2()[i].bmi, D(t2[i][4]));
