@@ -106,6 +106,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   MuscleModel muscles(mp, dt);
   TrackingGains gains = KneeSwingBehaviour::KneeSwingGains();
   gains.inertia[1] = pp.I();  // a rehearsed operator knows its leg + HAL (Hayashi sec. III)
+  gains.feedback_delay = s.hal.operator_delay;
   KneeSwingBehaviour swing(mp, s.hal.swing_freq, s.hal.cc_up, s.hal.cc_down, pp.mgl(), gains);
   SyntheticEmg emg(emg_cfg, seed + 13);
 
@@ -304,6 +305,10 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
     }
     m["sweep_argmin_viscosity"] = values[best];
     m["sweep_min_J_tau_m"] = J[best];
+    // Rise of the mean musculoskeletal moment from the trough to the ends of the swept range, %: a
+    // trough inside the range (Lee & Sankai Fig. 9) has both > 0.
+    m["sweep_rise_low_pct"] = 100 * (J.front() / J[best] - 1);
+    m["sweep_rise_high_pct"] = 100 * (J.back() / J[best] - 1);
     m["sweep_argmin_J_me_viscosity"] = values[ArgMin(Je)];
     m["sweep_paper_optimum"] = 1.56;  // Lee & Sankai sec. 4.2, N m/(rad/s)
     std::vector<double> bv = values;

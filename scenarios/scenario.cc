@@ -102,7 +102,7 @@ const std::set<std::string> kFaultTypes = {"sensor_stuck", "sensor_stale", "enco
 void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (s.device != Device::kHal3) r.Fail("hal", "only allowed with device: hal3");
   r.Keys(n, "hal", {"mode", "alpha_mu", "alpha_zeta", "virtual_viscosity", "sweep_viscosity", "swing_freq",
-                    "cc_up", "cc_down", "settle", "rls_gravity_in_input"});
+                    "cc_up", "cc_down", "settle", "rls_gravity_in_input", "operator_delay"});
   HalSpec& h = s.hal;
   if (n["mode"]) h.mode = r.Str(n["mode"], "hal.mode", {"none", "impedance", "assist"});
   if (n["alpha_mu"]) h.alpha_mu = r.Num(n["alpha_mu"], "hal.alpha_mu", 0, 5);
@@ -119,6 +119,7 @@ void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (n["cc_up"]) h.cc_up = r.Num(n["cc_up"], "hal.cc_up", 0, 1);
   if (n["cc_down"]) h.cc_down = r.Num(n["cc_down"], "hal.cc_down", 0, 1);
   if (n["settle"]) h.settle = r.Num(n["settle"], "hal.settle", 0, 3600);
+  if (n["operator_delay"]) h.operator_delay = r.Num(n["operator_delay"], "hal.operator_delay", 0, 0.3);
   if (n["rls_gravity_in_input"]) h.rls_gravity_in_input = r.Bool(n["rls_gravity_in_input"], "hal.rls_gravity_in_input");
 }
 

@@ -64,6 +64,7 @@ struct HalSpec {
   double cc_up = 0.0, cc_down = 0.05;  // co-contraction drive (fraction of MVC) outside / in swing-down
   double settle = 4.0;              // s at the start excluded from the metrics
   bool rls_gravity_in_input = true; // ViscoelasticRlsConfig::gravity_in_input
+  double operator_delay = 0.0;      // s, neural delay of the operator's feedback (TrackingGains::feedback_delay)
 };
 
 struct CheckSpec {

@@ -237,7 +237,15 @@ VoluntaryTracking::VoluntaryTracking(const MuscleParams& p, IntendedMotion motio
                                      CoContraction cocontraction, FeedForward ff)
     : p_(p), motion_(std::move(motion)), g_(gains), cc_(std::move(cocontraction)), ff_(std::move(ff)) {}
 
-MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q, const Eigen::Vector2d& qd) {
+MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
+                                        const Eigen::Vector2d& qd_now) {
+  Eigen::Vector2d q = q_now, qd = qd_now;
+  if (g_.feedback_delay > 0) {  // the newest sample at least feedback_delay old (the first before)
+    sensed_.push_back({t, q_now, qd_now});
+    while (sensed_.size() > 1 && sensed_[1].t <= t - g_.feedback_delay + 1e-12) sensed_.pop_front();
+    q = sensed_.front().q;
+    qd = sensed_.front().qd;
+  }
   Eigen::Vector2d qs(0, 0), qds(0, 0), qdds(0, 0);
   motion_(t, qs, qds, qdds);
   const Eigen::Vector2d ff = ff_ ? ff_(t, q, qd) : Eigen::Vector2d(0, 0);

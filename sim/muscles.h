@@ -18,6 +18,7 @@
 // (N m) = 100 x the paper's value. That reading is ours; the paper does not state the unit.
 #pragma once
 #include <array>
+#include <deque>
 #include <cstdint>
 #include <vector>
 #include <functional>
@@ -200,6 +201,11 @@ struct TrackingGains {
   Eigen::Vector2d kd{15.0, 4.0};     // N m s/rad
   Eigen::Vector2d inertia{0.0, 0.0}; // kg m^2 feed-forward inertia (0: none)
   Eigen::Vector2d active{1.0, 1.0};  // 1 = joint driven voluntarily, 0 = left relaxed
+  // Neural transmission delay of the feedback (s): the law sees q, qd as they were feedback_delay
+  // ago (proprioceptive long-latency / voluntary corrections: 50-150 ms, e.g. Kandel ch. 35;
+  // 0 = none, the default of the EXOwheel behaviours). The feed-forward (intended motion) is not
+  // delayed. The muscles' own co-contraction viscoelasticity acts without this delay.
+  double feedback_delay = 0.0;
 };
 
 // Voluntary tracking: desired torque tau_d = I_ff qdd* + kp (q* - q) + kd (qd* - qd) + ff(t, q, qd)
@@ -226,6 +232,11 @@ class VoluntaryTracking : public Behaviour {
   CoContraction cc_;
   FeedForward ff_;
   Eigen::Vector2d tau_d_{0, 0};
+  struct Sensed {
+    double t;
+    Eigen::Vector2d q, qd;
+  };
+  std::deque<Sensed> sensed_;  // history over the last feedback_delay s (delayed feedback)
 };
 
 // Exaggerated gait (Hwang & Jeon section 4.3): relaxed until t_active, then the subject tracks the

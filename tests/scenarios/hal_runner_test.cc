@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "analysis/csv_table.h"
 #include "model/input_error.h"
@@ -107,7 +109,7 @@ TEST(HalRunner, RejectsNonHalDevice) {
 }
 
 // Lee & Sankai Fig. 9 / eq. (12): J_tau_m over the virtual viscous coefficient. See the comment in
-// scenarios/hal3_viscous_sweep.yaml for where the twin's minimum falls and why.
+// scenarios/hal3_viscous_sweep.yaml for where the twin's trough falls and why.
 TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
   const RunResult r = RunShipped("hal3_viscous_sweep.yaml", "sweep");
   const Scenario s = ReadScenario(Shipped("hal3_viscous_sweep.yaml"));
@@ -120,16 +122,54 @@ TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
   }
   std::printf("[hal] twin minimum at B_v = %.2f (paper: 1.56)\n", r.metrics.at("sweep_argmin_viscosity"));
   EXPECT_EQ(r.metrics.at("runs"), static_cast<double>(s.hal.sweep_viscosity.size()));
-  // The twin's curve rises monotonically (minimum at the lowest B_v), unlike the paper's trough at
-  // 1.56: its operator does not raise co-contraction when the device's damping drops.
-  double prev = 0;
+  // A trough inside the range: J_tau_m falls down to the minimum and rises after it (the operator's
+  // delayed loop wobbles below it; muscle work against the damper grows above it).
+  const double best = r.metrics.at("sweep_argmin_viscosity");
+  EXPECT_GT(best, s.hal.sweep_viscosity.front());
+  EXPECT_LT(best, s.hal.sweep_viscosity.back());
+  double prev = 1e9;
   for (double v : s.hal.sweep_viscosity) {
     std::snprintf(key, sizeof(key), "J_tau_m@%g", v);
-    EXPECT_GE(r.metrics.at(key), prev - 1e-9) << key;
-    prev = r.metrics.at(key);
+    const double J = r.metrics.at(key);
+    if (v <= best) EXPECT_LE(J, prev + 1e-9) << key << " (falling towards the trough)";
+    else EXPECT_GE(J, prev - 1e-9) << key << " (rising after the trough)";
+    prev = J;
   }
-  EXPECT_EQ(r.metrics.at("sweep_argmin_viscosity"), s.hal.sweep_viscosity.front());
   for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;
+}
+
+// The mechanism: the same sweep with an operator whose feedback has no neural delay has no trough
+// (its minimum is the lowest B_v: less damping, less muscle work), as the twin printed before the
+// delay was modelled.
+TEST(HalRunner, ViscousSweepHasNoTroughWithoutOperatorDelay) {
+  Scenario s = ReadScenario(Shipped("hal3_viscous_sweep.yaml"));
+  s.hal.operator_delay = 0.0;
+  s.checks.clear();
+  RunOptions o;
+  o.out_dir = TempDir("sweep_nodelay");
+  const RunResult r = RunHalScenario(s, o);
+  EXPECT_EQ(r.metrics.at("sweep_argmin_viscosity"), s.hal.sweep_viscosity.front());
+}
+
+// Over 8 operators (muscle ground truth drawn from seeds 1..8) the trough falls at positive B_v
+// with a median within one grid step (0.25-0.31 N m s/rad) of the paper's 1.56 for its 3 operators.
+// Measured: 1.75, 1.25, 1.75, 0.5, 2.25, 1.25, 1.0, 1.0 (median 1.25).
+TEST(HalRunner, ViscousSweepTroughOverOperators) {
+  std::vector<double> argmin;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    Scenario s = ReadScenario(Shipped("hal3_viscous_sweep.yaml"));
+    s.human.muscle_seed = seed;
+    s.checks.clear();
+    RunOptions o;
+    o.out_dir = TempDir("sweep_ops");
+    argmin.push_back(RunHalScenario(s, o).metrics.at("sweep_argmin_viscosity"));
+    std::printf("[hal] operator %d: trough at B_v = %.2f\n", static_cast<int>(seed), argmin.back());
+    EXPECT_GT(argmin.back(), 0.0);
+  }
+  std::sort(argmin.begin(), argmin.end());
+  const double median = 0.5 * (argmin[3] + argmin[4]);
+  EXPECT_GE(median, 1.0);
+  EXPECT_LE(median, 2.0);
 }
 
 }  // namespace

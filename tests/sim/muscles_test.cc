@@ -272,5 +272,33 @@ TEST(Muscles, ExaggeratedGaitAmplifiesThePatternAfterTheRelaxedPhase) {
   EXPECT_GT(amp_hip, 0.3 * 1.15);        // more excursion than the 0.3 rad base pattern
 }
 
+// TrackingGains::feedback_delay: the delayed law at t acts on the state of t - delay, i.e. it equals
+// the undelayed law fed that older state (the intended motion itself is not delayed).
+TEST(Muscles, FeedbackDelayActsOnTheStateOfDelayAgo) {
+  const MuscleParams p = DrawMuscleParams(2);
+  const IntendedMotion motion = [](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+    q = {0.3 * std::sin(t), -0.6 + 0.4 * std::sin(2 * t)};
+    qd = {0.3 * std::cos(t), 0.8 * std::cos(2 * t)};
+    qdd = {-0.3 * std::sin(t), -1.6 * std::sin(2 * t)};
+  };
+  TrackingGains delayed_gains;
+  delayed_gains.feedback_delay = 0.060;
+  VoluntaryTracking now(p, motion, TrackingGains{}), delayed(p, motion, delayed_gains);
+  const double dt = 1e-3;
+  auto state = [](int k, Eigen::Vector2d& q, Eigen::Vector2d& qd) {  // a measured state off the intent
+    const double t = k * 1e-3;
+    q = {0.25 * std::sin(t + 0.2), -0.5 + 0.3 * std::sin(2 * t)};
+    qd = {0.25 * std::cos(t + 0.2), 0.6 * std::cos(2 * t)};
+  };
+  for (int k = 0; k < 300; ++k) {
+    Eigen::Vector2d q, qd, q_old, qd_old;
+    state(k, q, qd);
+    state(std::max(0, k - 60), q_old, qd_old);  // before 60 ms of history: the first sample
+    const MuscleVec u = delayed.Excitation(k * dt, q, qd);
+    const MuscleVec ref = now.Excitation(k * dt, q_old, qd_old);
+    ASSERT_LT((u - ref).cwiseAbs().maxCoeff(), 1e-12) << "step " << k;
+  }
+}
+
 }  // namespace
 }  // namespace exotwin
