@@ -320,8 +320,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   m["runs"] = runs;
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  result.checks = EvaluateChecks(s, m);
-  WriteResultJson(result, opt.out_dir + "/result.json");
+  FinishRun(s, result, opt.out_dir + "/result.json");
   return result;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include <unistd.h>
@@ -475,12 +476,15 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
   m["final_state"] = final_state;
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  result.checks = EvaluateChecks(s, m);
-  WriteResultJson(result, opt.out_dir + "/result.json");
+  FinishRun(s, result, opt.out_dir + "/result.json");
   return result;
 }
 
-std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::string, double>& m) {
+namespace {
+
+// The checks on `m`; a check whose metric is missing is failed with value NaN and named in *unknown.
+std::vector<CheckResult> Checks(const Scenario& s, const std::map<std::string, double>& m,
+                                std::string* unknown) {
   std::vector<CheckResult> out;
   for (const CheckSpec& c : s.checks) {
     CheckResult r;
@@ -490,15 +494,36 @@ std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::s
     r.limit = c.limit;
     auto it = m.find(c.metric);
     if (it == m.end()) {
-      std::string list;
-      for (const auto& kv : m) list += (list.empty() ? "" : ", ") + kv.first;
-      throw InputError(s.source + ": checks: unknown metric '" + c.metric + "', expected one of: " + list);
+      if (unknown->empty()) {
+        std::string list;
+        for (const auto& kv : m) list += (list.empty() ? "" : ", ") + kv.first;
+        *unknown = s.source + ": checks: unknown metric '" + c.metric + "', expected one of: " + list;
+      }
+      r.value = std::numeric_limits<double>::quiet_NaN();
+      r.passed = false;
+    } else {
+      r.value = it->second;
+      r.passed = c.op == "<=" ? r.value <= c.limit : r.value >= c.limit;
     }
-    r.value = it->second;
-    r.passed = c.op == "<=" ? r.value <= c.limit : r.value >= c.limit;
     out.push_back(r);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::string, double>& m) {
+  std::string unknown;
+  std::vector<CheckResult> out = Checks(s, m, &unknown);
+  if (!unknown.empty()) throw InputError(unknown);
+  return out;
+}
+
+void FinishRun(const Scenario& s, RunResult& result, const std::string& path) {
+  std::string unknown;
+  result.checks = Checks(s, result.metrics, &unknown);
+  WriteResultJson(result, path);
+  if (!unknown.empty()) throw InputError(unknown + " (the run's metrics are in " + path + ")");
 }
 
 void WriteResultJson(const RunResult& r, const std::string& path) {

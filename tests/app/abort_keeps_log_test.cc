@@ -1,14 +1,18 @@
 // Nothing lost: a run killed in the middle (SIGKILL) leaves a measured.csv that reads back as a valid
 // measured-data CSV (whole lines only) with the rows written so far, and no result.json (written
-// atomically at the end).
+// atomically at the end). A check naming a metric the run does not produce exits 2 only after
+// result.json holds the run's metrics.
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <fstream>
 #include <filesystem>
 #include <thread>
 
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include "analysis/measured_data.h"
 #include "tests/app/cli_test_util.h"
@@ -43,6 +47,23 @@ TEST(AbortKeepsLog, KilledRunLeavesReadableLog) {
   EXPECT_GT(d.size(), 1000u);
   EXPECT_LT(d.size(), 60000u);
   EXPECT_FALSE(std::filesystem::exists(dir + "/result.json"));
+}
+
+TEST(AbortKeepsLog, UnknownCheckMetricKeepsTheMetrics) {
+  const std::string dir = testing::TempDir("unknown_metric");
+  const std::string yaml = dir + "/s.yaml";
+  std::ofstream(yaml) << "name: short\nseed: 1\ndevice: exowheel\nsubject: {preset: S1}\n"
+                         "protocol: {trajectory: gait, stride_period: 2.0, duration: 1.0, ramp: 0.5}\n"
+                         "checks:\n  - {name: typo, metric: tracking_rms_hip_dge, max: 1}\n";
+  const testing::RunResult r = testing::RunExotwin("run " + yaml + " --out " + dir + "/out");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("tracking_rms_hip_dge"), std::string::npos) << r.output;
+  std::ifstream in(dir + "/out/result.json");
+  ASSERT_TRUE(in.good()) << "result.json must be written before the exit code 2";
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_GT(j.at("metrics").at("tracking_rms_hip_deg").get<double>(), 0.0);
+  EXPECT_FALSE(j.at("checks").at(0).at("passed").get<bool>());
+  EXPECT_TRUE(j.at("checks").at(0).at("value").is_null());
 }
 
 }  // namespace
