@@ -29,8 +29,14 @@ LinearFit FitEmgToTorque(const std::vector<double>& E, const std::vector<double>
   return f;
 }
 
+double NoiseCorrectedEnvelope(double E, double E0) {
+  if (!(E0 > 0)) return E;
+  return std::sqrt(std::max(E * E - E0 * E0, 0.0));
+}
+
 double EstimateMuscleTorque(const HalEmgCoefficients& c, double E_e, double E_f) {
-  return (c.extensor.a * E_e + c.extensor.b) - (c.flexor.a * E_f + c.flexor.b);  // eq. (2)
+  const double Ee = NoiseCorrectedEnvelope(E_e, c.baseline_e), Ef = NoiseCorrectedEnvelope(E_f, c.baseline_f);
+  return (c.extensor.a * Ee + c.extensor.b) - (c.flexor.a * Ef + c.flexor.b);  // eq. (2)
 }
 
 OneLinkPassive IdentifyOneLinkPassive(const std::vector<double>& th, const std::vector<double>& tau,

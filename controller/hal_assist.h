@@ -27,8 +27,21 @@ LinearFit FitEmgToTorque(const std::vector<double>& E, const std::vector<double>
 
 struct HalEmgCoefficients {
   LinearFit extensor, flexor;  // a in N m/V, b in N m
+  // Relaxed RMS envelope of each channel (V), measured at rest during the calibration; 0 = the
+  // paper's eq. (2) on the raw envelope. See NoiseCorrectedEnvelope.
+  double baseline_e = 0, baseline_f = 0;
 };
-// Eq. (2): mu^ = (a_e E_e + b_e) - (a_f E_f + b_f), N m (positive = extension).
+// Noise-corrected envelope sqrt(max(E^2 - E0^2, 0)) (V) of an RMS envelope E (V, eq. 1) with relaxed
+// level E0 (V). Our addition (Hayashi is silent): the relaxed noise (0.1 V / 0.04 V, Hayashi sec. IV)
+// is independent of the muscle signal, so their powers add, E^2 = (A e)^2 + E0^2, and E itself is
+// a hyperbola in the activation e, flat near rest. The seated swing lives at 0-5 % MVC, where A e is
+// comparable with E0, so a straight line (eq. 2) in E cannot fit the calibration and the swing at
+// once (seed 1: slope 1.25x too steep at swing level, under-estimate near rest). Subtracting the
+// noise power (noise-corrected RMS, as Clancy & Hogan's EMG amplitude estimators) makes the envelope
+// proportional to e, i.e. to the contraction torque, which is what eq. (2) assumes.
+double NoiseCorrectedEnvelope(double E, double E0);
+// Eq. (2): mu^ = (a_e E_e' + b_e) - (a_f E_f' + b_f), N m (positive = extension), with E' the
+// noise-corrected envelopes (E' = E when the baselines are 0, the paper's form).
 double EstimateMuscleTorque(const HalEmgCoefficients& c, double E_e, double E_f);
 
 // Passive one-link parameters of eq. (14)/(15): I thdd + B thd + Mgl sin th = tau.

@@ -2,6 +2,7 @@
 #include "scenarios/hal_emg_calibration.h"
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "controller/emg_processing.h"
@@ -18,7 +19,8 @@ HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConf
   const double a_ext = std::max(p.alpha(ext[0], 1), p.alpha(ext[1], 1));
   const double a_flx = std::max(p.alpha(flx[0], 1), p.alpha(flx[1], 1));
   std::vector<ContractionBlock> blocks;
-  double t0 = 1.0;
+  const double t_rest0 = 0.5, t_rest1 = t_rest0 + spec.rest;  // relaxed: baseline E0
+  double t0 = t_rest1;
   for (int k = 0; k < spec.levels; ++k) {
     const double level = spec.lo + (spec.hi - spec.lo) * k / std::max(1, spec.levels - 1);
     for (int dir = 0; dir < 2; ++dir) {
@@ -41,6 +43,8 @@ HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConf
   RmsEnvelope rms_e(1000.0, spec.rms_window), rms_f(1000.0, spec.rms_window);
   const Eigen::Vector2d q(1.5707963267948966, -1.5707963267948966), qd(0, 0);  // th_HAL = 0
   std::vector<double> Ee, te, Ef, tf;
+  double pe = 0, pf = 0;  // summed envelope power at rest, V^2
+  long n_rest = 0;
   const long n = static_cast<long>(prog.duration() / 1e-3) + 1000;
   for (long k = 0; k < n; ++k) {
     const double t = k * 1e-3;
@@ -51,13 +55,20 @@ HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConf
     const auto out = amp.Sample(v);
     const double E_e = rms_e.Step(out[spec.extensor_channel]);
     const double E_f = rms_f.Step(out[spec.flexor_channel]);
-    if (t < 0.5) continue;  // filter start-up
+    if (t < t_rest0) continue;  // filter start-up
+    if (t < t_rest1) pe += E_e * E_e, pf += E_f * E_f, ++n_rest;
     const double tau = ContractionTorque(p, muscles.mechanical_activation(), q, qd)[1];  // HAL reads it
     // Each group's line is fitted on its own contractions and the rests (torque 0 there).
     if (tau >= 0) Ee.push_back(E_e), te.push_back(tau);
     if (tau <= 0) Ef.push_back(E_f), tf.push_back(-tau);
   }
   HalEmgCoefficients c;
+  if (spec.noise_correction && n_rest > 0) {
+    c.baseline_e = std::sqrt(pe / n_rest);
+    c.baseline_f = std::sqrt(pf / n_rest);
+    for (double& E : Ee) E = NoiseCorrectedEnvelope(E, c.baseline_e);
+    for (double& E : Ef) E = NoiseCorrectedEnvelope(E, c.baseline_f);
+  }
   c.extensor = FitEmgToTorque(Ee, te);
   c.flexor = FitEmgToTorque(Ef, tf);
   return c;

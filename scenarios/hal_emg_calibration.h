@@ -19,10 +19,16 @@ struct HalEmgCalibrationSpec {
   double rms_window = 0.1;   // s, eq. (1)
   int levels = 4;            // contraction levels per direction, evenly from lo to hi
   double lo = 0.02, hi = 0.12;  // fraction of MVC: the range of a seated swing (our choice)
+  // Relaxed rest at the start (s, after 0.5 s of filter start-up): the mean envelope power there
+  // gives each channel's baseline E0, and eq. (2) is fitted on the noise-corrected envelopes
+  // (NoiseCorrectedEnvelope in controller/hal_assist.h). false: the paper's fit on raw E.
+  double rest = 1.5;
+  bool noise_correction = true;
 };
 
 // Runs the calibration exercise with the subject's muscles `p` and EMG `emg` (seeded by `seed`);
-// returns the eq. (2) coefficients (a in N m/V, b in N m). Deterministic for a seed.
+// returns the eq. (2) coefficients (a in N m/V, b in N m) and the relaxed baselines (V).
+// Deterministic for a seed.
 HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConfig& emg,
                                    const HalEmgCalibrationSpec& spec, uint64_t seed);
 
