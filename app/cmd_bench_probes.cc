@@ -97,6 +97,14 @@ json BenchClosedLoop(const BenchConfig& c) {
   RunOptions o;
   o.out_dir = c.scratch + "/closed_loop";
   const double closed = BestOf(c.repeat, [&] { RunScenario(s, o); });
+  // The human's share (issue 6): the same run without the EMG electrodes (muscles still stepped), and
+  // with the muscles driven voluntarily (exaggerated gait: tracking law + allocation every step).
+  Scenario no_emg = s, voluntary = s;
+  no_emg.human.emg = false;
+  voluntary.human.behaviour = "exaggerated_gait";
+  voluntary.human.active_from = 0.0;
+  const double closed_no_emg = BestOf(c.repeat, [&] { RunScenario(no_emg, o); });
+  const double closed_voluntary = BestOf(c.repeat, [&] { RunScenario(voluntary, o); });
   return json{{"status", "ok"},
               {"steps", n},
               {"bare_mj_step_s", bare},
@@ -104,7 +112,12 @@ json BenchClosedLoop(const BenchConfig& c) {
               {"bare_steps_per_s", n / bare},
               {"closed_loop_steps_per_s", n / closed},
               {"closed_loop_x_realtime", duration / closed},
-              {"ratio_closed_loop_to_bare", closed / bare}};
+              {"ratio_closed_loop_to_bare", closed / bare},
+              {"closed_loop_no_emg_s", closed_no_emg},
+              {"closed_loop_voluntary_human_s", closed_voluntary},
+              {"emg_cost_us_per_step", 1e6 * (closed - closed_no_emg) / n},
+              {"voluntary_human_cost_us_per_step", 1e6 * (closed_voluntary - closed) / n},
+              {"ratio_voluntary_human_to_bare", closed_voluntary / bare}};
 }
 
 json BenchRender(const BenchConfig& c) {

@@ -20,6 +20,8 @@ TEST(BenchCli, QuickJsonHasRatios) {
   EXPECT_EQ(j["closed_loop"]["status"], "ok");
   EXPECT_GT(j["closed_loop"]["ratio_closed_loop_to_bare"].get<double>(), 1.0);
   EXPECT_EQ(j["closed_loop"]["steps"], 2000);
+  EXPECT_GT(j["closed_loop"]["ratio_voluntary_human_to_bare"].get<double>(), 1.0);
+  EXPECT_TRUE(j["closed_loop"]["emg_cost_us_per_step"].is_number());
   EXPECT_GT(j["sweep"]["speedup_2_jobs"].get<double>(), 0.0);
   EXPECT_FALSE(j.contains("render"));
 }
