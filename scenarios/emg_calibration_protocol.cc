@@ -125,9 +125,10 @@ RunResult RunEmgCalibrationScenario(const Scenario& s, const RunOptions& opt) {
   if (!subject) throw InputError(s.source + ": subject: emg_calibration needs preset or random_seed");
   const MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
   auto& m = result.metrics;
-  double safe = 0, torque_max[2] = {0, 0};
+  double safe = 0, torque_max[2] = {0, 0}, samples = 0;
   auto absorb = [&](const RunResult& r, const std::string& tag) {
     safe = std::max(safe, r.metrics.at("safe_state_entered"));
+    samples += r.metrics.at("samples");
     for (int j = 0; j < 2; ++j)
       torque_max[j] = std::max(torque_max[j], r.metrics.at(std::string("torque_max_") + kJoint[j]));
     for (const std::string& f : r.files) result.files.push_back(tag + "/" + f);
@@ -286,6 +287,7 @@ RunResult RunEmgCalibrationScenario(const Scenario& s, const RunOptions& opt) {
     }
   }
   m["safe_state_entered"] = safe;
+  m["samples"] = samples;  // logged by the runner trials (the MVC records are not counted)
   m["torque_max_hip"] = torque_max[0];
   m["torque_max_knee"] = torque_max[1];
 
