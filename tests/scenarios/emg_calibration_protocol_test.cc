@@ -24,7 +24,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Scenario Shipped(const std::string& file) { return ReadScenario(ShippedScenarioDir() + "/" + file); }
+// Runs a shipped scenario into a fresh folder (out_dir) and expects every check to pass.
+RunResult RunShipped(const std::string& file, Scenario* s, std::string* out_dir) {
+  *s = ReadScenario(ShippedScenarioDir() + "/" + file);
+  RunOptions ro;
+  ro.out_dir = *out_dir = testing::TempDir("emgcal");
+  const RunResult r = RunScenario(*s, ro);
+  for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << file << ": " << c.name << " = " << c.value;
+  return r;
+}
 
 const char kHead[] =
     "name: cal\ndevice: exowheel\nsubject: {preset: S1}\nemg_calibration: {dynamic: false}\n";
@@ -78,20 +86,18 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
 // ground truth scaled by the MVC's peak / plateau ratio of the RECORDED envelopes (the paper's MVC is
 // a peak, so alpha is the torque at that peak).
 TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
-  const Scenario s = Shipped("exowheel_emg_isometric.yaml");
-  RunOptions ro;
-  ro.out_dir = testing::TempDir("emgcal_iso");
-  const RunResult r = RunScenario(s, ro);
-  for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;
+  Scenario s;
+  std::string out;
+  const RunResult r = RunShipped("exowheel_emg_isometric.yaml", &s, &out);
   for (const char* f : {"mvc/mvc_VM.csv", "isometric_hip/measured.csv", "isometric_knee/measured.csv",
                         "calibration.csv", "calibration.json", "result.json"})
-    EXPECT_TRUE(fs::exists(ro.out_dir + "/" + f)) << f;
-  EXPECT_FALSE(fs::exists(ro.out_dir + "/gait"));
+    EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+  EXPECT_FALSE(fs::exists(out + "/gait"));
   const MuscleParams truth = DrawMuscleParams(s.human.muscle_seed);
   Eigen::Matrix<double, kNumMuscles, 2> expected;
   for (int c = 0; c < kNumMuscles; ++c) {
     const Muscle mu = MuscleAt(c);
-    const CsvTable t = ReadCsv(ro.out_dir + "/mvc/mvc_" + MuscleName(mu) + ".csv");
+    const CsvTable t = ReadCsv(out + "/mvc/mvc_" + MuscleName(mu) + ".csv");
     const std::vector<double> env = OfflineLinearEnvelope(t.columns[t.Find(std::string("emg_") + MuscleName(mu))]);
     double plateau = 0;
     size_t n = 0;
@@ -127,7 +133,7 @@ TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
       }
   // calibration.json carries the same numbers as the metrics.
   nlohmann::json js;
-  std::ifstream(ro.out_dir + "/calibration.json") >> js;
+  std::ifstream(out + "/calibration.json") >> js;
   EXPECT_DOUBLE_EQ(js["isometric"]["knee"]["extension"]["r2"].get<double>(), r.metrics.at("iso_r2_knee_extension"));
   EXPECT_DOUBLE_EQ(js["isometric"]["hip"]["alpha_Nm"]["RF"].get<double>(), r.metrics.at("alpha_RF_hip"));
 }
@@ -136,14 +142,12 @@ TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
 // plant's true muscular torque (truth.csv) to well under the sensor/derivative error, the De Leva and
 // Dempster sets move it by several N m (Table 5's size), and the shipped checks pass.
 TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
-  const Scenario s = Shipped("exowheel_emg_dynamic.yaml");
-  RunOptions ro;
-  ro.out_dir = testing::TempDir("emgcal_dyn");
-  const RunResult r = RunScenario(s, ro);
-  for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;
-  const MeasuredData d = ReadMeasuredCsv(ro.out_dir + "/gait/measured.csv");
+  Scenario s;
+  std::string out;
+  const RunResult r = RunShipped("exowheel_emg_dynamic.yaml", &s, &out);
+  const MeasuredData d = ReadMeasuredCsv(out + "/gait/measured.csv");
   const Kinematics kin = DeriveKinematics(d);
-  const CsvTable tr = ReadCsv(ro.out_dir + "/gait/truth.csv");
+  const CsvTable tr = ReadCsv(out + "/gait/truth.csv");
   const std::vector<double>* truth_tau[2] = {&tr.columns[tr.Find("tau_M_hip")], &tr.columns[tr.Find("tau_M_knee")]};
   LegParams id = ResolveSubject(s);
   id.passive = PassiveModel::kRiener1999;
@@ -171,8 +175,8 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
     EXPECT_GT(r.metrics.at(k), 2.0) << k;
     EXPECT_LT(r.metrics.at(k), 8.0) << k;
   }
-  EXPECT_TRUE(fs::exists(ro.out_dir + "/calibration.csv"));
-  const CsvTable cal = ReadCsv(ro.out_dir + "/calibration.csv");
+  EXPECT_TRUE(fs::exists(out + "/calibration.csv"));
+  const CsvTable cal = ReadCsv(out + "/calibration.csv");
   EXPECT_EQ(cal.rows(), 2u + 6u);  // 2 isometric rows, 3 models x 2 joints
 }
 
