@@ -2,7 +2,11 @@
 // synthetic EMG (sim/synthetic_emg.h) -> amplifier (gain 1000; the band-pass is in the envelope
 // chain) -> linear envelope / MVC -> eq. (25) alpha and eq. (28) beta, gamma. Compared with the
 // ground truth and with Tables 6-7 (isometric R^2 0.951-0.976, NRMS 5.03-8.12 %; dynamic R^2 0.935
-// hip / 0.924 knee with identified parameters, 0.88 / 0.87 with De Leva).
+// hip / 0.924 knee with identified parameters, 0.884 / 0.877 with De Leva, 0.879 / 0.872 Dempster).
+// In-process (no plant: the exoskeleton imposes a sinusoidal gait, the sensor is truth + noise); the
+// De Leva / Dempster rows use sim/anthropometry. Table7ErrorBudget switches off one error source at a
+// time and prints the R^2 of the three parameter sets (the same pipeline runs on the full twin in
+// scenarios/exowheel_emg_dynamic.yaml).
 #include "analysis/emg_calibration.h"
 
 #include <cmath>
