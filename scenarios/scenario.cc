@@ -307,6 +307,10 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
       r.Fail("subject", "emg_calibration needs subject.preset or subject.random_seed (the anthropometric "
                         "models of Table 7 take the subject's weight and segment lengths)");
     if (!s.human.emg) r.Fail("human.emg", "emg_calibration needs the EMG amplifier (human.emg: true)");
+    if (root["protocol"])
+      r.Fail("protocol", "not used with emg_calibration (it sets the trials itself: MVC, isometric, gait)");
+    if (root["fixed_joints"])
+      r.Fail("fixed_joints", "not used with emg_calibration, expected emg_calibration.hip_pose / knee_pose");
     if (s.human.behaviour != "relaxed")
       r.Fail("human.behaviour", "emg_calibration sets the behaviour of each trial itself; leave it out");
   }

@@ -71,6 +71,8 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
   ExpectInputError("name: c\ndevice: exowheel\nsubject: {params: m.yaml}\nemg_calibration: {}\n", "subject");
   ExpectInputError(std::string(kHead) + "human: {behaviour: exaggerated_gait}\n", "human.behaviour");
   ExpectInputError(std::string(kHead) + "human: {emg: false}\n", "human.emg");
+  ExpectInputError(std::string(kHead) + "protocol: {duration: 5}\n", "protocol");
+  ExpectInputError(std::string(kHead) + "fixed_joints: {hip: 0.3}\n", "fixed_joints");
   ExpectInputError(std::string(kHead) + "human: {levels: [0.5, 0.2]}\n", "human.levels");
   ExpectInputError(std::string(kHead) + "human: {levels: [0.1, 1.5]}\n", "human.levels[1]");
   ExpectInputError(std::string(kHead) + "human: {levels: 0.3}\n", "human.levels");
