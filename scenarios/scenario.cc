@@ -311,6 +311,8 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
       r.Fail("protocol", "not used with emg_calibration (it sets the trials itself: MVC, isometric, gait)");
     if (root["fixed_joints"])
       r.Fail("fixed_joints", "not used with emg_calibration, expected emg_calibration.hip_pose / knee_pose");
+    if (s.human.contractions < 2)
+      r.Fail("human.contractions", "emg_calibration needs at least 2 (flexion and extension per joint)");
     if (s.human.behaviour != "relaxed")
       r.Fail("human.behaviour", "emg_calibration sets the behaviour of each trial itself; leave it out");
   }

@@ -72,6 +72,7 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
   ExpectInputError(std::string(kHead) + "human: {behaviour: exaggerated_gait}\n", "human.behaviour");
   ExpectInputError(std::string(kHead) + "human: {emg: false}\n", "human.emg");
   ExpectInputError(std::string(kHead) + "protocol: {duration: 5}\n", "protocol");
+  ExpectInputError(std::string(kHead) + "human: {contractions: 1}\n", "human.contractions");
   ExpectInputError(std::string(kHead) + "fixed_joints: {hip: 0.3}\n", "fixed_joints");
   ExpectInputError(std::string(kHead) + "human: {levels: [0.5, 0.2]}\n", "human.levels");
   ExpectInputError(std::string(kHead) + "human: {levels: [0.1, 1.5]}\n", "human.levels[1]");
