@@ -25,11 +25,23 @@ FitQuality Quality(const std::vector<double>& measured, const std::vector<double
 
 // Off-line EMG chain of the paper for one channel of AMPLIFIED EMG (V): zero-phase 4th-order
 // band-pass 20-450 Hz, full-wave rectification, zero-phase 4th-order 2 Hz low-pass (section 4.3).
-std::vector<double> OfflineLinearEnvelope(const std::vector<double>& amplified, double fs = 1000.0);
+// fs: sample rate (Hz); lowpass_hz: envelope cut-off (Hz; the paper's 2 Hz unless studying it).
+std::vector<double> OfflineLinearEnvelope(const std::vector<double>& amplified, double fs = 1000.0,
+                                          double lowpass_hz = 2.0);
 
 // MVC value: the mean of the maxima of `env` inside each [start, end) sample window (one window per
 // MVC trial; the paper averages the three highest peaks of three trials). Windows non-empty.
 double MvcOfTrials(const std::vector<double>& env, const std::vector<std::pair<size_t, size_t>>& trials);
+
+// Resting level of a linear envelope (V): its mean over the relaxed samples [a, b) (a < b <= size).
+double RestLevel(const std::vector<double>& env, size_t a, size_t b);
+
+// Normalized linear envelope LE (fraction of MVC) of each channel at sample k:
+//   LE = (env - rest) / (mvc - rest)   (env: one envelope per channel in Muscle order, V)
+// rest = 0 gives the paper's plain env / MVC. A relaxed electrode/amplifier floor left in LE reads as a
+// constant phantom torque alpha x rest / MVC in eq. (23)-(27) (see tests/analysis/emg_calibration_test.cc).
+MuscleVec NormalizedEnvelope(const std::vector<std::vector<double>>& env, size_t k, const MuscleVec& rest,
+                             const MuscleVec& mvc);
 
 // Isometric torque of eq. (23) (joint 0) or (24) (joint 1): sum_m sign(m, j) alpha_m LE_m (N m).
 double IsometricTorque(int joint, const MuscleVec& alpha, const MuscleVec& le);

@@ -1,5 +1,6 @@
 #include "scenarios/runner.h"
 
+#include "scenarios/emg_calibration_protocol.h"
 #include "scenarios/hal_runner.h"
 
 #include <nlohmann/json.hpp>
@@ -35,6 +36,17 @@ namespace exotwin {
 
 bool RunResult::all_passed() const {
   return std::all_of(checks.begin(), checks.end(), [](const CheckResult& c) { return c.passed; });
+}
+
+std::optional<Subject> ScenarioSubject(const Scenario& s) {
+  if (!s.subject.preset.empty()) return PresetSubject(s.subject.preset);
+  if (s.subject.random_seed) return DrawSubject(*s.subject.random_seed, 0);
+  return std::nullopt;
+}
+
+ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed) {
+  return IsometricProgramme(h.behaviour == "isometric_hip" ? 0 : 1, h.contractions, h.levels[0], h.levels[1],
+                            h.cocontraction, h.programme_seed ? *h.programme_seed : run_seed);
 }
 
 LegParams ResolveSubject(const Scenario& s) {
@@ -122,14 +134,9 @@ LegParams ControllerModel(const Scenario& s, const LegParams& truth) {
   m.exo = truth.exo;
   if (truth.human) {
     double weight = 68.0, L2 = 0.53;
-    if (!s.subject.preset.empty()) {
-      const Subject sub = PresetSubject(s.subject.preset);
-      weight = sub.weight;
-      L2 = sub.L2;
-    } else if (s.subject.random_seed) {
-      const Subject sub = DrawSubject(*s.subject.random_seed, 0);
-      weight = sub.weight;
-      L2 = sub.L2;
+    if (const std::optional<Subject> sub = ScenarioSubject(s)) {
+      weight = sub->weight;
+      L2 = sub->L2;
     }
     m.human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, weight, truth.L1, L2);
     m.passive = PassiveModel::kRiener1999;
@@ -154,14 +161,16 @@ controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegPar
   return c;
 }
 
+// Mean posture of the gait pattern (Winter, fitted): about 5 deg hip, -25 deg knee (rad).
+const Eigen::Vector2d kGaitMeanPosture(0.09, -0.45);
+
 // The subject's behaviour for the trial (relaxed unless the scenario's human block says otherwise).
 std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams& mp,
                                           const std::shared_ptr<const LegTrajectory>& trajectory,
                                           uint64_t seed) {
   const HumanSpec& h = s.human;
   if (h.behaviour == "isometric_hip" || h.behaviour == "isometric_knee")
-    return std::make_unique<ContractionProgramme>(
-        IsometricProgramme(h.behaviour == "isometric_hip" ? 0 : 1, h.contractions, 0.2, 0.8, 0.1, seed));
+    return std::make_unique<ContractionProgramme>(IsometricProgrammeOf(h, seed));
   if (h.behaviour == "exaggerated_gait") {
     IntendedMotion base = [trajectory](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
       controller::JointSetpoint a, b;
@@ -170,10 +179,29 @@ std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams&
       qd = {a.qd, b.qd};
       qdd = {a.qdd, b.qdd};
     };
-    // Mean posture of the gait pattern (Winter, fitted): about 5 deg hip, -25 deg knee.
-    return std::make_unique<ExaggeratedGait>(mp, base, Eigen::Vector2d(0.09, -0.45), h.gain, h.active_from);
+    // The exoskeleton imposes the motion (PD 600/400 N m/rad), so the subject's damping term of the
+    // tracking law (TrackingGains::kd, sized to stabilise the FREE limb with 55 ms of loop delay) has
+    // nothing to stabilise; kept, it adds kd (gain - 1) qd of the pattern: a drive in phase with the
+    // velocity that bursts at the knee's 1-3 Hz swing harmonics (measured: knee R^2 of eq. 28 falls
+    // from 0.93 to 0.24 with kd = 15), unlike a person exaggerating a slow 2 km/h gait, whose effort
+    // follows the posture. kd = 0: the exaggeration is an amplitude intent, kp (gain - 1)(q* - mean).
+    TrackingGains gains;
+    gains.kd.setZero();
+    return std::make_unique<ExaggeratedGait>(mp, base, kGaitMeanPosture, h.gain, h.active_from, 0.02, gains);
   }
   return std::make_unique<RelaxedBehaviour>();
+}
+
+// The posture the subject's co-contraction stiffens the joints about (MuscleParams::q_rest, rad).
+// Co-contraction raises the joint stiffness about the current equilibrium (Hogan 1984, IEEE TAC
+// 29(8)); the seated-hanging default of sim/muscles (Hayashi's K theta for the HAL knee swing) would
+// make a standing subject's co-contraction pull the knee towards -90 deg: a torque of -K (q - q_rest),
+// about -0.33 S N m in gait (S the co-contracted torque), that no EMG model sees. Isometric trials:
+// the held start pose; exaggerated gait: the pattern's mean posture (as tests/sim/muscles_test.cc).
+Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, const Eigen::Vector2d& start) {
+  if (s.human.behaviour == "exaggerated_gait") return kGaitMeanPosture;
+  if (s.human.behaviour == "isometric_hip" || s.human.behaviour == "isometric_knee") return start;
+  return mp.q_rest;
 }
 
 struct FaultSwitch {
@@ -233,6 +261,7 @@ struct Accum {
 
 RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
   if (s.device == Device::kHal3) return RunHalScenario(s, opt);
+  if (s.emg_calibration) return RunEmgCalibrationScenario(s, opt);
   RunResult result;
   result.scenario = s.name;
   result.seed = opt.seed ? *opt.seed : s.seed;
@@ -300,7 +329,8 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     // The human: muscles (ground truth alpha, beta, gamma), behaviour, surface EMG -> amplifier.
     const bool human = truth.human.has_value();
     const bool emg_on = human && s.human.emg;
-    const MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
+    MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
+    mp.q_rest = CoContractionPosture(s, mp, {h0.q, k0.q});
     MuscleModel muscles(mp, dt);
     std::unique_ptr<Behaviour> behaviour = BuildBehaviour(s, mp, trajectory, seed + 3);
     SyntheticEmg emg(DefaultSyntheticEmgConfig(), seed + 4);

@@ -10,6 +10,8 @@
 
 #include "model/lumped_params.h"
 #include "scenarios/scenario.h"
+#include "sim/muscles.h"
+#include "sim/subjects.h"
 
 namespace exotwin {
 
@@ -42,6 +44,14 @@ struct RunResult {
 // The subject's parameters as the twin's ground truth (preset, population draw or MODEL.yaml),
 // with the scenario's passive model; exo alone for the exo-only device.
 LegParams ResolveSubject(const Scenario& s);
+
+// The subject's characteristics (weight, segment lengths) for a preset or population draw; none for a
+// MODEL.yaml subject or the exo alone.
+std::optional<Subject> ScenarioSubject(const Scenario& s);
+
+// The contraction programme of an isometric_hip / isometric_knee behaviour (h.programme_seed, else
+// run_seed): the runner plays it, and the EMG calibration protocol reads its blocks (s, fraction of MVC).
+ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed);
 
 // Runs every trial of the scenario; writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
 // encoder angles, torque-sensor readings, commands) and DIR/truth[_trialN].csv (plant state and applied

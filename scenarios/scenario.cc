@@ -123,6 +123,18 @@ void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (n["rls_gravity_in_input"]) h.rls_gravity_in_input = r.Bool(n["rls_gravity_in_input"], "hal.rls_gravity_in_input");
 }
 
+void ParseEmgCalibration(const Reader& r, const YAML::Node& n, Scenario& s) {
+  if (s.device != Device::kExowheel) r.Fail("emg_calibration", "only allowed with device: exowheel");
+  r.Keys(n, "emg_calibration", {"dynamic", "mvc_trials", "hip_pose", "knee_pose", "strides"});
+  EmgCalibrationSpec c;
+  if (n["dynamic"]) c.dynamic = r.Bool(n["dynamic"], "emg_calibration.dynamic");
+  if (n["mvc_trials"]) c.mvc_trials = static_cast<int>(r.Num(n["mvc_trials"], "emg_calibration.mvc_trials", 1, 10));
+  if (n["hip_pose"]) r.Pair(n["hip_pose"], "emg_calibration.hip_pose", c.hip_pose, -2.5, 2.5);
+  if (n["knee_pose"]) r.Pair(n["knee_pose"], "emg_calibration.knee_pose", c.knee_pose, -2.5, 2.5);
+  if (n["strides"]) c.strides = static_cast<int>(r.Num(n["strides"], "emg_calibration.strides", 1, 100));
+  s.emg_calibration = c;
+}
+
 }  // namespace
 
 Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
@@ -136,7 +148,7 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
   if (!root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   r.Keys(root, "", {"name", "description", "seed", "subject", "human", "device", "fixed_joints", "protocol",
-                    "hardware", "controller", "faults", "logs", "checks", "hal"});
+                    "hardware", "controller", "faults", "logs", "checks", "hal", "emg_calibration"});
   Scenario s;
   s.source = source;
   if (!root["name"]) r.Fail("name", "missing, expected the scenario's name");
@@ -167,7 +179,8 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
 
   if (root["human"]) {
     const YAML::Node n = root["human"];
-    r.Keys(n, "human", {"behaviour", "active_from", "gain", "contractions", "emg", "muscle_seed"});
+    r.Keys(n, "human", {"behaviour", "active_from", "gain", "contractions", "levels", "cocontraction",
+                        "programme_seed", "emg", "muscle_seed"});
     HumanSpec& h = s.human;
     if (n["behaviour"])
       h.behaviour = r.Str(n["behaviour"], "human.behaviour",
@@ -175,11 +188,22 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
     if (n["active_from"]) h.active_from = r.Num(n["active_from"], "human.active_from", 0, 3600);
     if (n["gain"]) h.gain = r.Num(n["gain"], "human.gain", 0.5, 3);
     if (n["contractions"]) h.contractions = static_cast<int>(r.Num(n["contractions"], "human.contractions", 1, 100));
+    if (n["levels"]) {
+      const YAML::Node v = n["levels"];
+      if (!v.IsSequence() || v.size() != 2) r.Fail("human.levels", "expected [lo, hi] (fraction of MVC)" + Reader::Line(v));
+      h.levels[0] = r.Num(v[0], "human.levels[0]", 0, 1);
+      h.levels[1] = r.Num(v[1], "human.levels[1]", 0, 1);
+      if (!(h.levels[0] <= h.levels[1])) r.Fail("human.levels", "expected [lo, hi] with lo <= hi (fraction of MVC)");
+    }
+    if (n["cocontraction"]) h.cocontraction = r.Num(n["cocontraction"], "human.cocontraction", 0, 1);
+    if (n["programme_seed"])
+      h.programme_seed = static_cast<uint64_t>(r.Num(n["programme_seed"], "human.programme_seed", 0, 1e15));
     if (n["emg"]) h.emg = r.Bool(n["emg"], "human.emg");
     if (n["muscle_seed"]) h.muscle_seed = static_cast<uint64_t>(r.Num(n["muscle_seed"], "human.muscle_seed", 0, 1e15));
   }
 
   if (root["hal"]) ParseHal(r, root["hal"], s);
+  if (root["emg_calibration"]) ParseEmgCalibration(r, root["emg_calibration"], s);
 
   if (root["fixed_joints"]) {
     const YAML::Node n = root["fixed_joints"];
@@ -278,6 +302,20 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
       else { c.limit = r.Num(n["min"], key + ".min", -1e12, 1e12); c.op = ">="; }
       s.checks.push_back(c);
     }
+  }
+  if (s.emg_calibration) {
+    if (s.subject.preset.empty() && !s.subject.random_seed)
+      r.Fail("subject", "emg_calibration needs subject.preset or subject.random_seed (the anthropometric "
+                        "models of Table 7 take the subject's weight and segment lengths)");
+    if (!s.human.emg) r.Fail("human.emg", "emg_calibration needs the EMG amplifier (human.emg: true)");
+    if (root["protocol"])
+      r.Fail("protocol", "not used with emg_calibration (it sets the trials itself: MVC, isometric, gait)");
+    if (root["fixed_joints"])
+      r.Fail("fixed_joints", "not used with emg_calibration, expected emg_calibration.hip_pose / knee_pose");
+    if (s.human.contractions < 2)
+      r.Fail("human.contractions", "emg_calibration needs at least 2 (flexion and extension per joint)");
+    if (s.human.behaviour != "relaxed")
+      r.Fail("human.behaviour", "emg_calibration sets the behaviour of each trial itself; leave it out");
   }
   return s;
 }

@@ -48,8 +48,22 @@ struct HumanSpec {
   double active_from = 5.0;           // s: exaggerated gait starts here (relaxed before, as Fig. 9)
   double gain = 1.3;                  // exaggerated gait: amplification of the pattern
   int contractions = 6;               // isometric programmes: number of contractions
+  double levels[2] = {0.2, 0.8};      // isometric programmes: contraction levels, fraction of MVC
+  double cocontraction = 0.1;         // isometric programmes: antagonist drive / agonist level
+  std::optional<uint64_t> programme_seed;  // isometric programmes: seed (default: from the run seed)
   bool emg = true;                    // EMG electrodes + amplifier node on the bus
   uint64_t muscle_seed = 1;           // ground-truth alpha, beta, gamma drawn from Tables 6-7
+};
+
+// Hwang & Jeon 2015 sec. 4.3 EMG-to-torque calibration run as one scenario (EXOwheel with a
+// subject; scenarios/emg_calibration_protocol.h): MVC trials, isometric trials per joint (eq. 25)
+// and, with `dynamic`, the exaggerated gait (eq. 28) evaluated with three parameter sets.
+struct EmgCalibrationSpec {
+  bool dynamic = true;                  // run the gait trial and fit beta, gamma (Table 7)
+  int mvc_trials = 3;                   // MVC trials per muscle (paper: 3)
+  double hip_pose[2] = {0.0, 0.0};      // rad (hip, knee) held for hip isometric trials (Fig. 7a)
+  double knee_pose[2] = {0.7854, -1.5707963267948966};  // rad, knee trials (Fig. 7b; see yaml)
+  int strides = 10;                     // gait strides after human.active_from (paper: 10)
 };
 
 // HAL-3 settings (device: hal3 only; scenarios/hal_runner.h). The operator performs Hayashi's seated
@@ -101,6 +115,7 @@ struct Scenario {
   SubjectSpec subject;
   HumanSpec human;
   HalSpec hal;
+  std::optional<EmgCalibrationSpec> emg_calibration;
   Device device = Device::kExowheel;
   std::map<std::string, double> fixed_joints;  // joint -> angle (rad)
   ProtocolSpec protocol;

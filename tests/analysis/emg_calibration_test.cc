@@ -2,7 +2,11 @@
 // synthetic EMG (sim/synthetic_emg.h) -> amplifier (gain 1000; the band-pass is in the envelope
 // chain) -> linear envelope / MVC -> eq. (25) alpha and eq. (28) beta, gamma. Compared with the
 // ground truth and with Tables 6-7 (isometric R^2 0.951-0.976, NRMS 5.03-8.12 %; dynamic R^2 0.935
-// hip / 0.924 knee with identified parameters, 0.88 / 0.87 with De Leva).
+// hip / 0.924 knee with identified parameters, 0.884 / 0.877 with De Leva, 0.879 / 0.872 Dempster).
+// In-process (no plant: the exoskeleton imposes a sinusoidal gait, the sensor is truth + noise); the
+// De Leva / Dempster rows use sim/anthropometry. Table7ErrorBudget switches off one error source at a
+// time and prints the R^2 of the three parameter sets (the same pipeline runs on the full twin in
+// scenarios/exowheel_emg_dynamic.yaml).
 #include "analysis/emg_calibration.h"
 
 #include <cmath>
@@ -11,6 +15,8 @@
 #include <gtest/gtest.h>
 
 #include "model/leg_dynamics.h"
+#include "sim/anthropometry.h"
+#include "sim/subjects.h"
 #include "sim/synthetic_emg.h"
 
 namespace exotwin {
@@ -30,11 +36,12 @@ struct Record {
 // Runs behaviour b for T s with kinematics kin(t) -> (q, qd) imposed (the exoskeleton holds or
 // moves the joints); records the muscular torque and the processed EMG.
 template <class Kin>
-Record RunTrial(const MuscleParams& p, Behaviour& b, double T, Kin kin, uint64_t seed) {
+Record RunTrial(const MuscleParams& p, Behaviour& b, double T, Kin kin, uint64_t seed,
+                double envelope_hz = 2.0, bool oracle = false) {
   MuscleModel muscles(p, kDt);
   SyntheticEmg emg(g_cfg, seed);
   Record r;
-  std::vector<std::vector<double>> amp(kNumMuscles);
+  std::vector<std::vector<double>> amp(kNumMuscles), e_true(kNumMuscles);
   const int n = static_cast<int>(T / kDt);
   for (int k = 0; k < n; ++k) {
     Eigen::Vector2d q, qd;
@@ -42,33 +49,37 @@ Record RunTrial(const MuscleParams& p, Behaviour& b, double T, Kin kin, uint64_t
     muscles.Step(b.Excitation(k * kDt, q, qd));
     const MuscleVec x = emg.Sample(muscles.electrical_activation());
     for (int c = 0; c < kNumMuscles; ++c) amp[c].push_back(1000.0 * x[c]);  // amplifier gain 1000
+    for (int c = 0; c < kNumMuscles; ++c) e_true[c].push_back(muscles.electrical_activation()[c]);
     r.tau.push_back(muscles.Torques(q, qd).total());
     r.q.push_back(q);
     r.qd.push_back(qd);
   }
-  for (int c = 0; c < kNumMuscles; ++c) r.env.push_back(OfflineLinearEnvelope(amp[c]));
+  for (int c = 0; c < kNumMuscles; ++c) r.env.push_back(OfflineLinearEnvelope(amp[c], 1000.0, envelope_hz));
+  if (oracle)
+    for (int c = 0; c < kNumMuscles; ++c) r.env[c] = e_true[c];
   return r;
 }
 
-void Normalize(Record& r, const MuscleVec& mvc) {
+void Normalize(Record& r, const MuscleVec& mvc, const MuscleVec& rest = MuscleVec::Zero()) {
   r.le.resize(r.tau.size());
-  for (size_t k = 0; k < r.tau.size(); ++k)
-    for (int c = 0; c < kNumMuscles; ++c) r.le[k][c] = r.env[c][k] / mvc[c];
+  for (size_t k = 0; k < r.tau.size(); ++k) r.le[k] = NormalizedEnvelope(r.env, k, rest, mvc);
 }
 
 // MVC of every muscle from its own three MVC trials, as the paper.
-MuscleVec MeasureMvc(const MuscleParams& p, uint64_t seed, MuscleVec* peak_over_plateau = nullptr) {
+MuscleVec MeasureMvc(const MuscleParams& p, uint64_t seed, MuscleVec* peak_over_plateau = nullptr,
+                     double envelope_hz = 2.0, MuscleVec* rest = nullptr) {
   MuscleVec mvc;
   for (int m = 0; m < kNumMuscles; ++m) {
     ContractionProgramme prog = MvcProgramme(MuscleAt(m));
     const Record r = RunTrial(p, prog, prog.duration() + 1, [&](double, Eigen::Vector2d& q, Eigen::Vector2d& qd) {
       q = p.theta_c;
       qd.setZero();
-    }, seed + m);
+    }, seed + m, envelope_hz);
     std::vector<std::pair<size_t, size_t>> w;
     for (const auto& b : prog.blocks())
       w.push_back({static_cast<size_t>(b.t_start / kDt), static_cast<size_t>((b.t_start + 2 * b.ramp + b.hold) / kDt)});
     mvc[m] = MvcOfTrials(r.env[m], w);
+    if (rest) (*rest)[m] = RestLevel(r.env[m], 200, 700);  // relaxed before the first trial (t0 = 1 s)
     double s = 0;
     size_t n = 0;
     for (const auto& b : prog.blocks())
@@ -163,78 +174,177 @@ TEST(EmgCalibration, IsometricAlphaRecoversGroundTruthAndMatchesTable6) {
   EXPECT_LE(nrms_sum / n, 8.0);
 }
 
-LegParams Truth() {
-  LegParams p;
-  p.exo = {3.01, 0.74, 3.85, 1.73, 0.14, 0.18};
-  p.human = LumpedParams{1.69, 0.37, 4.54, 1.20, -0.16, 0.42};
-  p.passive = PassiveModel::kRiener1999;
-  return p;
+// One switch per EMG-side error source of the dynamic calibration (the error budget of Table 7).
+struct Knobs {
+  const char* name = "twin as shipped";
+  bool emd = true;            // electromechanical delay (EMG leads force by ~40 ms)
+  bool crosstalk = true;      // VM<->RF, ST<->GAS, GMAX<->ST crosstalk
+  bool cocontraction_kd = true;  // co-contraction K, D terms that eq. (26)-(27) lack
+  bool sensor_noise = true;   // 0.3 N m torque-sensor noise
+  bool baseline = true;       // relaxed EMG baseline (electrode noise)
+  double envelope_hz = 2.0;   // linear-envelope cut-off (Hz)
+  bool oracle_le = false;     // LE = the true electrical activation (no EMG at all)
+  double gait_kd = 0;         // subject's velocity gain in the gait (< 0: the free-limb default 15 / 4;
+                              // 0 as the runner: the exoskeleton imposes the motion)
+  double gait_gain = 2.0;     // exaggeration of the gait pattern (as exowheel_emg_dynamic.yaml)
+  bool seated_rest = false;   // co-contraction stiffness about the seated hanging posture (sim default)
+  bool rest_subtracted = false;  // processing: relaxed envelope level removed before normalizing
+};
+
+// Identified (= the twin's truth, Table 4 S1), De Leva and Dempster (sim/anthropometry from S1's
+// weight and lengths, Table 4 rule) lumped models, with the known exoskeleton and Riener passive.
+std::vector<LegParams> Table7Models() {
+  const Subject s1 = PresetSubject("S1");
+  LegParams id = SubjectLegParams(s1);
+  id.passive = PassiveModel::kRiener1999;
+  LegParams dl = id, dp = id;
+  dl.human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, s1.weight, s1.L1, s1.L2);
+  dp.human = Table4AnthropometricLumped(AnthropometricModel::kDempster, s1.weight, s1.L1, s1.L2);
+  return {id, dl, dp};
 }
 
-TEST(EmgCalibration, DynamicBetaGammaAndTheTable7Pattern) {
-  const uint64_t seed = 4;
-  const Calibrated c = CalibrateIsometric(seed);
-  // Gait on the exoskeleton (position-controlled pattern, 2 km/h-like 0.6 Hz); relaxed for 5 s, then
-  // exaggerated flexion/extension (Hwang & Jeon section 4.3).
-  const Eigen::Vector2d mean(0.2, -0.5);
-  const double w = 2 * kPi * 0.6;
+struct DynamicOutcome {
+  double r2[3][2];          // [identified, De Leva, Dempster][hip, knee]
+  double beta[3][2], gamma[3][2];
+  double rms_tau_m[2];      // RMS of the true muscular torque over the active gait, N m
+  double rms_model_err[3][2];  // RMS of the model's error on tau_M (eq. 9), N m
+};
+
+// The whole pipeline (MVC, isometric alpha, exaggerated gait, beta/gamma with 3 models) with knobs.
+DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
+  MuscleParams truth = DrawMuscleParams(seed);
+  if (!kb.emd) truth.emd = 0;
+  if (!kb.cocontraction_kd) truth.cK.setZero(), truth.cD.setZero();
+  const Eigen::Vector2d mean(0.2, -0.5);  // mean gait posture (rad)
+  const SyntheticEmgConfig saved = g_cfg;
+  if (!kb.crosstalk) g_cfg.crosstalk.setIdentity();
+  if (!kb.baseline) g_cfg.baseline_rms.setConstant(1e-9);
+  const double noise_sd = kb.sensor_noise ? 0.3 : 0.0;
+  // MVC and isometric alpha as in the Table 6 test.
+  MuscleVec rest = MuscleVec::Zero();
+  MuscleVec mvc = MeasureMvc(truth, seed * 100, nullptr, kb.envelope_hz, &rest);
+  if (!kb.rest_subtracted || kb.oracle_le) rest.setZero();
+  if (kb.oracle_le) mvc.setOnes();
+  SeededNormal noise(seed ^ 0x5e);
+  AlphaFit fit[2];
+  for (int j = 0; j < 2; ++j) {
+    ContractionProgramme prog = IsometricProgramme(j, 8, 0.1, 0.5, 0.1, seed + j);
+    MuscleParams held = truth;  // co-contraction stiffens about the held pose (runner.cc)
+    if (!kb.seated_rest) held.q_rest = truth.theta_c;
+    Record r = RunTrial(held, prog, prog.duration() + 1, [&](double, Eigen::Vector2d& q, Eigen::Vector2d& qd) {
+      q = truth.theta_c;
+      qd.setZero();
+    }, seed * 100 + 10 + j, kb.envelope_hz, kb.oracle_le);
+    Normalize(r, mvc, rest);
+    std::vector<double> tau;
+    for (const auto& t : r.tau) tau.push_back(t[j] + noise_sd * noise());
+    fit[j] = FitIsometricAlpha(j, r.le, tau);
+  }
+  // Gait on the exoskeleton: 2 s stride (2 km/h), relaxed 5 s then exaggerated (section 4.3).
+  if (!kb.seated_rest) truth.q_rest = mean;
+  const double w = 2 * kPi * 0.5;
   auto kin = [&](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd) {
     q = mean + Eigen::Vector2d(0.35 * std::sin(w * t), 0.45 * std::sin(w * t - 1.0));
     qd = Eigen::Vector2d(0.35 * w * std::cos(w * t), 0.45 * w * std::cos(w * t - 1.0));
   };
   auto kin_acc = [&](double t) { return Eigen::Vector2d(-0.35 * w * w * std::sin(w * t), -0.45 * w * w * std::sin(w * t - 1.0)); };
-  ExaggeratedGait gait(c.truth, [&](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+  TrackingGains gains;
+  if (kb.gait_kd >= 0) gains.kd.setConstant(kb.gait_kd);  // else the free-limb default
+  ExaggeratedGait gait(truth, [&](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
     kin(t, q, qd);
     qdd = kin_acc(t);
-  }, mean, 1.4, 5.0, 0.02);
-  Record r = RunTrial(c.truth, gait, 25.0, kin, seed * 100 + 50);
-  Normalize(r, c.mvc);
-  const LegParams truth = Truth();
-  // Anthropometric stand-ins for Table 7's De Leva / Dempster rows: the README's probe found the
-  // model-based X +6 %, J +20 % (De Leva) and X -3 %, J2 -20 % (Dempster) off the identified values.
-  LegParams deleva = truth, dempster = truth;
-  deleva.human->X1 *= 1.06; deleva.human->X2 *= 1.08; deleva.human->J1 *= 1.2; deleva.human->J2 *= 1.2;
-  dempster.human->X1 *= 0.97; dempster.human->X2 *= 0.96; dempster.human->J2 *= 0.8;
-  SeededNormal noise(seed ^ 0x77);
-  const char* joint[] = {"hip", "knee"};
+  }, mean, kb.gait_gain, 5.0, 0.02, gains);
+  Record r = RunTrial(truth, gait, 25.0, kin, seed * 100 + 50, kb.envelope_hz, kb.oracle_le);
+  Normalize(r, mvc, rest);
+  g_cfg = saved;
+  const std::vector<LegParams> models = Table7Models();
+  SeededNormal sn(seed ^ 0x77);
+  DynamicOutcome o{};
+  const size_t k0 = static_cast<size_t>(5.5 / kDt);
   for (int j = 0; j < 2; ++j) {
-    double r2[3];
-    int idx = 0;
-    for (const LegParams* model : std::vector<const LegParams*>{&truth, &deleva, &dempster}) {
+    double s2 = 0;
+    for (size_t k = k0; k < r.tau.size(); ++k) s2 += r.tau[k][j] * r.tau[k][j];
+    o.rms_tau_m[j] = std::sqrt(s2 / (r.tau.size() - k0));
+  }
+  std::vector<Eigen::Vector2d> tau_S;
+  for (size_t k = 0; k < r.tau.size(); ++k)  // sensor (eq. 8), the identified model as the plant
+    tau_S.push_back(r.tau[k] - ActuatorTorque(models[0], r.q[k], r.qd[k], kin_acc(k * kDt)) +
+                    noise_sd * Eigen::Vector2d(sn(), sn()));
+  for (int mi = 0; mi < 3; ++mi) {
+    for (int j = 0; j < 2; ++j) {
       std::vector<MuscleVec> le;
       std::vector<double> q, qd, tau_M;
-      for (size_t k = static_cast<size_t>(5.0 / kDt); k < r.tau.size(); ++k) {
-        const Eigen::Vector2d acc = kin_acc(k * kDt);
-        // Sensor (eq. 8) then eq. (9)-(10) with the model's parameters.
-        const Eigen::Vector2d tau_S = r.tau[k] - ActuatorTorque(truth, r.q[k], r.qd[k], acc) +
-                                      Eigen::Vector2d(0.3 * noise(), 0.3 * noise());
-        const Eigen::Vector2d tm = tau_S + ActuatorTorque(*model, r.q[k], r.qd[k], acc);
+      double e2 = 0;
+      for (size_t k = k0; k < r.tau.size(); ++k) {
+        const Eigen::Vector2d tm = tau_S[k] + ActuatorTorque(models[mi], r.q[k], r.qd[k], kin_acc(k * kDt));  // eq. 9
+        e2 += (tm[j] - r.tau[k][j]) * (tm[j] - r.tau[k][j]);
         le.push_back(r.le[k]);
         q.push_back(r.q[k][j]);
         qd.push_back(r.qd[k][j]);
         tau_M.push_back(tm[j]);
       }
-      const BetaGammaFit f = FitDynamicBetaGamma(j, c.fit[j].alpha, c.truth.theta_c[j], le, q, qd, tau_M);
-      r2[idx] = f.quality.r2;
-      std::printf("[calib] %s %s: beta %.2fe-3/deg gamma %.2fe-3/(deg/s) R^2 %.3f NRMS %.2f %% "
-                  "(truth beta %.2fe-3 gamma %.2fe-3)\n",
-                  joint[j], idx == 0 ? "identified" : idx == 1 ? "De Leva-like" : "Dempster-like",
-                  1e3 * f.beta_per_deg(), 1e3 * f.gamma_per_deg_s(), f.quality.r2, f.quality.nrms_pct,
-                  1e3 * c.truth.beta[j] / kDegPerRad, 1e3 * c.truth.gamma[j] / kDegPerRad);
-      if (idx == 0) {
-        // Table 7: 0.935 hip, 0.924 knee. The twin lands lower (0.80-0.84): its EMG-side errors
-        // (2 Hz envelope of 1-3 Hz bursts, 40 ms EMD, crosstalk, the co-contraction K, D that eq. 26-27
-        // lack) dominate; gamma comes out within 50 %, beta is biased (it absorbs the co-contraction
-        // stiffness about q_rest, sign flipped on this subject) -- reported, not asserted.
-        EXPECT_GE(f.quality.r2, 0.75);
-        EXPECT_NEAR(f.gamma, c.truth.gamma[j], 0.5 * c.truth.gamma[j]);
-      }
-      ++idx;
+      const BetaGammaFit f = FitDynamicBetaGamma(j, fit[j].alpha, truth.theta_c[j], le, q, qd, tau_M);
+      o.r2[mi][j] = f.quality.r2;
+      o.beta[mi][j] = f.beta;
+      o.gamma[mi][j] = f.gamma;
+      o.rms_model_err[mi][j] = std::sqrt(e2 / le.size());
     }
-    // Table 7's ranking (identified > De Leva, Dempster) needs the parameter error to matter against
-    // the EMG-side error; at 0.6 Hz gait with these sizes it does not (reported, not asserted).
-    std::printf("[calib] %s R^2 identified %.3f, De Leva-like %.3f, Dempster-like %.3f\n", joint[j], r2[0],
-                r2[1], r2[2]);
+  }
+  return o;
+}
+
+TEST(EmgCalibration, DynamicBetaGammaAndTheTable7Pattern) {
+  const DynamicOutcome o = RunPipeline(Knobs(), 4);
+  const char* joint[] = {"hip", "knee"};
+  const MuscleParams truth = DrawMuscleParams(4);
+  // Table 7 identified rows: mean - 2 SD (0.935 - 2 x 0.028, 0.924 - 2 x 0.034).
+  const double r2_min[2] = {0.935 - 2 * 0.028, 0.924 - 2 * 0.034};
+  for (int j = 0; j < 2; ++j) {
+    std::printf("[calib] %s R^2 identified %.3f, De Leva %.3f, Dempster %.3f (Table 7: %s); gamma %.2fe-3 "
+                "(truth %.2fe-3) /(deg/s); beta %.2fe-3 / %.2fe-3 / %.2fe-3 /deg\n", joint[j], o.r2[0][j],
+                o.r2[1][j], o.r2[2][j], j == 0 ? "0.935, 0.884, 0.879" : "0.924, 0.877, 0.872",
+                1e3 * o.gamma[0][j] / kDegPerRad, 1e3 * truth.gamma[j] / kDegPerRad, 1e3 * o.beta[0][j] / kDegPerRad,
+                1e3 * o.beta[1][j] / kDegPerRad, 1e3 * o.beta[2][j] / kDegPerRad);
+    EXPECT_GE(o.r2[0][j], r2_min[j]);
+    // gamma also absorbs the envelope's lead over the force (zero-phase envelope, 30-50 ms EMD).
+    EXPECT_GT(o.gamma[0][j], 0.5 * truth.gamma[j]);
+    EXPECT_LT(o.gamma[0][j], 3.0 * truth.gamma[j]);
+  }
+  // Table 7's ranking holds at the hip, where the anthropometric error on tau_M varies with the hip
+  // angle. At the knee the error is mostly a constant (Y2 = 0 instead of 0.42 kg m) that the beta
+  // column (E + F)(q - q_c) absorbs while the knee co-contracts (see exowheel_emg_dynamic.yaml).
+  EXPECT_GT(o.r2[0][0], o.r2[1][0]);
+  EXPECT_GT(o.r2[0][0], o.r2[2][0]);
+  EXPECT_LT(o.beta[1][1], o.beta[0][1]);  // the absorbed offset shows as a lower knee beta, as Table 7
+  EXPECT_LT(o.beta[2][1], o.beta[0][1]);
+}
+
+// The error budget of the twin's dynamic R^2 (Table 7): one EMG-side source switched off at a time,
+// next to the torque error the anthropometric models induce on tau_M (eq. 9) over the same gait.
+TEST(EmgCalibration, Table7ErrorBudget) {
+  std::vector<Knobs> rows(13);
+  rows[1].name = "no electromechanical delay"; rows[1].emd = false;
+  rows[2].name = "no crosstalk"; rows[2].crosstalk = false;
+  rows[3].name = "no co-contraction K, D"; rows[3].cocontraction_kd = false;
+  rows[4].name = "no torque-sensor noise"; rows[4].sensor_noise = false;
+  rows[5].name = "no EMG baseline"; rows[5].baseline = false;
+  rows[6].name = "rest level subtracted"; rows[6].rest_subtracted = true;
+  rows[7].name = "envelope 6 Hz"; rows[7].envelope_hz = 6.0;
+  rows[8].name = "oracle LE (true activation)"; rows[8].oracle_le = true;
+  rows[9].name = "free-limb kd 15 / 4 (before)"; rows[9].gait_kd = -1;
+  rows[10].name = "K about seated posture (before)"; rows[10].seated_rest = true;
+  rows[11].name = "gain 1.3 (before)"; rows[11].gait_gain = 1.3;
+  rows[12].name = "all three (before)"; rows[12].gait_kd = -1; rows[12].seated_rest = true;
+  rows[12].gait_gain = 1.3;
+  for (const Knobs& kb : rows) {
+    const DynamicOutcome o = RunPipeline(kb, 4);
+    std::printf("[budget] %-32s R^2 hip %.3f / %.3f / %.3f  knee %.3f / %.3f / %.3f  (identified / De Leva / "
+                "Dempster)\n", kb.name, o.r2[0][0], o.r2[1][0], o.r2[2][0], o.r2[0][1], o.r2[1][1], o.r2[2][1]);
+    if (&kb == &rows[0] || &kb == &rows[12])
+      for (int j = 0; j < 2; ++j)
+        std::printf("[budget] %s: RMS tau_M %.2f N m; model error on tau_M: identified %.2f, De Leva %.2f, "
+                    "Dempster %.2f N m\n", j ? "knee" : "hip", o.rms_tau_m[j], o.rms_model_err[0][j],
+                    o.rms_model_err[1][j], o.rms_model_err[2][j]);
   }
 }
 
