@@ -336,8 +336,7 @@ RunResult RunEmgCalibrationScenario(const Scenario& s, const RunOptions& opt) {
   result.files.push_back("calibration.csv");
   result.files.push_back("calibration.json");
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  result.checks = EvaluateChecks(s, m);
-  WriteResultJson(result, opt.out_dir + "/result.json");
+  FinishRun(s, result, opt.out_dir + "/result.json");
   return result;
 }
 

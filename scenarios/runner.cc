@@ -542,13 +542,6 @@ std::vector<CheckResult> Checks(const Scenario& s, const std::map<std::string, d
 
 }  // namespace
 
-std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::string, double>& m) {
-  std::string unknown;
-  std::vector<CheckResult> out = Checks(s, m, &unknown);
-  if (!unknown.empty()) throw InputError(unknown);
-  return out;
-}
-
 void FinishRun(const Scenario& s, RunResult& result, const std::string& path) {
   std::string unknown;
   result.checks = Checks(s, result.metrics, &unknown);

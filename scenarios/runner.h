@@ -59,9 +59,6 @@ ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed)
 // written so far stay on disk).
 RunResult RunScenario(const Scenario& s, const RunOptions& opt);
 
-// Evaluates the scenario's checks on the metrics. Throws InputError for a metric that does not exist.
-std::vector<CheckResult> EvaluateChecks(const Scenario& s, const std::map<std::string, double>& metrics);
-
 // End of a run: evaluates the checks on result.metrics, writes result.json at `path`, then throws
 // InputError if a check names a metric the run did not produce (that check is written as failed with
 // value null, so the metrics of a long run are kept on disk before the exit code 2).
