@@ -64,6 +64,10 @@ struct EmgCalibrationSpec {
   double hip_pose[2] = {0.0, 0.0};      // rad (hip, knee) held for hip isometric trials (Fig. 7a)
   double knee_pose[2] = {0.7854, -1.5707963267948966};  // rad, knee trials (Fig. 7b; see yaml)
   int strides = 10;                     // gait strides after human.active_from (paper: 10)
+  // > 1: the protocol on Table 4's subjects S1..S<subjects>, muscle ground truth human.muscle_seed + i - 1;
+  // result metrics are the means over the subjects (worst case for *max*, *min*, safe_state_entered),
+  // plus *_sd and per-subject "subject_S<i>.<metric>".
+  int subjects = 1;
 };
 
 // HAL-3 settings (device: hal3 only; scenarios/hal_runner.h). The operator performs Hayashi's seated

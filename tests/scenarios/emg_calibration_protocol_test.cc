@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -77,6 +78,8 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
   ExpectInputError(std::string(kHead) + "human: {levels: [0.5, 0.2]}\n", "human.levels");
   ExpectInputError(std::string(kHead) + "human: {levels: [0.1, 1.5]}\n", "human.levels[1]");
   ExpectInputError(std::string(kHead) + "human: {levels: 0.3}\n", "human.levels");
+  ExpectInputError("name: c\ndevice: exowheel\nsubject: {preset: S1}\nemg_calibration: {subjects: 11}\n",
+                   "emg_calibration.subjects");
   // Through the command line: exit 2 and the file named.
   const std::string dir = testing::TempDir("emgcal_bad");
   testing::WriteText(dir + "/bad.yaml", std::string(kHead) + "human: {levels: [0.5, 0.2]}\n");
@@ -181,6 +184,39 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
   EXPECT_TRUE(fs::exists(out + "/calibration.csv"));
   const CsvTable cal = ReadCsv(out + "/calibration.csv");
   EXPECT_EQ(cal.rows(), 2u + 6u);  // 2 isometric rows, 3 models x 2 joints
+}
+
+// Population mode (emg_calibration.subjects): each subject S<i> runs the single-subject protocol
+// with muscle_seed + i - 1 into subject_S<i>/; the result's metric is the mean over the subjects (the
+// worst for *max* / *min* / safe_state_entered), with *_sd; and no contraction exceeds the isometric
+// torque budget that keeps the +-120 N m sensors out of saturation (strong subjects' levels scaled).
+TEST(EmgCalibrationProtocol, PopulationModeAggregatesSubjectsAndRespectsTheTorqueBudget) {
+  Scenario s = ReadScenario(ShippedScenarioDir() + "/exowheel_emg_isometric.yaml");
+  s.emg_calibration->subjects = 3;
+  s.human.muscle_seed = 1;
+  s.checks.clear();
+  RunOptions ro;
+  ro.out_dir = testing::TempDir("emgcal_pop");
+  const RunResult r = RunScenario(s, ro);
+  EXPECT_EQ(r.metrics.at("subjects"), 3.0);
+  double mean = 0, sq = 0, worst = 1, tmax = 0;
+  for (int i = 1; i <= 3; ++i) {
+    const std::string p = "subject_S" + std::to_string(i) + ".";
+    EXPECT_TRUE(fs::exists(ro.out_dir + "/subject_S" + std::to_string(i) + "/isometric_knee/measured.csv"));
+    mean += r.metrics.at(p + "iso_r2_mean") / 3;
+    sq += r.metrics.at(p + "iso_r2_mean") * r.metrics.at(p + "iso_r2_mean");
+    worst = std::min(worst, r.metrics.at(p + "iso_r2_min"));
+    tmax = std::max(tmax, r.metrics.at(p + "torque_max_knee"));
+    EXPECT_EQ(r.metrics.at(p + "safe_state_entered"), 0.0) << p;
+    EXPECT_LE(r.metrics.at(p + "iso_level_scale_knee"), 1.0);
+  }
+  EXPECT_NEAR(r.metrics.at("iso_r2_mean"), mean, 1e-12);
+  EXPECT_NEAR(r.metrics.at("iso_r2_mean_sd"), std::sqrt((sq - 3 * mean * mean) / 2), 1e-9);
+  EXPECT_EQ(r.metrics.at("iso_r2_min"), worst);
+  EXPECT_EQ(r.metrics.at("torque_max_knee"), tmax);
+  EXPECT_LT(tmax, 120.0);  // the sensor range; without the budget these subjects saturate it
+  // The subjects differ: Table 4's S1..S3 with muscle seeds 1..3.
+  EXPECT_NE(r.metrics.at("subject_S1.alpha_VM_knee"), r.metrics.at("subject_S2.alpha_VM_knee"));
 }
 
 }  // namespace
