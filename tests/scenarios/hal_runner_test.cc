@@ -143,8 +143,11 @@ TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
   for (double v : s.hal.sweep_viscosity) {
     std::snprintf(key, sizeof(key), "J_tau_m@%g", v);
     const double J = r.metrics.at(key);
-    if (v <= best) EXPECT_LE(J, prev + 1e-9) << key << " (falling towards the trough)";
-    else EXPECT_GE(J, prev - 1e-9) << key << " (rising after the trough)";
+    if (v <= best) {
+      EXPECT_LE(J, prev + 1e-9) << key << " (falling towards the trough)";
+    } else {
+      EXPECT_GE(J, prev - 1e-9) << key << " (rising after the trough)";
+    }
     prev = J;
   }
   for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;

@@ -251,7 +251,9 @@ TEST(Muscles, ExaggeratedGaitAmplifiesThePatternAfterTheRelaxedPhase) {
   for (int k = 0; k < 12000; ++k) {
     const double t = k * 1e-3;
     const MuscleVec u = gait.Excitation(t, q, qd);
-    if (t < 2.0) EXPECT_EQ(u.sum(), 0.0);
+    if (t < 2.0) {
+      EXPECT_EQ(u.sum(), 0.0);
+    }
     muscles.Step(u);
     // The exoskeleton is not in this loop: the subject drives the human limb, gravity compensated
     // by a support (the paper's body-weight support + exo): only the dynamics apart from G act.
