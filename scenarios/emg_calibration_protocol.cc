@@ -176,7 +176,8 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
     // Levels scaled down (all blocks alike) so that no contraction asks for more than the torque
     // budget at either joint (eq. 23-24 at the programme's peaks; biarticular RF / ST load both).
     double peak_torque = 0;
-    for (const ContractionBlock& blk : IsometricProgrammeOf(sub.human, 0).blocks())
+    const ContractionProgramme planned = IsometricProgrammeOf(sub.human, 0);
+    for (const ContractionBlock& blk : planned.blocks())
       for (int jj = 0; jj < 2; ++jj)
         peak_torque = std::max(peak_torque, std::abs(IsometricTorque(jj, mp.alpha.col(jj), blk.peak)));
     const double scale = std::min(1.0, kIsometricTorqueBudget / peak_torque);
