@@ -62,8 +62,7 @@ std::pair<size_t, size_t> Window(const std::vector<double>& t, double t0, double
 // returns the MVC value (V): mean of the trial peaks of the recorded channel's linear envelope.
 double RecordMvc(const MuscleParams& mp, Muscle m, int trials, const Eigen::Vector2d& pose, uint64_t seed,
                  const std::string& path, const std::string& comment) {
-  const ContractionProgramme prog = MvcProgramme(m, trials);
-  ContractionProgramme play = prog;
+  ContractionProgramme prog = MvcProgramme(m, trials);
   MuscleModel muscles(mp, kDt);
   SyntheticEmg emg(DefaultSyntheticEmgConfig(), seed);
   hwsim::EmgAmplifier amplifier;
@@ -73,7 +72,7 @@ double RecordMvc(const MuscleParams& mp, Muscle m, int trials, const Eigen::Vect
     CsvStreamWriter w(path, names, {comment});
     const long n = std::lround((prog.duration() + 1.0) / kDt);
     for (long k = 0; k < n; ++k) {
-      muscles.Step(play.Excitation(k * kDt, pose, Eigen::Vector2d::Zero()));
+      muscles.Step(prog.Excitation(k * kDt, pose, Eigen::Vector2d::Zero()));
       const MuscleVec v = emg.Sample(muscles.electrical_activation());
       std::array<double, kNumMuscles> in{};
       for (int c = 0; c < kNumMuscles; ++c) in[c] = v[c];
@@ -105,12 +104,6 @@ RunResult RunTrial(Scenario sub, const std::string& tag, uint64_t seed, const Ru
   ro.seed = seed;
   fs::remove_all(ro.out_dir);
   return RunScenario(sub, ro);
-}
-
-double Mean(const std::vector<double>& v, size_t a, size_t b) {
-  double s = 0;
-  for (size_t k = a; k < b; ++k) s += v[k];
-  return b > a ? s / (b - a) : 0.0;
 }
 
 struct IsometricResult {
@@ -197,7 +190,7 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
     // first contraction is subtracted, so tau^ISO is the muscular torque alone (sec. 4.3).
     const auto base = Window(d.t, kHoldRamp + 0.1, prog.blocks().front().t_start);
     if (base.second - base.first < 100) throw InputError(s.source + ": isometric trial: no relaxed lead-in");
-    const double offset = Mean(tau_S, base.first, base.second);
+    const double offset = RestLevel(tau_S, base.first, base.second);  // mean relaxed reading
     const auto all = Window(d.t, kHoldRamp + 0.1, prog.duration() + 0.5);
     std::vector<MuscleVec> le;
     std::vector<double> tau;

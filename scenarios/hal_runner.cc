@@ -138,18 +138,8 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   KneeSwingBehaviour swing(mp, s.hal.swing_freq, s.hal.cc_up, s.hal.cc_down, pp.mgl(), gains);
   SyntheticEmg emg(emg_cfg, seed + 13);
 
-  hwsim::VirtualCanBusConfig bus_cfg;
-  bus_cfg.bitrate = s.hardware.can_bitrate;
-  bus_cfg.latency = s.hardware.can_latency;
-  bus_cfg.jitter = s.hardware.can_jitter;
-  bus_cfg.drop_probability = s.hardware.can_drop_rate;
-  bus_cfg.seed = seed;
-  hwsim::VirtualCanBus bus(bus_cfg);
-  if (can_log) bus.SetTap([&](const CanFrame& f) {
-    CanFrame g = f;
-    g.t += epoch;
-    can_log->Write(g);
-  });
+  hwsim::VirtualCanBus bus(BusConfigOf(s.hardware, seed));
+  TapToCandump(bus, can_log, epoch);
   auto* ctrl_ep = bus.AddNode("hal_controller", {msg::kIdHalKneeStatus, msg::kIdEmgSamples});
   auto* knee_ep = bus.AddNode("hal_knee", {msg::kIdHalKneeCommand});
   auto* emg_ep = bus.AddNode("emg_amplifier", {msg::kIdControllerHeartbeat});  // receives nothing used
@@ -159,7 +149,8 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   ks.driver.watchdog = s.hardware.watchdog;
   hwsim::Hal3KneeNode knee(ks, knee_ep, seed + 1);
   hwsim::EmgNode emg_node(hwsim::EmgAmplifierSpec{}, emg_ep);
-  controller::HalLoop loop(LoopConfig(s, pp, coeffs, B_v), ctrl_ep);
+  const controller::HalLoopConfig loop_cfg = LoopConfig(s, pp, coeffs, B_v);
+  controller::HalLoop loop(loop_cfg, ctrl_ep);
 
   std::unique_ptr<CsvStreamWriter> measured, truth_log;
   if (s.log_measured_csv) {
@@ -188,7 +179,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   Mean ext_up, ext_down, flex_up, flex_down, rect_up, strain_up, strain_down, mu_up;
   Mean D_hat, K_hat, D_true, K_true, D_proj, K_proj, track2;
   // Same memory as the RLS: its rho is per control tick, the sums here run per physics step.
-  ProjectedViscoelasticity projected(std::pow(LoopConfig(s, pp, coeffs, B_v).assist.rls.rho, dt / ctrl_dt));
+  ProjectedViscoelasticity projected(std::pow(loop_cfg.assist.rls.rho, dt / ctrl_dt));
   std::vector<double> tau_m, m_e, m_f;
   double th_max = -10, th_min = 10, t = 0;
   for (long k = 0; k < n_steps; ++k) {

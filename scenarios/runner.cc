@@ -294,19 +294,8 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     controller::JointSetpoint h0, k0;
     trajectory->Sample(0.0, &h0, &k0);
 
-    hwsim::VirtualCanBusConfig bus_cfg;
-    bus_cfg.bitrate = s.hardware.can_bitrate;
-    bus_cfg.latency = s.hardware.can_latency;
-    bus_cfg.jitter = s.hardware.can_jitter;
-    bus_cfg.drop_probability = s.hardware.can_drop_rate;
-    bus_cfg.seed = seed;
-    hwsim::VirtualCanBus bus(bus_cfg);
-    const double trial_epoch = trial * (s.protocol.duration + 1.0);
-    if (can_log) bus.SetTap([&](const CanFrame& f) {
-      CanFrame g = f;
-      g.t += trial_epoch;  // trials follow each other in one log
-      can_log->Write(g);
-    });
+    hwsim::VirtualCanBus bus(BusConfigOf(s.hardware, seed));
+    TapToCandump(bus, can_log.get(), trial * (s.protocol.duration + 1.0));  // trials follow each other
     hwsim::VirtualCanBus::Endpoint* ctrl_ep = bus.AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee, msg::kIdEmgSamples});
     CanBus* emg_ep = bus.AddNode("emg_amplifier", {0x7FF});  // sends only
     CanBus* hip_ep = bus.AddNode("hip_module", {msg::kIdJointCommandHip});
@@ -508,6 +497,25 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
 
   FinishRun(s, result, opt.out_dir + "/result.json");
   return result;
+}
+
+hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed) {
+  hwsim::VirtualCanBusConfig c;
+  c.bitrate = hw.can_bitrate;
+  c.latency = hw.can_latency;
+  c.jitter = hw.can_jitter;
+  c.drop_probability = hw.can_drop_rate;
+  c.seed = seed;
+  return c;
+}
+
+void TapToCandump(hwsim::VirtualCanBus& bus, CandumpWriter* log, double epoch) {
+  if (!log) return;
+  bus.SetTap([log, epoch](const CanFrame& f) {
+    CanFrame g = f;
+    g.t += epoch;
+    log->Write(g);
+  });
 }
 
 namespace {

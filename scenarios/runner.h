@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "hwsim/virtual_can_bus.h"
 #include "model/lumped_params.h"
+#include "protocol/candump.h"
 #include "scenarios/scenario.h"
 #include "sim/muscles.h"
 #include "sim/subjects.h"
@@ -58,6 +60,13 @@ ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed)
 // torque). Throws InputError on bad scenario content and SimulationError on divergence (the logs
 // written so far stay on disk).
 RunResult RunScenario(const Scenario& s, const RunOptions& opt);
+
+// The virtual CAN bus of a scenario's hardware (bitrate, latency, jitter, drop rate) with `seed`.
+hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed);
+
+// With a log (may be null: nothing), every frame on `bus` is written to it with its time shifted by
+// `epoch` s (successive trials follow each other in one candump file). `log` must outlive the bus.
+void TapToCandump(hwsim::VirtualCanBus& bus, CandumpWriter* log, double epoch);
 
 // End of a run: evaluates the checks on result.metrics, writes result.json at `path`, then throws
 // InputError if a check names a metric the run did not produce (that check is written as failed with
