@@ -1,5 +1,6 @@
 #include "analysis/csv_table.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
@@ -41,6 +42,13 @@ CsvTable ReadCsv(const std::string& path) {
     throw InputError(path + ": binary data (NUL byte), expected a text CSV file");
 
   CsvTable t;
+  if (content.rfind(kStreamMarker, 0) == 0 && content.back() != '\n') {
+    const size_t cut = content.rfind('\n') + 1;  // npos + 1 == 0: the marker line itself was cut
+    t.dropped_cut_line = static_cast<int>(std::count(content.begin(), content.begin() + cut, '\n')) + 1;
+    std::fprintf(stderr, "warning: %s:%d: last line has no newline in a streamed exotwin log: dropped "
+                 "(the run was killed while writing it)\n", path.c_str(), t.dropped_cut_line);
+    content.resize(cut);
+  }
   bool have_header = false;
   size_t pos = 0;
   int line_no = 0;
@@ -151,6 +159,7 @@ CsvStreamWriter::CsvStreamWriter(const std::string& path, const std::vector<std:
     : path_(path), columns_(names.size()), flush_rows_(flush_rows ? flush_rows : 1) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd_ < 0) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
+  buffer_ += std::string(kStreamMarker) + "\n";
   for (const auto& c : comments) buffer_ += "# " + c + "\n";
   for (size_t i = 0; i < names.size(); ++i) buffer_ += (i ? "," : "") + names[i];
   buffer_ += "\n";

@@ -7,10 +7,14 @@
 
 namespace exotwin {
 
+// First comment line of every streamed CSV: every complete row of such a file ends with '\n'.
+inline constexpr const char* kStreamMarker = "# exotwin stream: complete rows end with a newline";
+
 struct CsvTable {
   std::vector<std::string> names;
   std::vector<std::vector<double>> columns;  // columns[i] belongs to names[i]
   std::vector<int> line_of_row;              // 1-based file line of each data row
+  int dropped_cut_line = 0;  // line number of a cut last line dropped from a streamed file, else 0
 
   size_t rows() const { return columns.empty() ? 0 : columns[0].size(); }
   // Index of a column, -1 if absent.
@@ -19,7 +23,9 @@ struct CsvTable {
 
 // Parses a CSV file. Throws InputError naming the file and line for: unreadable or empty file, no
 // header, duplicated or empty column names, a row with the wrong number of fields, a field that is
-// not a number. NaN/inf are parsed (callers decide whether they are allowed).
+// not a number. NaN/inf are parsed (callers decide whether they are allowed). In a file that starts
+// with kStreamMarker, an unterminated last line is a row cut by a killed run: it is dropped, with a
+// warning on stderr, and its line number kept in dropped_cut_line.
 CsvTable ReadCsv(const std::string& path);
 
 // Writes a table with full double precision (%.17g), header first. `comments` go first as '# ' lines.
@@ -36,7 +42,10 @@ void WriteFileAtomic(const std::string& path, const std::string& text);
 namespace exotwin {
 
 // Streams rows to a CSV file as a run produces them, so that an abort loses at most the rows of the
-// last `flush_rows` (the buffer is written with one write(2) of whole lines, never a partial line).
+// last `flush_rows`. The buffer holds whole lines only, but a SIGKILL can still cut a write(2) to a
+// regular file at a page boundary (Linux checks for fatal signals between pages), so the last line
+// of a killed run may be cut. The file's first line is kStreamMarker; ReadCsv drops an unterminated
+// last line of such a file (and says so), and keeps every complete row.
 class CsvStreamWriter {
  public:
   // Opens (truncates) `path` and writes the comments and the header. Throws InputError if it cannot.
