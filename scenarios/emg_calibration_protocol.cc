@@ -64,7 +64,7 @@ double RecordMvc(const MuscleParams& mp, Muscle m, int trials, const Eigen::Vect
                  const std::string& path, const std::string& comment) {
   ContractionProgramme prog = MvcProgramme(m, trials);
   MuscleModel muscles(mp, kDt);
-  SyntheticEmg emg(DefaultSyntheticEmgConfig(), seed);
+  SyntheticEmg emg(ExowheelSyntheticEmgConfig(), seed);
   hwsim::EmgAmplifier amplifier;
   std::vector<std::string> names = {"t"};
   for (int c = 0; c < kNumMuscles; ++c) names.push_back(std::string("emg_") + MuscleName(MuscleAt(c)));

@@ -322,7 +322,7 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     mp.q_rest = CoContractionPosture(s, mp, {h0.q, k0.q});
     MuscleModel muscles(mp, dt);
     std::unique_ptr<Behaviour> behaviour = BuildBehaviour(s, mp, trajectory, seed + 3);
-    SyntheticEmg emg(DefaultSyntheticEmgConfig(), seed + 4);
+    SyntheticEmg emg(ExowheelSyntheticEmgConfig(), seed + 4);
     hwsim::EmgAmplifier amplifier;
     uint8_t emg_counter = 0;
 

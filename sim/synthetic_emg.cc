@@ -41,6 +41,12 @@ SyntheticEmgConfig DefaultSyntheticEmgConfig() {
   return c;
 }
 
+SyntheticEmgConfig ExowheelSyntheticEmgConfig() {
+  SyntheticEmgConfig c = DefaultSyntheticEmgConfig();
+  c.baseline_rms = MuscleVec::Constant(3.0e-6);
+  return c;
+}
+
 SyntheticEmg::SyntheticEmg(const SyntheticEmgConfig& config, uint64_t seed) : cfg_(config) {
   if (!(cfg_.f_hp > 0) || !(cfg_.f_lp > cfg_.f_hp) || !(cfg_.fs > 2 * cfg_.f_lp))
     throw std::invalid_argument("SyntheticEmg: need 0 < f_hp < f_lp < fs/2");

@@ -129,6 +129,27 @@ TEST(SyntheticEmg, RelaxedLevelsMatchHayashiAfterGain1000) {
   }
 }
 
+// The EXOwheel's Delsys set-up: a relaxed channel reads 3 uV RMS at the electrode (3 mV after gain
+// 1000 and the 20-450 Hz band-pass), 0.1-0.2 % of the muscle's MVC level; a full contraction is
+// unchanged from the default (the baseline is the only difference).
+TEST(SyntheticEmg, ExowheelRelaxedBaselineIsTheDelsysNoiseFloor) {
+  const SyntheticEmgConfig cfg = ExowheelSyntheticEmgConfig();
+  SyntheticEmg g(cfg, 1);
+  std::vector<MuscleVec> rec = g.Generate(std::vector<MuscleVec>(60000, MuscleVec::Zero()));
+  const auto bp = dsp::DesignButterworth(4, dsp::BandType::kBandPass, 1000, 20, 450);
+  for (int c = 0; c < kNumMuscles; ++c) {
+    std::vector<double> x;
+    for (const auto& v : rec) x.push_back(1000 * v[c]);
+    const double rms = Rms(dsp::FiltFilt(bp, x));
+    EXPECT_NEAR(rms, 3e-3, 0.05 * 3e-3) << MuscleName(MuscleAt(c));
+    EXPECT_LT(rms / (1000 * cfg.mvc_rms[c]), 0.0025) << MuscleName(MuscleAt(c)) << ": share of MVC";
+  }
+  const SyntheticEmgConfig hal = DefaultSyntheticEmgConfig();
+  EXPECT_EQ(cfg.mvc_rms, hal.mvc_rms);
+  EXPECT_EQ(cfg.crosstalk, hal.crosstalk);
+  EXPECT_GT(hal.baseline_rms.minCoeff(), 10 * cfg.baseline_rms.maxCoeff());
+}
+
 TEST(SyntheticEmg, MedianFrequencyAndBandOfTheSpectrum) {
   SyntheticEmg g(NoCrosstalk(), 2);
   const std::vector<double> x = Channel(g, MuscleVec::Constant(0.5), I(Muscle::kVM), 60000);
