@@ -182,6 +182,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   ProjectedViscoelasticity projected(std::pow(loop_cfg.assist.rls.rho, dt / ctrl_dt));
   std::vector<double> tau_m, m_e, m_f;
   double th_max = -10, th_min = 10, t = 0;
+  size_t samples = 0;  // log-rate samples (rows of measured.csv when it is written)
   for (long k = 0; k < n_steps; ++k) {
     if (k % steps_per_tick == 0) {
       bus.AdvanceTo(t + 0.5 * dt);
@@ -235,6 +236,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
       if (projected.valid()) D_proj.Add(projected.D()), K_proj.Add(projected.K());
       D_hat.Add(tel.assist.D), K_hat.Add(tel.assist.K);
     }
+    if (k % log_every == 0) ++samples;
     if (measured && k % log_every == 0) {
       const auto& o = emg_node.last_output();
       const double row[] = {t, tel.th, tel.strain, tel.tau_cmd, o[0], o[1], o[2], o[3], o[4],
@@ -250,6 +252,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   }
   TrialOut out;
   auto& m = out.m;
+  m["samples"] = static_cast<double>(samples);
   m["emg_ext_up_V"] = ext_up.get();
   m["emg_ext_down_V"] = ext_down.get();
   m["emg_flex_up_V"] = flex_up.get();
@@ -322,6 +325,9 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   }
   // Single run (or trials): the metrics of the last run; a sweep adds per-value metrics.
   for (const auto& kv : per_run.back()) m[kv.first] = kv.second;
+  double samples = 0;
+  for (const auto& r : per_run) samples += r.at("samples");
+  m["samples"] = samples;  // all runs (trials or sweep values), as the EXOwheel runner counts trials
   if (sweep) {
     std::vector<double> J, Je, Jf;
     for (const auto& r : per_run) J.push_back(r.at("J_tau_m")), Je.push_back(r.at("J_e")), Jf.push_back(r.at("J_f"));
