@@ -285,9 +285,20 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
         m["dyn_gamma_" + key + "_e3_per_deg_s"] = 1e3 * dyn[mi][j].gamma_per_deg_s();
         if (mi > 0) {
           m["r2_margin_" + key] = dyn[0][j].quality.r2 - dyn[mi][j].quality.r2;
-          double e2 = 0;  // how far the anthropometric model moves tau_M from the identified one
-          for (size_t k = 0; k < tau_M[0][j].size(); ++k) e2 += std::pow(tau_M[mi][j][k] - tau_M[0][j][k], 2);
+          // How far the anthropometric model moves tau_M from the identified one, how much of that
+          // shift is a copy of the effort itself (correlation with tau_M), and the R^2 the set would
+          // get without refitting beta, gamma (the identified set's): the refit's share of the margin.
+          double e2 = 0, m2 = 0, em = 0;
+          std::vector<double> yhat;
+          for (size_t k = 0; k < tau_M[0][j].size(); ++k) {
+            const double e = tau_M[mi][j][k] - tau_M[0][j][k];
+            e2 += e * e, m2 += tau_M[0][j][k] * tau_M[0][j][k], em += e * tau_M[0][j][k];
+            yhat.push_back(DynamicTorque(j, iso[j].fit.alpha, dyn[0][j].beta, dyn[0][j].gamma, mp.theta_c[j],
+                                         le[k], q[j][k], qd[j][k]));
+          }
           m["tau_M_shift_rms_" + key] = std::sqrt(e2 / tau_M[0][j].size());
+          m["tau_M_shift_effort_corr_" + key] = e2 > 0 && m2 > 0 ? em / std::sqrt(e2 * m2) : 0.0;
+          m["r2_margin_fixed_beta_gamma_" + key] = dyn[0][j].quality.r2 - Quality(tau_M[mi][j], yhat).r2;
         }
       }
       double s2 = 0;
