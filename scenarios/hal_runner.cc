@@ -18,6 +18,7 @@
 #include "model/input_error.h"
 #include "protocol/candump.h"
 #include "scenarios/hal_emg_calibration.h"
+#include "scenarios/sweep_plots.h"
 #include "sim/hal3_plant.h"
 #include "sim/muscles.h"
 #include "sim/subjects.h"
@@ -351,6 +352,22 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
              {&bv, &J, &Je, &Jf, &Jme, &Jmf},
              {"Lee & Sankai eq. (12)-(18) over the virtual viscous coefficient B_v (N m s/rad)"});
     result.files.push_back("sweep.csv");
+    // The curves of Lee & Sankai Fig. 9: each criterion over B_v, scaled to its maximum (J_me, J_mf
+    // are eq. 13-18's own normalisation), with the twin's and the paper's optimum marked.
+    LineChart chart;
+    chart.title = s.name + ": stress criteria over the virtual viscous coefficient (Lee & Sankai Fig. 9)";
+    chart.x_label = "virtual viscous coefficient B_v (N m s/rad)";
+    chart.y_label = "criterion / its maximum";
+    const double J_max = *std::max_element(J.begin(), J.end());
+    std::vector<double> J_scaled;
+    for (double v : J) J_scaled.push_back(J_max > 0 ? v / J_max : 0.0);
+    chart.series = {{"J_tau_m (eq. 12) / max", bv, J_scaled, "#c0392b"},
+                    {"J_me, extensor (eq. 16)", bv, Jme, "#2c6fbb"},
+                    {"J_mf, flexor (eq. 15)", bv, Jmf, "#2e9a48"}};
+    chart.markers = {{values[best], "twin minimum " + Fmt(values[best]), "#c0392b"},
+                     {1.56, "paper 1.56", "#555555"}};
+    WriteFileAtomic(opt.out_dir + "/sweep.svg", LineChartSvg(chart));
+    result.files.push_back("sweep.svg");
   }
   m["runs"] = runs;
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

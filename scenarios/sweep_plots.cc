@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstdio>
 
+#include "model/input_error.h"
 #include "scenarios/sweep_table.h"
 
 namespace exotwin {
@@ -114,6 +115,108 @@ std::string HistogramGridSvg(const std::string& title, const std::vector<Histogr
        "</text>\n";
   for (size_t i = 0; i < panels.size(); ++i)
     s += Panel(panels[i], (i % cols) * kPanelW, kTop + (i / cols) * kPanelH);
+  return s + "</svg>\n";
+}
+
+ChartFrame LayoutLineChart(const LineChart& c) {
+  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  for (const LineSeries& s : c.series) {
+    if (s.x.size() != s.y.size())
+      throw InputError("line chart '" + c.title + "': series '" + s.label + "' has " + std::to_string(s.x.size()) +
+                       " x and " + std::to_string(s.y.size()) + " y values (expected the same number)");
+    for (size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      xmin = std::min(xmin, s.x[i]), xmax = std::max(xmax, s.x[i]);
+      ymin = std::min(ymin, s.y[i]), ymax = std::max(ymax, s.y[i]);
+    }
+  }
+  if (!std::isfinite(xmin)) throw InputError("line chart '" + c.title + "': no finite point to draw");
+  for (const LineMarker& m : c.markers)
+    if (std::isfinite(m.x)) xmin = std::min(xmin, m.x), xmax = std::max(xmax, m.x);
+  auto pad = [](double lo, double hi, double* a, double* b) {
+    const double d = hi > lo ? 0.05 * (hi - lo) : std::max(1.0, 0.1 * std::abs(lo));
+    *a = lo - d, *b = hi + d;
+  };
+  ChartFrame f;
+  pad(xmin, xmax, &f.x0, &f.x1);
+  pad(ymin, ymax, &f.y0, &f.y1);
+  f.left = 80, f.right = c.width - 25, f.top = 50, f.bottom = c.height - 60;
+  return f;
+}
+
+std::string LineChartSvg(const LineChart& c) {
+  const ChartFrame f = LayoutLineChart(c);
+  std::string s = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" +
+                  Fmt("%.0f", c.width) + "\" height=\"" + Fmt("%.0f", c.height) + "\" viewBox=\"0 0 " +
+                  Fmt("%.0f", c.width) + " " + Fmt("%.0f", c.height) + "\" font-family=\"sans-serif\">\n";
+  s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s += "<text x=\"" + Fmt("%.0f", c.width / 2) + "\" y=\"28\" text-anchor=\"middle\" font-size=\"16\">" +
+       Escape(c.title) + "</text>\n";
+  // Grid and ticks: about 8 (x) and 6 (y) steps of 1, 2 or 5 x 10^k.
+  auto step_of = [](double span, int n) {
+    const double raw = span / n, p = std::pow(10.0, std::floor(std::log10(raw)));
+    for (double m : {1.0, 2.0, 5.0})
+      if (m * p >= raw) return m * p;
+    return 10 * p;
+  };
+  const double xs = step_of(f.x1 - f.x0, 8), ys = step_of(f.y1 - f.y0, 6);
+  for (double v = std::ceil(f.x0 / xs) * xs; v <= f.x1; v += xs) {
+    const double x = f.X(v);
+    s += "<line x1=\"" + Fmt("%.2f", x) + "\" x2=\"" + Fmt("%.2f", x) + "\" y1=\"" + Fmt("%.0f", f.top) + "\" y2=\"" +
+         Fmt("%.0f", f.bottom) + "\" stroke=\"#e3e3e3\"/>\n";
+    s += "<text x=\"" + Fmt("%.2f", x) + "\" y=\"" + Fmt("%.0f", f.bottom + 18) +
+         "\" text-anchor=\"middle\" font-size=\"12\">" + Tick(std::abs(v) < 1e-9 * xs ? 0.0 : v) + "</text>\n";
+  }
+  for (double v = std::ceil(f.y0 / ys) * ys; v <= f.y1; v += ys) {
+    const double y = f.Y(v);
+    s += "<line x1=\"" + Fmt("%.0f", f.left) + "\" x2=\"" + Fmt("%.0f", f.right) + "\" y1=\"" + Fmt("%.2f", y) +
+         "\" y2=\"" + Fmt("%.2f", y) + "\" stroke=\"#e3e3e3\"/>\n";
+    s += "<text x=\"" + Fmt("%.0f", f.left - 8) + "\" y=\"" + Fmt("%.2f", y + 4) +
+         "\" text-anchor=\"end\" font-size=\"12\">" + Tick(std::abs(v) < 1e-9 * ys ? 0.0 : v) + "</text>\n";
+  }
+  s += "<rect x=\"" + Fmt("%.0f", f.left) + "\" y=\"" + Fmt("%.0f", f.top) + "\" width=\"" + Fmt("%.0f", f.right - f.left) +
+       "\" height=\"" + Fmt("%.0f", f.bottom - f.top) + "\" fill=\"none\" stroke=\"#444\"/>\n";
+  s += "<text x=\"" + Fmt("%.0f", (f.left + f.right) / 2) + "\" y=\"" + Fmt("%.0f", c.height - 18) +
+       "\" text-anchor=\"middle\" font-size=\"13\">" + Escape(c.x_label) + "</text>\n";
+  s += "<text transform=\"translate(20," + Fmt("%.0f", (f.top + f.bottom) / 2) +
+       ") rotate(-90)\" text-anchor=\"middle\" font-size=\"13\">" + Escape(c.y_label) + "</text>\n";
+  int row = 0;
+  for (const LineMarker& m : c.markers) {
+    if (!std::isfinite(m.x)) continue;
+    const double x = f.X(m.x);
+    s += "<line class=\"marker\" x1=\"" + Fmt("%.2f", x) + "\" x2=\"" + Fmt("%.2f", x) + "\" y1=\"" + Fmt("%.0f", f.top) +
+         "\" y2=\"" + Fmt("%.0f", f.bottom) + "\" stroke=\"" + m.colour + "\" stroke-dasharray=\"6,4\"/>\n";
+    s += "<text x=\"" + Fmt("%.2f", x + 4) + "\" y=\"" + Fmt("%.0f", f.top + 16 + 16 * row++) + "\" font-size=\"12\" fill=\"" +
+         m.colour + "\">" + Escape(m.label) + "</text>\n";
+  }
+  for (const LineSeries& ser : c.series) {
+    std::string pts;
+    auto flush = [&] {
+      if (!pts.empty())
+        s += "<polyline class=\"series\" data-label=\"" + Escape(ser.label) + "\" fill=\"none\" stroke=\"" + ser.colour +
+             "\" stroke-width=\"2\" points=\"" + pts + "\"/>\n";
+      pts.clear();
+    };
+    for (size_t i = 0; i < ser.x.size(); ++i) {
+      if (!std::isfinite(ser.x[i]) || !std::isfinite(ser.y[i])) {
+        flush();
+        continue;
+      }
+      pts += (pts.empty() ? "" : " ") + Fmt("%.2f", f.X(ser.x[i])) + "," + Fmt("%.2f", f.Y(ser.y[i]));
+      if (ser.x.size() <= 60)
+        s += "<circle cx=\"" + Fmt("%.2f", f.X(ser.x[i])) + "\" cy=\"" + Fmt("%.2f", f.Y(ser.y[i])) + "\" r=\"3\" fill=\"" +
+             ser.colour + "\"/>\n";
+    }
+    flush();
+  }
+  row = 0;
+  for (const LineSeries& ser : c.series) {
+    const double y = f.top + 18 + 18 * row++;
+    s += "<line x1=\"" + Fmt("%.0f", f.right - 230) + "\" x2=\"" + Fmt("%.0f", f.right - 205) + "\" y1=\"" +
+         Fmt("%.0f", y - 4) + "\" y2=\"" + Fmt("%.0f", y - 4) + "\" stroke=\"" + ser.colour + "\" stroke-width=\"2\"/>\n";
+    s += "<text x=\"" + Fmt("%.0f", f.right - 198) + "\" y=\"" + Fmt("%.0f", y) + "\" font-size=\"12\">" +
+         Escape(ser.label) + "</text>\n";
+  }
   return s + "</svg>\n";
 }
 

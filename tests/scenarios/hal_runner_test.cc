@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <vector>
 
 #include "analysis/csv_table.h"
@@ -124,7 +126,9 @@ TEST(HalRunner, RejectsNonHalDevice) {
 // Lee & Sankai Fig. 9 / eq. (12): J_tau_m over the virtual viscous coefficient. See the comment in
 // scenarios/hal3_viscous_sweep.yaml for where the twin's trough falls and why.
 TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
-  const RunResult r = RunShipped("hal3_viscous_sweep.yaml", "sweep");
+  RunOptions o;
+  o.out_dir = TempDir("sweep");
+  const RunResult r = RunHalScenario(ReadScenario(Shipped("hal3_viscous_sweep.yaml")), o);
   const Scenario s = ReadScenario(Shipped("hal3_viscous_sweep.yaml"));
   std::printf("[hal] B_v (N m s/rad)   J_tau_m (N m)   J_me   J_mf\n");
   char key[64];
@@ -152,6 +156,15 @@ TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
     prev = J;
   }
   for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;
+  // The curves (Fig. 9) as SVG: one polyline per criterion with a point per swept value, and the
+  // twin's minimum marked (sweep_plots_test checks the chart's geometry).
+  EXPECT_NE(std::find(r.files.begin(), r.files.end(), "sweep.svg"), r.files.end());
+  std::ifstream in(o.out_dir + "/sweep.svg");
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* label : {"J_tau_m (eq. 12) / max", "J_me, extensor (eq. 16)", "J_mf, flexor (eq. 15)"})
+    EXPECT_NE(svg.find(std::string("data-label=\"") + label + "\""), std::string::npos) << label;
+  std::snprintf(key, sizeof(key), "twin minimum %g", best);
+  EXPECT_NE(svg.find(key), std::string::npos) << key;
 }
 
 // The mechanism: the same sweep with an operator whose feedback has no neural delay has no trough
