@@ -13,19 +13,21 @@ namespace exotwin {
 
 LinearFit FitEmgToTorque(const std::vector<double>& E, const std::vector<double>& tau) {
   if (E.size() != tau.size() || E.size() < 2) throw std::invalid_argument("FitEmgToTorque: sizes");
-  double mx = 0, my = 0;
-  for (size_t k = 0; k < E.size(); ++k) mx += E[k], my += tau[k];
-  mx /= E.size();
-  my /= E.size();
-  double sxx = 0, sxy = 0;
+  double mt = 0, me = 0;
+  for (size_t k = 0; k < E.size(); ++k) mt += tau[k], me += E[k];
+  mt /= E.size();
+  me /= E.size();
+  double stt = 0, ste = 0;
   for (size_t k = 0; k < E.size(); ++k) {
-    sxx += (E[k] - mx) * (E[k] - mx);
-    sxy += (E[k] - mx) * (tau[k] - my);
+    stt += (tau[k] - mt) * (tau[k] - mt);
+    ste += (tau[k] - mt) * (E[k] - me);
   }
-  if (!(sxx > 0)) throw std::invalid_argument("FitEmgToTorque: E is constant");
+  if (!(stt > 0)) throw std::invalid_argument("FitEmgToTorque: the calibration torque is constant");
+  const double c = ste / stt;  // V per N m: E = c tau + d
+  if (!(c > 0)) throw std::invalid_argument("FitEmgToTorque: the envelope does not grow with the torque");
   LinearFit f;
-  f.a = sxy / sxx;
-  f.b = my - f.a * mx;
+  f.a = 1.0 / c;
+  f.b = mt - f.a * me;  // the inverted line passes through the means: b = -d / c
   return f;
 }
 

@@ -21,8 +21,13 @@ namespace exotwin {
 struct LinearFit {
   double a = 0, b = 0;
 };
-// Eq. (2) calibration for one muscle group: least squares of the produced torque tau (N m, >= 0,
-// against HAL's reference torque) on its RMS envelope E (V). Same length >= 2, E not constant.
+// Eq. (2) calibration for one muscle group: the line tau = a E + b through the exercise's samples of
+// produced torque tau (N m, >= 0, against HAL's reference torque) and RMS envelope E (V). The torque
+// is known exactly and the envelope carries the estimation noise, so E is regressed on tau
+// (E = c tau + d) and the line inverted (a = 1/c, b = -d/c): an ordinary least squares of tau on the
+// noisy E is biased low by var(noise) / var(E) (errors in variables; 10 % in the twin's exercise at
+// 2-12 % MVC, where a 100 ms envelope of the relaxed-level noise is as large as the signal). Same
+// length >= 2; throws std::invalid_argument if tau is constant or E does not grow with tau.
 LinearFit FitEmgToTorque(const std::vector<double>& E, const std::vector<double>& tau);
 
 struct HalEmgCoefficients {

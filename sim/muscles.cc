@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/Cholesky>
+
 namespace exotwin {
 namespace {
 
@@ -252,7 +254,7 @@ MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
   const double cc = cc_ ? cc_(t, q, qd) : 0.0;
   // Torque map of the muscles at the active joints (rows), eq. (23)-(24) at q = q_c.
   Eigen::Matrix<double, 2, kNumMuscles> A = Eigen::Matrix<double, 2, kNumMuscles>::Zero();
-  MuscleVec target = MuscleVec::Zero(), u = MuscleVec::Zero();
+  MuscleVec target = MuscleVec::Zero();
   std::array<bool, kNumMuscles> used{};
   for (int j = 0; j < 2; ++j) {
     tau_d_[j] = 0;
@@ -265,24 +267,77 @@ MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
       target[m] = cc;
     }
   }
-  // Allocation: min |A u - tau_d|^2 + lambda |u - cc|^2, 0 <= u <= 1, by coordinate descent (a
-  // strictly convex box QP: converges; 40 sweeps are plenty for 5 variables). lambda is small
-  // against alpha^2, so the torque is met whenever the box allows; among the solutions the one
-  // nearest the co-contraction level is taken, which spreads the effort over the agonists and lets
-  // the biarticular RF and ST be balanced by the monoarticular muscles.
+  // Allocation: min |A u - tau_d|^2 + lambda |u - cc|^2, 0 <= u <= 1, solved exactly (SolveUnitBoxQp).
+  // lambda is small against alpha^2, so the torque is met whenever the box allows; among the
+  // solutions the one nearest the co-contraction level is taken (min-norm: synergists in proportion
+  // to their alpha), which spreads the effort over the agonists and lets the biarticular RF and ST be
+  // balanced by the monoarticular muscles. (Until session 3 this was 40 sweeps of coordinate descent,
+  // which does not converge along the null space of A when lambda is small: it left the effort on the
+  // first muscle of each group, VM over RF and ST over GAS, not the documented optimum.)
   const double lambda = 1e-3 * std::max(1.0, A.squaredNorm() / kNumMuscles);
   const Eigen::Matrix<double, kNumMuscles, kNumMuscles> H =
       A.transpose() * A + lambda * Eigen::Matrix<double, kNumMuscles, kNumMuscles>::Identity();
   const MuscleVec f = A.transpose() * tau_d_ + lambda * target;
-  u = target;
-  for (int sweep = 0; sweep < 40; ++sweep) {
-    for (int m = 0; m < kNumMuscles; ++m) {
-      if (!used[m]) continue;
-      const double r = f[m] - H.row(m).dot(u) + H(m, m) * u[m];
-      u[m] = Clip01(r / H(m, m));
+  return SolveUnitBoxQp(H, f, used, target);
+}
+
+MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& H, const MuscleVec& f,
+                         const std::array<bool, kNumMuscles>& used, const MuscleVec& start) {
+  enum State { kFree, kLow, kHigh, kUnused };
+  std::array<State, kNumMuscles> st{};
+  MuscleVec u = MuscleVec::Zero();
+  for (int m = 0; m < kNumMuscles; ++m) {
+    if (!used[m]) {
+      st[m] = kUnused;
+      continue;
+    }
+    u[m] = Clip01(start[m]);
+    st[m] = u[m] <= 0 ? kLow : (u[m] >= 1 ? kHigh : kFree);
+  }
+  // Each iteration either drops a constraint with a negative multiplier or moves to a point with a
+  // lower objective (adding the blocking bound); 4 * kNumMuscles iterations bound the finite method.
+  for (int iter = 0; iter < 4 * kNumMuscles * kNumMuscles; ++iter) {
+    const MuscleVec g = H * u - f;  // gradient
+    int idx[kNumMuscles], n = 0;
+    for (int m = 0; m < kNumMuscles; ++m)
+      if (st[m] == kFree) idx[n++] = m;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kNumMuscles, kNumMuscles> Hf(n, n);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kNumMuscles, 1> gf(n);
+    for (int a = 0; a < n; ++a) {
+      gf[a] = g[idx[a]];
+      for (int b = 0; b < n; ++b) Hf(a, b) = H(idx[a], idx[b]);
+    }
+    MuscleVec p = MuscleVec::Zero();
+    if (n > 0) {
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kNumMuscles, 1> pf = Hf.ldlt().solve(-gf);
+      for (int a = 0; a < n; ++a) p[idx[a]] = pf[a];
+    }
+    if (p.cwiseAbs().maxCoeff() <= 1e-13) {
+      // Stationary on the working set: optimal if every active bound's multiplier is >= 0.
+      int worst = -1;
+      double most_negative = -1e-12 * (1 + f.cwiseAbs().maxCoeff());
+      for (int m = 0; m < kNumMuscles; ++m) {
+        const double mult = st[m] == kLow ? g[m] : (st[m] == kHigh ? -g[m] : 0.0);
+        if (mult < most_negative) most_negative = mult, worst = m;
+      }
+      if (worst < 0) return u;
+      st[worst] = kFree;
+      continue;
+    }
+    double step = 1.0;
+    int blocking = -1;
+    for (int a = 0; a < n; ++a) {
+      const int m = idx[a];
+      if (p[m] < 0 && -u[m] / p[m] < step) step = -u[m] / p[m], blocking = m;
+      if (p[m] > 0 && (1 - u[m]) / p[m] < step) step = (1 - u[m]) / p[m], blocking = m;
+    }
+    u += step * p;
+    if (blocking >= 0) {
+      st[blocking] = p[blocking] < 0 ? kLow : kHigh;
+      u[blocking] = p[blocking] < 0 ? 0.0 : 1.0;
     }
   }
-  return u;
+  return u;  // not reached for a positive definite H (the method is finite)
 }
 
 ExaggeratedGait::ExaggeratedGait(const MuscleParams& p, IntendedMotion base, Eigen::Vector2d mean,

@@ -40,19 +40,33 @@ double Drive(double t) {
 }
 
 TEST(HalAssist, EmgCalibrationEq2) {
+  // The exercise: HAL's reference torque is exact, the envelope noisy (a 100 ms RMS of surface EMG
+  // scatters by ~20 %; here 0.06 V on 0.1-1 V). Eq. (2) as fitted: E regressed on the torque and the
+  // line inverted, so the noise in E does not flatten the slope; an ordinary least squares of tau on
+  // E is low by var(noise) / var(E) (errors in variables), here 0.0036 / 0.071 = 5 %.
   std::mt19937_64 rng(1);
-  std::normal_distribution<double> n(0, 0.3);  // test noise only
+  std::normal_distribution<double> n(0, 0.06);  // test noise only
   std::vector<double> E, tau;
-  for (int k = 0; k < 2000; ++k) {
-    const double e = 0.1 + 0.9 * k / 2000.0;
-    E.push_back(e);
-    tau.push_back(25.0 * e - 2.0 + n(rng));
+  double see = 0, ste = 0, me = 0, mt = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double e = 0.1 + 0.9 * (k % 2000) / 2000.0;  // noise-free envelope
+    const double t = 25.0 * e - 2.0;
+    E.push_back(e + n(rng));
+    tau.push_back(t);
   }
   const LinearFit f = FitEmgToTorque(E, tau);
   EXPECT_NEAR(f.a, 25.0, 0.2);
   EXPECT_NEAR(f.b, -2.0, 0.15);
+  for (size_t k = 0; k < E.size(); ++k) me += E[k], mt += tau[k];
+  me /= E.size(), mt /= E.size();
+  for (size_t k = 0; k < E.size(); ++k) see += (E[k] - me) * (E[k] - me), ste += (E[k] - me) * (tau[k] - mt);
+  const double forward = ste / see;  // the biased direction
+  EXPECT_LT(forward, 0.97 * 25.0);
+  EXPECT_NEAR(forward, 25.0 * (0.9 * 0.9 / 12) / (0.9 * 0.9 / 12 + 0.06 * 0.06), 0.2);
   const HalEmgCoefficients c{{25, -2}, {15, -0.5}};
   EXPECT_NEAR(EstimateMuscleTorque(c, 0.5, 0.2), (12.5 - 2) - (3 - 0.5), 1e-12);
+  EXPECT_THROW(FitEmgToTorque({0.1, 0.2}, {3.0, 3.0}), std::invalid_argument);   // constant torque
+  EXPECT_THROW(FitEmgToTorque({0.3, 0.1}, {1.0, 5.0}), std::invalid_argument);   // E falls with tau
 }
 
 // The relaxed noise adds in power to the muscle signal, E = sqrt((A e)^2 + E0^2). An eq. (2) line

@@ -64,8 +64,8 @@ TEST(HalRunner, AssistLowersExtensorEmgInSwingUpAsFig9) {
   const auto& a = Exp(1).metrics;
   const auto& b = Exp(2).metrics;
   // Compared above the relaxed level (~0.1 V, emg_baseline_ext_V): with the noise-corrected eq. (2)
-  // mu^ no longer over-assists at swing levels (the raw-envelope line was ~1.25x too steep there),
-  // and the raw envelope drops ~8 % (it dropped ~13 % with the over-assist), ~20 % above the baseline.
+  // mu^ no longer over-assists at swing levels (the raw-envelope line was ~1.25x too steep there).
+  // Seed 1: the envelope drops 0.143 -> 0.123 V (-14 %; -43 % above the baseline).
   const double E0 = b.at("emg_baseline_ext_V");
   EXPECT_GT(E0, 0.05);
   EXPECT_LT(b.at("emg_ext_up_V"), a.at("emg_ext_up_V"));
@@ -91,13 +91,13 @@ TEST(HalRunner, RlsViscosityWithin20PercentStiffnessIsAKnownGap) {
   // The time mean of K(t) (~7 N m/rad in the swing-down co-contraction, ~1 otherwise) is not what any
   // constant-parameter window can identify: the identifiable K is well below it (seed 1: ~1.0 vs ~3.1).
   EXPECT_LT(m.at("truth_K_mean"), 0.6 * m.at("truth_K_timemean"));
-  // With the noise-corrected EMG envelope (controller/hal_assist.h) D meets the 20 % on seed
-  // 1 (~9 %; it was ~37 % low against the same truth with the raw envelope). K does NOT: mu^ still
-  // over-estimates the contraction torque at extension (gain ~1.1, offset ~+0.5 N m, error ~ +1.5 th
-  // N m), and the RLS lumps that into K (~+2.3 N m/rad on a truth of ~1). Regression bounds, not the
-  // acceptance (scenarios/known_gaps/hal3_rls_tracking.yaml holds the failing 20 % checks).
+  // Seed 1: D within 7 %, K within 21 % (was +235 % before the exact muscle allocation and the
+  // errors-in-variables fit of eq. 2, see the known gap's header). K is ~6 % of the gravity stiffness
+  // the RLS also sees, so 1 % of gain error in mu^ is ~17 % of K: over seeds 1-5 K^ errs by 20-140 %.
+  // Regression bounds, not the acceptance (scenarios/known_gaps/hal3_rls_tracking.yaml holds the 20 %
+  // checks): D inside the bound, K inside twice it.
   EXPECT_LT(m.at("rls_D_err_pct"), 20.0);
-  EXPECT_LT(m.at("rls_K_err_pct"), 300.0);
+  EXPECT_LT(m.at("rls_K_err_pct"), 40.0);
 }
 
 TEST(HalRunner, WritesMeasuredCsvWithHalColumns) {
