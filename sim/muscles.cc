@@ -282,7 +282,7 @@ MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
 }
 
 MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& H, const MuscleVec& f,
-                         const std::array<bool, kNumMuscles>& used, const MuscleVec& start) {
+                         const std::array<bool, kNumMuscles>& used, const MuscleVec& start, int* iterations) {
   enum State { kFree, kLow, kHigh, kUnused };
   std::array<State, kNumMuscles> st{};
   MuscleVec u = MuscleVec::Zero();
@@ -294,9 +294,11 @@ MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& 
     u[m] = Clip01(start[m]);
     st[m] = u[m] <= 0 ? kLow : (u[m] >= 1 ? kHigh : kFree);
   }
-  // Each iteration either drops a constraint with a negative multiplier or moves to a point with a
-  // lower objective (adding the blocking bound); 4 * kNumMuscles iterations bound the finite method.
-  for (int iter = 0; iter < 4 * kNumMuscles * kNumMuscles; ++iter) {
+  // Each iteration either drops a bound with a negative multiplier or moves to a point with a lower
+  // objective (adding the blocking bound); the method is finite, a few iterations per variable.
+  constexpr int kMaxIterations = 4 * kNumMuscles * kNumMuscles;
+  for (int iter = 0; iter < kMaxIterations; ++iter) {
+    if (iterations) *iterations = iter + 1;
     const MuscleVec g = H * u - f;  // gradient
     int idx[kNumMuscles], n = 0;
     for (int m = 0; m < kNumMuscles; ++m)
@@ -312,7 +314,7 @@ MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& 
       const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kNumMuscles, 1> pf = Hf.ldlt().solve(-gf);
       for (int a = 0; a < n; ++a) p[idx[a]] = pf[a];
     }
-    if (p.cwiseAbs().maxCoeff() <= 1e-13) {
+    if (p.cwiseAbs().maxCoeff() <= 1e-10) {  // activation units: rounding of g is ~1e-12 here
       // Stationary on the working set: optimal if every active bound's multiplier is >= 0.
       int worst = -1;
       double most_negative = -1e-12 * (1 + f.cwiseAbs().maxCoeff());
@@ -337,7 +339,7 @@ MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& 
       u[blocking] = p[blocking] < 0 ? 0.0 : 1.0;
     }
   }
-  return u;  // not reached for a positive definite H (the method is finite)
+  return u;  // at the cap (not reached in tests/sim/muscles_test.cc): a feasible point
 }
 
 ExaggeratedGait::ExaggeratedGait(const MuscleParams& p, IntendedMotion base, Eigen::Vector2d mean,

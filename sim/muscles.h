@@ -210,9 +210,11 @@ struct TrackingGains {
 
 // Solves min_u 1/2 u'Hu - f'u over 0 <= u_m <= 1 for the muscles with used[m] (the others stay 0),
 // H symmetric positive definite on the used block. Exact (primal active set, Nocedal & Wright
-// alg. 16.3, finite for a strictly convex QP); starts from clip(start). Returns the minimiser.
+// alg. 16.3, finite for a strictly convex QP); starts from clip(start). Returns the minimiser;
+// `iterations` (optional) receives the iterations used (capped at 4 kNumMuscles^2).
 MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& H, const MuscleVec& f,
-                         const std::array<bool, kNumMuscles>& used, const MuscleVec& start);
+                         const std::array<bool, kNumMuscles>& used, const MuscleVec& start,
+                         int* iterations = nullptr);
 
 // Voluntary tracking: desired torque tau_d = I_ff qdd* + kp (q* - q) + kd (qd* - qd) + ff(t, q, qd)
 // per active joint, allocated to the muscles spanning the active joints by the box-constrained least

@@ -353,7 +353,9 @@ TEST(Muscles, BoxQpFindsTheExactMinimiser) {
       if (objective(u) < best) best = objective(u), best_u = u;
     }
     for (const MuscleVec& start : {MuscleVec::Zero().eval(), MuscleVec::Constant(0.5).eval(), MuscleVec::Ones().eval()}) {
-      const MuscleVec u = SolveUnitBoxQp(H, f, used, start);
+      int iterations = 0;
+      const MuscleVec u = SolveUnitBoxQp(H, f, used, start, &iterations);
+      EXPECT_LE(iterations, 3 * kNumMuscles) << "trial " << trial;  // cap 4 kNumMuscles^2
       EXPECT_NEAR(objective(u), best, 1e-9 * (1 + std::abs(best))) << "trial " << trial;
       EXPECT_LT((u - best_u).cwiseAbs().maxCoeff(), 1e-6) << "trial " << trial;
       for (int i = 0; i < kNumMuscles; ++i) {
