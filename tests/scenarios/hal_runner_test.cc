@@ -182,7 +182,7 @@ TEST(HalRunner, ViscousSweepHasNoTroughWithoutOperatorDelay) {
 
 // Over 8 operators (muscle ground truth drawn from seeds 1..8) the trough falls at positive B_v
 // with a median within one grid step (0.25-0.31 N m s/rad) of the paper's 1.56 for its 3 operators.
-// Measured: 1.75, 1.25, 1.75, 0.5, 2.25, 1.25, 1.0, 1.0 (median 1.25).
+// Measured: 1.56, 2.0, 1.56, 1.0, 2.25, 1.25, 1.0, 1.0 (median 1.4).
 TEST(HalRunner, ViscousSweepTroughOverOperators) {
   std::vector<double> argmin;
   for (uint64_t seed = 1; seed <= 8; ++seed) {
