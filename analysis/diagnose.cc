@@ -16,6 +16,7 @@
 #include "analysis/effects.h"
 #include "analysis/generate.h"
 #include "analysis/predict.h"
+#include "analysis/statistics.h"
 #include "model/leg_dynamics.h"
 #include "dsp/butterworth.h"
 #include "model/input_error.h"
@@ -231,18 +232,6 @@ Kinematics Slice(const Kinematics& kin, size_t a, size_t b) {
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
   k.derivative_source = kin.derivative_source;
   return k;
-}
-
-double Pearson(const std::vector<double>& x, const std::vector<double>& y, size_t a, size_t b) {
-  double mx = 0, my = 0;
-  const double n = static_cast<double>(b - a);
-  for (size_t i = a; i < b; ++i) mx += x[i], my += y[i];
-  mx /= n, my /= n;
-  double sxy = 0, sxx = 0, syy = 0;
-  for (size_t i = a; i < b; ++i) {
-    sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx), syy += (y[i] - my) * (y[i] - my);
-  }
-  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
 }
 
 // Dominant frequency (Hz) of x[a, b) by a direct DFT of a strided copy, 0.05 .. 25 Hz.

@@ -13,6 +13,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/emg_calibration.h"
 #include "analysis/measured_data.h"
+#include "analysis/statistics.h"
 #include "hwsim/emg_amplifier.h"
 #include "model/input_error.h"
 #include "model/leg_dynamics.h"
@@ -276,6 +277,7 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
       }
     }
     for (int j = 0; j < 2; ++j) {
+      std::vector<double> yhat_identified;  // eq. (27) with the identified set's beta, gamma
       for (int mi = 0; mi < 3; ++mi) {
         dyn[mi][j] = FitDynamicBetaGamma(j, iso[j].fit.alpha, mp.theta_c[j], le, q[j], qd[j], tau_M[mi][j]);
         const std::string key = std::string(kModel[mi]) + "_" + kJoint[j];
@@ -283,23 +285,25 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
         m["dyn_nrms_" + key + "_pct"] = dyn[mi][j].quality.nrms_pct;
         m["dyn_beta_" + key + "_e3_per_deg"] = 1e3 * dyn[mi][j].beta_per_deg();
         m["dyn_gamma_" + key + "_e3_per_deg_s"] = 1e3 * dyn[mi][j].gamma_per_deg_s();
-        if (mi > 0) {
-          m["r2_margin_" + key] = dyn[0][j].quality.r2 - dyn[mi][j].quality.r2;
-          // How far the anthropometric model moves tau_M from the identified one, how much of that
-          // shift is a copy of the effort itself (correlation with tau_M), and the R^2 the set would
-          // get without refitting beta, gamma (the identified set's): the refit's share of the margin.
-          double e2 = 0, m2 = 0, em = 0;
-          std::vector<double> yhat;
-          for (size_t k = 0; k < tau_M[0][j].size(); ++k) {
-            const double e = tau_M[mi][j][k] - tau_M[0][j][k];
-            e2 += e * e, m2 += tau_M[0][j][k] * tau_M[0][j][k], em += e * tau_M[0][j][k];
-            yhat.push_back(DynamicTorque(j, iso[j].fit.alpha, dyn[0][j].beta, dyn[0][j].gamma, mp.theta_c[j],
-                                         le[k], q[j][k], qd[j][k]));
-          }
-          m["tau_M_shift_rms_" + key] = std::sqrt(e2 / tau_M[0][j].size());
-          m["tau_M_shift_effort_corr_" + key] = e2 > 0 && m2 > 0 ? em / std::sqrt(e2 * m2) : 0.0;
-          m["r2_margin_fixed_beta_gamma_" + key] = dyn[0][j].quality.r2 - Quality(tau_M[mi][j], yhat).r2;
+        if (mi == 0) {
+          for (size_t k = 0; k < le.size(); ++k)
+            yhat_identified.push_back(DynamicTorque(j, iso[j].fit.alpha, dyn[0][j].beta, dyn[0][j].gamma,
+                                                    mp.theta_c[j], le[k], q[j][k], qd[j][k]));
+          continue;
         }
+        m["r2_margin_" + key] = dyn[0][j].quality.r2 - dyn[mi][j].quality.r2;
+        // How far the anthropometric model moves tau_M from the identified one, how much of that
+        // shift is a copy of the effort itself (correlation with tau_M), and the R^2 the set would
+        // get without refitting beta, gamma (the identified set's): the refit's share of the margin.
+        double e2 = 0;
+        std::vector<double> shift;
+        for (size_t k = 0; k < tau_M[0][j].size(); ++k) {
+          shift.push_back(tau_M[mi][j][k] - tau_M[0][j][k]);
+          e2 += shift.back() * shift.back();
+        }
+        m["tau_M_shift_rms_" + key] = std::sqrt(e2 / tau_M[0][j].size());
+        m["tau_M_shift_effort_corr_" + key] = Pearson(shift, tau_M[0][j]);
+        m["r2_margin_fixed_beta_gamma_" + key] = dyn[0][j].quality.r2 - Quality(tau_M[mi][j], yhat_identified).r2;
       }
       double s2 = 0;
       for (double v : tau_M[0][j]) s2 += v * v;

@@ -29,6 +29,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kExt = 1, kFlex = 3;  // EMG channels of HAL's two sensor units: VM, ST
+constexpr double kPaperViscousOptimum = 1.56;  // Lee & Sankai sec. 4.2, N m/(rad/s)
 constexpr double kRmsWindow = 0.1;  // s, T of eq. (1), controller and calibration alike
 
 struct Mean {
@@ -183,7 +184,6 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   ProjectedViscoelasticity projected(std::pow(loop_cfg.assist.rls.rho, dt / ctrl_dt));
   std::vector<double> tau_m, m_e, m_f;
   double th_max = -10, th_min = 10, t = 0;
-  size_t samples = 0;  // log-rate samples (rows of measured.csv when it is written)
   for (long k = 0; k < n_steps; ++k) {
     if (k % steps_per_tick == 0) {
       bus.AdvanceTo(t + 0.5 * dt);
@@ -237,7 +237,6 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
       if (projected.valid()) D_proj.Add(projected.D()), K_proj.Add(projected.K());
       D_hat.Add(tel.assist.D), K_hat.Add(tel.assist.K);
     }
-    if (k % log_every == 0) ++samples;
     if (measured && k % log_every == 0) {
       const auto& o = emg_node.last_output();
       const double row[] = {t, tel.th, tel.strain, tel.tau_cmd, o[0], o[1], o[2], o[3], o[4],
@@ -253,7 +252,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   }
   TrialOut out;
   auto& m = out.m;
-  m["samples"] = static_cast<double>(samples);
+  m["samples"] = static_cast<double>((n_steps + log_every - 1) / log_every);  // log-rate rows (k % log_every == 0)
   m["emg_ext_up_V"] = ext_up.get();
   m["emg_ext_down_V"] = ext_down.get();
   m["emg_flex_up_V"] = flex_up.get();
@@ -346,7 +345,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
     m["sweep_rise_low_pct"] = 100 * (J.front() / J[best] - 1);
     m["sweep_rise_high_pct"] = 100 * (J.back() / J[best] - 1);
     m["sweep_argmin_J_me_viscosity"] = values[ArgMin(Je)];
-    m["sweep_paper_optimum"] = 1.56;  // Lee & Sankai sec. 4.2, N m/(rad/s)
+    m["sweep_paper_optimum"] = kPaperViscousOptimum;
     std::vector<double> bv = values;
     WriteCsv(opt.out_dir + "/sweep.csv", {"B_v", "J_tau_m", "J_e", "J_f", "J_me", "J_mf"},
              {&bv, &J, &Je, &Jf, &Jme, &Jmf},
@@ -365,7 +364,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
                     {"J_me, extensor (eq. 16)", bv, Jme, "#2c6fbb"},
                     {"J_mf, flexor (eq. 15)", bv, Jmf, "#2e9a48"}};
     chart.markers = {{values[best], "twin minimum " + Fmt(values[best]), "#c0392b"},
-                     {1.56, "paper 1.56", "#555555"}};
+                     {kPaperViscousOptimum, "paper " + Fmt(kPaperViscousOptimum), "#555555"}};
     WriteFileAtomic(opt.out_dir + "/sweep.svg", LineChartSvg(chart));
     result.files.push_back("sweep.svg");
   }

@@ -202,10 +202,10 @@ std::string LineChartSvg(const LineChart& c) {
         flush();
         continue;
       }
-      pts += (pts.empty() ? "" : " ") + Fmt("%.2f", f.X(ser.x[i])) + "," + Fmt("%.2f", f.Y(ser.y[i]));
-      if (ser.x.size() <= 60)
-        s += "<circle cx=\"" + Fmt("%.2f", f.X(ser.x[i])) + "\" cy=\"" + Fmt("%.2f", f.Y(ser.y[i])) + "\" r=\"3\" fill=\"" +
-             ser.colour + "\"/>\n";
+      const std::string px = Fmt("%.2f", f.X(ser.x[i])), py = Fmt("%.2f", f.Y(ser.y[i]));
+      pts += (pts.empty() ? "" : " ") + px + "," + py;
+      if (ser.x.size() <= 60)  // dots on the samples of short series
+        s += "<circle cx=\"" + px + "\" cy=\"" + py + "\" r=\"3\" fill=\"" + ser.colour + "\"/>\n";
     }
     flush();
   }

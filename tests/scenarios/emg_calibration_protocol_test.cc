@@ -165,7 +165,8 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
   ASSERT_TRUE(subject.has_value());
   deleva.human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, subject->weight, id.L1, subject->L2);
   double e2[2] = {0, 0}, t2[2] = {0, 0};
-  double sh2[2] = {0, 0}, m2[2] = {0, 0}, shm[2] = {0, 0};  // De Leva's shift of tau_M against tau_M
+  // De Leva's shift of tau_M against tau_M: sums for their (centred) correlation.
+  double sh[2] = {0, 0}, tmv[2] = {0, 0}, sh2[2] = {0, 0}, m2[2] = {0, 0}, shm[2] = {0, 0};
   size_t n = 0;
   for (size_t k = 0; k < d.size(); ++k) {
     if (d.t[k] < s.human.active_from || d.t[k] > d.t.back() - 1.0) continue;
@@ -175,6 +176,7 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
     for (int j = 0; j < 2; ++j) {
       e2[j] += std::pow(tm[j] - (*truth_tau[j])[k], 2);
       t2[j] += std::pow((*truth_tau[j])[k], 2);
+      sh[j] += shift[j], tmv[j] += tm[j];
       sh2[j] += shift[j] * shift[j], m2[j] += tm[j] * tm[j], shm[j] += shift[j] * tm[j];
     }
     ++n;
@@ -186,7 +188,9 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
   // identified set's beta, gamma is never below the refitted one.
   for (int j = 0; j < 2; ++j) {
     const std::string jn = j ? "knee" : "hip";
-    const double corr = shm[j] / std::sqrt(sh2[j] * m2[j]);
+    const double cov = shm[j] - sh[j] * tmv[j] / n, var_sh = sh2[j] - sh[j] * sh[j] / n,
+                 var_m = m2[j] - tmv[j] * tmv[j] / n;
+    const double corr = cov / std::sqrt(var_sh * var_m);
     std::printf("[table7] %s: corr(De Leva shift, tau_M) %.3f (metric %.3f); margin %.4f refitted, %.4f with the "
                 "identified beta, gamma\n", jn.c_str(), corr, r.metrics.at("tau_M_shift_effort_corr_deleva_" + jn),
                 r.metrics.at("r2_margin_deleva_" + jn), r.metrics.at("r2_margin_fixed_beta_gamma_deleva_" + jn));

@@ -1,0 +1,20 @@
+#include "analysis/statistics.h"
+
+#include <cmath>
+
+namespace exotwin {
+
+double Pearson(const std::vector<double>& x, const std::vector<double>& y, size_t a, size_t b) {
+  if (b <= a) return 0.0;
+  double mx = 0, my = 0;
+  const double n = static_cast<double>(b - a);
+  for (size_t i = a; i < b; ++i) mx += x[i], my += y[i];
+  mx /= n, my /= n;
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = a; i < b; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx), syy += (y[i] - my) * (y[i] - my);
+  }
+  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+}
+
+}  // namespace exotwin
