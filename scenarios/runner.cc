@@ -187,7 +187,8 @@ std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams&
     // follows the posture. kd = 0: the exaggeration is an amplitude intent, kp (gain - 1)(q* - mean).
     TrackingGains gains;
     gains.kd.setZero();
-    return std::make_unique<ExaggeratedGait>(mp, base, kGaitMeanPosture, h.gain, h.active_from, 0.02, gains);
+    return std::make_unique<ExaggeratedGait>(mp, base, kGaitMeanPosture, h.gain, h.active_from, 0.02, gains,
+                                             h.outward_gate);
   }
   return std::make_unique<RelaxedBehaviour>();
 }

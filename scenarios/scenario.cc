@@ -181,13 +181,14 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   if (root["human"]) {
     const YAML::Node n = root["human"];
     r.Keys(n, "human", {"behaviour", "active_from", "gain", "contractions", "levels", "cocontraction",
-                        "programme_seed", "emg", "muscle_seed"});
+                        "programme_seed", "emg", "muscle_seed", "outward_gate"});
     HumanSpec& h = s.human;
     if (n["behaviour"])
       h.behaviour = r.Str(n["behaviour"], "human.behaviour",
                           {"relaxed", "exaggerated_gait", "isometric_hip", "isometric_knee"});
     if (n["active_from"]) h.active_from = r.Num(n["active_from"], "human.active_from", 0, 3600);
     if (n["gain"]) h.gain = r.Num(n["gain"], "human.gain", 0.5, 3);
+    if (n["outward_gate"]) h.outward_gate = r.Num(n["outward_gate"], "human.outward_gate", 0, 100);
     if (n["contractions"]) h.contractions = static_cast<int>(r.Num(n["contractions"], "human.contractions", 1, 100));
     if (n["levels"]) {
       const YAML::Node v = n["levels"];

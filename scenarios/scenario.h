@@ -47,6 +47,7 @@ struct HumanSpec {
   std::string behaviour = "relaxed";  // relaxed | exaggerated_gait | isometric_hip | isometric_knee
   double active_from = 5.0;           // s: exaggerated gait starts here (relaxed before, as Fig. 9)
   double gain = 1.3;                  // exaggerated gait: amplification of the pattern
+  double outward_gate = 0.0;          // exaggerated gait: ExaggeratedGait's outward gate s0 (rad^2/s; 0 = off)
   int contractions = 6;               // isometric programmes: number of contractions
   double levels[2] = {0.2, 0.8};      // isometric programmes: contraction levels, fraction of MVC
   double cocontraction = 0.1;         // isometric programmes: antagonist drive / agonist level

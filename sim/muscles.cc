@@ -342,18 +342,37 @@ MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& 
   return u;  // at the cap (not reached in tests/sim/muscles_test.cc): a feasible point
 }
 
+void ExaggeratedTarget(const Eigen::Vector2d& mean, double gain, double outward_gate, Eigen::Vector2d& q,
+                       Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+  if (outward_gate <= 0) {  // amplitude intent: the pattern scaled about its mean
+    q = mean + gain * (q - mean);
+    qd *= gain;
+    qdd *= gain;
+    return;
+  }
+  // q* = q_b + (gain - 1) w x, x = q_b - mean, w = (1 + tanh(p / s0)) / 2, p = x qd_b;
+  // qd* = qd_b + (gain - 1)(w qd_b + w' x), w' = (1 - tanh^2) / (2 s0) (qd_b^2 + x qdd_b);
+  // qdd* keeps (gain - 1) w qdd_b only (w'' dropped: the gait runner's feed-forward inertia is 0).
+  for (int j = 0; j < 2; ++j) {
+    const double x = q[j] - mean[j], th = std::tanh(x * qd[j] / outward_gate);
+    const double w = 0.5 * (1 + th);
+    const double w_dot = 0.5 * (1 - th * th) / outward_gate * (qd[j] * qd[j] + x * qdd[j]);
+    q[j] += (gain - 1) * w * x;
+    qd[j] += (gain - 1) * (w * qd[j] + w_dot * x);
+    qdd[j] += (gain - 1) * w * qdd[j];
+  }
+}
+
 ExaggeratedGait::ExaggeratedGait(const MuscleParams& p, IntendedMotion base, Eigen::Vector2d mean,
                                  double gain, double t_active, double cocontraction,
-                                 TrackingGains gains)
+                                 TrackingGains gains, double outward_gate)
     : t_active_(t_active),
       tracking_(
           p,
-          [base = std::move(base), mean, gain](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd,
-                                               Eigen::Vector2d& qdd) {
+          [base = std::move(base), mean, gain, outward_gate](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd,
+                                                             Eigen::Vector2d& qdd) {
             base(t, q, qd, qdd);
-            q = mean + gain * (q - mean);
-            qd *= gain;
-            qdd *= gain;
+            ExaggeratedTarget(mean, gain, outward_gate, q, qd, qdd);
           },
           gains, [cocontraction](double, const Eigen::Vector2d&, const Eigen::Vector2d&) {
             return cocontraction;

@@ -247,13 +247,23 @@ class VoluntaryTracking : public Behaviour {
   std::deque<Sensed> sensed_;  // history over the last feedback_delay s (delayed feedback)
 };
 
+// The exaggerated gait's intended motion from the pattern's (q, qd, qdd) = (q_b, qd_b, qdd_b),
+// replaced in place (rad, rad/s, rad/s^2). outward_gate <= 0: q* = mean + gain (q_b - mean) (the
+// amplitude intent). outward_gate = s0 > 0 (rad^2/s): the exaggeration (gain - 1)(q_b - mean) is
+// weighted per joint by w = (1 + tanh((q_b - mean) qd_b / s0)) / 2: pushed while the pattern moves
+// away from the mean, faded while it comes back; qd* is the exact derivative of q*.
+void ExaggeratedTarget(const Eigen::Vector2d& mean, double gain, double outward_gate, Eigen::Vector2d& q,
+                       Eigen::Vector2d& qd, Eigen::Vector2d& qdd);
+
 // Exaggerated gait (Hwang & Jeon section 4.3): relaxed until t_active, then the subject tracks the
 // exoskeleton's gait pattern `base` amplified about `mean` by `gain` (> 1: more flexion/extension
 // than the pattern), with co-contraction `cocontraction` (fraction of MVC).
 class ExaggeratedGait : public Behaviour {
  public:
+  // outward_gate: see ExaggeratedTarget (0 = the amplitude intent).
   ExaggeratedGait(const MuscleParams& p, IntendedMotion base, Eigen::Vector2d mean, double gain,
-                  double t_active, double cocontraction = 0.02, TrackingGains gains = {});
+                  double t_active, double cocontraction = 0.02, TrackingGains gains = {},
+                  double outward_gate = 0.0);
   MuscleVec Excitation(double t, const Eigen::Vector2d& q, const Eigen::Vector2d& qd) override;
 
  private:

@@ -71,6 +71,16 @@ TEST(Scenario, RejectsBadInput) {
   ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1, random_seed: 3}\n", "exactly one of");
   ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1}\ncontroller: {kp: [1]}\n",
               "controller.kp: expected [hip, knee]");
+  ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1}\nhuman: {outward_gate: -0.5}\n",
+              "human.outward_gate: value -0.5 out of range");
+}
+
+TEST(Scenario, ExaggeratedGaitOutwardGate) {
+  const Scenario off = ParseScenarioYaml("name: x\ndevice: exowheel\nsubject: {preset: S1}\n", "a.yaml");
+  EXPECT_EQ(off.human.outward_gate, 0.0);  // the amplitude intent unless asked
+  const Scenario on = ParseScenarioYaml(
+      "name: x\ndevice: exowheel\nsubject: {preset: S1}\nhuman: {behaviour: exaggerated_gait, outward_gate: 2}\n", "b.yaml");
+  EXPECT_EQ(on.human.outward_gate, 2.0);
 }
 
 }  // namespace

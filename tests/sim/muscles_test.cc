@@ -395,5 +395,58 @@ TEST(Muscles, KneeDemandIsSharedBySynergistsInProportionToAlpha) {
   }
 }
 
+
+// ExaggeratedTarget: the amplitude intent unchanged at s0 = 0; with the outward gate, qd* is the
+// derivative of q* (central difference, step 1e-5 s: truncation h^2 |q'''| / 6, up to ~3e-6 rad/s
+// where the steepest gate, s0 = 0.05, switches within a few ms and qd* reaches 18 rad/s; tolerance
+// 1e-6 (1 + |qd*|); an error in w' would show as O(1)) and w takes its limits: 1 moving out, 0 coming back, 1/2 at the turning points.
+TEST(Muscles, ExaggeratedTargetOutwardGateIsSmoothAndTakesItsLimits) {
+  const Eigen::Vector2d mean(0.25, -0.6);
+  const auto pattern = [&](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+    const double w = 2 * kPi * 0.5;  // a stride of 2 s with a second harmonic, like a gait pattern
+    q = mean + Eigen::Vector2d(0.3 * std::sin(w * t), 0.4 * std::sin(w * t - 1.0) + 0.1 * std::sin(2 * w * t));
+    qd = Eigen::Vector2d(0.3 * w * std::cos(w * t), 0.4 * w * std::cos(w * t - 1.0) + 0.2 * w * std::cos(2 * w * t));
+    qdd = Eigen::Vector2d(-0.3 * w * w * std::sin(w * t),
+                          -0.4 * w * w * std::sin(w * t - 1.0) - 0.4 * w * w * std::sin(2 * w * t));
+  };
+  const auto target = [&](double t, double s0, Eigen::Vector2d& q, Eigen::Vector2d& qd) {
+    Eigen::Vector2d qdd;
+    pattern(t, q, qd, qdd);
+    ExaggeratedTarget(mean, 2.0, s0, q, qd, qdd);
+  };
+  for (double t = 0; t < 2.0; t += 0.013) {
+    Eigen::Vector2d q, qd, qdd, q0, qd0;
+    pattern(t, q, qd, qdd);
+    const Eigen::Vector2d qb = q;
+    target(t, 0.0, q0, qd0);
+    EXPECT_EQ(q0, mean + 2.0 * (qb - mean));  // the amplitude intent, bit for bit
+    for (double s0 : {0.05, 0.5, 3.0}) {
+      Eigen::Vector2d qs, qds, qp, qm, dummy;
+      target(t, s0, qs, qds);
+      const double h = 1e-5;
+      target(t + h, s0, qp, dummy);
+      target(t - h, s0, qm, dummy);
+      for (int j = 0; j < 2; ++j) {
+        EXPECT_NEAR(qds[j], (qp[j] - qm[j]) / (2 * h), 1e-6 * (1 + std::abs(qds[j]))) << "t " << t << " s0 " << s0 << " joint " << j;
+        // Between the pattern (w = 0) and the full exaggeration (w = 1).
+        const double lo = std::min(qb[j], mean[j] + 2.0 * (qb[j] - mean[j]));
+        const double hi = std::max(qb[j], mean[j] + 2.0 * (qb[j] - mean[j]));
+        EXPECT_GE(qs[j], lo - 1e-12);
+        EXPECT_LE(qs[j], hi + 1e-12);
+      }
+    }
+  }
+  // Limits of w on a pure sine about the mean (x = A sin, qd = A w cos).
+  const auto limits = [&](double x, double v, double s0) {
+    Eigen::Vector2d q(mean[0] + x, mean[1]), qd(v, 0), qdd(0, 0);
+    ExaggeratedTarget(mean, 2.0, s0, q, qd, qdd);
+    return (q[0] - mean[0]) / x - 1.0;  // = (gain - 1) w = w
+  };
+  EXPECT_NEAR(limits(0.3, 1.0, 1e-3), 1.0, 1e-12);   // moving out: full push
+  EXPECT_NEAR(limits(0.3, -1.0, 1e-3), 0.0, 1e-12);  // coming back: relaxed onto the pattern
+  EXPECT_NEAR(limits(0.3, 0.0, 1e-3), 0.5, 1e-12);   // turning point
+  EXPECT_NEAR(limits(-0.3, -1.0, 0.5), 0.5 * (1 + std::tanh(0.3 / 0.5)), 1e-12);  // out on the other side
+}
+
 }  // namespace
 }  // namespace exotwin
