@@ -98,6 +98,10 @@ TEST(HalRunner, RlsViscosityWithin20PercentStiffnessIsAKnownGap) {
   // checks): D inside the bound, K inside twice it.
   EXPECT_LT(m.at("rls_D_err_pct"), 20.0);
   EXPECT_LT(m.at("rls_K_err_pct"), 40.0);
+  // On the RLS's own scale, K' = K + Mgl (eq. 8): recomputed from the reported means; seed 1 ~1 %.
+  const double Kp = m.at("truth_K_mean") + m.at("plant_mgl");
+  EXPECT_NEAR(m.at("rls_K_err_pct_of_Kprime"), 100 * std::abs(m.at("rls_K_mean") - m.at("truth_K_mean")) / Kp, 1e-9);
+  EXPECT_LT(m.at("rls_K_err_pct_of_Kprime"), 5.0);
 }
 
 TEST(HalRunner, WritesMeasuredCsvWithHalColumns) {
