@@ -395,11 +395,11 @@ TEST(Muscles, KneeDemandIsSharedBySynergistsInProportionToAlpha) {
   }
 }
 
-
-// ExaggeratedTarget: the amplitude intent unchanged at s0 = 0; with the outward gate, qd* is the
-// derivative of q* (central difference, step 1e-5 s: truncation h^2 |q'''| / 6, up to ~3e-6 rad/s
-// where the steepest gate, s0 = 0.05, switches within a few ms and qd* reaches 18 rad/s; tolerance
-// 1e-6 (1 + |qd*|); an error in w' would show as O(1)) and w takes its limits: 1 moving out, 0 coming back, 1/2 at the turning points.
+// ExaggeratedTarget: the amplitude intent unchanged at s0 = 0. With the outward gate, qd* is the
+// derivative of q*: central difference, step 1e-5 s, truncation h^2 |q'''| / 6 up to ~3e-6 rad/s
+// where the steepest gate (s0 = 0.05) switches within a few ms and qd* reaches 18 rad/s; tolerance
+// 1e-6 (1 + |qd*|), while an error in w' would show as O(1). And w takes its limits: 1 moving out,
+// 0 coming back, 1/2 at the turning points.
 TEST(Muscles, ExaggeratedTargetOutwardGateIsSmoothAndTakesItsLimits) {
   const Eigen::Vector2d mean(0.25, -0.6);
   const auto pattern = [&](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
