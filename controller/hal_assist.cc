@@ -77,6 +77,9 @@ ViscoelasticRls::ViscoelasticRls(const ViscoelasticRlsConfig& cfg) : cfg_(cfg) {
   const double Dp = cfg.D0 + cfg.R, Kp = cfg.K0 + (cfg.gravity_in_input ? 0.0 : cfg.mgl);
   X_ << e1_ - Dp / cfg.I0, e2_ - Kp / cfg.I0, cfg.dt / (2 * cfg.I0), 1 / cfg.I0;
   P_ = cfg.p0 * Eigen::Matrix4d::Identity();
+  // Known inertia: X3, X4 have zero covariance, so P phi has no X3, X4 component and eq. (13) is
+  // the two-parameter RLS on th - X3 phi3 - X4 phi4 (its rows and columns stay zero under eq. 13).
+  if (cfg.known_inertia) P_.block<2, 2>(2, 2).setZero();
 }
 
 void ViscoelasticRls::Step(double th, double u_in) {
@@ -139,7 +142,8 @@ HalAssistOutput HalAssistController::Step(double th, double E_e, double E_f, dou
     started_ = true;
   }
   o.mu_hat = EstimateMuscleTorque(cfg_.emg, E_e, E_f);     // eq. (2)
-  const double u = tau_prev_ + o.mu_hat;                    // eq. (9), sigma = 0
+  // Eq. (9), sigma = 0; minus the actuator's known Coulomb friction (friction_C, our extension).
+  const double u = tau_prev_ + o.mu_hat - cfg_.friction_C * std::tanh(thd_prev_ / cfg_.friction_eps);
   rls_.Step(th, u);
   // Safety (our addition): estimates outside a physical range (I beyond 1/4..4 x the identified
   // I0, negative or non-finite D, K) are replaced by the clamped / prior values, so a badly excited
@@ -161,6 +165,7 @@ HalAssistOutput HalAssistController::Step(double th, double E_e, double E_f, dou
   o.tau_c = tau_c;
   o.tau = std::clamp(o.tau_zeta + o.tau_mu + o.tau_c, -cfg_.tau_max, cfg_.tau_max);  // eq. (6)
   tau_prev_ = o.tau;
+  thd_prev_ = o.thd_hat;
   return o;
 }
 

@@ -83,6 +83,13 @@ struct ViscoelasticRlsConfig {
   // true (our extension): the known gravity moment is moved into the input, u - mgl sin th, so the
   // RLS estimates K' = K directly.
   bool gravity_in_input = false;
+  // false: the paper's eq. (11)-(13), all four X estimated, I^ = 1/X4.
+  // true (our extension): I is the identified I0 of eq. (14) (an invariant parameter like M g l and
+  // R), X3 = T/(2 I0) and X4 = 1/I0 are held, and the RLS estimates X1, X2 only. In a near-sinusoidal
+  // swing th'' ~ -w^2 th, so K' and I w^2 are nearly collinear and the four-parameter RLS trades
+  // them: K' = (e2 - X2) I^ inherits I^'s error (at 10 % co-contraction, K^ 60-80 % high with I^
+  // 2-6x the truth).
+  bool known_inertia = false;
 };
 
 class ViscoelasticRls {
@@ -139,6 +146,13 @@ struct HalAssistConfig {
   ViscoelasticRlsConfig rls;
   double lambda1 = 60.0, lambda2 = 80.0;
   double tau_max = 60.0;  // actuator limit, N m (models/hal3_knee.xml ctrlrange)
+  // Known Coulomb friction of HAL's actuator (N m; identified with eq. 15, used by tau_c), moved out
+  // of the RLS input: u = tau + mu^ - C tanh(thd^ / eps), thd^ the observer's previous velocity.
+  // Eq. (4) has no Coulomb term, so the part of tau that only overcomes it would otherwise be read
+  // as operator viscosity: C E|thd| / E[thd^2] (~0.25 N m s/rad, 7 % of D at 10 % co-contraction,
+  // C = 0.4 N m). 0 = the paper's input (eq. 9). Our extension.
+  double friction_C = 0.0;
+  double friction_eps = 0.05;  // rad/s (as controller/virtual_impedance.h)
 };
 
 // Torques of one control step, N m.
@@ -163,7 +177,7 @@ class HalAssistController {
   HalAssistConfig cfg_;
   ViscoelasticRls rls_;
   AdaptiveObserver obs_;
-  double tau_prev_ = 0;
+  double tau_prev_ = 0, thd_prev_ = 0;
   bool started_ = false;
 };
 

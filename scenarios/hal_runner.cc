@@ -111,6 +111,8 @@ controller::HalLoopConfig LoopConfig(const Scenario& s, const Hal3PlantParams& p
   a.rls.mgl = pp.mgl();  // eq. (14)
   a.rls.I0 = pp.I();
   a.rls.gravity_in_input = s.hal.rls_gravity_in_input;
+  a.rls.known_inertia = s.hal.rls_known_inertia;
+  if (s.hal.rls_friction_in_input) a.friction_C = pp.C;  // the identified C of tau_c (eq. 15)
   return c;
 }
 
@@ -132,11 +134,14 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
 
   const MuscleParams mp = OperatorMuscles(s);
   const SyntheticEmgConfig emg_cfg = DefaultSyntheticEmgConfig();
-  const HalEmgCoefficients coeffs = CalibrateHalEmg(mp, emg_cfg, {kExt, kFlex, kRmsWindow, 4, 0.02, 0.12}, seed + 11);
+  const HalEmgCalibrationSpec cal{kExt, kFlex, kRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
+                                  s.hal.calibration_rest};
+  const HalEmgCoefficients coeffs = CalibrateHalEmg(mp, emg_cfg, cal, seed + 11);
   MuscleModel muscles(mp, dt);
   TrackingGains gains = KneeSwingBehaviour::KneeSwingGains();
   gains.inertia[1] = pp.I();  // a rehearsed operator knows its leg + HAL (Hayashi sec. III)
   gains.feedback_delay = s.hal.operator_delay;
+  gains.cocontraction_synergy = s.hal.cc_synergy;
   KneeSwingBehaviour swing(mp, s.hal.swing_freq, s.hal.cc_up, s.hal.cc_down, pp.mgl(), gains);
   SyntheticEmg emg(emg_cfg, seed + 13);
 

@@ -102,7 +102,9 @@ const std::set<std::string> kFaultTypes = {"sensor_stuck", "sensor_stale", "enco
 void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (s.device != Device::kHal3) r.Fail("hal", "only allowed with device: hal3");
   r.Keys(n, "hal", {"mode", "alpha_mu", "alpha_zeta", "virtual_viscosity", "sweep_viscosity", "swing_freq",
-                    "cc_up", "cc_down", "settle", "rls_gravity_in_input", "operator_delay"});
+                    "cc_up", "cc_down", "settle", "rls_gravity_in_input", "rls_known_inertia",
+                    "operator_delay", "cc_synergy", "rls_friction_in_input", "calibration_levels",
+                    "calibration_hi", "calibration_rest"});
   HalSpec& h = s.hal;
   if (n["mode"]) h.mode = r.Str(n["mode"], "hal.mode", {"none", "impedance", "assist"});
   if (n["alpha_mu"]) h.alpha_mu = r.Num(n["alpha_mu"], "hal.alpha_mu", 0, 5);
@@ -121,6 +123,13 @@ void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (n["settle"]) h.settle = r.Num(n["settle"], "hal.settle", 0, 3600);
   if (n["operator_delay"]) h.operator_delay = r.Num(n["operator_delay"], "hal.operator_delay", 0, 0.3);
   if (n["rls_gravity_in_input"]) h.rls_gravity_in_input = r.Bool(n["rls_gravity_in_input"], "hal.rls_gravity_in_input");
+  if (n["calibration_levels"]) h.calibration_levels = static_cast<int>(r.Num(n["calibration_levels"], "hal.calibration_levels", 2, 50));
+  if (n["calibration_hi"]) h.calibration_hi = r.Num(n["calibration_hi"], "hal.calibration_hi", 0.05, 1);
+  if (n["calibration_rest"]) h.calibration_rest = r.Num(n["calibration_rest"], "hal.calibration_rest", 0.5, 60);
+  if (n["rls_friction_in_input"])
+    h.rls_friction_in_input = r.Bool(n["rls_friction_in_input"], "hal.rls_friction_in_input");
+  if (n["cc_synergy"]) h.cc_synergy = r.Bool(n["cc_synergy"], "hal.cc_synergy");
+  if (n["rls_known_inertia"]) h.rls_known_inertia = r.Bool(n["rls_known_inertia"], "hal.rls_known_inertia");
 }
 
 void ParseEmgCalibration(const Reader& r, const YAML::Node& n, Scenario& s) {

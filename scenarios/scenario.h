@@ -81,8 +81,16 @@ struct HalSpec {
   std::vector<double> sweep_viscosity;  // non-empty: one run per B_v (replaces protocol.trials)
   double swing_freq = 0.5;          // Hz
   double cc_up = 0.0, cc_down = 0.05;  // co-contraction drive (fraction of MVC) outside / in swing-down
+  bool cc_synergy = false;          // TrackingGains::cocontraction_synergy (mix within each group)
+  // Eq. (2) calibration exercise (scenarios/hal_emg_calibration.h): contraction levels per direction
+  // from 2 % to calibration_hi of MVC, and the relaxed rest (s) that gives the baselines.
+  int calibration_levels = 4;
+  double calibration_hi = 0.12;
+  double calibration_rest = 1.5;
   double settle = 4.0;              // s at the start excluded from the metrics
   bool rls_gravity_in_input = true; // ViscoelasticRlsConfig::gravity_in_input
+  bool rls_known_inertia = false;   // ViscoelasticRlsConfig::known_inertia (I from eq. 14)
+  bool rls_friction_in_input = false;  // HalAssistConfig::friction_C = the actuator's C (eq. 15)
   double operator_delay = 0.0;      // s, neural delay of the operator's feedback (TrackingGains::feedback_delay)
 };
 

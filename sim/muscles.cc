@@ -263,8 +263,16 @@ MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
     for (int m = 0; m < kNumMuscles; ++m) {
       if (kSign[m][j] == 0) continue;
       A(j, m) = kSign[m][j] * p_.alpha(m, j);
+      double share = 1.0;
+      if (g_.cocontraction_synergy) {
+        double group_max = 0;
+        for (int n = 0; n < kNumMuscles; ++n)
+          if (kSign[n][j] == kSign[m][j]) group_max = std::max(group_max, p_.alpha(n, j));
+        share = group_max > 0 ? p_.alpha(m, j) / group_max : 1.0;
+      }
+      // A muscle of two active joints takes the larger of its two shares.
+      target[m] = used[m] ? std::max(target[m], cc * share) : cc * share;
       used[m] = true;
-      target[m] = cc;
     }
   }
   // Allocation: min |A u - tau_d|^2 + lambda |u - cc|^2, 0 <= u <= 1, solved exactly (SolveUnitBoxQp).

@@ -206,6 +206,10 @@ struct TrackingGains {
   // 0 = none, the default of the EXOwheel behaviours). The feed-forward (intended motion) is not
   // delayed. The muscles' own co-contraction viscoelasticity acts without this delay.
   double feedback_delay = 0.0;
+  // Mix of the co-contraction drive c among the muscles of a group (same action at an active joint):
+  // false: every muscle at c; true: muscle m at c alpha(m, j) / max alpha of its group at j (the
+  // group's synergy, the mix of a voluntary contraction: min-norm allocation is alpha-proportional).
+  bool cocontraction_synergy = false;
 };
 
 // Solves min_u 1/2 u'Hu - f'u over 0 <= u_m <= 1 for the muscles with used[m] (the others stay 0),

@@ -94,14 +94,40 @@ TEST(HalRunner, RlsViscosityWithin20PercentStiffnessIsAKnownGap) {
   // Seed 1: D within 7 %, K within 21 % (was +235 % before the exact muscle allocation and the
   // errors-in-variables fit of eq. 2, see the known gap's header). K is ~6 % of the gravity stiffness
   // the RLS also sees, so 1 % of gain error in mu^ is ~17 % of K: over seeds 1-5 K^ errs by 20-140 %.
-  // Regression bounds, not the acceptance (scenarios/known_gaps/hal3_rls_tracking.yaml holds the 20 %
-  // checks): D inside the bound, K inside twice it.
+  // Regression bounds, not the acceptance (scenarios/hal3_rls_tracking.yaml meets the 20 % with a
+  // co-contracting operator; known_gaps/hal3_rls_exp2_stiffness.yaml holds experiment 2's own
+  // condition): D inside the bound, K inside twice it.
   EXPECT_LT(m.at("rls_D_err_pct"), 20.0);
   EXPECT_LT(m.at("rls_K_err_pct"), 40.0);
   // On the RLS's own scale, K' = K + Mgl (eq. 8): recomputed from the reported means; seed 1 ~1 %.
   const double Kp = m.at("truth_K_mean") + m.at("plant_mgl");
   EXPECT_NEAR(m.at("rls_K_err_pct_of_Kprime"), 100 * std::abs(m.at("rls_K_mean") - m.at("truth_K_mean")) / Kp, 1e-9);
   EXPECT_LT(m.at("rls_K_err_pct_of_Kprime"), 5.0);
+}
+
+// The acceptance: D^, K^ within 20 % of the identifiable truth after convergence, for an
+// operator who co-contracts (10 % of MVC), with the four extensions of the scenario's header. The
+// same run with the paper's four-parameter RLS (I estimated): K' trades with I w^2 in the 0.5 Hz
+// swing and K^ misses by far more (seed 1: ~60 %), while I^ leaves the truth; with the known
+// inertia I^ is eq. (14)'s exactly.
+TEST(HalRunner, RlsTracksACoContractingOperatorWithin20Percent) {
+  const Scenario s = ReadScenario(Shipped("hal3_rls_tracking.yaml"));
+  RunOptions o;
+  o.out_dir = TempDir("rls");
+  const RunResult r = RunHalScenario(s, o);
+  for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;
+  const auto& m = r.metrics;
+  std::printf("[hal] RLS, co-contraction 0.1: D^ %.3f vs truth %.3f (%.1f %%), K^ %.3f vs truth %.3f (%.1f %%)\n",
+              m.at("rls_D_mean"), m.at("truth_D_mean"), m.at("rls_D_err_pct"), m.at("rls_K_mean"),
+              m.at("truth_K_mean"), m.at("rls_K_err_pct"));
+  EXPECT_DOUBLE_EQ(m.at("rls_I_hat"), m.at("plant_I"));  // 1 / (1 / I0): rounding only
+  Scenario paper = s;
+  paper.hal.rls_known_inertia = false;
+  o.out_dir = TempDir("rls_paper");
+  const auto& mp = RunHalScenario(paper, o).metrics;
+  std::printf("[hal] same with the four-parameter RLS: K^ %.3f (%.1f %%), I^ %.3f vs %.3f\n", mp.at("rls_K_mean"),
+              mp.at("rls_K_err_pct"), mp.at("rls_I_hat"), mp.at("plant_I"));
+  EXPECT_GT(mp.at("rls_K_err_pct"), 2 * std::max(20.0, m.at("rls_K_err_pct")));
 }
 
 TEST(HalRunner, WritesMeasuredCsvWithHalColumns) {

@@ -13,8 +13,20 @@ device: hal3
 subject: {preset: S1}
 protocol: {duration: 6}
 hal: {mode: assist, alpha_mu: 0.8, alpha_zeta: 0.4, virtual_viscosity: 1.2, sweep_viscosity: [0, 1.56, 3],
-      swing_freq: 0.6, cc_up: 0.01, cc_down: 0.08, settle: 2.5, rls_gravity_in_input: false}
+      swing_freq: 0.6, cc_up: 0.01, cc_down: 0.08, settle: 2.5, rls_gravity_in_input: false,
+      rls_known_inertia: true, rls_friction_in_input: true, cc_synergy: true, calibration_levels: 9,
+      calibration_hi: 0.25, calibration_rest: 4.5}
 )";
+
+// The twin's extensions of Hayashi's method (all on or all off here) and the calibration exercise.
+void ExpectExtensions(const Scenario& s, bool on, int levels, double hi, double rest) {
+  EXPECT_EQ(s.hal.rls_known_inertia, on);
+  EXPECT_EQ(s.hal.rls_friction_in_input, on);
+  EXPECT_EQ(s.hal.cc_synergy, on);
+  EXPECT_EQ(s.hal.calibration_levels, levels);
+  EXPECT_DOUBLE_EQ(s.hal.calibration_hi, hi);
+  EXPECT_DOUBLE_EQ(s.hal.calibration_rest, rest);
+}
 
 TEST(HalScenario, ParsesEveryField) {
   const Scenario s = ParseScenarioYaml(kHal, "hal.yaml");
@@ -30,6 +42,7 @@ TEST(HalScenario, ParsesEveryField) {
   EXPECT_DOUBLE_EQ(s.hal.cc_down, 0.08);
   EXPECT_DOUBLE_EQ(s.hal.settle, 2.5);
   EXPECT_FALSE(s.hal.rls_gravity_in_input);
+  ExpectExtensions(s, true, 9, 0.25, 4.5);
 }
 
 TEST(HalScenario, DefaultsWithoutBlock) {
@@ -38,6 +51,7 @@ TEST(HalScenario, DefaultsWithoutBlock) {
   EXPECT_DOUBLE_EQ(s.hal.alpha_mu, 1.0);
   EXPECT_DOUBLE_EQ(s.hal.alpha_zeta, 0.5);
   EXPECT_TRUE(s.hal.sweep_viscosity.empty());
+  ExpectExtensions(s, false, 4, 0.12, 1.5);  // the paper's method unless asked otherwise
 }
 
 void ExpectRejected(const std::string& hal_line, const std::string& needle, const std::string& device = "hal3") {
@@ -62,6 +76,12 @@ TEST(HalScenario, RejectsBadInput) {
   ExpectRejected("hal: {swing_freq: 0}", "hal.swing_freq");
   ExpectRejected("hal: {cc_down: 2}", "hal.cc_down");
   ExpectRejected("hal: {rls_gravity_in_input: maybe}", "hal.rls_gravity_in_input");
+  ExpectRejected("hal: {rls_known_inertia: 2}", "hal.rls_known_inertia");
+  ExpectRejected("hal: {rls_friction_in_input: yes please}", "hal.rls_friction_in_input");
+  ExpectRejected("hal: {cc_synergy: 0.5}", "hal.cc_synergy");
+  ExpectRejected("hal: {calibration_levels: 1}", "hal.calibration_levels");
+  ExpectRejected("hal: {calibration_hi: 0.01}", "hal.calibration_hi");
+  ExpectRejected("hal: {calibration_rest: 100}", "hal.calibration_rest");
   ExpectRejected("hal: {gain: 1}", "unknown key");
   ExpectRejected("hal: [1, 2]", "hal");
   ExpectRejected("hal: {mode: assist}", "only allowed with device: hal3", "exowheel");

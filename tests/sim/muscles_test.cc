@@ -395,6 +395,44 @@ TEST(Muscles, KneeDemandIsSharedBySynergistsInProportionToAlpha) {
   }
 }
 
+// Co-contraction mix (TrackingGains::cocontraction_synergy): with a knee demand AND co-contraction c,
+// the synergy mix keeps every group alpha-proportional (target c alpha / max alpha plus the min-norm
+// correction, also alpha-proportional), the mix eq. (2) was calibrated with; the uniform mix (every
+// muscle at c) does not, which is what shifts a one-electrode-per-group mu^ under co-contraction.
+TEST(Muscles, CoContractionSynergyKeepsTheCalibrationMix) {
+  const MuscleParams p = DrawMuscleParams(2);
+  const auto I = [](Muscle m) { return static_cast<int>(m); };
+  const IntendedMotion hold = [](double, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+    q = {1.5707963267948966, -1.5707963267948966 + 0.2};
+    qd.setZero();
+    qdd.setZero();
+  };
+  const Eigen::Vector2d q0(1.5707963267948966, -1.5707963267948966), zero(0, 0);
+  for (bool synergy : {true, false}) {
+    TrackingGains g;
+    g.active = {0, 1};
+    g.kp = {0, 60};
+    g.kd = {0, 0};
+    g.cocontraction_synergy = synergy;
+    VoluntaryTracking b(p, hold, g, [](double, const Eigen::Vector2d&, const Eigen::Vector2d&) { return 0.1; });
+    const MuscleVec u = b.Excitation(0.0, q0, zero);
+    for (Muscle m : {Muscle::kVM, Muscle::kRF, Muscle::kST, Muscle::kGAS})  // no bound active
+      ASSERT_TRUE(u[I(m)] > 0 && u[I(m)] < 1) << MuscleName(m) << " " << u[I(m)];
+    const double ext = u[I(Muscle::kRF)] / u[I(Muscle::kVM)] / (p.alpha(I(Muscle::kRF), 1) / p.alpha(I(Muscle::kVM), 1));
+    const double flx = u[I(Muscle::kGAS)] / u[I(Muscle::kST)] / (p.alpha(I(Muscle::kGAS), 1) / p.alpha(I(Muscle::kST), 1));
+    std::printf("[muscles] co-contraction 0.1, %s mix: (RF/VM) / (alpha ratio) %.4f, (GAS/ST) / (alpha ratio) %.4f\n",
+                synergy ? "synergy" : "uniform", ext, flx);
+    if (synergy) {
+      EXPECT_NEAR(ext, 1.0, 1e-6);
+      EXPECT_NEAR(flx, 1.0, 1e-6);
+    } else {  // muscle_seed 2: alpha ratios far from 1, so the uniform mix departs from them
+      EXPECT_GT(std::abs(ext - 1) + std::abs(flx - 1), 0.05);
+    }
+    // Either way the desired torque is met: 60 N m/rad x 0.2 rad.
+    EXPECT_NEAR(ContractionTorque(p, u, q0, zero)[1], 12.0, 1e-3 * 12);
+  }
+}
+
 // ExaggeratedTarget: the amplitude intent unchanged at s0 = 0. With the outward gate, qd* is the
 // derivative of q*: central difference, step 1e-5 s, truncation h^2 |q'''| / 6 up to ~3e-6 rad/s
 // where the steepest gate (s0 = 0.05) switches within a few ms and qd* reaches 18 rad/s; tolerance
