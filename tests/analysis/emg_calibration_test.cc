@@ -201,7 +201,7 @@ struct Knobs {
   bool oracle_le = false;     // LE = the true electrical activation (no EMG at all)
   double gait_kd = 0;         // subject's velocity gain in the gait (< 0: the free-limb default 15 / 4;
                               // 0 as the runner: the exoskeleton imposes the motion)
-  double gait_gain = 2.0;     // exaggeration of the gait pattern (as exowheel_emg_dynamic.yaml)
+  double gait_gain = 1.8;     // exaggeration of the gait pattern (as exowheel_emg_dynamic.yaml)
   bool seated_rest = false;   // co-contraction stiffness about the seated hanging posture (sim default)
   bool rest_subtracted = false;  // processing: relaxed envelope level removed before normalizing
 };
