@@ -259,7 +259,10 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
     model[1] = model[2] = model[0];
     model[1].human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, subject->weight, model[0].L1, subject->L2);
     model[2].human = Table4AnthropometricLumped(AnthropometricModel::kDempster, subject->weight, model[0].L1, subject->L2);
-    const auto w = Window(d.t, s.human.active_from, t_end);
+    // Fitted window: the exaggerated strides, or the whole trial after the gait fade-in (fit_window).
+    const double t_fit = cal.fit_window == "trial" ? std::min(kGaitRamp, s.human.active_from) : s.human.active_from;
+    const auto w = Window(d.t, t_fit, t_end);
+    m["dyn_fit_window_s"] = t_end - t_fit;
     std::vector<MuscleVec> le;
     std::vector<double> q[2], qd[2], tau_M[3][2];
     for (size_t k = w.first; k < w.second; ++k) {

@@ -134,7 +134,7 @@ void ParseHal(const Reader& r, const YAML::Node& n, Scenario& s) {
 
 void ParseEmgCalibration(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (s.device != Device::kExowheel) r.Fail("emg_calibration", "only allowed with device: exowheel");
-  r.Keys(n, "emg_calibration", {"dynamic", "mvc_trials", "hip_pose", "knee_pose", "strides", "subjects"});
+  r.Keys(n, "emg_calibration", {"dynamic", "mvc_trials", "hip_pose", "knee_pose", "strides", "subjects", "fit_window"});
   EmgCalibrationSpec c;
   if (n["dynamic"]) c.dynamic = r.Bool(n["dynamic"], "emg_calibration.dynamic");
   if (n["mvc_trials"]) c.mvc_trials = static_cast<int>(r.Num(n["mvc_trials"], "emg_calibration.mvc_trials", 1, 10));
@@ -142,6 +142,7 @@ void ParseEmgCalibration(const Reader& r, const YAML::Node& n, Scenario& s) {
   if (n["knee_pose"]) r.Pair(n["knee_pose"], "emg_calibration.knee_pose", c.knee_pose, -2.5, 2.5);
   if (n["strides"]) c.strides = static_cast<int>(r.Num(n["strides"], "emg_calibration.strides", 1, 100));
   if (n["subjects"]) c.subjects = static_cast<int>(r.Num(n["subjects"], "emg_calibration.subjects", 1, 10));
+  if (n["fit_window"]) c.fit_window = r.Str(n["fit_window"], "emg_calibration.fit_window", {"active", "trial"});
   s.emg_calibration = c;
 }
 

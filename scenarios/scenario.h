@@ -69,6 +69,11 @@ struct EmgCalibrationSpec {
   // result metrics are the means over the subjects (worst case for *max*, *min*, safe_state_entered),
   // plus *_sd and per-subject "subject_S<i>.<metric>".
   int subjects = 1;
+  // Samples of the eq. (28) fit and of Table 7's R^2: "active" = the exaggerated strides only
+  // (human.active_from .. the last stride); "trial" = the whole gait trial after the controller's
+  // fade-in, so the relaxed lead-in (Fig. 9: relaxed up to 5 s, tau_M ~ 0 with the identified set)
+  // is part of the comparison, as Fig. 9-d shows it.
+  std::string fit_window = "active";
 };
 
 // HAL-3 settings (device: hal3 only; scenarios/hal_runner.h). The operator performs Hayashi's seated

@@ -61,6 +61,10 @@ TEST(EmgCalibrationProtocol, ParsesTheBlockAndTheHumanKeys) {
   EXPECT_DOUBLE_EQ(s.human.levels[1], 0.4);
   EXPECT_DOUBLE_EQ(s.human.cocontraction, 0.2);
   EXPECT_EQ(*s.human.programme_seed, 9u);
+  EXPECT_EQ(s.emg_calibration->fit_window, "active");  // default: the exaggerated strides only
+  const Scenario t = ParseScenarioYaml(
+      "name: cal\ndevice: exowheel\nsubject: {preset: S1}\nemg_calibration: {fit_window: trial}\n", "good.yaml");
+  EXPECT_EQ(t.emg_calibration->fit_window, "trial");
 }
 
 TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
@@ -83,6 +87,8 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
   ExpectInputError(std::string(kHead) + "human: {levels: 0.3}\n", "human.levels");
   ExpectInputError("name: c\ndevice: exowheel\nsubject: {preset: S1}\nemg_calibration: {subjects: 11}\n",
                    "emg_calibration.subjects");
+  ExpectInputError("name: c\ndevice: exowheel\nsubject: {preset: S1}\nemg_calibration: {fit_window: all}\n",
+                   "emg_calibration.fit_window");
   // Through the command line: exit 2 and the file named.
   const std::string dir = testing::TempDir("emgcal_bad");
   testing::WriteText(dir + "/bad.yaml", std::string(kHead) + "human: {levels: [0.5, 0.2]}\n");
@@ -168,8 +174,16 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
   // De Leva's shift of tau_M against tau_M: sums for their (centred) correlation.
   double sh[2] = {0, 0}, tmv[2] = {0, 0}, sh2[2] = {0, 0}, m2[2] = {0, 0}, shm[2] = {0, 0};
   size_t n = 0;
+  // The fitted window (emg_calibration.fit_window: trial): from the end of the 2 s gait fade-in, so the
+  // relaxed lead-in up to human.active_from is compared too, as in Fig. 9-d.
+  ASSERT_EQ(s.emg_calibration->fit_window, "trial");
+  const double t_end = s.human.active_from + s.emg_calibration->strides * 2.0;
+  EXPECT_DOUBLE_EQ(r.metrics.at("dyn_fit_window_s"), t_end - 2.0);
+  const double t_start = t_end - r.metrics.at("dyn_fit_window_s");
+  double rest_tm2[2] = {0, 0}, rest_sh2[2] = {0, 0};
+  size_t n_rest = 0;
   for (size_t k = 0; k < d.size(); ++k) {
-    if (d.t[k] < s.human.active_from || d.t[k] > d.t.back() - 1.0) continue;
+    if (d.t[k] < t_start || d.t[k] > d.t.back() - 1.0) continue;
     const Vec2 qk(kin.q[0][k], kin.q[1][k]), qdk(kin.qd[0][k], kin.qd[1][k]), qddk(kin.qdd[0][k], kin.qdd[1][k]);
     const Vec2 tm = Vec2(d.tau_hip[k], d.tau_knee[k]) + ActuatorTorque(id, qk, qdk, qddk);
     const Vec2 shift = ActuatorTorque(deleva, qk, qdk, qddk) - ActuatorTorque(id, qk, qdk, qddk);
@@ -178,8 +192,19 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
       t2[j] += std::pow((*truth_tau[j])[k], 2);
       sh[j] += shift[j], tmv[j] += tm[j];
       sh2[j] += shift[j] * shift[j], m2[j] += tm[j] * tm[j], shm[j] += shift[j] * tm[j];
+      if (d.t[k] < s.human.active_from) rest_tm2[j] += tm[j] * tm[j], rest_sh2[j] += shift[j] * shift[j];
     }
     ++n;
+    if (d.t[k] < s.human.active_from) ++n_rest;
+  }
+  // Fig. 9: relaxed, the identified set's tau_M is near zero (the passive torque removed), while De
+  // Leva's stays off by its Table 5 error, with no EMG there for eq. (28)'s beta to absorb it.
+  ASSERT_GT(n_rest, 1000u);
+  for (int j = 0; j < 2; ++j) {
+    std::printf("[table7] relaxed lead-in, %s: tau_M RMS %.2f N m (identified), De Leva shift %.2f N m\n",
+                j ? "knee" : "hip", std::sqrt(rest_tm2[j] / n_rest), std::sqrt(rest_sh2[j] / n_rest));
+    EXPECT_LT(std::sqrt(rest_tm2[j] / n_rest), 0.6);
+    EXPECT_GT(std::sqrt(rest_sh2[j] / n_rest), 2.0);
   }
   // The De Leva shift of tau_M is partly a copy of the effort (the exaggerated motion's posture and
   // acceleration drive both): the metric agrees with this recomputation over the whole active window
