@@ -87,8 +87,8 @@ struct ViscoelasticRlsConfig {
   // true (our extension): I is the identified I0 of eq. (14) (an invariant parameter like M g l and
   // R), X3 = T/(2 I0) and X4 = 1/I0 are held, and the RLS estimates X1, X2 only. In a near-sinusoidal
   // swing th'' ~ -w^2 th, so K' and I w^2 are nearly collinear and the four-parameter RLS trades
-  // them: K' = (e2 - X2) I^ inherits I^'s error (at 10 % co-contraction, K^ 60-80 % high with I^
-  // 2-6x the truth).
+  // them: K' = (e2 - X2) I^ inherits I^'s error (at 10 % co-contraction, K^ 57-81 % high with I^
+  // 2-100x the truth at the end of a 12 s run; scenarios/hal3_rls_tracking.yaml).
   bool known_inertia = false;
 };
 
