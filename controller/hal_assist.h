@@ -152,7 +152,7 @@ struct HalAssistConfig {
   // as operator viscosity: C E|thd| / E[thd^2] (~0.25 N m s/rad, 7 % of D at 10 % co-contraction,
   // C = 0.4 N m). 0 = the paper's input (eq. 9). Our extension.
   double friction_C = 0.0;
-  double friction_eps = 0.05;  // rad/s (as controller/virtual_impedance.h)
+  double friction_eps = 0.05;  // rad/s, sgn(thd) ~ tanh(thd / eps); the runner passes tau_c's own
 };
 
 // Torques of one control step, N m.

@@ -112,7 +112,10 @@ controller::HalLoopConfig LoopConfig(const Scenario& s, const Hal3PlantParams& p
   a.rls.I0 = pp.I();
   a.rls.gravity_in_input = s.hal.rls_gravity_in_input;
   a.rls.known_inertia = s.hal.rls_known_inertia;
-  if (s.hal.rls_friction_in_input) a.friction_C = pp.C;  // the identified C of tau_c (eq. 15)
+  if (s.hal.rls_friction_in_input) {  // the identified C of tau_c (eq. 15), smoothed as tau_c smooths it
+    a.friction_C = c.impedance.actual.C;
+    a.friction_eps = c.impedance.coulomb_eps;
+  }
   return c;
 }
 

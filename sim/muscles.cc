@@ -237,7 +237,17 @@ ContractionProgramme MvcProgramme(Muscle m, int trials, double t0, double rest) 
 // ------------------------------------------------------------------------------------------------
 VoluntaryTracking::VoluntaryTracking(const MuscleParams& p, IntendedMotion motion, TrackingGains gains,
                                      CoContraction cocontraction, FeedForward ff)
-    : p_(p), motion_(std::move(motion)), g_(gains), cc_(std::move(cocontraction)), ff_(std::move(ff)) {}
+    : p_(p), motion_(std::move(motion)), g_(gains), cc_(std::move(cocontraction)), ff_(std::move(ff)) {
+  if (!g_.cocontraction_synergy) return;
+  for (int j = 0; j < 2; ++j)
+    for (int m = 0; m < kNumMuscles; ++m) {
+      if (kSign[m][j] == 0) continue;
+      double group_max = 0;
+      for (int n = 0; n < kNumMuscles; ++n)
+        if (kSign[n][j] == kSign[m][j]) group_max = std::max(group_max, p_.alpha(n, j));
+      cc_share_(m, j) = group_max > 0 ? p_.alpha(m, j) / group_max : 1.0;
+    }
+}
 
 MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
                                         const Eigen::Vector2d& qd_now) {
@@ -263,15 +273,9 @@ MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
     for (int m = 0; m < kNumMuscles; ++m) {
       if (kSign[m][j] == 0) continue;
       A(j, m) = kSign[m][j] * p_.alpha(m, j);
-      double share = 1.0;
-      if (g_.cocontraction_synergy) {
-        double group_max = 0;
-        for (int n = 0; n < kNumMuscles; ++n)
-          if (kSign[n][j] == kSign[m][j]) group_max = std::max(group_max, p_.alpha(n, j));
-        share = group_max > 0 ? p_.alpha(m, j) / group_max : 1.0;
-      }
       // A muscle of two active joints takes the larger of its two shares.
-      target[m] = used[m] ? std::max(target[m], cc * share) : cc * share;
+      const double c = cc * cc_share_(m, j);
+      target[m] = used[m] ? std::max(target[m], c) : c;
       used[m] = true;
     }
   }

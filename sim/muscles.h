@@ -244,6 +244,9 @@ class VoluntaryTracking : public Behaviour {
   CoContraction cc_;
   FeedForward ff_;
   Eigen::Vector2d tau_d_{0, 0};
+  // Co-contraction share of muscle m at joint j (1, or alpha(m, j) / its group's largest with
+  // cocontraction_synergy): constant for the subject, computed once.
+  Eigen::Matrix<double, kNumMuscles, 2> cc_share_ = Eigen::Matrix<double, kNumMuscles, 2>::Ones();
   struct Sensed {
     double t;
     Eigen::Vector2d q, qd;
