@@ -1,114 +1,51 @@
 #include "analysis/diagnose.h"
 
 #include <algorithm>
-#include <cmath>
-#include <map>
-#include <set>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "analysis/diagnose_columns.h"
+#include "analysis/diagnose_select.h"
 #include "analysis/effects.h"
 #include "analysis/generate.h"
 #include "analysis/predict.h"
 #include "analysis/statistics.h"
-#include "model/leg_dynamics.h"
 #include "dsp/butterworth.h"
 #include "model/input_error.h"
+#include "model/leg_dynamics.h"
 #include "sim/plant.h"
 
 namespace exotwin {
 namespace {
 
-constexpr double kBicMargin = 10.0;       // BIC drop needed to name an effect (strong evidence)
-constexpr double kMinHeldoutGain = 0.05;  // held-out SSE drop needed (fraction)
-constexpr double kMinT = 4.0;             // |coefficient| / standard error
 const char* kJoint[2] = {"hip", "knee"};
 
-// Least-squares fit of a column subset from Gram matrices (train and held-out).
-struct Fit {
-  bool ok = false;
-  std::vector<int> cols;
-  Eigen::VectorXd coef, se;
-  double sse_tr = 0, sse_te = 0, bic = 0;
+// One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
+// the twin's prediction and the residual.
+struct Rec {
+  const MeasuredData* data = nullptr;
+  Kinematics kin;
+  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (parallel filtering)
+  std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque, reading with its effects
+  std::vector<double> resid[2];
+  size_t split = 0;
+  size_t n() const { return kin.t.size(); }
 };
 
-struct Grams {
-  Eigen::MatrixXd Gtr, Gte;
-  Eigen::VectorXd btr, bte;
-  double rrtr = 0, rrte = 0;
-  double n_tr = 0, n_eff = 0;
-};
-
-Grams MakeGrams(const ColumnBank& b) {
-  const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
-  const Eigen::Index mtr = static_cast<Eigen::Index>(std::count(b.train.begin(), b.train.end(), true));
-  const Eigen::Index C = b.X.cols();
-  Grams g;
-  g.Gtr = Eigen::MatrixXd::Zero(C, C);
-  g.Gte = Eigen::MatrixXd::Zero(C, C);
-  g.btr = Eigen::VectorXd::Zero(C);
-  g.bte = Eigen::VectorXd::Zero(C);
-  for (Eigen::Index j = 0; j < 2; ++j) {  // train rows come first in each joint block
-    const auto tr = b.X.middleRows(j * m, mtr);
-    const auto te = b.X.middleRows(j * m + mtr, m - mtr);
-    g.Gtr.selfadjointView<Eigen::Lower>().rankUpdate(tr.transpose());
-    g.Gte.selfadjointView<Eigen::Lower>().rankUpdate(te.transpose());
-    g.btr += tr.transpose() * b.r.segment(j * m, mtr);
-    g.bte += te.transpose() * b.r.segment(j * m + mtr, m - mtr);
-    g.rrtr += b.r.segment(j * m, mtr).squaredNorm();
-    g.rrte += b.r.segment(j * m + mtr, m - mtr).squaredNorm();
-  }
-  g.Gtr = g.Gtr.selfadjointView<Eigen::Lower>();
-  g.Gte = g.Gte.selfadjointView<Eigen::Lower>();
-  g.n_tr = static_cast<double>(2 * mtr);
-  return g;
+std::string Num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof(b), "%g", v);
+  return b;
 }
 
-Fit FitCols(const Grams& g, std::vector<int> cols) {
-  std::sort(cols.begin(), cols.end());
-  cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
-  Fit f;
-  f.cols = cols;
-  const int p = static_cast<int>(cols.size());
-  if (p == 0) {
-    f.ok = true;
-    f.sse_tr = g.rrtr, f.sse_te = g.rrte;
-    f.bic = g.n_eff * std::log(g.rrtr / g.n_tr);
-    return f;
-  }
-  Eigen::MatrixXd A(p, p), Ate(p, p);
-  Eigen::VectorXd bb(p), bte(p);
-  for (int a = 0; a < p; ++a) {
-    bb[a] = g.btr[cols[a]], bte[a] = g.bte[cols[a]];
-    for (int c = 0; c < p; ++c) A(a, c) = g.Gtr(cols[a], cols[c]), Ate(a, c) = g.Gte(cols[a], cols[c]);
-  }
-  // Conditioning on the column-normalized Gram (near collinearity makes a candidate unusable).
-  Eigen::VectorXd d = A.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-  const Eigen::MatrixXd An = d.asDiagonal() * A * d.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(An);
-  if (!(es.eigenvalues()[0] > 1e-8 * es.eigenvalues()[p - 1])) return f;
-  const Eigen::MatrixXd Ainv = d.asDiagonal() *
-                               (es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
-                                es.eigenvectors().transpose()) *
-                               d.asDiagonal();
-  f.coef = Ainv * bb;
-  f.sse_tr = std::max(1e-300, g.rrtr - 2 * f.coef.dot(bb) + f.coef.dot(A * f.coef));
-  f.sse_te = std::max(0.0, g.rrte - 2 * f.coef.dot(bte) + f.coef.dot(Ate * f.coef));
-  // Covariance with the residual variance and the autocorrelation length n_tr / n_eff.
-  const double s2 = f.sse_tr / (g.n_tr - p) * (g.n_tr / g.n_eff);
-  f.se = (Ainv.diagonal() * s2).cwiseMax(0).cwiseSqrt();
-  f.bic = g.n_eff * std::log(f.sse_tr / g.n_tr) + p * std::log(g.n_eff);
-  f.ok = true;
-  return f;
-}
-
-// Integrated autocorrelation length (in rows) of the residual after the kitchen-sink fit.
+// Integrated autocorrelation length (in rows) of a residual (2m rows: hip block, knee block).
 double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
   double worst = 1.0;
   for (int j = 0; j < 2; ++j) {
@@ -126,83 +63,39 @@ double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
   return worst;
 }
 
-std::vector<int> Union(const std::vector<const Candidate*>& set) {
-  std::vector<int> cols;
-  for (const auto* c : set) cols.insert(cols.end(), c->cols.begin(), c->cols.end());
-  return cols;
-}
-
-double CoefOf(const Fit& f, int col) {
-  for (size_t i = 0; i < f.cols.size(); ++i)
-    if (f.cols[i] == col) return f.coef[i];
-  return 0;
-}
-double SeOf(const Fit& f, int col) {
-  for (size_t i = 0; i < f.cols.size(); ++i)
-    if (f.cols[i] == col) return f.se[i];
-  return 0;
-}
-
-// Physically admissible and significant? (sign constraints of DESIGN.md, |t| on the main column).
-bool Admissible(const Candidate& c, const Fit& f) {
-  if (!f.ok) return false;
-  const double v = CoefOf(f, c.cols[0]), se = SeOf(f, c.cols[0]);
-  if (c.name == "torque_ripple") {
-    const double b = CoefOf(f, c.cols[1]), sb = SeOf(f, c.cols[1]);
-    return std::hypot(v, b) > kMinT * std::max(se, sb);
+// Records of one device: the same columns the analysis reads, and sample rates within a factor 5.
+void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
+  auto known = [](const MeasuredData& d) {
+    std::set<std::string> s;
+    for (const auto& n : d.table.names)
+      if (n.rfind("emg_", 0) == 0 || n.rfind("qd_", 0) == 0 || n.rfind("qdd_", 0) == 0) s.insert(n);
+    return s;
+  };
+  const MeasuredData& a = *records[0];
+  const std::set<std::string> ka = known(a);
+  const double dta = MedianStep(a.t);
+  for (size_t i = 1; i < records.size(); ++i) {
+    const MeasuredData& b = *records[i];
+    if (known(b) != ka) {
+      std::string sa, sb;
+      for (const auto& n : ka) sa += " " + n;
+      for (const auto& n : known(b)) sb += " " + n;
+      throw InputError(b.source + ": columns (emg_*, qd_*, qdd_*:" + (sb.empty() ? " none" : sb) +
+                       ") differ from " + a.source + "'s (" + (sa.empty() ? " none" : sa) +
+                       "), expected records of one device with the same columns");
+    }
+    const double r = MedianStep(b.t) / dta;
+    if (!(r < 5 && r > 0.2))
+      throw InputError(b.source + ": median time step " + Num(MedianStep(b.t)) + " s against " +
+                       Num(dta) + " s in " + a.source +
+                       ", expected records of one device in the same time unit (s)");
   }
-  if (c.name == "muscle_activity") {
-    for (int col : c.cols)
-      if (std::abs(CoefOf(f, col)) > kMinT * SeOf(f, col)) return true;
-    return false;
-  }
-  if ((c.name == "coulomb_friction" || c.name == "backlash" || c.name == "series_compliance" ||
-       c.name == "sensor_delay") && !(v > 0))
-    return false;
-  if (c.name == "series_compliance" && 1.0 / v > 1e6) return false;
-  if (c.name == "sensor_gain" && !(v > -0.9)) return false;
-  return std::abs(v) > kMinT * se;
-}
-
-DiagnosedEffect ToEffect(const Candidate& c, const Fit& f, double g) {
-  DiagnosedEffect d;
-  Effect& e = d.effect;
-  e.name = c.name, e.joint = kJoint[c.joint], e.axis = c.axis;
-  const double v = CoefOf(f, c.cols[0]), se = SeOf(f, c.cols[0]);
-  d.ci_lo = v - 1.96 * se, d.ci_hi = v + 1.96 * se;
-  e.value = v;
-  static const std::map<std::string, std::string> units = {
-      {"coulomb_friction", "N m"}, {"viscous_friction", "N m s/rad"}, {"inertia_error", "kg m^2"},
-      {"gravity_error", "kg m"}, {"joint_stiffness", "N m/rad"}, {"backlash", "rad"},
-      {"series_compliance", "N m/rad"}, {"torque_ripple", "N m"}, {"sensor_offset", "N m"},
-      {"sensor_gain", "relative"}, {"sensor_delay", "s"}, {"muscle_activity", "-"}};
-  e.unit = units.at(c.name);
-  if (c.name == "joint_stiffness") {
-    e.fields["q0"] = std::abs(v) > 0 ? CoefOf(f, c.cols[1]) / v : 0.0;
-  } else if (c.name == "series_compliance") {
-    e.value = 1.0 / v;
-    d.ci_lo = v + 1.96 * se > 0 ? 1.0 / (v + 1.96 * se) : 1.0;
-    d.ci_hi = v - 1.96 * se > 0 ? 1.0 / (v - 1.96 * se) : 1e6;
-  } else if (c.name == "torque_ripple") {
-    const double b = CoefOf(f, c.cols[1]), sb = SeOf(f, c.cols[1]);
-    e.value = std::hypot(v, b);
-    const double sA = e.value > 0 ? std::sqrt(std::pow(v * se, 2) + std::pow(b * sb, 2)) / e.value : 0;
-    d.ci_lo = e.value - 1.96 * sA, d.ci_hi = e.value + 1.96 * sA;
-    e.fields["cycles_per_rad"] = c.ripple_f;
-    e.fields["phase"] = std::atan2(b, v);
-  } else if (c.name == "muscle_activity") {
-    e.value = 1.0, d.ci_lo = d.ci_hi = 1.0;
-    for (size_t k = 0; k < c.cols.size(); ++k)
-      if (std::abs(CoefOf(f, c.cols[k])) > 2.0 * SeOf(f, c.cols[k]))
-        e.fields["w_" + c.channels[k]] = CoefOf(f, c.cols[k]);
-    if (e.fields.empty()) e.fields["w_" + c.channels[0]] = CoefOf(f, c.cols[0]);
-  }
-  return d;
 }
 
 // Weighted SSE of measured - (base tau_R through ApplyEffects(p)) on samples [a, b).
 double ExactSse(const LegParams& p, const Kinematics& kin, const std::vector<double> tau_R[2],
                 const std::vector<double> meas[2], const double w[2], size_t a, size_t b) {
+  if (b <= a + 2) return 0;
   Kinematics k;
   k.t.assign(kin.t.begin() + a, kin.t.begin() + b);
   std::vector<double> tr[2], ts[2];
@@ -257,189 +150,239 @@ double DominantHz(const std::vector<double>& t, const std::vector<double>& x, si
 
 }  // namespace
 
-Diagnosis Diagnose(const LegParams& params, const MeasuredData& data, const DiagnoseOptions& opt) {
+Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                   const DiagnoseOptions& opt) {
   // EXOTWIN_DIAG_TIMING=1 prints the time of each stage to stderr.
   const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
-  auto t_last = std::chrono::steady_clock::now();
+  auto clock0 = std::chrono::steady_clock::now();
   auto Lap = [&](const char* what) {
     if (!timing) return;
     const auto now = std::chrono::steady_clock::now();
-    std::fprintf(stderr, "diagnose: %-22s %8.1f ms\n", what,
-                 std::chrono::duration<double, std::milli>(now - t_last).count());
-    t_last = now;
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s\n", what, std::chrono::duration<double>(now - clock0).count());
+    clock0 = now;
   };
-  if (data.size() < 200)
-    throw InputError(data.source + ": " + std::to_string(data.size()) +
-                     " samples, expected at least 200 for a diagnosis (fit and held-out parts)");
+  if (records.empty()) throw InputError("diagnose: expected at least one measured record");
+  for (const MeasuredData* d : records)
+    if (d->size() < 200)
+      throw InputError(d->source + ": " + std::to_string(d->size()) +
+                       " samples, expected at least 200 for a diagnosis (fit and held-out parts)");
   if (!(opt.holdout_fraction >= 0.1 && opt.holdout_fraction <= 0.5))
     throw InputError("holdout fraction: expected 0.1 .. 0.5");
+  if (!(opt.max_effects >= 0 && opt.max_effects <= 6)) throw InputError("max effects: expected 0 .. 6");
+  CheckSameDevice(records);
   Diagnosis D;
   D.holdout_fraction = opt.holdout_fraction;
-  // The zero-phase derivative filter's start and end transients (about 0.5 s) are not data: trim.
-  {
-    const Kinematics full = DeriveKinematics(data);
+  const size_t R = records.size();
+  D.leave_one_out = R >= 2;
+
+  // 1. The derivative cutoff (chosen from the data unless given) and the parallel filter.
+  if (opt.cutoff_hz > 0) {
+    D.cutoff.hz = opt.cutoff_hz;
+    D.cutoff.why = "given (--cutoff " + Num(opt.cutoff_hz) + ")";
+  } else {
+    D.cutoff = ChooseCutoff(records, params.L1, params.g);
+  }
+  Lap("cutoff choice");
+
+  // 2. Every record: kinematics, measured torque filtered alike, the twin, the residual.
+  Plant plant(opt.mjcf.empty() ? ShippedModelFor(params) : opt.mjcf);
+  plant.SetParams(params);  // validates the realization
+  std::vector<Rec> recs(R);
+  for (size_t r = 0; r < R; ++r) {
+    const MeasuredData& data = *records[r];
+    Rec& rc = recs[r];
+    rc.data = &data;
+    const Kinematics full = DeriveKinematics(data, D.cutoff.from_columns ? 20.0 : D.cutoff.hz);
+    const bool filtered = full.derivative_source != "measured columns";
+    std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
+    if (filtered)
+      for (auto& m : meas) m = LowPassOnTimeBase(data, m, D.cutoff.hz);
+    // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
     const double T = full.t.back() - full.t.front();
     const double edge = std::min(0.5, 0.05 * T);
     const size_t a = static_cast<size_t>(
         std::lower_bound(full.t.begin(), full.t.end(), full.t.front() + edge) - full.t.begin());
     const size_t b = static_cast<size_t>(
         std::upper_bound(full.t.begin(), full.t.end(), full.t.back() - edge) - full.t.begin());
-    D.kin = Slice(full, a, b);
-    D.measured[0].assign(data.tau_hip.begin() + a, data.tau_hip.begin() + b);
-    D.measured[1].assign(data.tau_knee.begin() + a, data.tau_knee.begin() + b);
+    rc.kin = Slice(full, a, b);
+    for (int j = 0; j < 2; ++j) rc.meas[j].assign(meas[j].begin() + a, meas[j].begin() + b);
+    const Kinematics& kin = rc.kin;
+    const size_t n = kin.t.size();
+    const double t_split = kin.t.front() + (1 - opt.holdout_fraction) * (kin.t.back() - kin.t.front());
+    rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
+    // The twin: eq. (5)-(7) + P(q) + the model's own effects, which equals predict's MuJoCo inverse
+    // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
+    // run below is predict itself.
+    for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
+                                                 {kin.qdd[0][i], kin.qdd[1][i]});
+      rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
+    }
+    std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
+    ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
+    for (int j = 0; j < 2; ++j) {
+      rc.resid[j].resize(n);
+      for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.meas[j][i] - rc.tau_S[j][i];
+    }
   }
-  const Kinematics& kin = D.kin;
-  const size_t n = kin.t.size();
-  Lap("kinematics");
-  const double t_split = kin.t.front() + (1 - opt.holdout_fraction) * (kin.t.back() - kin.t.front());
-  D.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
-
-  // The twin on the whole record: eq. (5)-(7) + P(q) + the model's own effects, which equals
-  // predict's MuJoCo inverse dynamics to round-off (tests/integration) at a tenth of the cost; the
-  // extended twin's held-out run below is predict itself.
-  Plant plant(opt.mjcf.empty() ? ShippedModelFor(params) : opt.mjcf);
-  plant.SetParams(params);  // validates the realization
-  Prediction base;
-  base.t = kin.t;
-  for (auto& v : base.tau_R) v.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]},
-                                               {kin.qd[0][i], kin.qd[1][i]}, {kin.qdd[0][i], kin.qdd[1][i]});
-    base.tau_R[0][i] = tau[0], base.tau_R[1][i] = tau[1];
-  }
-  {
-    std::vector<double> rigid[2] = {base.tau_R[0], base.tau_R[1]};
-    ApplyEffects(params, kin, rigid, base.tau_S);  // base.tau_R stays the rigid torque
-  }
-  std::vector<double> resid[2];
+  // Noise per joint (first differences of the residual, pooled) and the row weights.
   double w[2];
   for (int j = 0; j < 2; ++j) {
-    D.before[j] = base.tau_S[j];
-    resid[j].resize(n);
-    for (size_t i = 0; i < n; ++i) resid[j][i] = D.measured[j][i] - base.tau_S[j][i];
-    double s = 0;
-    for (size_t i = 1; i < n; ++i) s += std::pow(resid[j][i] - resid[j][i - 1], 2);
-    D.noise[j] = std::max(1e-6, std::sqrt(s / (2.0 * static_cast<double>(n - 1))));
+    double s = 0, cnt = 0;
+    for (const Rec& rc : recs)
+      for (size_t i = 1; i < rc.n(); ++i) s += std::pow(rc.resid[j][i] - rc.resid[j][i - 1], 2), cnt += 1;
+    D.noise[j] = std::max(1e-6, std::sqrt(s / (2.0 * std::max(cnt, 1.0))));
     w[j] = 1.0 / D.noise[j];
   }
+  Lap("kinematics + twin");
 
-  Lap("twin (predict)");
-  // Candidates, the kitchen-sink residual (noise structure, ripple search), Gram matrices.
-  ColumnBank bank = BuildColumns(params, kin, base.tau_R, base.tau_S, resid, w, D.split, opt.max_fit_rows);
-  const size_t m = bank.sample.size();
-  {
-    Eigen::MatrixXd Gr = Eigen::MatrixXd::Zero(bank.X.cols(), bank.X.cols());
-    Gr.selfadjointView<Eigen::Lower>().rankUpdate(bank.X.transpose());
+  // 3. Candidates per record (same columns), the kitchen-sink residual, the ripple search.
+  std::vector<ColumnBank> banks;
+  std::vector<const Kinematics*> kins;
+  for (const Rec& rc : recs) {
+    banks.push_back(BuildColumns(params, rc.kin, rc.tau_R, rc.tau_S, rc.resid, w, rc.split,
+                                 std::max<size_t>(2000, opt.max_fit_rows / R)));
+    kins.push_back(&rc.kin);
+  }
+  auto kitchen_sink = [&](std::vector<Eigen::VectorXd>* resid_out) {
+    const Eigen::Index C = banks[0].X.cols();
+    Eigen::MatrixXd Gr = Eigen::MatrixXd::Zero(C, C);
+    Eigen::VectorXd br = Eigen::VectorXd::Zero(C);
+    for (const ColumnBank& b : banks) {
+      Gr.selfadjointView<Eigen::Lower>().rankUpdate(b.X.transpose());
+      br += b.X.transpose() * b.r;
+    }
     Gr = Gr.selfadjointView<Eigen::Lower>();
     Gr.diagonal() += 1e-9 * Gr.diagonal().cwiseMax(1e-300);
-    const Eigen::VectorXd c = Gr.ldlt().solve(bank.X.transpose() * bank.r);
-    const Eigen::VectorXd e = bank.r - bank.X * c;
+    const Eigen::VectorXd c = Gr.ldlt().solve(br);
+    resid_out->clear();
+    for (const ColumnBank& b : banks) resid_out->push_back(b.r - b.X * c);
+  };
+  {
+    std::vector<Eigen::VectorXd> e, raw;
+    kitchen_sink(&e);
+    for (const ColumnBank& b : banks) raw.push_back(b.r);
     // Ripple frequency searched on what the other candidates leave and on the raw residual (a slow
     // ripple, ~1 cycle over the range, is otherwise absorbed by the stiffness/gravity columns).
-    AddRippleCandidates(bank, kin, e);
-    AddRippleCandidates(bank, kin, bank.r);
+    AddRippleCandidates(banks, kins, e);
+    AddRippleCandidates(banks, kins, raw);
   }
   Lap("columns + ripple search");
   // Delay: replace the derivative column by the secant (tau_S(t - d) - tau_S(t)) / d at the single
-  // fit's d, twice, so the second-order term is not left for sensor_gain to absorb.
+  // fit's d (pooled over records), twice, so the second-order term is not left for sensor_gain.
   for (int pass = 0; pass < 2; ++pass) {
-    for (const auto& c : bank.candidates) {
+    for (const auto& c : banks[0].candidates) {
       if (c.name != "sensor_delay") continue;
+      const int j = c.joint;
       double xr = 0, xx = 0;
-      for (size_t k = 0; k < m; ++k) {
-        if (!bank.train[k]) continue;
-        const double x = bank.X(c.joint * m + k, c.cols[0]);
-        xr += x * bank.r[c.joint * m + k], xx += x * x;
+      for (const ColumnBank& b : banks) {
+        const size_t m = b.sample.size();
+        for (size_t k = 0; k < m; ++k) {
+          if (!b.train[k]) continue;
+          const double x = b.X(j * m + k, c.cols[0]);
+          xr += x * b.r[j * m + k], xx += x * x;
+        }
       }
       const double d = xx > 0 ? xr / xx : 0;
       if (!(d > 1e-4 && d < 0.5)) continue;
-      const int j = c.joint;
-      std::vector<double> tq(n);
-      for (size_t i = 0; i < n; ++i) tq[i] = kin.t[i] - d;
-      const std::vector<double> shifted = Interpolate(kin.t, base.tau_S[j], tq);
-      for (size_t k = 0; k < m; ++k) {
-        const size_t i = bank.sample[k];
-        bank.X(j * m + k, c.cols[0]) = w[j] * (shifted[i] - base.tau_S[j][i]) / d;
+      for (size_t r = 0; r < R; ++r) {
+        const Rec& rc = recs[r];
+        ColumnBank& b = banks[r];
+        const size_t m = b.sample.size();
+        std::vector<double> tq(rc.n());
+        for (size_t i = 0; i < rc.n(); ++i) tq[i] = rc.kin.t[i] - d;
+        const std::vector<double> shifted = Interpolate(rc.kin.t, rc.tau_S[j], tq);
+        for (size_t k = 0; k < m; ++k) {
+          const size_t i = b.sample[k];
+          b.X(j * m + k, c.cols[0]) = w[j] * (shifted[i] - rc.tau_S[j][i]) / d;
+        }
       }
     }
   }
-  Grams g = MakeGrams(bank);
+  Grams g = MakeGrams(banks);
   {
     // Autocorrelation length of what no candidate explains: kitchen sink incl. ripple.
-    Eigen::MatrixXd Gr = g.Gtr + g.Gte;
-    Gr.diagonal() += 1e-9 * Gr.diagonal().cwiseMax(1e-300);
-    const Eigen::VectorXd c = Gr.ldlt().solve(g.btr + g.bte);
-    D.tau_eff = AutocorrLength(bank.r - bank.X * c, m);
+    std::vector<Eigen::VectorXd> e;
+    kitchen_sink(&e);
+    D.tau_eff = 1;
+    for (size_t r = 0; r < R; ++r) D.tau_eff = std::max(D.tau_eff, AutocorrLength(e[r], banks[r].sample.size()));
     g.n_eff = g.n_tr / D.tau_eff;
   }
-
+  const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
   Lap("grams + noise");
-  // Scores: baseline, singles, pairs.
-  const Fit f0 = FitCols(g, {});
-  struct Scored {
-    std::vector<const Candidate*> set;
-    Fit fit;
-    bool admissible;
-  };
-  std::vector<Scored> singles, pairs;
-  for (const auto& c : bank.candidates) {
-    Fit f = FitCols(g, c.cols);
-    singles.push_back({{&c}, f, Admissible(c, f)});
-  }
-  auto gain = [&](const Fit& f) { return f0.sse_te > 0 ? 1 - f.sse_te / f0.sse_te : 0.0; };
-  auto ok_single = [&](const Scored& s) {
-    return s.admissible && s.fit.bic < f0.bic - kBicMargin && gain(s.fit) >= kMinHeldoutGain;
-  };
-  for (size_t a = 0; a < bank.candidates.size(); ++a)
-    for (size_t b = a + 1; b < bank.candidates.size(); ++b) {
-      const Candidate& A = bank.candidates[a];
-      const Candidate& B = bank.candidates[b];
-      if (A.name == B.name && A.joint == B.joint) continue;  // gravity X and Y: one effect at a time
-      Fit f = FitCols(g, Union({&A, &B}));
-      pairs.push_back({{&A, &B}, f, f.ok && Admissible(A, f) && Admissible(B, f)});
-    }
-  std::sort(singles.begin(), singles.end(), [](const Scored& x, const Scored& y) {
-    return (x.fit.ok ? x.fit.bic : 1e300) < (y.fit.ok ? y.fit.bic : 1e300);
-  });
-  std::sort(pairs.begin(), pairs.end(), [](const Scored& x, const Scored& y) {
-    return (x.fit.ok && x.admissible ? x.fit.bic : 1e300) < (y.fit.ok && y.admissible ? y.fit.bic : 1e300);
-  });
-  const Scored* chosen = nullptr;
-  for (const auto& s : singles)
-    if (ok_single(s)) { chosen = &s; break; }
-  // Nested candidates (sensor_offset's column is part of joint_stiffness): the extra parameter must
-  // earn its own BIC margin and held-out drop (as a second effect must), else the simpler is named.
-  if (chosen)
-    for (const auto& s : singles) {
-      const bool earns = s.fit.bic >= chosen->fit.bic + kBicMargin &&
-                         chosen->fit.sse_te <= (1 - kMinHeldoutGain) * s.fit.sse_te;
-      if (&s == chosen || !ok_single(s) || earns) continue;
-      const auto& big = chosen->set[0]->cols;
-      const auto& small = s.set[0]->cols;
-      if (small.size() < big.size() &&
-          std::all_of(small.begin(), small.end(), [&](int c) {
-            return std::find(big.begin(), big.end(), c) != big.end();
-          })) {
-        chosen = &s;
-        break;
-      }
-    }
-  if (chosen && opt.max_effects >= 2 && !pairs.empty() && pairs[0].admissible) {
-    const Scored& p = pairs[0];
-    const double extra = (chosen->fit.sse_te - p.fit.sse_te) / std::max(chosen->fit.sse_te, 1e-300);
-    if (p.fit.bic < chosen->fit.bic - kBicMargin && extra >= kMinHeldoutGain &&
-        gain(p.fit) >= kMinHeldoutGain)
-      chosen = &p;
-  }
-  for (size_t i = 0; i < singles.size() && i < 12; ++i)
-    D.scores.push_back({singles[i].set[0]->Label(), singles[i].fit.ok ? singles[i].fit.bic - f0.bic : 0,
-                        100 * gain(singles[i].fit), &singles[i] == chosen});
-  for (size_t i = 0; i < pairs.size() && i < 5; ++i)
-    D.scores.push_back({pairs[i].set[0]->Label() + " + " + pairs[i].set[1]->Label(),
-                        pairs[i].fit.ok ? pairs[i].fit.bic - f0.bic : 0, 100 * gain(pairs[i].fit),
-                        &pairs[i] == chosen});
 
-  // Nearly collinear candidates on this record (first columns, train rows).
+  // 4. Physical scale of the ranges, and the joint selection.
+  PhysicalScale scale;
+  {
+    const LumpedParams tot = params.Total();
+    const double Xd[2] = {tot.X1, tot.X2}, Yd[2] = {tot.Y1, tot.Y2};
+    LegParams rigid = params;
+    rigid.effects.clear();
+    for (int j = 0; j < 2; ++j) {
+      scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
+      scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
+      double msum = 0, mcnt = 0;
+      for (const Rec& rc : recs) {
+        const size_t stride = std::max<size_t>(1, rc.n() / 4000);
+        for (size_t i = 0; i < rc.n(); ++i) {
+          scale.q_min[j] = std::min(scale.q_min[j], rc.kin.q[j][i]);
+          scale.q_max[j] = std::max(scale.q_max[j], rc.kin.q[j][i]);
+          scale.tau_max[j] = std::max(scale.tau_max[j], std::abs(rc.meas[j][i]));
+        }
+        for (size_t i = 0; i < rc.n(); i += stride) {
+          msum += MassMatrix(tot, params.L1, rc.kin.q[1][i])(j, j), mcnt += 1;
+          const Eigen::Vector2d tc = CompliantPartTorque(
+              rigid, {rc.kin.q[0][i], rc.kin.q[1][i]}, {rc.kin.qd[0][i], rc.kin.qd[1][i]},
+              {rc.kin.qdd[0][i], rc.kin.qdd[1][i]});
+          scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(tc[j]));
+        }
+      }
+      scale.M_jj[j] = msum / std::max(mcnt, 1.0);
+      // The strap's neglected dynamics: J_c w_q^2, with J_c the compliant part's mean diagonal
+      // inertia and w_q = RMS(qd) / RMS(q - mean q) the motion's effective angular frequency.
+      double jc = 0, v2 = 0, q1 = 0, q2 = 0, cn = 0;
+      for (const Rec& rc : recs)
+        for (size_t i = 0; i < rc.n(); ++i) {
+          jc += MassMatrix(params.human ? *params.human : tot, params.L1, rc.kin.q[1][i])(j, j);
+          v2 += rc.kin.qd[j][i] * rc.kin.qd[j][i], q1 += rc.kin.q[j][i], q2 += rc.kin.q[j][i] * rc.kin.q[j][i];
+          cn += 1;
+        }
+      const double var_q = q2 / cn - (q1 / cn) * (q1 / cn);
+      scale.strap_dynamics[j] = var_q > 0 ? jc / cn * v2 / cn / var_q : 0.0;
+    }
+  }
+  const Fit f0 = FitCols(g, {});
+  Fit chosen_fit;
+  SelectionTrace trace;
+  const std::vector<int> chosen = SelectEffects(bank, g, scale, opt.max_effects, D.leave_one_out, &chosen_fit, &trace);
+  D.selection = trace.steps;
+  auto gain = [&](const Fit& f) { return f0.sse_te > 0 ? 1 - f.sse_te / f0.sse_te : 0.0; };
+  {
+    std::vector<std::pair<double, size_t>> order;
+    std::vector<Fit> singles;
+    for (size_t c = 0; c < bank.candidates.size(); ++c) {
+      singles.push_back(FitCols(g, bank.candidates[c].cols));
+      order.push_back({singles.back().ok ? singles.back().bic : 1e300, c});
+    }
+    std::sort(order.begin(), order.end());
+    for (size_t i = 0; i < order.size() && i < 12; ++i) {
+      const Fit& f = singles[order[i].second];
+      const Candidate& c = bank.candidates[order[i].second];
+      D.scores.push_back({c.Label(), f.ok ? f.bic - f0.bic : 0, 100 * gain(f),
+                          std::find(chosen.begin(), chosen.end(), static_cast<int>(order[i].second)) != chosen.end()});
+      std::string why;
+      if (f.ok && f.bic < f0.bic - kBicMargin && !Plausible(ToEffect(c, f), scale, &why))
+        D.implausible.push_back(c.Label() + " = " + Num(ToEffect(c, f).effect.value) + " " +
+                                ToEffect(c, f).effect.unit + ": " + why);
+    }
+    if (!chosen.empty()) {
+      std::string label;
+      for (int c : chosen) label += (label.empty() ? "" : " + ") + bank.candidates[c].Label();
+      D.scores.push_back({label, chosen_fit.bic - f0.bic, 100 * gain(chosen_fit), true});
+    }
+  }
+  // Nearly collinear candidates (first columns, train rows).
   for (size_t a = 0; a < bank.candidates.size(); ++a)
     for (size_t b = a + 1; b < bank.candidates.size(); ++b) {
       const int ca = bank.candidates[a].cols[0], cb = bank.candidates[b].cols[0];
@@ -449,80 +392,135 @@ Diagnosis Diagnose(const LegParams& params, const MeasuredData& data, const Diag
         D.collinear.push_back(bank.candidates[a].Label() + " ~ " + bank.candidates[b].Label() +
                               " (|cos| = " + std::to_string(std::abs(r)).substr(0, 5) + ")");
     }
-
   Lap("selection");
-  // The extension; exact refinement of the first-order values (delay, backlash, straps).
-  D.extended = params;
-  if (chosen) {
-    for (const Candidate* c : chosen->set) D.effects.push_back(ToEffect(*c, chosen->fit, params.g));
-    for (auto& de : D.effects) D.extended.effects.push_back(de.effect);
-    const size_t win_b = std::min(D.split, static_cast<size_t>(std::min<double>(D.split, 6000.0)));
-    const size_t win_a = 0;
-    for (size_t k = 0; k < D.effects.size(); ++k) {
-      const std::string& nm = D.effects[k].effect.name;
-      if (nm != "sensor_delay" && nm != "backlash" && nm != "series_compliance") continue;
-      const size_t idx = params.effects.size() + k;
-      const double v0 = D.extended.effects[idx].value;
-      auto obj = [&](double v) {
-        LegParams p = D.extended;
-        p.effects[idx].value = v;
-        return ExactSse(p, kin, base.tau_R, D.measured, w, win_a, win_b);
-      };
-      double lo = 0.6 * v0, hi = 1.6 * v0;
-      const double gr = 0.5 * (std::sqrt(5.0) - 1);
-      double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo), f1 = obj(x1), f2 = obj(x2);
-      for (int it = 0; it < 16; ++it) {
-        if (f1 < f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - gr * (hi - lo), f1 = obj(x1);
-        else lo = x1, x1 = x2, f1 = f2, x2 = lo + gr * (hi - lo), f2 = obj(x2);
-      }
-      const double v = 0.5 * (lo + hi);
-      D.extended.effects[idx].value = v;
-      D.effects[k].effect.value = v;
-      D.effects[k].ci_lo *= v / v0, D.effects[k].ci_hi *= v / v0;
-    }
-    // Share of the held-out residual each effect removes (linear model, leave-one-out).
-    for (size_t k = 0; k < chosen->set.size(); ++k) {
-      std::vector<const Candidate*> rest;
-      for (size_t l = 0; l < chosen->set.size(); ++l)
-        if (l != k) rest.push_back(chosen->set[l]);
-      const Fit fr = FitCols(g, Union(rest));
-      D.effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen->fit.sse_te) / f0.sse_te : 0;
-    }
-  }
 
+  // 5. The extension; exact refinement of the first-order values (delay, backlash, straps).
+  D.extended = params;
+  std::vector<double> refine_ratio(chosen.size(), 1.0);
+  for (int c : chosen) D.effects.push_back(ToEffect(bank.candidates[c], chosen_fit));
+  for (auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  for (size_t k = 0; k < D.effects.size(); ++k) {
+    const std::string& nm = D.effects[k].effect.name;
+    if (nm != "sensor_delay" && nm != "backlash" && nm != "series_compliance") continue;
+    const size_t idx = params.effects.size() + k;
+    const double v0 = D.extended.effects[idx].value;
+    auto obj = [&](double v) {
+      LegParams p = D.extended;
+      p.effects[idx].value = v;
+      double s = 0;
+      for (const Rec& rc : recs)
+        s += ExactSse(p, rc.kin, rc.tau_R, rc.meas, w, 0, std::min<size_t>(rc.split, 6000 / R + 1));
+      return s;
+    };
+    double lo = 0.6 * v0, hi = 1.6 * v0;
+    const double gr = 0.5 * (std::sqrt(5.0) - 1);
+    double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo), f1 = obj(x1), f2 = obj(x2);
+    for (int it = 0; it < 16; ++it) {
+      if (f1 < f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - gr * (hi - lo), f1 = obj(x1);
+      else lo = x1, x1 = x2, f1 = f2, x2 = lo + gr * (hi - lo), f2 = obj(x2);
+    }
+    const double v = 0.5 * (lo + hi);
+    refine_ratio[k] = v / v0;
+    D.extended.effects[idx].value = v;
+    D.effects[k].effect.value = v;
+    D.effects[k].ci_lo *= v / v0, D.effects[k].ci_hi *= v / v0;
+  }
+  // Share of the held-out residual each effect removes (joint linear model, leave-one-effect-out).
+  for (size_t k = 0; k < chosen.size(); ++k) {
+    std::vector<int> cols;
+    for (size_t l = 0; l < chosen.size(); ++l)
+      if (l != k) cols.insert(cols.end(), bank.candidates[chosen[l]].cols.begin(), bank.candidates[chosen[l]].cols.end());
+    const Fit fr = FitCols(g, cols);
+    D.effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
+  }
   Lap("refinement");
-  // Extended twin: full record (plots, signature) and the held-out run that gives rmse_after.
+
+  // 6. The extended twin (predict) on every record's held-out part; with several records, each
+  // whole record predicted by the effects fitted on the others.
   {
     Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
     ext_plant.SetParams(D.extended);
-    // The held-out run starts 1 s early so that its filters (EMG envelope, delay) have settled;
-    // only the held-out samples are scored.
-    const size_t warm = static_cast<size_t>(
-        std::lower_bound(kin.t.begin(), kin.t.end(), kin.t[D.split] - 1.0) - kin.t.begin());
-    const Prediction held_w = PredictTorque(ext_plant, Slice(kin, warm, n));
-    Prediction held;
-    for (int j = 0; j < 2; ++j) {
-      held.tau_S[j].assign(held_w.tau_S[j].begin() + (D.split - warm), held_w.tau_S[j].end());
-      D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
-      std::copy(held.tau_S[j].begin(), held.tau_S[j].end(), D.after[j].begin() + D.split);
+    double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
+    for (size_t r = 0; r < R; ++r) {
+      const Rec& rc = recs[r];
+      const size_t n = rc.n();
+      RecordScore rs;
+      rs.source = rc.data->source;
+      rs.samples = rc.data->size();
+      // The held-out run starts 1 s early so that its filters (EMG envelope, delay) have settled;
+      // only the held-out samples are scored.
+      const size_t warm = static_cast<size_t>(
+          std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
+      const Prediction held = PredictTorque(ext_plant, Slice(rc.kin, warm, n));
+      for (int j = 0; j < 2; ++j) {
+        double b = 0, a = 0;
+        for (size_t i = rc.split; i < n; ++i) {
+          b += std::pow(rc.meas[j][i] - rc.tau_S[j][i], 2);
+          a += std::pow(rc.meas[j][i] - held.tau_S[j][i - warm], 2);
+        }
+        const double c = static_cast<double>(std::max<size_t>(1, n - rc.split));
+        rs.split[j] = {std::sqrt(b / c), std::sqrt(a / c), b > 0 ? 100 * (1 - std::sqrt(a / b)) : 0};
+        sb[j] += b, sa[j] += a;
+        if (r == 0) {
+          D.before[j] = rc.tau_S[j];
+          D.measured[j] = rc.meas[j];
+          D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
+          for (size_t i = rc.split; i < n; ++i) D.after[j][i] = held.tau_S[j][i - warm];
+        }
+      }
+      cnt += static_cast<double>(n - rc.split);
+      if (D.leave_one_out) {
+        LegParams p = params;
+        std::vector<int> cols;
+        for (int c : chosen) cols.insert(cols.end(), bank.candidates[c].cols.begin(), bank.candidates[c].cols.end());
+        std::sort(cols.begin(), cols.end());
+        cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+        const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
+        if (!cols.empty() && x.size() == 0)
+          throw InputError(rc.data->source + ": without this record the chosen effects are not identifiable");
+        for (size_t k = 0; k < chosen.size(); ++k) {
+          Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
+          e.value *= refine_ratio[k];
+          p.effects.push_back(e);
+        }
+        Plant loo_plant(opt.mjcf.empty() ? ShippedModelFor(p) : opt.mjcf);
+        loo_plant.SetParams(p);
+        const Prediction whole = PredictTorque(loo_plant, rc.kin);
+        for (int j = 0; j < 2; ++j) {
+          double b = 0, a = 0;
+          for (size_t i = 0; i < n; ++i) {
+            b += std::pow(rc.meas[j][i] - rc.tau_S[j][i], 2);
+            a += std::pow(rc.meas[j][i] - whole.tau_S[j][i], 2);
+          }
+          rs.left_out[j] = {std::sqrt(b / n), std::sqrt(a / n), b > 0 ? 100 * (1 - std::sqrt(a / b)) : 0};
+          lb[j] += b, la[j] += a;
+        }
+        lcnt += static_cast<double>(n);
+      }
+      D.records.push_back(rs);
     }
     for (int j = 0; j < 2; ++j) {
-      double sb = 0, sa = 0;
-      for (size_t i = D.split; i < n; ++i) {
-        sb += std::pow(D.measured[j][i] - base.tau_S[j][i], 2);
-        sa += std::pow(D.measured[j][i] - held.tau_S[j][i - D.split], 2);
-      }
-      const double cnt = static_cast<double>(n - D.split);
-      D.joints[j].rmse_before = std::sqrt(sb / cnt);
-      D.joints[j].rmse_after = std::sqrt(sa / cnt);
-      D.joints[j].gain_pct =
-          D.joints[j].rmse_before > 0 ? 100 * (1 - D.joints[j].rmse_after / D.joints[j].rmse_before) : 0;
+      D.joints[j].rmse_before = std::sqrt(sb[j] / cnt);
+      D.joints[j].rmse_after = std::sqrt(sa[j] / cnt);
+      D.joints[j].gain_pct = sb[j] > 0 ? 100 * (1 - std::sqrt(sa[j] / sb[j])) : 0;
+      if (D.leave_one_out)
+        D.left_out[j] = {std::sqrt(lb[j] / lcnt), std::sqrt(la[j] / lcnt), lb[j] > 0 ? 100 * (1 - std::sqrt(la[j] / lb[j])) : 0};
     }
   }
-
+  // Effects in order of what they explain.
+  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
+    return a.explained_pct > b.explained_pct;
+  });
+  D.extended.effects.resize(params.effects.size());
+  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  D.kin = recs[0].kin;
+  D.split = recs[0].split;
   Lap("extended twin");
   // Unexplained structure: 5 Hz low-passed held-out residual of the extended twin vs the noise.
   {
+    const Diagnosis& Dc = D;
+    const Kinematics& kin = Dc.kin;
+    const size_t n = kin.t.size();
     const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
     const double fs = 1.0 / dt;
     for (int j = 0; j < 2; ++j) {
@@ -558,13 +556,19 @@ Diagnosis Diagnose(const LegParams& params, const MeasuredData& data, const Diag
   }
   Lap("unexplained");
   std::ostringstream m_os;
-  m_os << "time split: fit on the first " << 100 * (1 - opt.holdout_fraction)
-       << " %, rmse by the extended twin (predict) on the last " << 100 * opt.holdout_fraction
-       << " %; every DESIGN effect per joint as a linearized least-squares candidate (ripple frequency"
+  m_os << "derivatives and torque filtered alike (zero-phase 2nd-order Butterworth, "
+       << (D.cutoff.from_columns ? std::string("measured qd/qdd columns") : Num(D.cutoff.hz) + " Hz")
+       << "); time split: fit on the first " << 100 * (1 - opt.holdout_fraction)
+       << " % of every record, rmse by the extended twin (predict) on the last " << 100 * opt.holdout_fraction
+       << " %" << (D.leave_one_out ? "; every whole record also left out in turn" : "")
+       << "; every DESIGN effect per joint as a linearized least-squares candidate (ripple frequency"
           " by grid + golden search; delay, backlash, strap stiffness refined by golden search on the"
-          " exact model); selection by BIC (effective sample size from the residual autocorrelation,"
-          " margin " << kBicMargin << ") and held-out error (>= " << 100 * kMinHeldoutGain
-       << " % drop), |t| > " << kMinT << ", at most " << opt.max_effects << " effects";
+          " exact model); forward selection with backward elimination of up to " << opt.max_effects
+       << " effects fitted together, each significant (|t| > " << kMinT << "), inside its physical range,"
+          " lowering BIC (effective sample size from the residual autocorrelation) by more than "
+       << kBicMargin << " and the held-out error by at least " << 100 * kMinHeldoutGain
+       << " %; fewer parameters preferred unless the richer effect lowers the held-out error by more than "
+       << 100 * kParsimony << " %";
   D.method = m_os.str();
   return D;
 }

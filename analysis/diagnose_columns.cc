@@ -125,18 +125,22 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
   return b;
 }
 
-void AddRippleCandidates(ColumnBank& b, const Kinematics& kin, const Eigen::VectorXd& target) {
-  const size_t m = b.sample.size();
+void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
+                         const std::vector<Eigen::VectorXd>& targets) {
   for (int j = 0; j < 2; ++j) {
-    // The search uses at most ~8000 fitting rows (every step-th).
-    const size_t step = std::max<size_t>(1, m / 8000);
     auto sse = [&](double f) {
       double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
-      for (size_t k = 0; k < m; k += step) {
-        if (!b.train[k]) continue;
-        const double x = 2 * M_PI * f * kin.q[j][b.sample[k]];
-        const double s = std::sin(x), c = std::cos(x), y = target[j * m + k];
-        ss += s * s, sc += s * c, cc += c * c, ys += y * s, yc += y * c, yy += y * y;
+      for (size_t r = 0; r < banks.size(); ++r) {
+        const ColumnBank& b = banks[r];
+        const size_t m = b.sample.size();
+        // The search uses at most ~8000 fitting rows per record (every step-th).
+        const size_t step = std::max<size_t>(1, m / 8000);
+        for (size_t k = 0; k < m; k += step) {
+          if (!b.train[k]) continue;
+          const double x = 2 * M_PI * f * kins[r]->q[j][b.sample[k]];
+          const double s = std::sin(x), c = std::cos(x), y = targets[r][j * m + k];
+          ss += s * s, sc += s * c, cc += c * c, ys += y * s, yc += y * c, yy += y * y;
+        }
       }
       const double det = ss * cc - sc * sc;
       if (det <= 1e-12 * (ss * cc + 1e-300)) return yy;
@@ -155,26 +159,30 @@ void AddRippleCandidates(ColumnBank& b, const Kinematics& kin, const Eigen::Vect
       if (sse(x1) < sse(x2)) hi = x2; else lo = x1;
     }
     const double f = 0.5 * (lo + hi);
-    // Weight of joint j rows: the offset column of joint j holds exactly w_j there.
-    const int off = [&] {
-      for (const auto& c : b.candidates)
-        if (c.name == "sensor_offset" && c.joint == j) return c.cols[0];
-      return -1;
-    }();
-    const double w = b.X(j * m, off);
-    const int c0 = static_cast<int>(b.X.cols());
-    b.X.conservativeResize(Eigen::NoChange, c0 + 2);
-    b.used = c0 + 2;
-    b.X.col(c0).setZero();
-    b.X.col(c0 + 1).setZero();
-    for (size_t k = 0; k < m; ++k) {
-      const double x = 2 * M_PI * f * kin.q[j][b.sample[k]];
-      b.X(j * m + k, c0) = -w * std::sin(x);
-      b.X(j * m + k, c0 + 1) = -w * std::cos(x);
+    for (size_t r = 0; r < banks.size(); ++r) {
+      ColumnBank& b = banks[r];
+      const size_t m = b.sample.size();
+      // Weight of joint j rows: the offset column of joint j holds exactly w_j there.
+      const int off = [&] {
+        for (const auto& c : b.candidates)
+          if (c.name == "sensor_offset" && c.joint == j) return c.cols[0];
+        return -1;
+      }();
+      const double w = b.X(j * m, off);
+      const int c0 = static_cast<int>(b.X.cols());
+      b.X.conservativeResize(Eigen::NoChange, c0 + 2);
+      b.used = c0 + 2;
+      b.X.col(c0).setZero();
+      b.X.col(c0 + 1).setZero();
+      for (size_t k = 0; k < m; ++k) {
+        const double x = 2 * M_PI * f * kins[r]->q[j][b.sample[k]];
+        b.X(j * m + k, c0) = -w * std::sin(x);
+        b.X(j * m + k, c0 + 1) = -w * std::cos(x);
+      }
+      Candidate c;
+      c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
+      b.candidates.push_back(c);
     }
-    Candidate c;
-    c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
-    b.candidates.push_back(c);
   }
 }
 

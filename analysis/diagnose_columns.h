@@ -39,8 +39,10 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         const std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows);
 
-// Adds the torque_ripple candidates (sin/cos of 2 pi f q_j) with f (1 .. 10 cycles/rad) found by
-// grid + golden search on `target` (2m weighted rows, e.g. the residual of all other columns).
-void AddRippleCandidates(ColumnBank& bank, const Kinematics& kin, const Eigen::VectorXd& target);
+// Adds the torque_ripple candidates (sin/cos of 2 pi f q_j) to every bank (one per record of one
+// device, same columns), with f (1 .. 10 cycles/rad) found by grid + golden search on the train rows
+// of `targets` pooled (per bank 2m weighted rows, e.g. the residual of all other columns).
+void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
+                         const std::vector<Eigen::VectorXd>& targets);
 
 }  // namespace exotwin

@@ -40,9 +40,36 @@ std::string DiagnosisJson(const Diagnosis& d) {
     j["joints"][names[k]] = {{"rmse_before", d.joints[k].rmse_before},
                              {"rmse_after", d.joints[k].rmse_after},
                              {"gain_pct", d.joints[k].gain_pct}};
-  j["validation"] = {{"method", d.method}, {"holdout_fraction", d.holdout_fraction}};
+  j["validation"] = {{"method", d.method}, {"holdout_fraction", d.holdout_fraction},
+                     {"leave_one_record_out", d.leave_one_out}};
   j["noise"] = {{"hip", d.noise[0]}, {"knee", d.noise[1]}, {"autocorrelation_rows", d.tau_eff}};
   j["collinear"] = d.collinear;
+  j["cutoff"] = {{"hz", d.cutoff.from_columns ? 0.0 : d.cutoff.hz},
+                 {"source", d.cutoff.from_columns ? "measured qd/qdd columns" : "butterworth"},
+                 {"why", d.cutoff.why},
+                 {"candidates_hz", d.cutoff.candidates_hz},
+                 {"heldout_rmse_hip", d.cutoff.heldout_rmse[0]},
+                 {"heldout_rmse_knee", d.cutoff.heldout_rmse[1]}};
+  j["selection"] = d.selection;
+  j["implausible"] = d.implausible;
+  j["records"] = json::array();
+  for (const auto& r : d.records) {
+    json x = {{"source", r.source}, {"samples", r.samples}};
+    for (int k = 0; k < 2; ++k) {
+      x["split"][names[k]] = {{"rmse_before", r.split[k].rmse_before}, {"rmse_after", r.split[k].rmse_after},
+                              {"gain_pct", r.split[k].gain_pct}};
+      if (d.leave_one_out)
+        x["left_out"][names[k]] = {{"rmse_before", r.left_out[k].rmse_before},
+                                   {"rmse_after", r.left_out[k].rmse_after},
+                                   {"gain_pct", r.left_out[k].gain_pct}};
+    }
+    j["records"].push_back(x);
+  }
+  if (d.leave_one_out)
+    for (int k = 0; k < 2; ++k)
+      j["left_out"][names[k]] = {{"rmse_before", d.left_out[k].rmse_before},
+                                 {"rmse_after", d.left_out[k].rmse_after},
+                                 {"gain_pct", d.left_out[k].gain_pct}};
   return j.dump(2) + "\n";
 }
 

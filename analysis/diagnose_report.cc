@@ -118,6 +118,16 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<h1>exotwin diagnosis</h1><p>Twin: <code>" << Esc(params_path) << "</code>, measured: <code>"
     << Esc(measured_path) << "</code>, " << n << " samples, " << Fmt(k.t.back() - k.t.front(), 4)
     << " s; derivatives: " << Esc(k.derivative_source) << ".</p>\n";
+  o << "<h2>Filtering</h2><p>Angles and measured torque are low-passed alike before residuals are "
+       "formed (parallel filtering): " << Esc(d.cutoff.why) << ".</p>";
+  if (!d.cutoff.candidates_hz.empty()) {
+    o << "<table><tr><th>cutoff (Hz)</th><th>held-out rmse hip (N m)</th><th>held-out rmse knee (N m)</th></tr>";
+    for (size_t i = 0; i < d.cutoff.candidates_hz.size(); ++i)
+      o << "<tr><td>" << (d.cutoff.candidates_hz[i] == d.cutoff.hz ? "<b>" : "") << Fmt(d.cutoff.candidates_hz[i])
+        << (d.cutoff.candidates_hz[i] == d.cutoff.hz ? "</b>" : "") << "</td><td>" << Fmt(d.cutoff.heldout_rmse[0][i], 4)
+        << "</td><td>" << Fmt(d.cutoff.heldout_rmse[1][i], 4) << "</td></tr>";
+    o << "</table>";
+  }
   o << "<h2>What the twin gets wrong, and why</h2>";
   if (d.effects.empty()) {
     o << "<p><b>No effect named</b>: no candidate explanation is supported by the data (information "
@@ -142,7 +152,29 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
     o << "<tr><td>" << jn[j] << "</td><td>" << Fmt(d.joints[j].rmse_before, 4) << "</td><td>"
       << Fmt(d.joints[j].rmse_after, 4) << "</td><td>" << Fmt(d.joints[j].gain_pct, 3) << " %</td><td>"
       << Fmt(d.noise[j], 3) << "</td></tr>";
-  o << "</table><p><small>" << Esc(d.method) << "</small></p>";
+  o << "</table>";
+  if (d.records.size() > 1) {
+    o << "<h2>Records</h2><table><tr><th>record</th><th>samples</th><th>hip: held-out 30 % before / after (N m)</th>"
+         "<th>knee: held-out 30 %</th><th>hip: whole record left out</th><th>knee: whole record left out</th></tr>";
+    auto cell = [&](const JointScore& s) {
+      return Fmt(s.rmse_before, 4) + " / " + Fmt(s.rmse_after, 4) + " (" + Fmt(s.gain_pct, 3) + " %)";
+    };
+    for (const auto& r : d.records)
+      o << "<tr><td>" << Esc(r.source) << "</td><td>" << r.samples << "</td><td>" << cell(r.split[0]) << "</td><td>"
+        << cell(r.split[1]) << "</td><td>" << cell(r.left_out[0]) << "</td><td>" << cell(r.left_out[1]) << "</td></tr>";
+    o << "<tr><th>all</th><td></td><td>" << cell(d.joints[0]) << "</td><td>" << cell(d.joints[1]) << "</td><td>"
+      << cell(d.left_out[0]) << "</td><td>" << cell(d.left_out[1]) << "</td></tr></table>"
+      << "<p>Plots below: the first record.</p>";
+  }
+  o << "<p><small>" << Esc(d.method) << "</small></p>";
+  o << "<h2>Selection</h2><ol>";
+  for (const auto& s : d.selection) o << "<li>" << Esc(s) << "</li>";
+  o << "</ol>";
+  if (!d.implausible.empty()) {
+    o << "<p>Fitted alone but outside their physical range, so not named:</p><ul>";
+    for (const auto& s : d.implausible) o << "<li>" << Esc(s) << "</li>";
+    o << "</ul>";
+  }
   o << "<h2>Unexplained structure</h2>";
   if (d.unexplained.empty()) o << "<p>None above the noise.</p>";
   for (const auto& u : d.unexplained)
@@ -169,7 +201,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const size_t st_line = std::max<size_t>(1, win / 1500), st_dot = std::max<size_t>(1, n / 1500);
   for (int j = 0; j < 2; ++j) {
     o << "<h2>" << jn[j] << "</h2>\n";
-    Series m{{}, {}, "#000", "measured"}, b{{}, {}, "#d62728", "twin before"}, a{{}, {}, "#1f77b4", "extended twin"};
+    Series m{{}, {}, "#000", "measured (filtered alike)"}, b{{}, {}, "#d62728", "twin before"}, a{{}, {}, "#1f77b4", "extended twin"};
     for (size_t i = a0; i < a0 + win; i += st_line) {
       m.x.push_back(k.t[i]), m.y.push_back(d.measured[j][i]);
       b.x.push_back(k.t[i]), b.y.push_back(d.before[j][i]);

@@ -23,13 +23,6 @@ std::vector<double> Delayed(const std::vector<double>& t, const std::vector<doub
   return Interpolate(t, x, tq);
 }
 
-double MedianStep(const std::vector<double>& t) {
-  std::vector<double> d(t.size() - 1);
-  for (size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
-}
-
 Eigen::Vector2d At(const std::vector<double> v[2], size_t i) { return {v[0][i], v[1][i]}; }
 
 }  // namespace

@@ -76,6 +76,13 @@ MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
   return d;
 }
 
+double MedianStep(const std::vector<double>& t) {
+  std::vector<double> d(t.size() - 1);
+  for (size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
 std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<double>& y,
                                 const std::vector<double>& xq) {
   std::vector<double> out(xq.size());
@@ -90,6 +97,56 @@ std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<
     out[i] = y[j] + w * (y[j + 1] - y[j]);
   }
   return out;
+}
+
+namespace {
+
+// The record's sampling: median step, and a uniform grid at that step when any step is off it by
+// more than 1 % (else the record's own times).
+struct SampleGrid {
+  double dt = 0;
+  bool uniform = true;
+  std::vector<double> grid;
+};
+
+SampleGrid MakeGrid(const MeasuredData& data, double cutoff_hz) {
+  SampleGrid s;
+  const size_t n = data.t.size();
+  s.dt = MedianStep(data.t);
+  if (!(s.dt >= 1e-6))
+    throw InputError(data.source + ": column 't': median sample period " + Short(s.dt) +
+                     " s, expected at least 1e-6 s (a sample rate up to 1 MHz)");
+  for (size_t i = 0; i + 1 < n; ++i)
+    if (std::abs(data.t[i + 1] - data.t[i] - s.dt) > 0.01 * s.dt) { s.uniform = false; break; }
+  if (s.uniform) {
+    s.grid = data.t;
+  } else {
+    const double span = data.t.back() - data.t.front();
+    const double points = std::floor(span / s.dt) + 1;
+    if (!(points <= std::max(100.0 * static_cast<double>(n), 1e6)))
+      throw InputError(data.source + ": column 't': sampling too irregular to resample (median step " +
+                       Short(s.dt) + " s over " + Short(span) + " s needs " + Short(points) +
+                       " grid points for " + std::to_string(n) +
+                       " samples), expected roughly uniform sampling without long gaps");
+    const size_t m = static_cast<size_t>(points);
+    s.grid.resize(m);
+    for (size_t i = 0; i < m; ++i) s.grid[i] = data.t.front() + s.dt * static_cast<double>(i);
+  }
+  if (!(cutoff_hz < 0.5 / s.dt))
+    throw InputError(data.source + ": sample period " + Short(s.dt) + " s is too long for the " +
+                     Short(cutoff_hz) + " Hz derivative filter, expected a sample rate above " +
+                     Short(2 * cutoff_hz) + " Hz");
+  return s;
+}
+
+}  // namespace
+
+std::vector<double> LowPassOnTimeBase(const MeasuredData& data, const std::vector<double>& x,
+                                      double cutoff_hz) {
+  const SampleGrid s = MakeGrid(data, cutoff_hz);
+  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, cutoff_hz);
+  if (s.uniform) return dsp::FiltFilt(sos, x);
+  return Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(data.t, x, s.grid)), data.t);
 }
 
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
@@ -116,58 +173,26 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
     k.derivative_source = "measured columns";
     return k;
   }
-
-  // Uniform grid check.
-  const size_t n = data.t.size();
-  std::vector<double> dts(n - 1);
-  for (size_t i = 0; i + 1 < n; ++i) dts[i] = data.t[i + 1] - data.t[i];
-  std::vector<double> sorted = dts;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double dt = sorted[sorted.size() / 2];
-  if (!(dt >= 1e-6))
-    throw InputError(data.source + ": column 't': median sample period " + Short(dt) +
-                     " s, expected at least 1e-6 s (a sample rate up to 1 MHz)");
-  bool uniform = true;
-  for (double s : dts)
-    if (std::abs(s - dt) > 0.01 * dt) { uniform = false; break; }
-
-  std::vector<double> grid;
-  if (uniform) {
-    grid = data.t;
-  } else {
-    const double span = data.t.back() - data.t.front();
-    const double points = std::floor(span / dt) + 1;
-    if (!(points <= std::max(100.0 * static_cast<double>(n), 1e6)))
-      throw InputError(data.source + ": column 't': sampling too irregular to resample (median step " +
-                       Short(dt) + " s over " + Short(span) + " s needs " + Short(points) +
-                       " grid points for " + std::to_string(n) +
-                       " samples), expected roughly uniform sampling without long gaps");
-    const size_t m = static_cast<size_t>(points);
-    grid.resize(m);
-    for (size_t i = 0; i < m; ++i) grid[i] = data.t.front() + dt * static_cast<double>(i);
-    k.resampled = true;
-  }
-  const double fs = 1.0 / dt;
-  if (!(cutoff_hz < 0.5 * fs))
-    throw InputError(data.source + ": sample period " + std::to_string(dt) +
-                     " s is too long for the 20 Hz derivative filter, expected a sample rate above " +
-                     std::to_string(2 * cutoff_hz) + " Hz");
-  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, fs, cutoff_hz);
+  const SampleGrid s = MakeGrid(data, cutoff_hz);
+  k.resampled = !s.uniform;
+  const double dt = s.dt;
+  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, cutoff_hz);
   for (int j = 0; j < 2; ++j) {
     const auto* qd = data.Column(std::string("qd_") + names[j]);
     const auto* qdd = data.Column(std::string("qdd_") + names[j]);
-    const std::vector<double> qg = uniform ? k.q[j] : Interpolate(data.t, k.q[j], grid);
+    const std::vector<double> qg = s.uniform ? k.q[j] : Interpolate(data.t, k.q[j], s.grid);
     const std::vector<double> qf = dsp::FiltFilt(sos, qg);
     std::vector<double> v = dsp::Gradient(qf, dt);
     std::vector<double> a = dsp::Gradient(v, dt);
-    if (!uniform) {
-      v = Interpolate(grid, v, data.t);
-      a = Interpolate(grid, a, data.t);
+    if (!s.uniform) {
+      v = Interpolate(s.grid, v, data.t);
+      a = Interpolate(s.grid, a, data.t);
     }
     k.qd[j] = qd ? *qd : v;
     k.qdd[j] = qdd ? *qdd : a;
   }
-  k.derivative_source = "butterworth 20 Hz";
+  k.derivative_source = "butterworth " + Short(cutoff_hz) + " Hz";
+  k.cutoff_hz = cutoff_hz;
   return k;
 }
 

@@ -30,6 +30,7 @@ struct Kinematics {
   std::vector<double> q[2], qd[2], qdd[2];  // [0] hip, [1] knee; rad, rad/s, rad/s^2
   bool resampled = false;                    // the input was non-uniform and went through a grid
   std::string derivative_source;             // "measured columns" or "butterworth 20 Hz"
+  double cutoff_hz = 0;                      // the derivative filter's cutoff, 0 for measured columns
   std::map<std::string, std::vector<double>> emg;  // emg_<channel> columns (V) by channel, e.g. "VM"
 };
 
@@ -39,6 +40,16 @@ struct Kinematics {
 // 1 %) is handled by resampling the angles onto a uniform grid at the median step (linear
 // interpolation), differentiating there, and interpolating back onto the measured times.
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz = 20.0);
+
+// x (one value per sample of `data`) filtered exactly as DeriveKinematics filters the angles: the
+// zero-phase 2nd-order Butterworth low-pass at cutoff_hz, on the same uniform grid when the record
+// is sampled non-uniformly. Used to filter the measured torque alike (parallel filtering, so that
+// the filter's own lag and attenuation never show as a discrepancy).
+std::vector<double> LowPassOnTimeBase(const MeasuredData& data, const std::vector<double>& x,
+                                      double cutoff_hz);
+
+// Median sample period (s) of strictly increasing times (>= 2 samples).
+double MedianStep(const std::vector<double>& t);
 
 // Linear interpolation of (x, y) at xq (x strictly increasing; clamped at the ends).
 std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<double>& y,

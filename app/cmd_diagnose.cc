@@ -13,26 +13,44 @@ namespace {
 
 CommandRunner RegisterDiagnose(CLI::App& app) {
   struct Opts {
-    std::string params, measured, out, mjcf;
+    std::string params, out, mjcf, cutoff = "auto";
+    std::vector<std::string> measured;
     double holdout = 0.3;
+    int max_effects = 6;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
       "diagnose", "Where twin and measured data disagree, the cause, the extended model and its gain");
   sub->add_option("--params", o->params, "MODEL.yaml of the twin")->required();
-  sub->add_option("--measured", o->measured, "measured-data CSV")->required();
+  sub->add_option("--measured", o->measured,
+                  "measured-data CSV; repeat for several records of one device (one set of effects, "
+                  "validated on whole records left out)")->required();
   sub->add_option("--out", o->out, "output folder (diagnosis.json, extended.yaml, report.html)")->required();
   sub->add_option("--holdout", o->holdout, "held-out fraction at the end of the record (default 0.3)");
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
+  sub->add_option("--cutoff", o->cutoff,
+                  "derivative filter cutoff in Hz, the torque filtered alike, or 'auto' (default: "
+                  "chosen from the data by held-out prediction error)");
+  sub->add_option("--max-effects", o->max_effects, "most effects named together (0..6, default 6)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
-    const MeasuredData data = ReadMeasuredCsv(o->measured);
     DiagnoseOptions opt;
     opt.holdout_fraction = o->holdout;
     opt.mjcf = o->mjcf;
-    const Diagnosis d = Diagnose(params, data, opt);
-    WriteDiagnosis(d, o->out, o->params, o->measured);
+    opt.cutoff_hz = ParseCutoffOption(o->cutoff, "diagnose --cutoff");
+    opt.max_effects = o->max_effects;
+    std::vector<MeasuredData> data;
+    std::string names;
+    for (const std::string& m : o->measured) {
+      data.push_back(ReadMeasuredCsv(m));
+      names += (names.empty() ? "" : ", ") + m;
+    }
+    std::vector<const MeasuredData*> records;
+    for (const auto& m : data) records.push_back(&m);
+    const Diagnosis d = Diagnose(params, records, opt);
+    WriteDiagnosis(d, o->out, o->params, names);
+    std::printf("diagnose: derivative cutoff %s\n", d.cutoff.why.c_str());
     for (const auto& e : d.effects)
       std::printf("diagnose: %s (%s) = %g %s [%g, %g]\n", e.effect.name.c_str(), e.effect.joint.c_str(),
                   e.effect.value, e.effect.unit.c_str(), e.ci_lo, e.ci_hi);
@@ -40,6 +58,10 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     std::printf("diagnose: held-out rmse hip %.4f -> %.4f N m, knee %.4f -> %.4f N m; report %s/report.html\n",
                 d.joints[0].rmse_before, d.joints[0].rmse_after, d.joints[1].rmse_before,
                 d.joints[1].rmse_after, o->out.c_str());
+    if (d.leave_one_out)
+      std::printf("diagnose: whole records left out: rmse hip %.4f -> %.4f N m, knee %.4f -> %.4f N m\n",
+                  d.left_out[0].rmse_before, d.left_out[0].rmse_after, d.left_out[1].rmse_before,
+                  d.left_out[1].rmse_after);
     return 0;
   };
 }

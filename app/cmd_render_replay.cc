@@ -23,13 +23,6 @@ namespace {
 
 constexpr double kEmgEnvelopeHz = 6.0;  // low-pass of the rectified EMG (zero-phase, 2nd order)
 
-double MedianStep(const std::vector<double>& t) {
-  std::vector<double> dt;
-  for (size_t i = 1; i < t.size(); ++i) dt.push_back(t[i] - t[i - 1]);
-  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
-  return dt[dt.size() / 2];
-}
-
 // Envelope of an amplified EMG signal (V): mean removed, full-wave rectified, low-passed.
 std::vector<double> Envelope(const std::vector<double>& x, double fs) {
   double mean = 0;

@@ -1,0 +1,45 @@
+// The cutoff of the zero-phase derivative filter (DeriveKinematics), chosen from the data.
+//
+// Differentiating a measured angle twice multiplies its noise by (2 pi f)^2: on a rig with a coarse
+// encoder at 500 Hz the 20 Hz filter of Hwang & Jeon sec. 3.2 leaves more noise in qdd than the
+// effects have signal (shared/data/real_rig/README.md), while on a clean 1 kHz record a low cutoff
+// distorts the motion itself. The choice is the classic bias-variance trade-off, settled by held-out
+// prediction error:
+//   for each candidate cutoff fc (1.5 .. 50 Hz, below fs / 4), the kinematics are derived at fc and a
+//   generic linear model of the joint torques is fitted by least squares on the first 70 % (in time)
+//   of every record: the rigid two-link regressor in the lumped parameters (FullRegressor: M qdd + V
+//   + G, any device with that structure), plus per joint a torque offset, Coulomb (sign qd) and
+//   viscous (qd) friction. Its error is scored on the last 30 % against the raw, unfiltered measured
+//   torque, whose own noise is the same for every fc. The score is the sum over joints of the
+//   held-out mean square error divided by that joint's torque variance. The chosen cutoff is the
+//   highest whose score is within 2 % of the best (the least filtering the data allow: effects with
+//   fast signatures, such as a sensor delay or a torque ripple, keep their shape).
+// Model-free apart from L1 and g (the fitted parameters absorb the device), so `identify`, `predict`
+// and `diagnose` share it.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "analysis/measured_data.h"
+
+namespace exotwin {
+
+struct CutoffChoice {
+  double hz = 20.0;                     // chosen cutoff
+  bool from_columns = false;            // every record has qd_* and qdd_* columns: no filter used
+  std::vector<double> candidates_hz;    // scored cutoffs, ascending
+  std::vector<double> heldout_rmse[2];  // N m, per candidate, hip / knee, against the raw torque
+  std::vector<double> score;            // the criterion per candidate (lower is better)
+  std::string why;                      // one sentence for the report
+};
+
+// Chooses the cutoff for records of one device (each at least 200 samples). L1 (m) and g (m/s^2)
+// enter the regressor's coupling and gravity columns. Throws InputError when no candidate fits the
+// records' sample rate (fs / 4 <= 1.5 Hz).
+CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g);
+
+// Parses a `--cutoff` value: "auto" gives 0 (choose from the data), else a frequency in Hz > 0.
+// Throws InputError naming `what` (the option) otherwise.
+double ParseCutoffOption(const std::string& value, const std::string& what);
+
+}  // namespace exotwin
