@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "analysis/column_map.h"
 #include "analysis/csv_table.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
@@ -24,19 +25,23 @@ namespace {
 
 CommandRunner RegisterPredict(CLI::App& app) {
   struct Opts {
-    std::string params, measured, out, mjcf;
+    std::string params, measured, map, out, mjcf;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
       "predict", "Torque-sensor reading the twin predicts for measured kinematics (t,tau_hip,tau_knee)");
   sub->add_option("--params", o->params, "MODEL.yaml (lumped parameters, passive model, effects)")->required();
   sub->add_option("--measured", o->measured, "measured-data CSV (t, q_hip, q_knee, ...)")->required();
+  sub->add_option("--map", o->map, "column map (YAML) turning a foreign --measured CSV into the schema");
   sub->add_option("--out", o->out, "output CSV of the prediction")->required();
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
-    const MeasuredData data = ReadMeasuredCsv(o->measured);
+    MapReport map_report;
+    const MeasuredData data = ReadMeasured(o->measured, o->map, 20, &map_report);
+    if (!o->map.empty()) std::fprintf(stderr, "predict: %s", map_report.Summary().c_str());
+    if (params.human) CheckHumanJointRange(data);
     Plant plant(o->mjcf.empty() ? DefaultModelFor(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
     const Kinematics kin = DeriveKinematics(data);
@@ -48,7 +53,8 @@ CommandRunner RegisterPredict(CLI::App& app) {
     const Prediction p = PredictTorque(plant, kin);
     WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&p.t, &p.tau_S[0], &p.tau_S[1]},
              {"exotwin predict: torque-sensor reading tau_S = -tau_R (N m)",
-              "params: " + o->params + ", measured: " + o->measured + ", derivatives: " +
+              "params: " + o->params + ", measured: " + o->measured +
+                  (o->map.empty() ? "" : " (map: " + o->map + ")") + ", derivatives: " +
                   kin.derivative_source});
     return 0;
   };
