@@ -14,15 +14,15 @@ const std::vector<double>* MeasuredData::Column(const std::string& name) const {
   return i < 0 ? nullptr : &table.columns[i];
 }
 
-namespace {
-
-bool IsKnownColumn(const std::string& n) {
+bool IsMeasuredColumn(const std::string& n) {
   static const char* kKnown[] = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "qd_hip", "qd_knee",
                                  "qdd_hip", "qdd_knee", "cmd_hip", "cmd_knee"};
   for (const char* k : kKnown)
     if (n == k) return true;
   return n.rfind("emg_", 0) == 0;
 }
+
+namespace {
 
 // %g (std::to_string prints 1e300 as 301 digits).
 std::string Short(double v) {
@@ -31,42 +31,48 @@ std::string Short(double v) {
   return buf;
 }
 
+// "<file>:<line>: column '<name>': " (the sample's index when the table was built without lines).
+std::string Where(const std::string& source, const CsvTable& t, size_t row, const std::string& column) {
+  const std::string at = row < t.line_of_row.size() ? std::to_string(t.line_of_row[row])
+                                                     : "sample " + std::to_string(row + 1);
+  return source + ":" + at + ": column '" + column + "': ";
+}
+
 }  // namespace
 
-MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
+MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t min_samples) {
   MeasuredData d;
-  d.source = path;
-  d.table = ReadCsv(path);
+  d.source = source;
+  d.table = std::move(table);
   const CsvTable& t = d.table;
   for (const char* req : {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"})
     if (t.Find(req) < 0)
-      throw InputError(path + ": missing required column '" + req +
+      throw InputError(source + ": missing required column '" + req +
                        "' (expected t, q_hip, q_knee, tau_hip, tau_knee)");
   if (t.rows() < min_samples)
-    throw InputError(path + ": " + std::to_string(t.rows()) + " samples, expected at least " +
+    throw InputError(source + ": " + std::to_string(t.rows()) + " samples, expected at least " +
                      std::to_string(min_samples));
   for (size_t c = 0; c < t.names.size(); ++c) {
     const std::string& n = t.names[c];
-    if (!IsKnownColumn(n)) continue;
+    if (!IsMeasuredColumn(n)) continue;
     double limit = 1e6;
     std::string unit;
-    if (n == "q_hip" || n == "q_knee") { limit = 2 * M_PI; unit = "rad"; }
+    if (n == "q_hip" || n == "q_knee") { limit = kMaxRecordedAngle; unit = "rad"; }
     if (n == "tau_hip" || n == "tau_knee" || n.rfind("cmd_", 0) == 0) { limit = 1000; unit = "N m"; }
     if (n.rfind("emg_", 0) == 0) { limit = 100; unit = "V"; }
     for (size_t r = 0; r < t.rows(); ++r) {
       const double v = t.columns[c][r];
-      const std::string where = path + ":" + std::to_string(t.line_of_row[r]) + ": column '" + n + "': ";
-      if (!std::isfinite(v)) throw InputError(where + "value is not finite, expected a finite number");
+      if (!std::isfinite(v))
+        throw InputError(Where(source, t, r, n) + "value is not finite, expected a finite number");
       if (std::abs(v) > limit)
-        throw InputError(where + "value " + Short(v) + " out of range, expected |x| <= " +
+        throw InputError(Where(source, t, r, n) + "value " + Short(v) + " out of range, expected |x| <= " +
                          std::to_string(limit) + " " + unit);
     }
   }
   const auto& tc = t.columns[t.Find("t")];
   for (size_t r = 1; r < tc.size(); ++r)
     if (!(tc[r] > tc[r - 1]))
-      throw InputError(path + ":" + std::to_string(t.line_of_row[r]) + ": column 't': " +
-                       std::to_string(tc[r]) + " not greater than the previous " +
+      throw InputError(Where(source, t, r, "t") + std::to_string(tc[r]) + " not greater than the previous " +
                        std::to_string(tc[r - 1]) + ", expected strictly increasing time");
   d.t = tc;
   d.q_hip = t.columns[t.Find("q_hip")];
@@ -81,6 +87,23 @@ double MedianStep(const std::vector<double>& t) {
   for (size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   return d[d.size() / 2];
+}
+
+MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
+  return MeasuredFromTable(ReadCsv(path), path, min_samples);
+}
+
+void CheckHumanJointRange(const MeasuredData& data) {
+  const std::pair<const char*, const std::vector<double>*> angles[] = {{"q_hip", &data.q_hip},
+                                                                      {"q_knee", &data.q_knee}};
+  for (const auto& [name, q] : angles)
+    for (size_t r = 0; r < q->size(); ++r)
+      if (std::abs((*q)[r]) > kMaxHumanJointAngle)
+        throw InputError(Where(data.source, data.table, r, name) + "angle " + Short((*q)[r]) +
+                         " rad is beyond a human joint's range, expected |q| <= " +
+                         std::to_string(kMaxHumanJointAngle) +
+                         " rad (2 pi) for a model with a human: block (a record of the device alone may "
+                         "turn further: drop the human: block)");
 }
 
 std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<double>& y,

@@ -1,6 +1,7 @@
 // The measured-data CSV of DESIGN.md (input of predict / diagnose / identify) and the kinematics
 // derived from it.
 #pragma once
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -19,10 +20,31 @@ struct MeasuredData {
   const std::vector<double>* Column(const std::string& name) const;
 };
 
-// Reads and validates a measured-data CSV: required columns t, q_hip, q_knee, tau_hip, tau_knee;
-// strictly increasing t; finite values in every known column; angles within +-2 pi rad; torques
-// within +-1000 N m; at least `min_samples` rows. Throws InputError naming file, line and column.
+// Sanity bound on a recorded angle, rad: a record of an exoskeleton or a rig alone may turn a joint
+// through several revolutions (the DFKI double pendulum's second link turns through 11 rad); beyond
+// 1e4 rad the column is not an angle in rad (encoder counts, degrees declared as rad, ...).
+inline constexpr double kMaxRecordedAngle = 1e4;
+// A human joint's range, rad: the angle of a leg stays within one revolution.
+inline constexpr double kMaxHumanJointAngle = 2 * M_PI;
+
+// True for the column names of the measured-data schema (DESIGN.md): t, q_hip, q_knee, tau_hip,
+// tau_knee, qd_*, qdd_*, cmd_* of hip and knee, and emg_<channel>.
+bool IsMeasuredColumn(const std::string& name);
+
+// Validates a table in the measured-data schema and returns it as MeasuredData (`source` names it in
+// messages; the table's line_of_row gives the lines): required columns t, q_hip, q_knee, tau_hip,
+// tau_knee; strictly increasing t; finite values in every schema column; angles within
+// +-kMaxRecordedAngle rad; torques within +-1000 N m; EMG within +-100 V; at least `min_samples`
+// rows. Throws InputError naming file, line and column.
+MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t min_samples = 20);
+
+// Reads a measured-data CSV and validates it as MeasuredFromTable does.
 MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples = 20);
+
+// The check for records of a human wearing the device (predict / identify / diagnose with a
+// `human:` block): |q_hip|, |q_knee| <= kMaxHumanJointAngle. Throws InputError naming the file,
+// the line and the column of the first angle beyond it.
+void CheckHumanJointRange(const MeasuredData& data);
 
 // Joint kinematics on the measured time base.
 struct Kinematics {

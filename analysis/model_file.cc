@@ -1,81 +1,32 @@
 #include "analysis/model_file.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
+#include "analysis/yaml_fields.h"
 #include "model/input_error.h"
 
 namespace exotwin {
 namespace {
 
-struct Ctx {
-  std::string source;
-  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    throw InputError(source + ": " + key + ": " + what);
-  }
-};
-
-std::string Mark(const YAML::Node& n) {
-  const YAML::Mark m = n.Mark();
-  return m.line >= 0 ? " (line " + std::to_string(m.line + 1) + ")" : "";
-}
-
-double Number(const Ctx& c, const YAML::Node& n, const std::string& key, double lo, double hi,
-              const std::string& unit) {
-  if (!n || !n.IsScalar()) c.Fail(key, "expected a number" + Mark(n));
-  double v;
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    c.Fail(key, "'" + n.Scalar() + "' is not a number" + Mark(n));
-  }
-  if (!std::isfinite(v)) c.Fail(key, "expected a finite number, got " + n.Scalar() + Mark(n));
-  if (v < lo || v > hi) {
-    std::ostringstream os;
-    os << "value " << v << " out of range, expected " << lo << " .. " << hi << " " << unit << Mark(n);
-    c.Fail(key, os.str());
-  }
-  return v;
-}
-
-void CheckKeys(const Ctx& c, const YAML::Node& map, const std::string& key,
-               const std::set<std::string>& allowed) {
-  if (!map.IsMap()) c.Fail(key, "expected a mapping" + Mark(map));
-  std::set<std::string> seen;
-  for (const auto& kv : map) {
-    if (!kv.first.IsScalar())
-      c.Fail(key.empty() ? "(top level)" : key, "expected plain keys, found a non-scalar key" + Mark(kv.first));
-    const std::string k = kv.first.Scalar();
-    if (!seen.insert(k).second) c.Fail(key.empty() ? k : key + "." + k, "duplicated key" + Mark(kv.first));
-    if (!allowed.count(k)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      c.Fail(key.empty() ? k : key + "." + k, "unknown key, expected one of: " + list);
-    }
-  }
-}
-
-LumpedParams ReadLumped(const Ctx& c, const YAML::Node& n, const std::string& key) {
-  CheckKeys(c, n, key, {"J1", "J2", "X1", "X2", "Y1", "Y2", "m1", "m2"});
+LumpedParams ReadLumped(const YamlContext& c, const YAML::Node& n, const std::string& key) {
+  YamlCheckKeys(c, n, key, {"J1", "J2", "X1", "X2", "Y1", "Y2", "m1", "m2"});
   LumpedParams p;
   for (const char* req : {"J1", "J2", "X1", "X2", "Y1", "Y2"})
     if (!n[req]) c.Fail(key + "." + req, "missing, expected a number");
-  p.J1 = Number(c, n["J1"], key + ".J1", 0.0, 50.0, "kg m^2");
-  p.J2 = Number(c, n["J2"], key + ".J2", 0.0, 50.0, "kg m^2");
-  p.X1 = Number(c, n["X1"], key + ".X1", -50.0, 50.0, "kg m");
-  p.X2 = Number(c, n["X2"], key + ".X2", -50.0, 50.0, "kg m");
-  p.Y1 = Number(c, n["Y1"], key + ".Y1", -50.0, 50.0, "kg m");
-  p.Y2 = Number(c, n["Y2"], key + ".Y2", -50.0, 50.0, "kg m");
+  p.J1 = YamlNumber(c, n["J1"], key + ".J1", 0.0, 50.0, "kg m^2");
+  p.J2 = YamlNumber(c, n["J2"], key + ".J2", 0.0, 50.0, "kg m^2");
+  p.X1 = YamlNumber(c, n["X1"], key + ".X1", -50.0, 50.0, "kg m");
+  p.X2 = YamlNumber(c, n["X2"], key + ".X2", -50.0, 50.0, "kg m");
+  p.Y1 = YamlNumber(c, n["Y1"], key + ".Y1", -50.0, 50.0, "kg m");
+  p.Y2 = YamlNumber(c, n["Y2"], key + ".Y2", -50.0, 50.0, "kg m");
   if (n["m1"]) {
-    p.m1 = Number(c, n["m1"], key + ".m1", -1e9, 500.0, "kg");
+    p.m1 = YamlNumber(c, n["m1"], key + ".m1", -1e9, 500.0, "kg");
     if (!(p.m1 > 0)) c.Fail(key + ".m1", "mass must be > 0 kg, got " + n["m1"].Scalar());
   }
   if (n["m2"]) {
-    p.m2 = Number(c, n["m2"], key + ".m2", -1e9, 500.0, "kg");
+    p.m2 = YamlNumber(c, n["m2"], key + ".m2", -1e9, 500.0, "kg");
     if (!(p.m2 > 0)) c.Fail(key + ".m2", "mass must be > 0 kg, got " + n["m2"].Scalar());
   }
   return p;
@@ -106,8 +57,8 @@ const std::vector<EffectSpec>& EffectSpecs() {
   return kSpecs;
 }
 
-Effect ReadEffect(const Ctx& c, const YAML::Node& n, const std::string& key) {
-  if (!n.IsMap()) c.Fail(key, "expected a mapping {name, joint, value, unit, ...}" + Mark(n));
+Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& key) {
+  if (!n.IsMap()) c.Fail(key, "expected a mapping {name, joint, value, unit, ...}" + YamlLine(n));
   if (!n["name"] || !n["name"].IsScalar()) c.Fail(key + ".name", "missing, expected an effect name");
   Effect e;
   e.name = n["name"].Scalar();
@@ -123,19 +74,19 @@ Effect ReadEffect(const Ctx& c, const YAML::Node& n, const std::string& key) {
   allowed.insert(spec->fields.begin(), spec->fields.end());
   if (e.name == "gravity_error") allowed.insert("axis");
   if (e.name == "muscle_activity") allowed.insert({"weights", "channels"});
-  CheckKeys(c, n, key, allowed);
+  YamlCheckKeys(c, n, key, allowed);
   if (!n["joint"] || !n["joint"].IsScalar() ||
       (n["joint"].Scalar() != "hip" && n["joint"].Scalar() != "knee"))
     c.Fail(key + ".joint", "expected 'hip' or 'knee'");
   e.joint = n["joint"].Scalar();
   if (!n["value"]) c.Fail(key + ".value", "missing, expected a number in " + std::string(spec->unit));
-  e.value = Number(c, n["value"], key + ".value", spec->lo, spec->hi, spec->unit);
+  e.value = YamlNumber(c, n["value"], key + ".value", spec->lo, spec->hi, spec->unit);
   e.unit = spec->unit;
   if (n["unit"] && n["unit"].Scalar() != spec->unit)
     c.Fail(key + ".unit", "expected '" + std::string(spec->unit) + "', got '" + n["unit"].Scalar() + "'");
   for (const auto& f : spec->fields) {
     if (!n[f]) c.Fail(key + "." + f, "missing, required by " + e.name);
-    e.fields[f] = Number(c, n[f], key + "." + f, -1e6, 1e6, "");
+    e.fields[f] = YamlNumber(c, n[f], key + "." + f, -1e6, 1e6, "");
   }
   if (e.name == "gravity_error") {
     e.axis = n["axis"] ? n["axis"].Scalar() : "X";
@@ -147,8 +98,8 @@ Effect ReadEffect(const Ctx& c, const YAML::Node& n, const std::string& key) {
       const std::string ch = kv.first.IsScalar() ? kv.first.Scalar() : "";
       const char* kIdent = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_";
       if (ch.empty() || ch.find_first_not_of(kIdent) != std::string::npos)
-        c.Fail(key + ".weights", "expected EMG channel names (letters, digits, '_') as keys" + Mark(kv.first));
-      e.fields["w_" + ch] = Number(c, kv.second, key + ".weights." + ch, -1e6, 1e6, "");
+        c.Fail(key + ".weights", "expected EMG channel names (letters, digits, '_') as keys" + YamlLine(kv.first));
+      e.fields["w_" + ch] = YamlNumber(c, kv.second, key + ".weights." + ch, -1e6, 1e6, "");
     }
   }
   return e;
@@ -157,20 +108,15 @@ Effect ReadEffect(const Ctx& c, const YAML::Node& n, const std::string& key) {
 }  // namespace
 
 LegParams ParseModelYaml(const std::string& text, const std::string& source) {
-  Ctx c{source};
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(source + ": line " + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
-  }
+  YamlContext c{source};
+  const YAML::Node root = ParseYaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty model file, expected L1 and exo:");
   if (!root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
-  CheckKeys(c, root, "", {"L1", "g", "exo", "human", "passive", "effects", "identification", "name"});
+  YamlCheckKeys(c, root, "", {"L1", "g", "exo", "human", "passive", "effects", "identification", "name"});
   LegParams p;
   if (!root["L1"]) c.Fail("L1", "missing, expected the thigh length in m");
-  p.L1 = Number(c, root["L1"], "L1", 0.1, 1.0, "m");
-  if (root["g"]) p.g = Number(c, root["g"], "g", 0.0, 20.0, "m/s^2");
+  p.L1 = YamlNumber(c, root["L1"], "L1", 0.1, 1.0, "m");
+  if (root["g"]) p.g = YamlNumber(c, root["g"], "g", 0.0, 20.0, "m/s^2");
   if (!root["exo"]) c.Fail("exo", "missing, expected {J1, J2, X1, X2, Y1, Y2}");
   p.exo = ReadLumped(c, root["exo"], "exo");
   if (root["human"] && !root["human"].IsNull()) p.human = ReadLumped(c, root["human"], "human");
@@ -192,14 +138,7 @@ LegParams ParseModelYaml(const std::string& text, const std::string& source) {
 }
 
 LegParams ReadModelFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open model file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
-  if (text.find('\0') != std::string::npos)
-    throw InputError(path + ": binary data (NUL byte), expected a YAML text file");
-  return ParseModelYaml(text, path);
+  return ParseModelYaml(ReadYamlText(path, "model"), path);
 }
 
 namespace {

@@ -11,4 +11,7 @@ double Pearson(const std::vector<double>& x, const std::vector<double>& y, size_
 // The same over all samples (x.size() == y.size()).
 inline double Pearson(const std::vector<double>& x, const std::vector<double>& y) { return Pearson(x, y, 0, x.size()); }
 
+// p in [0, 1] of sorted values (linear interpolation between closest ranks); NaN if empty.
+double Percentile(const std::vector<double>& sorted, double p);
+
 }  // namespace exotwin

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "analysis/column_map.h"
 #include "analysis/diagnose.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
@@ -13,7 +14,7 @@ namespace {
 
 CommandRunner RegisterDiagnose(CLI::App& app) {
   struct Opts {
-    std::string params, out, mjcf, cutoff = "auto";
+    std::string params, out, mjcf, map, cutoff = "auto";
     std::vector<std::string> measured;
     double holdout = 0.3;
     int max_effects = 6;
@@ -28,6 +29,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
   sub->add_option("--out", o->out, "output folder (diagnosis.json, extended.yaml, report.html)")->required();
   sub->add_option("--holdout", o->holdout, "held-out fraction at the end of the record (default 0.3)");
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
+  sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs into the schema");
   sub->add_option("--cutoff", o->cutoff,
                   "derivative filter cutoff in Hz, the torque filtered alike, or 'auto' (default: "
                   "chosen from the data by held-out prediction error)");
@@ -43,7 +45,10 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     std::vector<MeasuredData> data;
     std::string names;
     for (const std::string& m : o->measured) {
-      data.push_back(ReadMeasuredCsv(m));
+      MapReport report;
+      data.push_back(ReadMeasured(m, o->map, 20, &report));
+      if (!o->map.empty()) std::fprintf(stderr, "diagnose: %s", report.Summary().c_str());
+      if (params.human) CheckHumanJointRange(data.back());
       names += (names.empty() ? "" : ", ") + m;
     }
     std::vector<const MeasuredData*> records;

@@ -1,4 +1,4 @@
-// `exotwin identify --measured A.csv --measured B.csv [--known MODEL.yaml] --out MODEL.yaml`
+// `exotwin identify --measured A.csv --measured B.csv [--known MODEL.yaml] [--map MAP.yaml] --out MODEL.yaml`
 // (DESIGN.md): least-squares identification of the exoskeleton (steps 1-2) or, with --known, of the
 // subject (steps 3-4), Hwang & Jeon 2015 sec. 3.2. --measured takes files or folders (every *.csv
 // inside with the measured-data columns; others are skipped with a note), in any order.
@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <map>
 
+#include "analysis/column_map.h"
+#include "analysis/derivative_cutoff.h"
 #include "analysis/csv_table.h"
 #include "analysis/identification.h"
 #include "analysis/measured_data.h"
@@ -24,11 +26,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Reads one --measured argument: a CSV file, or a folder of CSVs (sorted by name).
-void ReadMeasuredArg(const std::string& arg, std::vector<MeasuredData>* out) {
+// Reads one --measured argument: a CSV file, or a folder of CSVs (sorted by name), through the column
+// map `map` when not empty.
+void ReadMeasuredArg(const std::string& arg, const std::string& map, std::vector<MeasuredData>* out) {
   std::error_code ec;
   if (!fs::is_directory(arg, ec)) {
-    out->push_back(ReadMeasuredCsv(arg));
+    out->push_back(ReadMeasured(arg, map));
     return;
   }
   std::vector<std::string> csvs;
@@ -38,7 +41,7 @@ void ReadMeasuredArg(const std::string& arg, std::vector<MeasuredData>* out) {
   size_t used = 0;
   for (const std::string& f : csvs) {
     try {
-      out->push_back(ReadMeasuredCsv(f));
+      out->push_back(ReadMeasured(f, map));
       ++used;
     } catch (const InputError& e) {
       if (std::string(e.what()).find("missing required column") == std::string::npos) throw;
@@ -65,7 +68,7 @@ void ParseThreshold(const std::string& s, std::map<std::string, double>* th) {
 CommandRunner RegisterIdentify(CLI::App& app) {
   struct Opts {
     std::vector<std::string> measured, thresholds;
-    std::string known, out, passive = "riener1999";
+    std::string known, map, out, passive = "riener1999", cutoff = "20";
     double L1 = 0.0, emg_reference = 2.0, emg_envelope = 0.0, trim = 0.1;
   };
   auto o = std::make_shared<Opts>();
@@ -74,6 +77,7 @@ CommandRunner RegisterIdentify(CLI::App& app) {
   sub->add_option("--measured", o->measured,
                   "measured-data CSV or folder of CSVs: the knee-swing and hip-swing recordings, any order")
       ->required();
+  sub->add_option("--map", o->map, "column map (YAML) applied to every --measured file (foreign CSVs)");
   sub->add_option("--known", o->known, "MODEL.yaml holding the exoskeleton (exo:); identifies the human");
   sub->add_option("--out", o->out, "MODEL.yaml to write")->required();
   sub->add_option("--L1", o->L1, "thigh length, m (default: from --known, else 0.41)");
@@ -85,6 +89,9 @@ CommandRunner RegisterIdentify(CLI::App& app) {
                   "eq. (13) threshold instead of the reference: CHANNEL=V (e.g. VM=0.3) or V for all");
   sub->add_option("--emg-envelope", o->emg_envelope,
                   "s, moving average of the rectified EMG before thresholding (default 0: per sample)");
+  sub->add_option("--cutoff", o->cutoff,
+                  "derivative filter cutoff in Hz, or 'auto' (chosen from the data by held-out "
+                  "prediction error over every file); default 20 (Hwang & Jeon sec. 3.2)");
   sub->add_option("--trim", o->trim, "s dropped at both ends of every file (default 0.1)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
@@ -114,8 +121,18 @@ CommandRunner RegisterIdentify(CLI::App& app) {
                      o->known.c_str());
     }
     std::vector<MeasuredData> files;
-    for (const std::string& m : o->measured) ReadMeasuredArg(m, &files);
+    for (const std::string& m : o->measured) ReadMeasuredArg(m, o->map, &files);
+    if (!o->known.empty())  // steps 3-4: the records are of a human wearing the device
+      for (const MeasuredData& f : files) CheckHumanJointRange(f);
     const double L1 = o->L1 != 0.0 ? o->L1 : 0.41;
+    opt.cutoff_hz = ParseCutoffOption(o->cutoff, "identify --cutoff");
+    if (opt.cutoff_hz == 0) {
+      std::vector<const MeasuredData*> recs;
+      for (const MeasuredData& f : files) recs.push_back(&f);
+      const CutoffChoice c = ChooseCutoff(recs, L1, 9.81);
+      opt.cutoff_hz = c.from_columns ? 20.0 : c.hz;
+      std::fprintf(stderr, "identify: derivative cutoff %s\n", c.why.c_str());
+    }
     const IdentificationResult r = Identify(files, o->known.empty() ? nullptr : &known, L1, opt);
 
     std::string header = "exotwin identify: Hwang & Jeon 2015 ";

@@ -2,7 +2,9 @@
 
 #include <cstdio>
 
+#include "analysis/column_map.h"
 #include "analysis/csv_table.h"
+#include "analysis/derivative_cutoff.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
 #include "analysis/predict.h"
@@ -24,22 +26,35 @@ namespace {
 
 CommandRunner RegisterPredict(CLI::App& app) {
   struct Opts {
-    std::string params, measured, out, mjcf;
+    std::string params, measured, map, out, mjcf, cutoff = "20";
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
       "predict", "Torque-sensor reading the twin predicts for measured kinematics (t,tau_hip,tau_knee)");
   sub->add_option("--params", o->params, "MODEL.yaml (lumped parameters, passive model, effects)")->required();
   sub->add_option("--measured", o->measured, "measured-data CSV (t, q_hip, q_knee, ...)")->required();
+  sub->add_option("--map", o->map, "column map (YAML) turning a foreign --measured CSV into the schema");
   sub->add_option("--out", o->out, "output CSV of the prediction")->required();
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
+  sub->add_option("--cutoff", o->cutoff,
+                  "derivative filter cutoff in Hz, or 'auto' (chosen from the data by held-out "
+                  "prediction error, as diagnose does); default 20 (Hwang & Jeon sec. 3.2)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
-    const MeasuredData data = ReadMeasuredCsv(o->measured);
+    MapReport map_report;
+    const MeasuredData data = ReadMeasured(o->measured, o->map, 20, &map_report);
+    if (!o->map.empty()) std::fprintf(stderr, "predict: %s", map_report.Summary().c_str());
+    if (params.human) CheckHumanJointRange(data);
     Plant plant(o->mjcf.empty() ? DefaultModelFor(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
-    const Kinematics kin = DeriveKinematics(data);
+    double cutoff = ParseCutoffOption(o->cutoff, "predict --cutoff");
+    if (cutoff == 0) {
+      const CutoffChoice c = ChooseCutoff({&data}, params.L1, params.g);
+      cutoff = c.from_columns ? 20.0 : c.hz;
+      std::fprintf(stderr, "predict: derivative cutoff %s\n", c.why.c_str());
+    }
+    const Kinematics kin = DeriveKinematics(data, cutoff);
     if (kin.resampled)
       std::fprintf(stderr,
                    "predict: %s is sampled non-uniformly; derivatives computed on a uniform grid at "
@@ -48,7 +63,8 @@ CommandRunner RegisterPredict(CLI::App& app) {
     const Prediction p = PredictTorque(plant, kin);
     WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&p.t, &p.tau_S[0], &p.tau_S[1]},
              {"exotwin predict: torque-sensor reading tau_S = -tau_R (N m)",
-              "params: " + o->params + ", measured: " + o->measured + ", derivatives: " +
+              "params: " + o->params + ", measured: " + o->measured +
+                  (o->map.empty() ? "" : " (map: " + o->map + ")") + ", derivatives: " +
                   kin.derivative_source});
     return 0;
   };

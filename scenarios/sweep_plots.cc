@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstdio>
 
+#include "analysis/statistics.h"
 #include "model/input_error.h"
 #include "scenarios/sweep_table.h"
 

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "analysis/csv_table.h"
+#include "analysis/statistics.h"
 #include "model/input_error.h"
 #include "scenarios/sweep_plots.h"
 
@@ -144,14 +145,6 @@ std::vector<SweepRow> ParseSweepCsv(const std::string& text, const std::string& 
   }
   if (header.empty()) throw InputError(source + ": empty, expected a sweep CSV with a header row");
   return rows;
-}
-
-double Percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return std::nan("");
-  const double pos = p * (sorted.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(pos));
-  const size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (pos - lo) * (sorted[hi] - sorted[lo]);
 }
 
 std::string SweepSummaryJson(const SweepManifest& m, const std::vector<SweepRow>& rows) {

@@ -58,7 +58,4 @@ void ReadSweepAggregate(const std::string& dir, SweepManifest* m, std::vector<Sw
 // (scenarios, subjects, seed, shard count), a shard is missing or given twice, or a row is duplicated.
 void MergeSweepParts(const std::vector<std::string>& dirs, SweepManifest* m, std::vector<SweepRow>* rows);
 
-// p in [0, 1] of sorted values (linear interpolation between closest ranks); NaN if empty.
-double Percentile(const std::vector<double>& sorted, double p);
-
 }  // namespace exotwin

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/column_map.h"
 #include "analysis/diagnose.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
@@ -23,33 +24,16 @@ const std::string kDir = std::string(EXOTWIN_SOURCE_DIR) + "/../shared/data/real
 const char* kRecords[] = {"trajectory_00", "trajectory_01", "trajectory_02", "trajectory_03",
                           "trajectory_04", "trajectory_05", "trajectory_11"};
 
-// DEV SHIM until the column map lands.
+// The rig's records through the shipped column map.
 std::vector<MeasuredData> ReadRig() {
   std::vector<MeasuredData> out;
-  for (const char* r : kRecords) {
-    MeasuredData d;
-    d.source = kDir + "/" + r + ".csv";
-    const CsvTable t = ReadCsv(d.source);
-    for (size_t i = 0; i < t.rows(); ++i) {
-      const double tt = t.columns[t.Find("time")][i];
-      if (!d.t.empty() && !(tt > d.t.back())) continue;
-      d.t.push_back(tt);
-      d.q_hip.push_back(t.columns[t.Find("pos_meas1")][i]);
-      d.q_knee.push_back(t.columns[t.Find("pos_meas2")][i]);
-      d.tau_hip.push_back(-t.columns[t.Find("tau_meas1")][i]);
-      d.tau_knee.push_back(-t.columns[t.Find("tau_meas2")][i]);
-    }
-    d.table.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
-    d.table.columns = {d.t, d.q_hip, d.q_knee, d.tau_hip, d.tau_knee};
-    out.push_back(d);
-  }
+  for (const char* r : kRecords)
+    out.push_back(ReadMeasured(kDir + "/" + r + ".csv",
+                               std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/dfki_double_pendulum_A0.map.yaml"));
   return out;
 }
 
-LegParams RigModel() {
-  return ParseModelYaml("L1: 0.3\nexo: {J1: 0.131785, J2: 0.023924, X1: 0.349118, X2: 0.111066, Y1: 0, Y2: 0}\n"
-                        "passive: none\neffects: []\n", "rig");
-}
+LegParams RigModel() { return ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/model.yaml"); }
 
 const Effect* Named(const Diagnosis& d, const std::string& name, const std::string& joint) {
   for (const auto& e : d.effects)

@@ -1,8 +1,8 @@
 // The bad-input matrix of issue 8: one test per case of bad input over MJCF models, MODEL.yaml
-// parameter files, measured-data CSV and scenario YAML (truncated files, wrong types, units out of
-// range, NaN and inf, empty files, huge values, duplicated keys/columns, binary junk). Each goes
-// through the command line (`exotwin predict` for MJCF / parameters / CSV, `exotwin run` for
-// scenarios) and must exit 2 with a message naming the place (file, line or field) and what was
+// parameter files, measured-data CSV, column maps and scenario YAML (truncated files, wrong types,
+// units out of range, NaN and inf, empty files, huge values, duplicated keys/columns, binary junk).
+// Each goes through the command line (`exotwin predict` for MJCF / parameters / CSV / maps, `exotwin
+// run` for scenarios) and must exit 2 with a message naming the place (file, line or field) and what was
 // expected. Complements tests/app/predict_cli_test.cc (whose cases are not repeated here).
 #include <gtest/gtest.h>
 
@@ -53,6 +53,31 @@ std::string CsvWithRow(int row, const std::string& line) {
   return out;
 }
 
+// A foreign log (another rig's names, the actuator's torque sign, one angle in degrees) and a map
+// that reads it; map cases replace parts of the map. Map line 2 is `t`, line 4 `q_knee`.
+std::string ForeignCsv() {
+  std::ostringstream os;
+  os << "time,pos1,pos2_deg,trq1,trq2,counts\n";
+  for (int i = 0; i < 200; ++i) {
+    const double t = i * 0.001;
+    os << t << "," << 0.3 + 0.1 * std::sin(2 * t) << "," << -40 + 10 * std::sin(3 * t) << ",20,5," << 4096 + i
+       << "\n";
+  }
+  return os.str();
+}
+const char kMap[] =
+    "columns:\n"
+    "  t:        {from: time}\n"
+    "  q_hip:    {from: pos1}\n"
+    "  q_knee:   {from: pos2_deg, unit: deg}\n"
+    "  tau_hip:  {from: trq1, sign: -1}\n"
+    "  tau_knee: {from: trq2, scale: -1}\n";
+std::string MapReplace(const std::string& from, const std::string& to) {
+  std::string m = kMap;
+  const size_t p = m.find(from);
+  return p == std::string::npos ? "pattern not found: " + from : m.replace(p, from.size(), to);
+}
+
 std::string ShippedMjcf() {
   std::ifstream in(std::string(EXOTWIN_SOURCE_DIR) + "/models/leg_exowheel.xml", std::ios::binary);
   std::stringstream ss;
@@ -77,7 +102,7 @@ std::string Junk(size_t n, bool with_nul, unsigned seed) {
   return s;
 }
 
-enum class Kind { kParams, kCsv, kMjcf, kScenario };
+enum class Kind { kParams, kCsv, kMjcf, kScenario, kMap };
 
 struct Case {
   std::string name;
@@ -173,8 +198,11 @@ std::vector<Case> Cases() {
        "expected a finite number"},
       {"CsvOverflowingNumber", Kind::kCsv, CsvWithRow(10, "0.01,1e999,-0.7,-20,-5"), "d.csv:12: column 'q_hip'",
        "expected a finite number"},
-      {"CsvAngleOutOfRange", Kind::kCsv, CsvWithRow(20, "0.02,0.3,-7.5,-20,-5"), "d.csv:22: column 'q_knee'",
-       "expected |x| <= 6.28"},
+      // A record may turn a joint through revolutions (up to 1e4 rad); a leg (human: block) may not.
+      {"CsvAngleBeyondHumanRange", Kind::kCsv, CsvWithRow(20, "0.02,0.3,-7.5,-20,-5"), "d.csv:22: column 'q_knee'",
+       "expected |q| <= 6.28"},
+      {"CsvAngleBeyondSanityBound", Kind::kCsv, CsvWithRow(20, "0.02,0.3,-2e4,-20,-5"), "d.csv:22: column 'q_knee'",
+       "expected |x| <= 10000"},
       {"CsvHugeTorque", Kind::kCsv, CsvWithRow(30, "0.03,0.3,-0.7,1e300,-5"), "d.csv:32: column 'tau_hip'",
        "expected |x| <= 1000"},
       {"CsvEmgOutOfRange", Kind::kCsv, GoodCsv(200, ",emg_VM", ",250"), "d.csv:2: column 'emg_VM'",
@@ -189,6 +217,25 @@ std::vector<Case> Cases() {
       {"CsvSampledTooSlowly", Kind::kCsv, "", "d.csv", "expected a sample rate above 40"},
       {"CsvSamplingGap", Kind::kCsv, "", "d.csv: column 't'", "expected roughly uniform sampling"},
       {"CsvMissingFile", Kind::kCsv, "", "nonexistent.csv", "cannot open file", "/nonexistent.csv"},
+      // ---- column maps (predict --measured foreign.csv --map) ----
+      {"MapMissingColumn", Kind::kMap, MapReplace("from: pos1", "from: pos_meas1"), "map.yaml: columns.q_hip.from (line 3)",
+       "missing required column 'pos_meas1' in"},
+      {"MapZeroScale", Kind::kMap, MapReplace("scale: -1", "scale: 0"), "map.yaml: columns.tau_knee.scale",
+       "expected a non-zero number"},
+      {"MapUnknownTarget", Kind::kMap, std::string(kMap) + "  q_ankle: {from: counts}\n", "map.yaml: columns.q_ankle",
+       "expected one of: t, q_hip"},
+      {"MapMissingTarget", Kind::kMap, MapReplace("  t:        {from: time}\n", ""), "map.yaml: columns",
+       "missing required target 't'"},
+      {"MapDegreesBeyond720", Kind::kMap, MapReplace("from: pos2_deg", "from: counts"),
+       "foreign.csv:2: column 'counts' (q_knee in deg", "beyond +-720 deg, expected an angle in degrees"},
+      {"MapBadSign", Kind::kMap, MapReplace("sign: -1", "sign: 2"), "map.yaml: columns.tau_hip.sign",
+       "expected +1 or -1"},
+      {"MapBadUnit", Kind::kMap, MapReplace("unit: deg", "unit: turns"), "map.yaml: columns.q_knee.unit",
+       "expected one of: rad, deg"},
+      {"MapNotYaml", Kind::kMap, "columns: {t: [time\n", "map.yaml: line", "malformed YAML"},
+      {"MapBinaryJunk", Kind::kMap, Junk(300, true, 8), "map.yaml: binary data", "expected a YAML text file"},
+      {"MapEmptyFile", Kind::kMap, "", "map.yaml: empty column map", "expected columns:"},
+      {"MapMissingFile", Kind::kMap, "", "nonexistent.yaml", "cannot open column map file", "/nonexistent.yaml"},
       // ---- scenario YAML (run) ----
       {"ScenarioEmptyFile", Kind::kScenario, "", "s.yaml: empty scenario file", ""},
       {"ScenarioTruncated", Kind::kScenario, S.substr(0, 45), "s.yaml: line", "malformed YAML"},
@@ -247,17 +294,22 @@ TEST_P(BadInputMatrix, ExitsTwoNamingPlaceAndExpectation) {
   std::string bad = dir + (k.kind == Kind::kParams ? "/m.yaml"
                            : k.kind == Kind::kCsv  ? "/d.csv"
                            : k.kind == Kind::kMjcf ? "/x.xml"
+                           : k.kind == Kind::kMap  ? "/map.yaml"
                                                    : "/s.yaml");
   WriteText(bad, k.content);
   if (!k.args.empty()) bad = dir + k.args;  // a path that does not exist
   WriteText(dir + "/m_ok.yaml", kModel);
   WriteText(dir + "/d_ok.csv", GoodCsv());
+  WriteText(dir + "/foreign.csv", ForeignCsv());
   std::string args;
   switch (k.kind) {
     case Kind::kParams: args = "predict --params " + bad + " --measured " + dir + "/d_ok.csv"; break;
     case Kind::kCsv: args = "predict --params " + dir + "/m_ok.yaml --measured " + bad; break;
     case Kind::kMjcf:
       args = "predict --params " + dir + "/m_ok.yaml --measured " + dir + "/d_ok.csv --mjcf " + bad;
+      break;
+    case Kind::kMap:
+      args = "predict --params " + dir + "/m_ok.yaml --measured " + dir + "/foreign.csv --map " + bad;
       break;
     case Kind::kScenario: args = "run " + bad; break;
   }
@@ -275,6 +327,17 @@ TEST_P(BadInputMatrix, ExitsTwoNamingPlaceAndExpectation) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, BadInputMatrix, ::testing::ValuesIn(Cases()),
                          [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
+
+// The map cases start from a foreign log and map that read fine.
+TEST(BadInputMatrixControl, ForeignCsvThroughTheBaseMapPredicts) {
+  const std::string dir = TempDir("badinput_control");
+  WriteText(dir + "/m.yaml", kModel);
+  WriteText(dir + "/foreign.csv", ForeignCsv());
+  WriteText(dir + "/map.yaml", kMap);
+  const auto r = RunExotwin("predict --params " + dir + "/m.yaml --measured " + dir + "/foreign.csv --map " + dir +
+                            "/map.yaml --out " + dir + "/pred.csv");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
 
 TEST(BadInputMatrixSize, AtLeastThirtyCases) { EXPECT_GE(Cases().size(), 30u); }
 

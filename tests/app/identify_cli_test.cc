@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "analysis/csv_table.h"
 #include "analysis/identification_data.h"
 #include "analysis/model_file.h"
 #include "tests/app/cli_test_util.h"
@@ -82,6 +83,56 @@ TEST_F(IdentifyCli, ExoThenHumanWithKnown) {
   for (const char* key : {"identification:", "segment: H2", "segment: H1", "std_error:",
                           "condition_number:", "passive_selection:"})
     EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
+}
+
+// The exo recordings as a foreign rig would log them (time in ms, angles in degrees, torques with the
+// actuator's sign, other names), in a folder: one --map applies to every --measured file, and the
+// identification equals the one on the schema files.
+TEST_F(IdentifyCli, OneMapForEveryMeasuredFile) {
+  std::system(("mkdir -p " + D() + "/foreign").c_str());
+  for (const char* name : {"knee_1", "knee_2", "hip_1", "hip_2"}) {
+    const CsvTable t = ReadCsv(D() + "/exo/" + name + ".csv");
+    std::vector<double> c[5];
+    const double scale[5] = {1e3, 180 / M_PI, 180 / M_PI, -1, -1};
+    const char* from[5] = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+    for (int k = 0; k < 5; ++k)
+      for (double v : t.columns[t.Find(from[k])]) c[k].push_back(scale[k] * v);
+    WriteCsv(D() + "/foreign/" + name + ".csv", {"ms", "a1", "a2", "m1", "m2"},
+             {&c[0], &c[1], &c[2], &c[3], &c[4]});
+  }
+  testing::WriteText(D() + "/foreign/notes.csv", "a,b\n1,2\n");  // not this rig's log: skipped
+  testing::WriteText(D() + "/foreign.yaml",
+                     "columns:\n  t: {from: ms, unit: ms}\n  q_hip: {from: a1, unit: deg}\n"
+                     "  q_knee: {from: a2, unit: deg}\n  tau_hip: {from: m1, sign: -1}\n"
+                     "  tau_knee: {from: m2, sign: -1}\n");
+  const auto r1 = RunExotwin("identify --measured " + D() + "/exo --L1 0.41 --out " + D() + "/exo_plain.yaml");
+  ASSERT_EQ(r1.exit_code, 0) << r1.output;
+  const auto r2 = RunExotwin("identify --measured " + D() + "/foreign --map " + D() +
+                             "/foreign.yaml --L1 0.41 --out " + D() + "/exo_map.yaml");
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  EXPECT_NE(r2.output.find("skipping " + D() + "/foreign/notes.csv"), std::string::npos) << r2.output;
+  const LegParams a = ReadModelFile(D() + "/exo_plain.yaml"), b = ReadModelFile(D() + "/exo_map.yaml");
+  EXPECT_NEAR(b.exo.J1, a.exo.J1, 1e-6 * a.exo.J1);
+  EXPECT_NEAR(b.exo.J2, a.exo.J2, 1e-6 * a.exo.J2);
+  EXPECT_NEAR(b.exo.X1, a.exo.X1, 1e-6 * a.exo.X1);
+  EXPECT_NEAR(b.exo.X2, a.exo.X2, 1e-6 * a.exo.X2);
+  EXPECT_NEAR(b.exo.Y1, a.exo.Y1, 1e-6);
+  EXPECT_NEAR(b.exo.Y2, a.exo.Y2, 1e-6);
+}
+
+// With --known the records are of a human: an angle beyond 2 pi is bad input (exo alone: allowed).
+TEST_F(IdentifyCli, KnownChecksAHumanJointsRange) {
+  std::system(("mkdir -p " + D() + "/wide").c_str());
+  CsvTable t = ReadCsv(D() + "/human/knee_1.csv");
+  t.columns[t.Find("q_knee")][100] = -7.0;
+  std::vector<const std::vector<double>*> cols;
+  for (const auto& c : t.columns) cols.push_back(&c);
+  WriteCsv(D() + "/wide/knee_1.csv", t.names, cols);  // header on line 1: row 100 on line 102
+  testing::WriteText(D() + "/exo_known.yaml",
+                     "L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n");
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/wide/knee_1.csv --measured " + D() +
+                            "/human/hip_1.csv --known " + D() + "/exo_known.yaml --out " + D() + "/x.yaml"),
+                 "wide/knee_1.csv:102: column 'q_knee': angle -7 rad is beyond a human joint's range");
 }
 
 TEST_F(IdentifyCli, FileFittingNeitherConfiguration) {

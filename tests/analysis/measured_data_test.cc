@@ -1,0 +1,57 @@
+// Measured-data angles: a record may turn a joint through several revolutions (up to the sanity
+// bound kMaxRecordedAngle); a human joint's range (2 pi) is a separate check naming file, line, column.
+#include "analysis/measured_data.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "model/input_error.h"
+
+namespace exotwin {
+namespace {
+
+// 30 rows at 1 kHz, data row i on line i + 2; q_knee of row `row` set to `q`.
+CsvTable Table(int row, double q) {
+  CsvTable t;
+  t.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+  t.columns.assign(5, {});
+  for (int i = 0; i < 30; ++i) {
+    const double v[5] = {1e-3 * i, 0.1, i == row ? q : -0.5, 1.0, 2.0};
+    for (int c = 0; c < 5; ++c) t.columns[c].push_back(v[c]);
+    t.line_of_row.push_back(i + 2);
+  }
+  return t;
+}
+
+TEST(MeasuredAngles, ARecordMayTurnThroughSeveralRevolutions) {
+  const MeasuredData d = MeasuredFromTable(Table(7, 11.0), "rig.csv");
+  EXPECT_DOUBLE_EQ(d.q_knee[7], 11.0);
+  EXPECT_NO_THROW(MeasuredFromTable(Table(7, -kMaxRecordedAngle), "rig.csv"));
+}
+
+TEST(MeasuredAngles, BeyondTheSanityBoundIsBadInput) {
+  try {
+    MeasuredFromTable(Table(7, 2e4), "rig.csv");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("rig.csv:9: column 'q_knee': value 20000 out of range, expected |x| <= 10000"),
+              std::string::npos) << m;
+  }
+}
+
+TEST(MeasuredAngles, HumanJointRangeIsASeparateCheck) {
+  EXPECT_NO_THROW(CheckHumanJointRange(MeasuredFromTable(Table(7, -6.28), "leg.csv")));
+  try {
+    CheckHumanJointRange(MeasuredFromTable(Table(12, -7.5), "leg.csv"));
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("leg.csv:14: column 'q_knee': angle -7.5 rad is beyond a human joint's range, "
+                     "expected |q| <= 6.28"), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+}  // namespace exotwin
