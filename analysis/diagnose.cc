@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -32,11 +33,22 @@ const char* kJoint[2] = {"hip", "knee"};
 struct Rec {
   const MeasuredData* data = nullptr;
   Kinematics kin;
-  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (parallel filtering)
+  std::vector<double> raw[2];           // measured tau_S
+  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
+  double hz = 0;                        // the parallel low-pass (0: none)
   std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque, reading with its effects
   std::vector<double> resid[2];
   size_t split = 0;
   size_t n() const { return kin.t.size(); }
+  // The residual's low-pass: the angles' derivative filter, applied to measured minus predicted
+  // torque (parallel filtering: both are filtered alike).
+  std::vector<double> Filter(const std::vector<double>& x) const {
+    return hz > 0 ? LowPassOnTimeBase(kin.t, x, hz, data->source) : x;
+  }
+  std::function<std::vector<double>(const std::vector<double>&)> FilterFn() const {
+    if (!(hz > 0)) return {};
+    return [this](const std::vector<double>& x) { return Filter(x); };
+  }
 };
 
 std::string Num(double v) {
@@ -92,10 +104,10 @@ void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
   }
 }
 
-// Weighted SSE of measured - (base tau_R through ApplyEffects(p)) on samples [a, b).
-double ExactSse(const LegParams& p, const Kinematics& kin, const std::vector<double> tau_R[2],
-                const std::vector<double> meas[2], const double w[2], size_t a, size_t b) {
+// Weighted SSE of the filtered (measured - (base tau_R through ApplyEffects(p))) on samples [a, b).
+double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, size_t b) {
   if (b <= a + 2) return 0;
+  const Kinematics& kin = rc.kin;
   Kinematics k;
   k.t.assign(kin.t.begin() + a, kin.t.begin() + b);
   std::vector<double> tr[2], ts[2];
@@ -103,14 +115,18 @@ double ExactSse(const LegParams& p, const Kinematics& kin, const std::vector<dou
     k.q[j].assign(kin.q[j].begin() + a, kin.q[j].begin() + b);
     k.qd[j].assign(kin.qd[j].begin() + a, kin.qd[j].begin() + b);
     k.qdd[j].assign(kin.qdd[j].begin() + a, kin.qdd[j].begin() + b);
-    tr[j].assign(tau_R[j].begin() + a, tau_R[j].begin() + b);
+    tr[j].assign(rc.tau_R[j].begin() + a, rc.tau_R[j].begin() + b);
   }
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
   ApplyEffects(p, k, tr, ts);
   double s = 0;
   const size_t lo = std::min<size_t>(200, (b - a) / 10);  // skip the edges (delay, filters)
-  for (int j = 0; j < 2; ++j)
-    for (size_t i = lo; i + lo < b - a; ++i) s += std::pow(w[j] * (meas[j][a + i] - ts[j][i]), 2);
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> e(b - a);
+    for (size_t i = 0; i < b - a; ++i) e[i] = rc.raw[j][a + i] - ts[j][i];
+    if (rc.hz > 0) e = LowPassOnTimeBase(k.t, e, rc.hz, rc.data->source);
+    for (size_t i = lo; i + lo < b - a; ++i) s += std::pow(w[j] * e[i], 2);
+  }
   return s;
 }
 
@@ -194,9 +210,8 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     rc.data = &data;
     const Kinematics full = DeriveKinematics(data, D.cutoff.from_columns ? 20.0 : D.cutoff.hz);
     const bool filtered = full.derivative_source != "measured columns";
-    std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
-    if (filtered)
-      for (auto& m : meas) m = LowPassOnTimeBase(data, m, D.cutoff.hz);
+    rc.hz = filtered ? D.cutoff.hz : 0.0;
+    const std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
     // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
     const double T = full.t.back() - full.t.front();
     const double edge = std::min(0.5, 0.05 * T);
@@ -205,7 +220,10 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     const size_t b = static_cast<size_t>(
         std::upper_bound(full.t.begin(), full.t.end(), full.t.back() - edge) - full.t.begin());
     rc.kin = Slice(full, a, b);
-    for (int j = 0; j < 2; ++j) rc.meas[j].assign(meas[j].begin() + a, meas[j].begin() + b);
+    for (int j = 0; j < 2; ++j) {
+      rc.raw[j].assign(meas[j].begin() + a, meas[j].begin() + b);
+      rc.meas[j] = rc.Filter(rc.raw[j]);
+    }
     const Kinematics& kin = rc.kin;
     const size_t n = kin.t.size();
     const double t_split = kin.t.front() + (1 - opt.holdout_fraction) * (kin.t.back() - kin.t.front());
@@ -223,7 +241,8 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
     for (int j = 0; j < 2; ++j) {
       rc.resid[j].resize(n);
-      for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.meas[j][i] - rc.tau_S[j][i];
+      for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.raw[j][i] - rc.tau_S[j][i];
+      rc.resid[j] = rc.Filter(rc.resid[j]);
     }
   }
   // Noise per joint (first differences of the residual, pooled) and the row weights.
@@ -242,7 +261,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   std::vector<const Kinematics*> kins;
   for (const Rec& rc : recs) {
     banks.push_back(BuildColumns(params, rc.kin, rc.tau_R, rc.tau_S, rc.resid, w, rc.split,
-                                 std::max<size_t>(2000, opt.max_fit_rows / R)));
+                                 std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn()));
     kins.push_back(&rc.kin);
   }
   auto kitchen_sink = [&](std::vector<Eigen::VectorXd>* resid_out) {
@@ -293,10 +312,10 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
         std::vector<double> tq(rc.n());
         for (size_t i = 0; i < rc.n(); ++i) tq[i] = rc.kin.t[i] - d;
         const std::vector<double> shifted = Interpolate(rc.kin.t, rc.tau_S[j], tq);
-        for (size_t k = 0; k < m; ++k) {
-          const size_t i = b.sample[k];
-          b.X(j * m + k, c.cols[0]) = w[j] * (shifted[i] - rc.tau_S[j][i]) / d;
-        }
+        std::vector<double> v[2] = {std::vector<double>(rc.n(), 0.0), std::vector<double>(rc.n(), 0.0)};
+        for (size_t i = 0; i < rc.n(); ++i) v[j][i] = (shifted[i] - rc.tau_S[j][i]) / d;
+        (void)m;
+        SetColumn(b, c.cols[0], w, v);
       }
     }
   }
@@ -339,17 +358,17 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
         }
       }
       scale.M_jj[j] = msum / std::max(mcnt, 1.0);
-      // The strap's neglected dynamics: J_c w_q^2, with J_c the compliant part's mean diagonal
-      // inertia and w_q = RMS(qd) / RMS(q - mean q) the motion's effective angular frequency.
-      double jc = 0, v2 = 0, q1 = 0, q2 = 0, cn = 0;
+      // The strap's neglected dynamics: J_c w^2, with J_c the compliant part's mean diagonal
+      // inertia and w = RMS(qdd) / RMS(qd) the motion's effective angular frequency (of the
+      // velocity: a link that spins through many turns has a slow angle but a fast velocity).
+      double jc = 0, v2 = 0, a2 = 0, cn = 0;
       for (const Rec& rc : recs)
         for (size_t i = 0; i < rc.n(); ++i) {
           jc += MassMatrix(params.human ? *params.human : tot, params.L1, rc.kin.q[1][i])(j, j);
-          v2 += rc.kin.qd[j][i] * rc.kin.qd[j][i], q1 += rc.kin.q[j][i], q2 += rc.kin.q[j][i] * rc.kin.q[j][i];
+          v2 += rc.kin.qd[j][i] * rc.kin.qd[j][i], a2 += rc.kin.qdd[j][i] * rc.kin.qdd[j][i];
           cn += 1;
         }
-      const double var_q = q2 / cn - (q1 / cn) * (q1 / cn);
-      scale.strap_dynamics[j] = var_q > 0 ? jc / cn * v2 / cn / var_q : 0.0;
+      scale.strap_dynamics[j] = v2 > 0 ? jc / cn * a2 / v2 : 0.0;
     }
   }
   const Fit f0 = FitCols(g, {});
@@ -409,7 +428,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       p.effects[idx].value = v;
       double s = 0;
       for (const Rec& rc : recs)
-        s += ExactSse(p, rc.kin, rc.tau_R, rc.meas, w, 0, std::min<size_t>(rc.split, 6000 / R + 1));
+        s += ExactSse(p, rc, w, 0, std::min<size_t>(rc.split, 6000 / R + 1));
       return s;
     };
     double lo = 0.6 * v0, hi = 1.6 * v0;
@@ -441,6 +460,11 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
     ext_plant.SetParams(D.extended);
     double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
+    auto hz_filter = [](const Rec& rc, size_t from, const std::vector<double>& x) {
+      if (!(rc.hz > 0)) return x;
+      const std::vector<double> t(rc.kin.t.begin() + from, rc.kin.t.end());
+      return LowPassOnTimeBase(t, x, rc.hz, rc.data->source);
+    };
     for (size_t r = 0; r < R; ++r) {
       const Rec& rc = recs[r];
       const size_t n = rc.n();
@@ -453,19 +477,23 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
           std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
       const Prediction held = PredictTorque(ext_plant, Slice(rc.kin, warm, n));
       for (int j = 0; j < 2; ++j) {
+        std::vector<double> ea(n - warm);
+        for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
+        ea = hz_filter(rc, warm, ea);
         double b = 0, a = 0;
         for (size_t i = rc.split; i < n; ++i) {
-          b += std::pow(rc.meas[j][i] - rc.tau_S[j][i], 2);
-          a += std::pow(rc.meas[j][i] - held.tau_S[j][i - warm], 2);
+          b += std::pow(rc.resid[j][i], 2);
+          a += std::pow(ea[i - warm], 2);
         }
         const double c = static_cast<double>(std::max<size_t>(1, n - rc.split));
         rs.split[j] = {std::sqrt(b / c), std::sqrt(a / c), b > 0 ? 100 * (1 - std::sqrt(a / b)) : 0};
         sb[j] += b, sa[j] += a;
         if (r == 0) {
-          D.before[j] = rc.tau_S[j];
           D.measured[j] = rc.meas[j];
+          D.before[j].resize(n);
+          for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - rc.resid[j][i];
           D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
-          for (size_t i = rc.split; i < n; ++i) D.after[j][i] = held.tau_S[j][i - warm];
+          for (size_t i = rc.split; i < n; ++i) D.after[j][i] = rc.meas[j][i] - ea[i - warm];
         }
       }
       cnt += static_cast<double>(n - rc.split);
@@ -487,11 +515,11 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
         loo_plant.SetParams(p);
         const Prediction whole = PredictTorque(loo_plant, rc.kin);
         for (int j = 0; j < 2; ++j) {
+          std::vector<double> ea(n);
+          for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
+          ea = rc.Filter(ea);
           double b = 0, a = 0;
-          for (size_t i = 0; i < n; ++i) {
-            b += std::pow(rc.meas[j][i] - rc.tau_S[j][i], 2);
-            a += std::pow(rc.meas[j][i] - whole.tau_S[j][i], 2);
-          }
+          for (size_t i = 0; i < n; ++i) b += std::pow(rc.resid[j][i], 2), a += std::pow(ea[i], 2);
           rs.left_out[j] = {std::sqrt(b / n), std::sqrt(a / n), b > 0 ? 100 * (1 - std::sqrt(a / b)) : 0};
           lb[j] += b, la[j] += a;
         }

@@ -23,6 +23,15 @@ int AddColumn(ColumnBank& b, const double w[2], F f) {
   const size_t m = b.sample.size();
   const int c = b.used++;
   if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);
+  if (b.filter) {
+    std::vector<double> v[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
+    for (size_t i = 0; i < b.n; ++i) {
+      const Eigen::Vector2d x = f(i);
+      v[0][i] = x[0], v[1][i] = x[1];
+    }
+    SetColumn(b, c, w, v);
+    return c;
+  }
   for (size_t k = 0; k < m; ++k) {
     const Eigen::Vector2d v = f(b.sample[k]);
     b.X(k, c) = w[0] * v[0];
@@ -35,12 +44,24 @@ Eigen::Vector2d Row(int j, double v) { return j == 0 ? Eigen::Vector2d(v, 0) : E
 
 }  // namespace
 
+void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]) {
+  const size_t m = b.sample.size();
+  for (int j = 0; j < 2; ++j) {
+    bool zero = true;
+    for (double x : v[j]) zero &= x == 0.0;
+    if (!zero && b.filter) v[j] = b.filter(v[j]);
+    for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * v[j][b.sample[k]];
+  }
+}
+
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         const std::vector<double> tau_R[2], const std::vector<double> tau_S[2],
                         const std::vector<double> resid[2], const double w[2], size_t split,
-                        size_t max_rows) {
+                        size_t max_rows, std::function<std::vector<double>(const std::vector<double>&)> filter) {
   ColumnBank b;
   const size_t n = kin.t.size();
+  b.filter = std::move(filter);
+  b.n = n;
   const size_t stride = std::max<size_t>(1, (n + max_rows - 1) / max_rows);
   for (size_t i = 0; i < n; i += stride) {
     b.sample.push_back(i);
@@ -174,11 +195,16 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       b.used = c0 + 2;
       b.X.col(c0).setZero();
       b.X.col(c0 + 1).setZero();
-      for (size_t k = 0; k < m; ++k) {
-        const double x = 2 * M_PI * f * kins[r]->q[j][b.sample[k]];
-        b.X(j * m + k, c0) = -w * std::sin(x);
-        b.X(j * m + k, c0 + 1) = -w * std::cos(x);
+      const size_t n = kins[r]->t.size();
+      std::vector<double> vs[2] = {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+      std::vector<double> vc[2] = {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+      for (size_t i = 0; i < n; ++i) {
+        const double x = 2 * M_PI * f * kins[r]->q[j][i];
+        vs[j][i] = -std::sin(x), vc[j][i] = -std::cos(x);
       }
+      const double ww[2] = {j == 0 ? w : 0.0, j == 1 ? w : 0.0};
+      SetColumn(b, c0, ww, vs);
+      SetColumn(b, c0 + 1, ww, vc);
       Candidate c;
       c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
       b.candidates.push_back(c);

@@ -1,6 +1,7 @@
 // Candidate explanations of a twin residual as columns of a linear model (first order in each
 // effect of DESIGN.md "Effects"); used by Diagnose (diagnose.h).
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ struct ColumnBank {
   Eigen::VectorXd r;           // 2m weighted residual
   std::vector<Candidate> candidates;
   int used = 0;                // columns in use (X may be over-allocated while building)
+  // The residual's low-pass (parallel filtering): every column is evaluated on all n samples and
+  // filtered by it before its fit rows are taken. Empty: no filter.
+  std::function<std::vector<double>(const std::vector<double>&)> filter;
+  size_t n = 0;                // samples of the record
 };
 
 // Builds every candidate for both joints. tau_R, tau_S: the twin's prediction (N m) on all samples;
@@ -37,7 +42,12 @@ struct ColumnBank {
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         const std::vector<double> tau_R[2], const std::vector<double> tau_S[2],
                         const std::vector<double> resid[2], const double w[2], size_t split,
-                        size_t max_rows);
+                        size_t max_rows,
+                        std::function<std::vector<double>(const std::vector<double>&)> filter = {});
+
+// Stores column c of the bank from per-sample values v[0] (hip rows), v[1] (knee rows), n each,
+// filtered by bank.filter when set and weighted by w.
+void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]);
 
 // Adds the torque_ripple candidates (sin/cos of 2 pi f q_j) to every bank (one per record of one
 // device, same columns), with f (1 .. 10 cycles/rad) found by grid + golden search on the train rows

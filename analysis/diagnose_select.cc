@@ -13,7 +13,7 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
-constexpr double kStrapDynamics = 0.5;  // (motion frequency / strap resonance)^2, at most
+constexpr double kStrapDynamics = 1.0;  // (motion frequency / strap resonance)^2, at most
 
 std::string Num(double v) {
   char b[32];
@@ -228,7 +228,7 @@ bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* wh
          " (the quasi-static strap model)";
   if (e.name == "torque_ripple" && !(v <= 0.5 * s.tau_max[j])) no = "ripple beyond half the largest torque";
   if (e.name == "sensor_offset" && !(std::abs(v) <= 0.5 * s.tau_max[j])) no = "offset beyond half the largest torque";
-  if (e.name == "sensor_gain" && !(v >= -0.5 && v <= 1.0)) no = "gain error outside -50 % .. +100 %";
+  if (e.name == "sensor_gain" && !(v >= -0.25 && v <= 0.25)) no = "gain error outside -25 % .. +25 %";
   if (e.name == "sensor_delay" && !(v > 0 && v <= 0.05)) no = "delay outside (0, 50] ms";
   if (why) *why = no;
   return no.empty();

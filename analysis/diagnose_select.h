@@ -72,9 +72,9 @@ struct PhysicalScale {
   double q_min[2] = {0, 0}, q_max[2] = {0, 0};  // rad, over every record
   double tau_max[2] = {0, 0};                   // N m, max |measured torque|
   double tau_C_max[2] = {0, 0};                 // N m, max |torque of the series-compliant part|
-  // N m/rad: J_c w_q^2, with J_c the compliant part's mean diagonal inertia and w_q = RMS(qd) /
-  // RMS(q - mean q) the motion's effective angular frequency. The quasi-static strap model holds well
-  // below the strap's resonance sqrt(k / J_c): strap_dynamics / k = (w_q / resonance)^2.
+  // N m/rad: J_c w^2, with J_c the compliant part's mean diagonal inertia and w = RMS(qdd) /
+  // RMS(qd) the motion's effective angular frequency. The quasi-static strap model holds below the
+  // strap's resonance sqrt(k / J_c): strap_dynamics / k = (w / resonance)^2.
   double strap_dynamics[2] = {0, 0};
   double M_jj[2] = {0, 0};                      // kg m^2, the twin's mean diagonal inertia
   double distal_moment[2] = {0, 0};             // kg m, hypot(X, Y) of the segments distal to j

@@ -132,31 +132,31 @@ struct SampleGrid {
   std::vector<double> grid;
 };
 
-SampleGrid MakeGrid(const MeasuredData& data, double cutoff_hz) {
+SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, double cutoff_hz) {
   SampleGrid s;
-  const size_t n = data.t.size();
-  s.dt = MedianStep(data.t);
+  const size_t n = t.size();
+  s.dt = MedianStep(t);
   if (!(s.dt >= 1e-6))
-    throw InputError(data.source + ": column 't': median sample period " + Short(s.dt) +
+    throw InputError(source + ": column 't': median sample period " + Short(s.dt) +
                      " s, expected at least 1e-6 s (a sample rate up to 1 MHz)");
   for (size_t i = 0; i + 1 < n; ++i)
-    if (std::abs(data.t[i + 1] - data.t[i] - s.dt) > 0.01 * s.dt) { s.uniform = false; break; }
+    if (std::abs(t[i + 1] - t[i] - s.dt) > 0.01 * s.dt) { s.uniform = false; break; }
   if (s.uniform) {
-    s.grid = data.t;
+    s.grid = t;
   } else {
-    const double span = data.t.back() - data.t.front();
+    const double span = t.back() - t.front();
     const double points = std::floor(span / s.dt) + 1;
     if (!(points <= std::max(100.0 * static_cast<double>(n), 1e6)))
-      throw InputError(data.source + ": column 't': sampling too irregular to resample (median step " +
+      throw InputError(source + ": column 't': sampling too irregular to resample (median step " +
                        Short(s.dt) + " s over " + Short(span) + " s needs " + Short(points) +
                        " grid points for " + std::to_string(n) +
                        " samples), expected roughly uniform sampling without long gaps");
     const size_t m = static_cast<size_t>(points);
     s.grid.resize(m);
-    for (size_t i = 0; i < m; ++i) s.grid[i] = data.t.front() + s.dt * static_cast<double>(i);
+    for (size_t i = 0; i < m; ++i) s.grid[i] = t.front() + s.dt * static_cast<double>(i);
   }
   if (!(cutoff_hz < 0.5 / s.dt))
-    throw InputError(data.source + ": sample period " + Short(s.dt) + " s is too long for the " +
+    throw InputError(source + ": sample period " + Short(s.dt) + " s is too long for the " +
                      Short(cutoff_hz) + " Hz derivative filter, expected a sample rate above " +
                      Short(2 * cutoff_hz) + " Hz");
   return s;
@@ -164,12 +164,12 @@ SampleGrid MakeGrid(const MeasuredData& data, double cutoff_hz) {
 
 }  // namespace
 
-std::vector<double> LowPassOnTimeBase(const MeasuredData& data, const std::vector<double>& x,
-                                      double cutoff_hz) {
-  const SampleGrid s = MakeGrid(data, cutoff_hz);
+std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::vector<double>& x,
+                                      double cutoff_hz, const std::string& source) {
+  const SampleGrid s = MakeGrid(t, source, cutoff_hz);
   const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, cutoff_hz);
   if (s.uniform) return dsp::FiltFilt(sos, x);
-  return Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(data.t, x, s.grid)), data.t);
+  return Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(t, x, s.grid)), t);
 }
 
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
@@ -196,7 +196,7 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
     k.derivative_source = "measured columns";
     return k;
   }
-  const SampleGrid s = MakeGrid(data, cutoff_hz);
+  const SampleGrid s = MakeGrid(data.t, data.source, cutoff_hz);
   k.resampled = !s.uniform;
   const double dt = s.dt;
   const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, cutoff_hz);

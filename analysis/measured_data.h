@@ -63,12 +63,13 @@ struct Kinematics {
 // interpolation), differentiating there, and interpolating back onto the measured times.
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz = 20.0);
 
-// x (one value per sample of `data`) filtered exactly as DeriveKinematics filters the angles: the
-// zero-phase 2nd-order Butterworth low-pass at cutoff_hz, on the same uniform grid when the record
-// is sampled non-uniformly. Used to filter the measured torque alike (parallel filtering, so that
-// the filter's own lag and attenuation never show as a discrepancy).
-std::vector<double> LowPassOnTimeBase(const MeasuredData& data, const std::vector<double>& x,
-                                      double cutoff_hz);
+// x (one value per time of t) filtered exactly as DeriveKinematics filters the angles: the
+// zero-phase 2nd-order Butterworth low-pass at cutoff_hz, on a uniform grid at the median step when
+// t is non-uniform. Used to filter measured and predicted torque alike (parallel filtering, so that
+// the noise differentiation injects above the cutoff never shows as a discrepancy). `source` names
+// the record in messages.
+std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::vector<double>& x,
+                                      double cutoff_hz, const std::string& source);
 
 // Median sample period (s) of strictly increasing times (>= 2 samples).
 double MedianStep(const std::vector<double>& t);
