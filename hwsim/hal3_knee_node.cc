@@ -7,7 +7,8 @@
 namespace exotwin::hwsim {
 
 Hal3KneeNode::Hal3KneeNode(const Hal3KneeNodeSpec& spec, CanBus* bus, uint64_t seed)
-    : spec_(spec), bus_(bus), rng_(seed), driver_(spec.driver) {}
+    : spec_(spec), bus_(bus), rng_(seed), driver_(spec.driver),
+      strain_skew_(std::max(spec.torque_sensor_skew, 0)), angle_skew_(std::max(-spec.torque_sensor_skew, 0)) {}
 
 double Hal3KneeNode::ReadPotentiometer(double th) {
   const double lsb = spec_.pot.range / std::ldexp(1.0, spec_.pot.adc_bits);
@@ -23,8 +24,8 @@ double Hal3KneeNode::ReadStrainGauge(double tau) {
 }
 
 CanStatus Hal3KneeNode::Sample(double, double th, double tau_int) {
-  angle_ = ReadPotentiometer(th);
-  strain_ = ReadStrainGauge(tau_int);
+  angle_ = ReadPotentiometer(angle_skew_.Push(th));
+  strain_ = ReadStrainGauge(strain_skew_.Push(tau_int));
   msg::HalKneeStatus s;
   s.angle = angle_;
   s.torque = strain_;

@@ -35,14 +35,20 @@ struct Hal3KneeNodeSpec {
   PotentiometerSpec pot;
   StrainGaugeSpec strain;
   MotorDriverSpec driver{0.5e-3, 60.0, 0.02};  // limit = models/hal3_knee.xml ctrlrange
+  // Deliberate skew, in node samples, of the strain gauge against the potentiometer (as
+  // JointModuleSpec::torque_sensor_skew; SampleSkew, hwsim/sensors.h): 0 = one sampling instant.
+  int torque_sensor_skew = 0;
 };
 
 class Hal3KneeNode {
  public:
   // bus: this node's endpoint (not owned, outlives the node); seed drives both sensors' noise.
   Hal3KneeNode(const Hal3KneeNodeSpec& spec, CanBus* bus, uint64_t seed);
-  // Samples at time t (s) the true knee angle th (rad) and the true frame torque tau_int (N m) and
-  // sends one HalKneeStatus frame. Returns the CanStatus of the send.
+  // Samples at the instant t (s) the true knee angle th(t) (rad) and the true frame torque
+  // tau_int(t) (N m) and sends one HalKneeStatus frame. Returns the CanStatus of the send. Both
+  // arguments belong to the same instant (DESIGN.md "Sampling instant of a joint node"): th(t) and the
+  // frame torque of the plant step [t, t + dt] (Hal3Plant::interaction_torque, computed from the state
+  // at t); the spec's torque_sensor_skew then delays one of them.
   CanStatus Sample(double t, double th, double tau_int);
   // Reads HalKneeCommand frames and advances the driver to t by dt (s); returns the motor torque
   // (N m) for the next physics step.
@@ -60,6 +66,7 @@ class Hal3KneeNode {
   CanBus* bus_;
   Rng rng_;
   MotorDriver driver_;
+  SampleSkew strain_skew_, angle_skew_;  // delay lines of torque_sensor_skew (one of them is 0)
   double angle_ = 0, strain_ = 0;
   uint8_t counter_ = 0;
   uint32_t commands_received_ = 0;

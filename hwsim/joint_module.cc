@@ -1,11 +1,13 @@
 #include "hwsim/joint_module.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace exotwin::hwsim {
 
 JointModule::JointModule(const JointModuleSpec& spec, CanBus* bus, uint64_t seed)
     : spec_(spec), bus_(bus), torque_sensor_(spec.torque_sensor, seed), encoder_(spec.encoder),
+      torque_skew_(std::max(spec.torque_sensor_skew, 0)), angle_skew_(std::max(-spec.torque_sensor_skew, 0)),
       driver_(spec.driver) {}
 
 CanStatus JointModule::Sample(double t, double q, double tau_R) {
@@ -13,8 +15,8 @@ CanStatus JointModule::Sample(double t, double q, double tau_R) {
                                                : (faults_.sensor_nan ? SensorFault::kNaN : SensorFault::kNone));
   encoder_.SetFault(faults_.sensor_stuck ? SensorFault::kStuck
                                          : (faults_.encoder_glitch ? SensorFault::kGlitch : SensorFault::kNone));
-  const double tau_S = torque_sensor_.Read(-tau_R);
-  const double angle = encoder_.Read(q);
+  const double tau_S = torque_sensor_.Read(-torque_skew_.Push(tau_R));
+  const double angle = encoder_.Read(angle_skew_.Push(q));
   if (faults_.stale) return CanStatus::kOk;  // nothing leaves the module
   msg::JointStatus s;
   s.joint = spec_.joint;

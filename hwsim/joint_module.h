@@ -16,6 +16,11 @@ struct JointModuleSpec {
   TorqueSensorSpec torque_sensor;
   EncoderSpec encoder;
   MotorDriverSpec driver;
+  // Deliberate skew between the sensors, in module samples (SampleSkew, hwsim/sensors.h): 0 = encoder
+  // and torque sensor sampled at one instant; k > 0 = the torque sensor samples k periods before the
+  // encoder (the frame of t carries the torque of t - k T), k < 0 = the encoder is the older one.
+  // Scenario key hardware.torque_sensor_skew.
+  int torque_sensor_skew = 0;
 };
 
 // Switchable faults of a module.
@@ -32,9 +37,12 @@ class JointModule {
   // bus: this node's endpoint (not owned, outlives the module).
   JointModule(const JointModuleSpec& spec, CanBus* bus, uint64_t seed);
 
-  // Samples the sensors at time t (s) with the true link angle q (rad) and the torque the motor
-  // applies tau_R (N m; the sensor sits between motor and link, so it reads tau_S = -tau_R, eq. 8)
-  // and sends a JointStatus frame (unless stale). Returns the CanStatus of the send.
+  // Samples the sensors at the instant t (s), with the true link angle q(t) (rad) and the torque the
+  // motor applies at t, tau_R(t) (N m; the sensor sits between motor and link, so it reads
+  // tau_S = -tau_R, eq. 8), and sends a JointStatus frame (unless stale). Returns the CanStatus of
+  // the send. Both arguments must belong to the same instant (DESIGN.md "Sampling instant of a joint
+  // node"): with the plant's semi-implicit Euler step, q(t) and the torque held over [t, t + dt]
+  // (the driver's output at t, Applied()); the spec's torque_sensor_skew then delays one of them.
   CanStatus Sample(double t, double q, double tau_R);
   // Reads command frames (those addressed to this joint) and advances the driver to t by dt (s).
   // Returns the torque (N m) the motor applies during the next physics step.
@@ -49,6 +57,7 @@ class JointModule {
   CanBus* bus_;
   TorqueSensor torque_sensor_;
   Encoder encoder_;
+  SampleSkew torque_skew_, angle_skew_;  // delay lines of torque_sensor_skew (one of them is 0)
   MotorDriver driver_;
   JointModuleFaults faults_;
   uint8_t counter_ = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace exotwin::hwsim {
 
@@ -42,6 +43,19 @@ double Encoder::Read(double q) {
   const double res = resolution();
   last_ = std::round(q / res) * res;
   return last_;
+}
+
+SampleSkew::SampleSkew(int samples) : samples_(samples) {
+  if (samples < 0) throw std::invalid_argument("SampleSkew: samples must be >= 0");
+}
+
+double SampleSkew::Push(double v) {
+  if (samples_ == 0) return v;
+  if (line_.empty()) line_.assign(static_cast<size_t>(samples_), v);
+  line_.push_back(v);
+  const double out = line_.front();
+  line_.pop_front();
+  return out;
 }
 
 MotorDriver::MotorDriver(const MotorDriverSpec& spec) : spec_(spec) {}

@@ -2,6 +2,7 @@
 // Pure device physics (no bus): the joint-module node packs their readings into frames.
 #pragma once
 #include <cstdint>
+#include <deque>
 
 #include "hwsim/rng.h"
 
@@ -55,6 +56,26 @@ class Encoder {
   EncoderSpec spec_;
   SensorFault fault_ = SensorFault::kNone;
   double last_ = 0.0;
+};
+
+// Sampling skew between the two sensors of a node (JointModuleSpec / Hal3KneeNodeSpec
+// ::torque_sensor_skew, DESIGN.md "Sampling instant of a joint node"). A node samples its angle sensor
+// and its torque sensor at one instant t_k (skew 0, the default). A skew of k samples (k > 0) makes the
+// torque sensor sample k node periods before the angle sensor: the frame of t_k carries q(t_k) beside
+// the torque of t_{k-k}; k < 0 makes the angle sensor the older one by |k| samples. This class is the
+// delay line of the older sensor's true input.
+class SampleSkew {
+ public:
+  // samples >= 0 (the delay of this input); throws std::invalid_argument otherwise.
+  explicit SampleSkew(int samples);
+  // The true value at this sample in, the value of `samples` samples ago out (the first value until
+  // the line is full: the sensor held its first sample before the record started).
+  double Push(double v);
+  int samples() const { return samples_; }
+
+ private:
+  int samples_;
+  std::deque<double> line_;
 };
 
 // Motor driver: torque command -> applied torque through a first-order current-loop lag, saturation

@@ -154,6 +154,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   auto* knee_ep = bus.AddNode("hal_knee", {msg::kIdHalKneeCommand});
   auto* emg_ep = bus.AddNode("emg_amplifier", {msg::kIdControllerHeartbeat});  // receives nothing used
   hwsim::Hal3KneeNodeSpec ks;
+  ks.torque_sensor_skew = s.hardware.torque_sensor_skew;
   ks.driver.lag = s.hardware.motor_lag;
   ks.driver.limit = std::min(60.0, s.hardware.torque_limit);
   ks.driver.watchdog = s.hardware.watchdog;
@@ -183,7 +184,6 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
 
   const double w = 2 * kPi * s.hal.swing_freq;
   plant.Reset(0.35, 0.65 * w, 0.0);
-  knee.Sample(0.0, plant.th(), 0.0);
   const long n_steps = std::lround(s.protocol.duration / dt);
   const long log_every = std::max(1L, std::lround(1.0 / (s.log_rate_hz * dt)));
   Mean ext_up, ext_down, flex_up, flex_down, rect_up, strain_up, strain_down, mu_up;
@@ -192,21 +192,33 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   ProjectedViscoelasticity projected(std::pow(loop_cfg.assist.rls.rho, dt / ctrl_dt));
   std::vector<double> tau_m, m_e, m_f;
   double th_max = -10, th_min = 10, t = 0;
+  // Timing of one physics step [t, t + dt], as runner.cc's (DESIGN.md "Sampling instant of a joint
+  // node"): the plant holds the driver's output at t over [t, t + dt]; the knee node samples th(t)
+  // and the frame torque at t at one instant; the controller ticks at t + dt/2 on that frame, and its
+  // command shows in the driver's output at t + dt (one sample from sampling to torque). The frame
+  // torque at t needs the acceleration a(t) of this step (Hal3Plant::interaction_torque: semi-implicit
+  // Euler, a(t) from the state at t and the torques held over [t, t + dt]), so the step is computed
+  // before the tick: everything it uses is fixed at t, and the controller sees the plant only
+  // through the bus. (Until this was settled, the frame of t + dt paired th(t + dt) with the frame
+  // torque of [t, t + dt]: a 1-sample skew.)
+  double tau_motor = 0;  // the driver's output at t = 0: no command yet
   for (long k = 0; k < n_steps; ++k) {
+    const double th_t = plant.th();
+    const Eigen::Vector2d q(kPi / 2, th_t - kPi / 2), qd(0, plant.thd());
+    muscles.Step(swing.Excitation(t, q, qd));
+    const MuscleTorques mt = muscles.Torques(q, qd);
+    const double mu = mt.total()[1];
+    const double applied = tau_motor;  // held over [t, t + dt], for the metrics and truth.csv
+    plant.Step(tau_motor, mu);
+    knee.Sample(t, th_t, plant.interaction_torque());  // one instant: th(t) and the frame torque at t
     if (k % steps_per_tick == 0) {
       bus.AdvanceTo(t + 0.5 * dt);
       loop.Tick(t + 0.5 * dt);
     }
     bus.AdvanceTo(t + 0.999 * dt);
-    const double tau_motor = knee.Applied(t + dt, dt);
-    const Eigen::Vector2d q(kPi / 2, plant.th() - kPi / 2), qd(0, plant.thd());
-    muscles.Step(swing.Excitation(t, q, qd));
-    const MuscleTorques mt = muscles.Torques(q, qd);
-    const double mu = mt.total()[1];
-    plant.Step(tau_motor, mu);
+    tau_motor = knee.Applied(t + dt, dt);  // the driver at t + dt
     t = plant.time();
     const double th = plant.th(), thd = plant.thd();
-    knee.Sample(t, th, plant.interaction_torque());
     const MuscleVec raw = emg.Sample(muscles.electrical_activation());
     std::array<double, hwsim::EmgAmplifier::kChannels> v{};
     for (int c = 0; c < kNumMuscles; ++c) v[c] = raw[c];
@@ -250,11 +262,11 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
       const double row[] = {t, tel.th, tel.strain, tel.tau_cmd, o[0], o[1], o[2], o[3], o[4],
                             tel.E_e, tel.E_f, tel.assist.mu_hat, tel.assist.D, tel.assist.K};
       measured->Row(row, 14);
-      const double trow[] = {t, th, thd, tau_motor, mu, plant.interaction_torque(), Dt, Kt, mu_c};
+      const double trow[] = {t, th, thd, applied, mu, plant.interaction_torque(), Dt, Kt, mu_c};
       truth_log->Row(trow, 9);
     }
     if (opt.on_sample && k % log_every == 0) {
-      const double qa[2] = {kPi / 2, th - kPi / 2}, ta[2] = {0, tau_motor};
+      const double qa[2] = {kPi / 2, th - kPi / 2}, ta[2] = {0, applied};
       opt.on_sample(t, qa, ta);
     }
   }

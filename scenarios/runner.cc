@@ -311,6 +311,7 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
       ms[j].driver.lag = s.hardware.motor_lag;
       ms[j].driver.limit = s.hardware.torque_limit;
       ms[j].driver.watchdog = s.hardware.watchdog;
+      ms[j].torque_sensor_skew = s.hardware.torque_sensor_skew;
     }
     hwsim::JointModule hip(ms[0], hip_ep, seed + 1), knee(ms[1], knee_ep, seed + 2);
     hwsim::JointModule* modules[2] = {&hip, &knee};
@@ -363,7 +364,20 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
       envelope.assign(5, dsp::SosFilter(dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, 3.0)));
     }
     size_t events_seen = result.events.size();
-    double tau[2] = {0, 0};
+    // Timing of one physics step [t, t + dt] (DESIGN.md "Sampling instant of a joint node"):
+    //  - the plant holds tau, the drivers' output at t, over [t, t + dt] (forward zero-order hold);
+    //  - the controller ticks at t + dt/2 on the frames sampled at t; its command reaches the driver
+    //    before t + dt and shows in the drivers' output at t + dt, which the plant holds over the next
+    //    step: one sample (1 ms) from sampling to torque, the transport and computation delay of a
+    //    1 kHz CAN loop (sample, send, compute, command, apply at the next period);
+    //  - at t + dt each module samples q(t + dt) and the torque held from t + dt, one instant: with
+    //    MuJoCo's semi-implicit Euler, qd(t+dt) = qd(t) + dt a(t), q(t+dt) = q(t) + dt qd(t+dt), so
+    //    q(t+dt) - 2 q(t) + q(t-dt) = dt^2 a(t) and a(t) follows from the torque held over [t, t + dt]:
+    //    the central differences of the logged angles meet inverse dynamics on the logged torque with
+    //    no lag. (Until this was settled the plant held over [t, t + dt] the drivers' output at t + dt,
+    //    a command issued at t + dt/2 acting from t, and each frame paired q(t + dt) with that torque:
+    //    a 1-sample skew that `diagnose` named as a 1 ms sensor_delay.)
+    double tau[2] = {0, 0};  // the drivers' output at t = 0: no command yet
     const long n_steps = std::lround(s.protocol.duration / dt);
     const long log_every = std::max(1L, std::lround(1.0 / (s.log_rate_hz * dt)));
     const double ctrl_offset = 0.5 * dt;
@@ -380,17 +394,20 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
         bus.AdvanceTo(t + ctrl_offset);
         ctrl.Tick(t + ctrl_offset);
       }
-      bus.AdvanceTo(t + dt * 0.999);
-      for (int j = 0; j < 2; ++j) tau[j] = modules[j]->Applied(t + dt, dt);
       Eigen::Vector2d tau_M = Eigen::Vector2d::Zero();
       if (human) {
         muscles.Step(behaviour->Excitation(t, plant.q(), plant.qd()));
         tau_M = muscles.Torques(plant.q(), plant.qd()).total();
       }
-      plant.Step({tau[0], tau[1]}, tau_M);
+      // The torques of this step, for the metrics and truth.csv (row t + dt: the state at t + dt and
+      // the actuator and muscle torques held over [t, t + dt], the step that ended there).
+      const double applied[2] = {tau[0], tau[1]};
+      plant.Step({tau[0], tau[1]}, tau_M);  // the drivers' output at t, held over [t, t + dt]
+      bus.AdvanceTo(t + dt * 0.999);
+      for (int j = 0; j < 2; ++j) tau[j] = modules[j]->Applied(t + dt, dt);  // the drivers at t + dt
       t = static_cast<double>(k + 1) * dt;  // exact grid (plant.time() accumulates rounding)
       const Eigen::Vector2d q = plant.q();
-      hip.Sample(t, q[0], tau[0]);
+      hip.Sample(t, q[0], tau[0]);  // one instant: q(t) and the torque held from t
       knee.Sample(t, q[1], tau[1]);
       if (emg_on) {  // the amplifier samples the electrodes at 1 kHz and sends one frame
         const MuscleVec v = emg.Sample(muscles.electrical_activation());
@@ -408,15 +425,15 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
       if (tel.safety.state != controller::SafetyState::kRunning && safe_time < 0) safe_time = t;
       for (int j = 0; j < 2; ++j) {
         if (after_ramp && fault_time < 0) track[j].Add(Deg(tel.ref[j].q - q[j]));
-        torque[j].Add(tau[j]);
-        if (safe_time >= 0 && t > safe_time + 0.05) max_torque_after_safe = std::max(max_torque_after_safe, std::abs(tau[j]));
+        torque[j].Add(applied[j]);
+        if (safe_time >= 0 && t > safe_time + 0.05) max_torque_after_safe = std::max(max_torque_after_safe, std::abs(applied[j]));
         // Torque on the faulted joints from 50 ms after the fault on (the damping of a safe state on
         // the other joint is bounded separately by torque_max_after_safe).
         bool faulted_joint = false;
         for (const auto& f : faults)
           faulted_joint |= f.active && (f.spec.joint == "all" || f.spec.joint == (j == 0 ? "hip" : "knee"));
         if (fault_time >= 0 && t > fault_time + 0.05 && faulted_joint)
-          torque_after_fault = std::max(torque_after_fault, std::abs(tau[j]));
+          torque_after_fault = std::max(torque_after_fault, std::abs(applied[j]));
       }
       if (k % log_every == 0) {
         ++samples;
@@ -427,7 +444,7 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
                                 tel.emg[3], tel.emg[4]};
           measured->Row(row, emg_on ? 15 : 10);
           const Eigen::Vector2d qd = plant.qd();
-          const double trow[] = {t, q[0], q[1], qd[0], qd[1], tau[0], tau[1], tau_M[0], tau_M[1]};
+          const double trow[] = {t, q[0], q[1], qd[0], qd[1], applied[0], applied[1], tau_M[0], tau_M[1]};
           truth_log->Row(trow, 9);
         }
         if (video) {
@@ -450,7 +467,7 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
         }
         if (opt.on_sample) {
           const double qa[2] = {q[0], q[1]};
-          opt.on_sample(t, qa, tau);
+          opt.on_sample(t, qa, applied);
         }
       }
       if (tty && k % 2000 == 0) {

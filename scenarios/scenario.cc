@@ -248,7 +248,8 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   if (root["hardware"]) {
     const YAML::Node n = root["hardware"];
     r.Keys(n, "hardware", {"can_bitrate", "can_latency", "can_jitter", "can_drop_rate", "torque_sensor_noise",
-                           "torque_sensor_offset", "encoder_bits", "motor_lag", "torque_limit", "watchdog"});
+                           "torque_sensor_offset", "encoder_bits", "motor_lag", "torque_limit", "watchdog",
+                           "torque_sensor_skew"});
     HardwareSpec& h = s.hardware;
     if (n["can_bitrate"]) h.can_bitrate = r.Num(n["can_bitrate"], "hardware.can_bitrate", 10e3, 1e6);
     if (n["can_latency"]) h.can_latency = r.Num(n["can_latency"], "hardware.can_latency", 0, 0.1);
@@ -262,6 +263,13 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
     if (n["motor_lag"]) h.motor_lag = r.Num(n["motor_lag"], "hardware.motor_lag", 0, 0.05);
     if (n["torque_limit"]) h.torque_limit = r.Num(n["torque_limit"], "hardware.torque_limit", 1, 500);
     if (n["watchdog"]) h.watchdog = r.Num(n["watchdog"], "hardware.watchdog", 0.002, 1);
+    if (n["torque_sensor_skew"]) {
+      const double k = r.Num(n["torque_sensor_skew"], "hardware.torque_sensor_skew", -100, 100);
+      if (k != std::round(k))
+        r.Fail("hardware.torque_sensor_skew", "expected a whole number of samples, found " + n["torque_sensor_skew"].Scalar() +
+                                                     Reader::Line(n["torque_sensor_skew"]));
+      h.torque_sensor_skew = static_cast<int>(k);
+    }
   }
 
   if (root["controller"]) {

@@ -117,6 +117,8 @@ struct HardwareSpec {
   double motor_lag = 0.5e-3;        // s, current-loop time constant
   double torque_limit = 120;        // N m, driver saturation
   double watchdog = 0.02;           // s without a command -> driver cuts torque
+  int torque_sensor_skew = 0;       // samples, torque sensor older than the angle sensor (< 0: younger);
+                                    // JointModuleSpec / Hal3KneeNodeSpec::torque_sensor_skew
 };
 
 struct ControllerSpec {

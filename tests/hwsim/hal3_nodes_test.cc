@@ -1,6 +1,7 @@
 // HAL-3 knee node and EMG amplifier node on the virtual bus: frames, sensor resolution, driver.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "hwsim/emg_node.h"
@@ -28,6 +29,31 @@ TEST(Hal3KneeNode, StatusFramesCarryPotentiometerAndStrainGauge) {
   const double lsb = spec.pot.range / std::ldexp(1.0, spec.pot.adc_bits);
   EXPECT_NEAR(s.angle, 0.5, 0.5 * lsb + 1e-4);  // ADC LSB + frame LSB
   EXPECT_NEAR(s.torque, -3.21, 0.01);
+}
+
+// Hal3KneeNodeSpec::torque_sensor_skew: 0 pairs the potentiometer and the strain gauge of one
+// instant; k = 2 sends the strain gauge of two samples before (the first reading held until then).
+TEST(Hal3KneeNode, StrainGaugeSkewIsAKStepDelay) {
+  for (int k : {0, 2}) {
+    VirtualCanBus bus;
+    auto* ctrl = bus.AddNode("ctrl", {msg::kIdHalKneeStatus});
+    auto* node_ep = bus.AddNode("knee", {msg::kIdHalKneeCommand});
+    Hal3KneeNodeSpec spec;
+    spec.pot.noise = 0;
+    spec.strain.noise = 0;
+    spec.torque_sensor_skew = k;
+    Hal3KneeNode node(spec, node_ep, 1);
+    for (int i = 0; i < 6; ++i) {
+      ASSERT_EQ(node.Sample(i * 1e-3, 0.1 * i, 1.0 * i), CanStatus::kOk);
+      bus.AdvanceTo(i * 1e-3 + 0.9e-3);
+      CanFrame f;
+      ASSERT_EQ(ctrl->Receive(&f), CanStatus::kOk);
+      msg::HalKneeStatus s;
+      ASSERT_TRUE(msg::Decode(f, &s));
+      EXPECT_NEAR(s.angle, 0.1 * i, 1e-3) << "k " << k << " sample " << i;
+      EXPECT_NEAR(s.torque, 1.0 * std::max(i - k, 0), 0.011) << "k " << k << " sample " << i;
+    }
+  }
 }
 
 TEST(Hal3KneeNode, CommandFramesDriveTheMotorAndWatchdogCuts) {

@@ -16,7 +16,7 @@ device: exowheel
 subject: {preset: S3}
 fixed_joints: {hip: 1.5708}
 protocol: {trajectory: excitation, duration: 40, trials: 5, moving_joint: knee}
-hardware: {can_drop_rate: 0.01, torque_sensor_offset: [0.1, -0.2]}
+hardware: {can_drop_rate: 0.01, torque_sensor_offset: [0.1, -0.2], torque_sensor_skew: -2}
 controller: {kp: [800, 500], kd: [40, 20]}
 faults:
   - {type: sensor_stuck, joint: knee, at: 3.5, duration: 1}
@@ -36,6 +36,8 @@ TEST(Scenario, ParsesEveryField) {
   EXPECT_EQ(s.protocol.moving_joint, "knee");
   EXPECT_DOUBLE_EQ(s.hardware.can_drop_rate, 0.01);
   EXPECT_DOUBLE_EQ(s.hardware.torque_sensor_offset[1], -0.2);
+  EXPECT_EQ(s.hardware.torque_sensor_skew, -2);
+  EXPECT_EQ(ParseScenarioYaml("name: x\ndevice: exowheel\nsubject: {preset: S1}\n", "a.yaml").hardware.torque_sensor_skew, 0);
   EXPECT_DOUBLE_EQ(s.controller.kp[0], 800);
   ASSERT_EQ(s.faults.size(), 1u);
   EXPECT_EQ(s.faults[0].type, "sensor_stuck");
@@ -68,6 +70,8 @@ TEST(Scenario, RejectsBadInput) {
   ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1}\nchecks: [{metric: m}]\n",
               "expected exactly one of max, min");
   ExpectError("name: [x\n", "malformed YAML");
+  ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1}\nhardware: {torque_sensor_skew: 1.5}\n",
+              "hardware.torque_sensor_skew: expected a whole number of samples, found 1.5 (line 4)");
   ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1, random_seed: 3}\n", "exactly one of");
   ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1}\ncontroller: {kp: [1]}\n",
               "controller.kp: expected [hip, knee]");
