@@ -27,6 +27,7 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
+constexpr double kDerivativeFactor = 2.0;  // derivative filter cutoff / residual filter cutoff
 
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
@@ -208,7 +209,13 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     const MeasuredData& data = *records[r];
     Rec& rc = recs[r];
     rc.data = &data;
-    const Kinematics full = DeriveKinematics(data, D.cutoff.from_columns ? 20.0 : D.cutoff.hz);
+    // Parallel filtering (as in robot identification practice): the residual is low-passed at the
+    // chosen cutoff fc, the derivatives are taken at kDerivativeFactor fc, so that the derivative
+    // filter is flat where the residual filter passes and measured and predicted torque see one
+    // and the same filter.
+    const double fs = 1.0 / MedianStep(data.t);
+    const Kinematics full = DeriveKinematics(
+        data, D.cutoff.from_columns ? 20.0 : std::min(kDerivativeFactor * D.cutoff.hz, 0.4 * fs));
     const bool filtered = full.derivative_source != "measured columns";
     rc.hz = filtered ? D.cutoff.hz : 0.0;
     const std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
