@@ -27,7 +27,7 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
-constexpr double kDerivativeFactor = 2.0;  // derivative filter cutoff / residual filter cutoff
+constexpr double kDerivativeFactor = 4.0;  // derivative filter cutoff / residual filter cutoff
 
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
@@ -327,6 +327,10 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     }
   }
   Grams g = MakeGrams(banks);
+  for (size_t r = 0; r < R; ++r)  // the measured torque's scale on the held-out rows (materiality)
+    for (size_t k = 0; k < banks[r].sample.size(); ++k)
+      if (!banks[r].train[k])
+        for (int j = 0; j < 2; ++j) g.tt_te[j] += std::pow(w[j] * recs[r].meas[j][banks[r].sample[k]], 2);
   {
     // Autocorrelation length of what no candidate explains: kitchen sink incl. ripple.
     std::vector<Eigen::VectorXd> e;

@@ -13,7 +13,7 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
-constexpr double kStrapDynamics = 1.0;  // (motion frequency / strap resonance)^2, at most
+constexpr double kStrapDynamics = 0.25;  // (motion frequency / strap resonance)^2: resonance >= 2x
 
 std::string Num(double v) {
   char b[32];
@@ -290,6 +290,12 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
     return f.sse_te_j[j] <= (1 - frac) * ref.sse_te_j[j] &&
            (!loo || f.sse_loo_j[j] <= (1 - frac) * ref.sse_loo_j[j]);
   };
+  // Material: the drop is also at least kMinMaterial of the rigid twin's held-out error there.
+  const Fit rigid = cur;
+  auto material = [&](const Fit& f, const Fit& ref, int j) {
+    return ref.sse_te_j[j] - f.sse_te_j[j] >=
+           std::max(kMinMaterial * rigid.sse_te_j[j], kMinTorqueShare * kMinTorqueShare * g.tt_te[j]);
+  };
   std::string last_rejected;
   auto score = [&](const Fit& f) {
     std::string s = "BIC " + Num(f.bic - FitCols(g, {}).bic) + ", held-out SSE " + Num(f.sse_te);
@@ -314,7 +320,7 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
       Fit f = FitCols(g, ColsOf(bank, next));
       if (!f.ok || !(f.bic < cur.bic - kBicMargin)) continue;
       const int j = bank.candidates[c].joint;
-      if (!held_ok(f, cur, j, kMinHeldoutGain)) {
+      if (!held_ok(f, cur, j, kMinHeldoutGain) || !material(f, cur, j)) {
         if (f.bic < best_rejected_bic)
           best_rejected_bic = f.bic,
           last_rejected = bank.candidates[c].Label() + " (BIC " + Num(f.bic - cur.bic) + ") lowers the held-out " +
