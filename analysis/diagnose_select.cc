@@ -290,11 +290,9 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
     return f.sse_te_j[j] <= (1 - frac) * ref.sse_te_j[j] &&
            (!loo || f.sse_loo_j[j] <= (1 - frac) * ref.sse_loo_j[j]);
   };
-  // Material: the drop is also at least kMinMaterial of the rigid twin's held-out error there.
-  const Fit rigid = cur;
+  // Material: the drop is at least (kMinTorqueShare of the measured torque's RMS)^2 there.
   auto material = [&](const Fit& f, const Fit& ref, int j) {
-    return ref.sse_te_j[j] - f.sse_te_j[j] >=
-           std::max(kMinMaterial * rigid.sse_te_j[j], kMinTorqueShare * kMinTorqueShare * g.tt_te[j]);
+    return ref.sse_te_j[j] - f.sse_te_j[j] >= kMinTorqueShare * kMinTorqueShare * g.tt_te[j];
   };
   std::string last_rejected;
   auto score = [&](const Fit& f) {

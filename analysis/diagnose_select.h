@@ -7,7 +7,8 @@
 //    sample size from the residual autocorrelation), provided that the BIC drops by more than
 //    kBicMargin, the held-out error at the candidate's joint (last 30 % of every record; and, with
 //    several records, every whole record left out in turn) drops by at least kMinHeldoutGain of its
-//    current value and by at least kMinMaterial of the rigid twin's, and every
+//    current value and by at least (kMinTorqueShare of the measured torque's RMS)^2 (an effect too
+//    small to matter is not named), and every
 //    effect of the new set is significant (|t| > kMinT) and inside its physical range (Plausible);
 //  - the simplest explanation: among the admissible additions at the same joint, one with fewer
 //    parameters wins over the best unless the best lowers that joint's held-out error by more than
@@ -29,8 +30,7 @@ constexpr double kBicMargin = 10.0;       // BIC drop needed to name an effect (
 constexpr double kMinHeldoutGain = 0.05;  // held-out SSE drop needed per added effect (fraction)
 constexpr double kMinT = 4.0;             // |coefficient| / standard error
 constexpr double kParsimony = 0.05;
-constexpr double kMinMaterial = 0.02;     // and by at least this fraction of the rigid twin's error
-constexpr double kMinTorqueShare = 0.005; // and by at least (this share of the torque's RMS)^2       // held-out SSE margin a richer explanation must win by
+constexpr double kMinTorqueShare = 0.0025;  // and by at least (this share of the torque's RMS)^2       // held-out SSE margin a richer explanation must win by
 
 // Gram matrices of the weighted columns: train / held-out rows (time split) pooled over records,
 // and every record's whole rows (for leave-one-record-out).

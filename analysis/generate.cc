@@ -56,7 +56,10 @@ Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
   } else if (name == "backlash") {
     e.value = rng.Uniform(0.3, 1.7) * kDeg, e.unit = "rad";
   } else if (name == "series_compliance") {
-    e.value = rng.Uniform(150.0, 800.0), e.unit = "N m/rad";
+    // The quasi-static strap model holds well below the strap's resonance sqrt(k / J_c): at the
+    // hip J_c is the whole leg's (~2.5 kg m^2 against ~0.4 at the knee), so for the same margin
+    // above the gait's frequencies the hip's straps are drawn stiffer (effects.h).
+    e.value = joint == 0 ? rng.Uniform(800.0, 3000.0) : rng.Uniform(150.0, 800.0), e.unit = "N m/rad";
   } else if (name == "torque_ripple") {
     e.value = rng.Uniform(0.2, 1.0), e.unit = "N m";
     e.fields["cycles_per_rad"] = rng.Uniform(2.0, 8.0);

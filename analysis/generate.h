@@ -30,8 +30,10 @@ const std::vector<std::string>& AllEffectNames();
 
 // Draws one effect of `name` at `joint` (0 hip, 1 knee) with a magnitude in its realistic range:
 // coulomb 0.3-1.5 N m, viscous 0.3-2 N m s/rad, inertia +-(0.05-0.3) kg m^2, gravity +-(0.05-0.3)
-// kg m, stiffness 3-15 N m/rad, backlash 0.3-1.7 deg, straps 150-800 N m/rad, ripple 0.2-1 N m at
-// 2-8 cycles/rad, offset +-(0.2-2) N m, gain +-(2-10) %, delay 5-30 ms, muscle weights 3-10 N m/V.
+// kg m, stiffness 3-15 N m/rad, backlash 0.3-1.7 deg, straps 150-800 N m/rad at the knee and
+// 800-3000 at the hip (resonance at least twice the motion's frequency, DESIGN.md's range), ripple
+// 0.2-1 N m at 2-8 cycles/rad, offset +-(0.2-2) N m, gain +-(2-10) %, delay 5-30 ms, muscle
+// weights 3-10 N m/V.
 template <class Rng>
 Effect DrawEffect(Rng& rng, const std::string& name, int joint);
 

@@ -2,6 +2,7 @@
 // time stamp averaged / kept first / rejected, counted and located; the time step and its jitter
 // reported; the shipped map of examples/real_rig/ on its shipped records gives the README's mapping;
 // bad maps throw InputError naming the map file, the key and what was expected.
+#include "tests/temp_dir.h"
 #include "analysis/column_map.h"
 
 #include <gtest/gtest.h>
@@ -18,8 +19,8 @@ namespace exotwin {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("exotwin_map_" + std::to_string(::getpid()) + "_" + name)).string();
+  static const std::string dir = testing::TempDir("map");
+  return dir + "/" + name;
 }
 
 void Spit(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }

@@ -1,5 +1,6 @@
 // CSV tables: a streamed log cut anywhere by a killed run reads back as its complete rows; the same
 // cut in a file without the stream marker is an error; a hand-written file may omit the last newline.
+#include "tests/temp_dir.h"
 #include "analysis/csv_table.h"
 
 #include <gtest/gtest.h>
@@ -15,8 +16,8 @@ namespace exotwin {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("exotwin_csv_" + std::to_string(::getpid()) + "_" + name)).string();
+  static const std::string dir = testing::TempDir("csv");
+  return dir + "/" + name;
 }
 
 std::string Slurp(const std::string& path) {

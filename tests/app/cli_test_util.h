@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "tests/temp_dir.h"
+
 namespace exotwin::testing {
 
 struct RunResult {
@@ -32,13 +34,6 @@ inline RunResult RunExotwin(const std::string& args) {
   const int st = pclose(p);
   r.exit_code = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
   return r;
-}
-
-// A fresh temporary directory for one test.
-inline std::string TempDir(const std::string& tag) {
-  std::string tmpl = "/tmp/exotwin_" + tag + "_XXXXXX";
-  char* d = mkdtemp(tmpl.data());
-  return d ? std::string(d) : std::string("/tmp");
 }
 
 inline void WriteText(const std::string& path, const std::string& text) {

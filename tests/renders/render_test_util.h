@@ -8,13 +8,11 @@
 
 #include <opencv2/core.hpp>
 
+#include "tests/temp_dir.h"
+
 namespace exotwin::testing {
 
-inline std::string RenderTempDir(const std::string& tag) {
-  std::string tmpl = "/tmp/exotwin_render_" + tag + "_XXXXXX";
-  char* d = mkdtemp(tmpl.data());
-  return d ? std::string(d) : std::string("/tmp");
-}
+inline std::string RenderTempDir(const std::string& tag) { return TempDir("render_" + tag); }
 
 // Skin (human segments, rgba 0.93 0.76 0.62): red dominant over blue.
 inline bool IsSkin(const cv::Vec3b& bgr) {

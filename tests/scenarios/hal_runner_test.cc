@@ -1,5 +1,6 @@
 // HAL-3 end to end (scenarios/hal_runner.h): Hayashi's experiment 1 against 2 (Fig. 9), the on-line
 // RLS of D and K against the twin's ground truth, and Lee & Sankai's viscous sweep (Fig. 9, eq. 12).
+#include "tests/temp_dir.h"
 #include "scenarios/hal_runner.h"
 
 #include <gtest/gtest.h>
@@ -19,12 +20,7 @@ namespace {
 
 std::string Shipped(const std::string& rel) { return std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/" + rel; }
 
-std::string TempDir(const std::string& tag) {
-  const auto p = std::filesystem::temp_directory_path() / ("exotwin_hal_" + tag);
-  std::filesystem::remove_all(p);
-  std::filesystem::create_directories(p);
-  return p.string();
-}
+std::string TempDir(const std::string& tag) { return testing::TempDir("hal_" + tag); }
 
 RunResult RunShipped(const std::string& file, const std::string& tag) {
   RunOptions o;

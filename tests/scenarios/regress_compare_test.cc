@@ -1,5 +1,6 @@
 // The regression gate's pieces: tolerances and verdicts (scenarios/metric_tolerance.h), baseline
 // files (scenarios/baseline.h), suite listing and evaluation (scenarios/regress.h).
+#include "tests/temp_dir.h"
 #include "scenarios/regress.h"
 
 #include <gtest/gtest.h>
@@ -13,12 +14,7 @@
 namespace exotwin {
 namespace {
 
-std::string TempDir(const std::string& tag) {
-  const auto p = std::filesystem::temp_directory_path() / ("exotwin_regress_" + tag);
-  std::filesystem::remove_all(p);
-  std::filesystem::create_directories(p);
-  return p.string();
-}
+std::string TempDir(const std::string& tag) { return testing::TempDir("regress_" + tag); }
 
 const MetricDelta& Find(const std::vector<MetricDelta>& v, const std::string& m) {
   for (const auto& d : v)

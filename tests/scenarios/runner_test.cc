@@ -1,5 +1,6 @@
 // The lockstep co-simulation end to end: plant -> joint modules -> virtual CAN bus -> the real
 // controller -> command frames -> drivers -> plant.
+#include "tests/temp_dir.h"
 #include "scenarios/runner.h"
 
 #include <gtest/gtest.h>
@@ -22,12 +23,7 @@ std::string Slurp(const std::string& path) {
 
 std::string Shipped(const std::string& rel) { return std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/" + rel; }
 
-std::string TempDir(const std::string& tag) {
-  const auto p = std::filesystem::temp_directory_path() / ("exotwin_runner_" + tag);
-  std::filesystem::remove_all(p);
-  std::filesystem::create_directories(p);
-  return p.string();
-}
+std::string TempDir(const std::string& tag) { return testing::TempDir("runner_" + tag); }
 
 // PD tracking on the default gait (2 km/h, S1 relaxed, 20 s here instead of 60): the stated bound is
 // 1 deg RMS per joint and 3 deg peak after the 2 s ramp (measured: about 0.4 / 0.65 deg RMS).

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "tests/temp_dir.h"
 #include "analysis/diagnose.h"
 #include "analysis/measured_data.h"
 #include "scenarios/runner.h"
@@ -20,8 +21,7 @@ Diagnosis DiagnoseGait(int skew, const std::string& tag) {
   s.protocol.duration = 30;
   s.hardware.torque_sensor_skew = skew;
   RunOptions o;
-  o.out_dir = (std::filesystem::temp_directory_path() / ("exotwin_sampling_instant_" + tag)).string();
-  std::filesystem::remove_all(o.out_dir);
+  o.out_dir = testing::TempDir("sampling_instant_" + tag);
   RunScenario(s, o);
   const MeasuredData d = ReadMeasuredCsv(o.out_dir + "/measured.csv");
   const Diagnosis dg = Diagnose(ResolveSubject(s), d);

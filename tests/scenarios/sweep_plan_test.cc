@@ -1,4 +1,5 @@
 // Sweep planning (scenarios/sweep_plan.h) and the aggregate tables (scenarios/sweep_table.h).
+#include "tests/temp_dir.h"
 #include "scenarios/sweep_plan.h"
 
 #include <gtest/gtest.h>
@@ -102,8 +103,7 @@ TEST(SweepTable, SummaryStatistics) {
 }
 
 TEST(SweepTable, MergeRejectsMissingAndDuplicateShards) {
-  const auto base = std::filesystem::temp_directory_path() / "exotwin_sweep_merge_test";
-  std::filesystem::remove_all(base);
+  const std::filesystem::path base = testing::TempDir("sweep_merge");
   SweepManifest m;
   m.scenarios = {"s"};
   m.files = {"s.yaml"};

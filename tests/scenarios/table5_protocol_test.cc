@@ -1,6 +1,7 @@
 // The Table 5 protocol end to end on 2 subjects with short trials (scenarios/table5_protocol.h):
 // identification through the closed loop recovers the hidden truth, and the identified parameters
 // predict the relaxed-gait torque better than both anthropometric tables at both joints.
+#include "tests/temp_dir.h"
 #include "scenarios/table5_protocol.h"
 
 #include <gtest/gtest.h>
@@ -41,7 +42,7 @@ TEST(Table5Protocol, TwoSubjectsShortTrialsRecoverTruthAndBeatAnthropometry) {
   opt.trial_duration = 20.0;
   opt.strides = 4;
   opt.keep_logs = false;
-  opt.out_dir = (std::filesystem::temp_directory_path() / "exotwin_table5_test").string();
+  opt.out_dir = testing::TempDir("table5");
   for (const std::string subject : {"S1", "S7"}) {
     const Table5SubjectRun run = RunTable5Subject(subject, opt);
     const Table5Entry& e = run.entry;
