@@ -13,6 +13,7 @@
 #include "analysis/diagnose.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
+#include "analysis/seeded_rng.h"
 
 namespace exotwin {
 namespace {
@@ -135,6 +136,44 @@ TEST(DiagnoseHiddenEffect, PairsAreFound) {
   }
   std::printf("pairs: both found in %d / %d seeds\n", found_both, seeds);
   EXPECT_GE(found_both * 10, seeds * 7);
+}
+
+// A sensor offset and Coulomb friction hidden together (issue 15: a hip offset beside knee friction
+// was once named as a hip joint_stiffness with q0 = -214 rad). Both must be named, within 15 %, and
+// no stiffness may stand in for the offset.
+TEST(DiagnoseHiddenEffect, OffsetAndFrictionTogetherAreBothNamed) {
+  const LegParams base = S1();
+  const int seeds = EnvInt("EXOTWIN_DIAG_PAIR_SEEDS", 10);
+  int both = 0;
+  for (int s = 0; s < seeds; ++s) {
+    SeededRng rng(7000 + s);
+    const int oj = s % 2, fj = (s / 2) % 2;  // every joint combination
+    LegParams truth = base;
+    truth.effects.push_back({"sensor_offset", oj == 0 ? "hip" : "knee", rng.Sign() * rng.Uniform(0.2, 2.0), "N m", {}, ""});
+    truth.effects.push_back({"coulomb_friction", fj == 0 ? "hip" : "knee", rng.Uniform(0.3, 1.5), "N m", {}, ""});
+    GenerateOptions g;
+    g.seed = 7000 + s;
+    g.effects = 0;
+    g.duration = 30;
+    g.rate = 500;
+    const Diagnosis d = Diagnose(base, GenerateMeasured(truth, g).data);
+    const DiagnosedEffect* off = Find(d, truth.effects[0]);
+    const DiagnosedEffect* fr = Find(d, truth.effects[1]);
+    for (const auto& e : d.effects) EXPECT_NE(e.effect.name, "joint_stiffness") << "seed " << g.seed;
+    const bool ok = off && fr && ValueError(truth.effects[0], off->effect) <= 0.15 &&
+                    ValueError(truth.effects[1], fr->effect) <= 0.15;
+    if (ok) ++both;
+    else {
+      std::printf("  offset+friction seed %llu: truth offset(%s)=%g coulomb(%s)=%g; found:",
+                  (unsigned long long)g.seed, truth.effects[0].joint.c_str(), truth.effects[0].value,
+                  truth.effects[1].joint.c_str(), truth.effects[1].value);
+      for (const auto& e : d.effects)
+        std::printf(" %s(%s)=%g", e.effect.name.c_str(), e.effect.joint.c_str(), e.effect.value);
+      std::printf("\n");
+    }
+  }
+  std::printf("offset + friction: both named in %d / %d seeds\n", both, seeds);
+  EXPECT_GE(both * 10, seeds * 9);
 }
 
 TEST(DiagnoseHiddenEffect, NoEffectNamedOnCleanData) {
