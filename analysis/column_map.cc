@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analysis/number_text.h"
 #include "analysis/statistics.h"
 #include "analysis/yaml_fields.h"
 #include "model/input_error.h"
@@ -42,12 +43,6 @@ std::vector<Unit> UnitsOf(const std::string& target) {
   if (target.rfind("q_", 0) == 0) return {{"rad", 1.0}, {"deg", kRadPerDeg}};
   if (target.rfind("emg_", 0) == 0) return {{"V", 1.0}, {"mV", 1e-3}};
   return {{"N m", 1.0}};
-}
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
 }
 
 ColumnSpec ReadSpec(const YamlContext& c, const std::string& target, const YAML::Node& n) {
@@ -93,9 +88,9 @@ ColumnSpec ReadSpec(const YamlContext& c, const std::string& target, const YAML:
 std::string Describe(const ColumnSpec& s) {
   std::string d = s.target + " <- ";
   if (s.sign < 0) d += "-";
-  if (s.scale != 1) d += Num(s.scale) + " * ";
+  if (s.scale != 1) d += NumberText(s.scale) + " * ";
   d += s.from;
-  if (s.offset != 0) d += " + " + Num(s.offset);
+  if (s.offset != 0) d += " + " + NumberText(s.offset);
   if (!s.unit.empty()) d += " [" + s.unit + "]";
   return d;
 }
@@ -116,7 +111,7 @@ void MergeRepeatedTimes(const ColumnMap& map, const std::string& source, CsvTabl
     }
     if (map.duplicates == DuplicateTimes::kError)
       throw InputError(source + ":" + std::to_string(tab->line_of_row[r]) + ": column '" + map.columns[0].from +
-                       "' (t): time stamp " + Num(tab->columns[0][r]) + " repeats the one on line " +
+                       "' (t): time stamp " + NumberText(tab->columns[0][r]) + " repeats the one on line " +
                        std::to_string(tab->line_of_row[w - 1]) + ", expected distinct time stamps (" +
                        map.source + ": time.duplicates is error; average or first merge them)");
     if (count[w - 1] == 1) ++rep->repeated_stamps;
@@ -167,8 +162,8 @@ std::string MapReport::Summary() const {
     if (rows_merged > repeated_lines.size()) s += " ...";
     s += ")";
   }
-  s += "\n  time step: median " + Num(dt_median * 1e3) + " ms, min " + Num(dt_min * 1e3) + " ms, max " +
-       Num(dt_max * 1e3) + " ms, p99 " + Num(dt_p99 * 1e3) + " ms; jitter " + Num(100 * jitter) +
+  s += "\n  time step: median " + NumberText(dt_median * 1e3) + " ms, min " + NumberText(dt_min * 1e3) + " ms, max " +
+       NumberText(dt_max * 1e3) + " ms, p99 " + NumberText(dt_p99 * 1e3) + " ms; jitter " + NumberText(100 * jitter) +
        " % of the median (std of the step)\n";
   return s;
 }
@@ -237,7 +232,7 @@ MeasuredData ApplyColumnMap(const ColumnMap& map, const CsvTable& in, const std:
       if (s.unit == "deg" && std::abs(x) > kMaxDegrees)
         throw InputError(source + ":" + std::to_string(in.line_of_row[r]) + ": column '" + s.from + "' (" +
                          s.target + " in deg, " + map.source + " line " + std::to_string(s.line) + "): " +
-                         Num(x) + " deg is beyond +-720 deg, expected an angle in degrees (is the unit right?)");
+                         NumberText(x) + " deg is beyond +-720 deg, expected an angle in degrees (is the unit right?)");
       v[r] = s.to_si * x;
     }
     out.names.push_back(s.target);

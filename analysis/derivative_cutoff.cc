@@ -6,6 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "analysis/number_text.h"
+#include "analysis/statistics.h"
 #include "model/input_error.h"
 #include "model/regressors.h"
 
@@ -14,18 +16,11 @@ namespace {
 
 constexpr double kCandidatesHz[] = {1.5, 2, 3, 4, 5, 7, 10, 14, 20, 30, 50};
 constexpr double kTrainFraction = 0.7;
-constexpr double kWithinBest = 0.02;  // the highest cutoff within 2 % of the best score wins
 constexpr size_t kMaxRowsPerRecord = 20000;
 constexpr int kCols = 6 + 2 * 3;  // lumped [J1 J2 X1 X2 Y1 Y2], per joint offset, Coulomb, viscous
 
-std::string Num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof(b), "%g", v);
-  return b;
-}
-
 // Regressor rows (hip, knee) of the generic torque model at one sample; target tau_R = -tau_S.
-void Rows(double L1, double g, const Kinematics& k, size_t i, Eigen::Matrix<double, 2, kCols>* Y) {
+void RegressorRows(double L1, double g, const Kinematics& k, size_t i, Eigen::Matrix<double, 2, kCols>* Y) {
   Y->setZero();
   Y->leftCols<6>() = FullRegressor(L1, g, {k.q[0][i], k.q[1][i]}, {k.qd[0][i], k.qd[1][i]},
                                    {k.qdd[0][i], k.qdd[1][i]});
@@ -39,6 +34,8 @@ void Rows(double L1, double g, const Kinematics& k, size_t i, Eigen::Matrix<doub
 
 }  // namespace
 
+double DerivativeCutoffHz(double fc, double fs) { return std::min(kDerivativeCutoffFactor * fc, 0.4 * fs); }
+
 double ParseCutoffOption(const std::string& value, const std::string& what) {
   if (value == "auto") return 0.0;
   char* end = nullptr;
@@ -46,6 +43,19 @@ double ParseCutoffOption(const std::string& value, const std::string& what) {
   if (end == value.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0))
     throw InputError(what + ": '" + value + "', expected a cutoff in Hz (> 0) or 'auto'");
   return v;
+}
+
+double ResolveCutoffOption(const std::string& value, const std::string& what,
+                           const std::vector<const MeasuredData*>& records, double L1, double g,
+                           std::string* why) {
+  const double hz = ParseCutoffOption(value, what);
+  if (hz > 0) {
+    if (why) *why = "given (" + what + " " + NumberText(hz) + ")";
+    return hz;
+  }
+  const CutoffChoice c = ChooseCutoff(records, L1, g);
+  if (why) *why = c.why;
+  return c.from_columns ? 20.0 : c.hz;
 }
 
 CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g) {
@@ -69,7 +79,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   for (double f : kCandidatesHz)
     if (f < 0.25 * fs_min) c.candidates_hz.push_back(f);
   if (c.candidates_hz.empty())
-    throw InputError(records[0]->source + ": sample rate " + Num(fs_min) +
+    throw InputError(records[0]->source + ": sample rate " + NumberText(fs_min) +
                      " Hz is too low to differentiate the angles, expected above 6 Hz");
   // Torque variance per joint over all records (the score's normalization).
   double var[2] = {0, 0};
@@ -79,29 +89,50 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       for (double v : j == 0 ? d->tau_hip : d->tau_knee) s += v, ss += v * v, n += 1;
     var[j] = std::max(ss / n - (s / n) * (s / n), 1e-12);
   }
+  std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
   for (double fc : c.candidates_hz) {
+    // Per record, on every stride-th sample: the regressor from the angles differentiated at
+    // DerivativeCutoffHz(fc), each column and the torque low-passed at fc (parallel filtering),
+    // and the raw torque the score is taken against.
+    struct Rows {
+      std::vector<Eigen::Matrix<double, 2, kCols>> Y;
+      std::vector<Eigen::Vector2d> u_f, u_raw;
+      std::vector<bool> train;
+    };
+    std::vector<Rows> rows(records.size());
     Eigen::Matrix<double, kCols, kCols> A = Eigen::Matrix<double, kCols, kCols>::Zero();
     Eigen::Matrix<double, kCols, 1> b = Eigen::Matrix<double, kCols, 1>::Zero();
-    struct Held {
-      Kinematics kin;
-      const MeasuredData* d;
-      size_t from, stride;
-    };
-    std::vector<Held> held;
-    Eigen::Matrix<double, 2, kCols> Y;
-    for (const MeasuredData* d : records) {
-      Kinematics k = DeriveKinematics(*d, fc);
-      const size_t n = d->size();
-      const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 * fs_min));  // filter edges
+    for (size_t r = 0; r < records.size(); ++r) {
+      const MeasuredData& d = *records[r];
+      const size_t n = d.size();
+      const Kinematics k = DeriveKinematics(d, DerivativeCutoffHz(fc, 1.0 / MedianStep(d.t)));
+      const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 / MedianStep(d.t)));  // filter edges
       const size_t split = static_cast<size_t>(kTrainFraction * static_cast<double>(n));
       const size_t stride = std::max<size_t>(1, n / kMaxRowsPerRecord);
-      for (size_t i = edge; i < split; i += stride) {
-        Rows(L1, g, k, i, &Y);
-        const Eigen::Vector2d u(-d->tau_hip[i], -d->tau_knee[i]);
-        A.noalias() += Y.transpose() * Y;
-        b.noalias() += Y.transpose() * u;
+      std::vector<size_t> at;
+      for (size_t i = edge; i + edge < n; i += stride) at.push_back(i);
+      Rows& R = rows[r];
+      R.Y.assign(at.size(), Eigen::Matrix<double, 2, kCols>::Zero());
+      R.u_f.resize(at.size()), R.u_raw.resize(at.size()), R.train.resize(at.size());
+      std::vector<Eigen::Matrix<double, 2, kCols>> full(n);
+      for (size_t i = 0; i < n; ++i) RegressorRows(L1, g, k, i, &full[i]);
+      std::vector<double> x(n);
+      for (int j = 0; j < 2; ++j) {
+        for (int col = 0; col < kCols; ++col) {
+          for (size_t i = 0; i < n; ++i) x[i] = full[i](j, col);
+          const std::vector<double> xf = LowPassOnTimeBase(d.t, x, fc, d.source);
+          for (size_t a = 0; a < at.size(); ++a) R.Y[a](j, col) = xf[at[a]];
+        }
+        const std::vector<double>& tau = j == 0 ? d.tau_hip : d.tau_knee;
+        const std::vector<double> tf = LowPassOnTimeBase(d.t, tau, fc, d.source);
+        for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -tf[at[a]], R.u_raw[a][j] = -tau[at[a]];
       }
-      held.push_back({std::move(k), d, split, stride});
+      for (size_t a = 0; a < at.size(); ++a) {
+        R.train[a] = at[a] < split;
+        if (!R.train[a]) continue;
+        A.noalias() += R.Y[a].transpose() * R.Y[a];
+        b.noalias() += R.Y[a].transpose() * R.u_f[a];
+      }
     }
     // Least squares on the column-normalized normal equations; directions the motion does not
     // excite (e.g. a joint held still) are dropped by an eigenvalue floor.
@@ -116,33 +147,43 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
         s.asDiagonal() * (es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose()) *
         s.asDiagonal() * b;
     double sse[2] = {0, 0}, cnt = 0;
-    for (const Held& h : held) {
-      const size_t n = h.d->size();
-      const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 * fs_min));
-      for (size_t i = h.from; i + edge < n; i += h.stride) {
-        Rows(L1, g, h.kin, i, &Y);
-        const Eigen::Vector2d e = Eigen::Vector2d(-h.d->tau_hip[i], -h.d->tau_knee[i]) - Y * theta;
+    std::vector<double>& scores = row_scores.emplace_back();
+    for (const Rows& R : rows)
+      for (size_t a = 0; a < R.Y.size(); ++a) {
+        if (R.train[a]) continue;
+        const Eigen::Vector2d e = R.u_raw[a] - R.Y[a] * theta;
         sse[0] += e[0] * e[0], sse[1] += e[1] * e[1], cnt += 1;
+        scores.push_back(e[0] * e[0] / var[0] + e[1] * e[1] / var[1]);
       }
-    }
     cnt = std::max(cnt, 1.0);
     for (int j = 0; j < 2; ++j) c.heldout_rmse[j].push_back(std::sqrt(sse[j] / cnt));
-    c.score.push_back(sse[0] / cnt / var[0] + sse[1] / cnt / var[1]);
+    c.score.push_back(sse[0] / cnt / var[0] + sse[1] / cnt / var[1]);  // = mean of scores
   }
-  const double best = *std::min_element(c.score.begin(), c.score.end());
-  size_t pick = 0;
-  for (size_t i = 0; i < c.score.size(); ++i)
-    if (c.score[i] <= best * (1 + kWithinBest)) pick = i;
-  c.hz = c.candidates_hz[pick];
   const size_t at_best = static_cast<size_t>(std::min_element(c.score.begin(), c.score.end()) - c.score.begin());
-  c.why = "highest cutoff within " + Num(100 * kWithinBest) + " % of the least held-out error of a "
-          "generic rigid two-link + friction + offset fit (last 30 % of each record, against the raw "
-          "torque): " + Num(c.hz) + " Hz (held-out rmse hip " + Num(c.heldout_rmse[0][pick]) + ", knee " +
-          Num(c.heldout_rmse[1][pick]) + " N m; best " + Num(c.candidates_hz[at_best]) + " Hz, 20 Hz " +
+  // Each candidate against the best on the same held-out rows: the mean of the paired differences
+  // and its standard error (the rows' spread and autocorrelation length), so that what both fits
+  // miss alike cancels.
+  c.score_se.assign(c.score.size(), 0.0);
+  size_t pick = at_best;
+  for (size_t i = 0; i < c.score.size(); ++i) {
+    std::vector<double> diff(row_scores[i].size());
+    for (size_t a = 0; a < diff.size(); ++a) diff[a] = row_scores[i][a] - row_scores[at_best][a];
+    const double n = static_cast<double>(diff.size()), mean = c.score[i] - c.score[at_best];
+    double ss = 0;
+    for (double x : diff) ss += (x - mean) * (x - mean);
+    const double tau = AutocorrelationLength(diff.data(), diff.size());
+    c.score_se[i] = n > 1 ? std::sqrt(ss / (n - 1) * tau / n) : 0.0;
+    if (i < pick && mean <= c.score_se[i]) pick = i;
+  }
+  c.hz = c.candidates_hz[pick];
+  c.why = "lowest cutoff within one standard error (paired, on the same rows) of the least held-out error of a "
+          "generic rigid two-link + friction + offset fit filtered alike (last 30 % of each record, "
+          "against the raw torque): " + NumberText(c.hz) + " Hz (held-out rmse hip " + NumberText(c.heldout_rmse[0][pick]) + ", knee " +
+          NumberText(c.heldout_rmse[1][pick]) + " N m; best " + NumberText(c.candidates_hz[at_best]) + " Hz, 20 Hz " +
           [&] {
             for (size_t i = 0; i < c.candidates_hz.size(); ++i)
               if (c.candidates_hz[i] == 20.0)
-                return Num(c.heldout_rmse[0][i]) + " / " + Num(c.heldout_rmse[1][i]) + " N m";
+                return NumberText(c.heldout_rmse[0][i]) + " / " + NumberText(c.heldout_rmse[1][i]) + " N m";
             return std::string("not a candidate");
           }() + ")";
   return c;

@@ -4,16 +4,22 @@
 // encoder at 500 Hz the 20 Hz filter of Hwang & Jeon sec. 3.2 leaves more noise in qdd than the
 // effects have signal (shared/data/real_rig/README.md), while on a clean 1 kHz record a low cutoff
 // distorts the motion itself. The choice is the classic bias-variance trade-off, settled by held-out
-// prediction error:
-//   for each candidate cutoff fc (1.5 .. 50 Hz, below fs / 4), the kinematics are derived at fc and a
-//   generic linear model of the joint torques is fitted by least squares on the first 70 % (in time)
-//   of every record: the rigid two-link regressor in the lumped parameters (FullRegressor: M qdd + V
-//   + G, any device with that structure), plus per joint a torque offset, Coulomb (sign qd) and
-//   viscous (qd) friction. Its error is scored on the last 30 % against the raw, unfiltered measured
-//   torque, whose own noise is the same for every fc. The score is the sum over joints of the
+// prediction error of the pipeline `diagnose` runs (parallel filtering, as in robot identification
+// practice):
+//   for each candidate cutoff fc (1.5 .. 50 Hz, below fs / 4), the angles are differentiated at
+//   DerivativeCutoffHz(fc) (a zero-phase filter flat where fc passes), and a generic linear model of
+//   the joint torques is fitted by least squares on the first 70 % (in time) of every record, its
+//   columns and the measured torque both low-passed at fc: the rigid two-link regressor in the lumped
+//   parameters (FullRegressor: M qdd + V + G, any device with that structure), plus per joint a
+//   torque offset, Coulomb (sign qd) and viscous (qd) friction. Its filtered prediction is scored on
+//   the last 30 % against the raw, unfiltered measured torque, whose own noise is the same for
+//   every fc. The score is the sum over joints of the
 //   held-out mean square error divided by that joint's torque variance. The chosen cutoff is the
-//   highest whose score is within 2 % of the best (the least filtering the data allow: effects with
-//   fast signatures, such as a sensor delay or a torque ripple, keep their shape).
+//   lowest (the most filtering, the most regularized model) whose score is within one standard
+//   error of the best: the one-standard-error rule of cross-validation (Hastie, Tibshirani &
+//   Friedman, The Elements of Statistical Learning, sec. 7.10), the standard error taken of the
+//   paired row-by-row differences to the best (their spread and autocorrelation length), so that
+//   what every fit misses alike cancels.
 // Model-free apart from L1 and g (the fitted parameters absorb the device), so `identify`, `predict`
 // and `diagnose` share it.
 #pragma once
@@ -30,6 +36,7 @@ struct CutoffChoice {
   std::vector<double> candidates_hz;    // scored cutoffs, ascending
   std::vector<double> heldout_rmse[2];  // N m, per candidate, hip / knee, against the raw torque
   std::vector<double> score;            // the criterion per candidate (lower is better)
+  std::vector<double> score_se;         // standard error of score - best score (paired rows)
   std::string why;                      // one sentence for the report
 };
 
@@ -38,8 +45,21 @@ struct CutoffChoice {
 // records' sample rate (fs / 4 <= 1.5 Hz).
 CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g);
 
+// The angles' derivative cutoff under a residual low-pass at fc: 4 fc (the zero-phase 2nd-order
+// Butterworth then passes 99 % at fc, so measured and predicted torque see one filter), at most
+// 0.4 fs.
+constexpr double kDerivativeCutoffFactor = 4.0;
+double DerivativeCutoffHz(double fc, double fs);
+
 // Parses a `--cutoff` value: "auto" gives 0 (choose from the data), else a frequency in Hz > 0.
 // Throws InputError naming `what` (the option) otherwise.
 double ParseCutoffOption(const std::string& value, const std::string& what);
+
+// The cutoff (Hz) a `--cutoff` value asks for on `records`: a frequency as given, "auto" through
+// ChooseCutoff (20 Hz, unused, when the records carry their own qd/qdd columns). *why (optional)
+// says how it was chosen.
+double ResolveCutoffOption(const std::string& value, const std::string& what,
+                           const std::vector<const MeasuredData*>& records, double L1, double g,
+                           std::string* why = nullptr);
 
 }  // namespace exotwin

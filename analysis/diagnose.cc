@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <map>
 #include <set>
 #include <sstream>
 
@@ -16,6 +15,7 @@
 #include "analysis/diagnose_select.h"
 #include "analysis/effects.h"
 #include "analysis/generate.h"
+#include "analysis/number_text.h"
 #include "analysis/predict.h"
 #include "analysis/statistics.h"
 #include "dsp/butterworth.h"
@@ -27,7 +27,6 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
-constexpr double kDerivativeFactor = 4.0;  // derivative filter cutoff / residual filter cutoff
 
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
@@ -41,10 +40,13 @@ struct Rec {
   std::vector<double> resid[2];
   size_t split = 0;
   size_t n() const { return kin.t.size(); }
-  // The residual's low-pass: the angles' derivative filter, applied to measured minus predicted
-  // torque (parallel filtering: both are filtered alike).
-  std::vector<double> Filter(const std::vector<double>& x) const {
-    return hz > 0 ? LowPassOnTimeBase(kin.t, x, hz, data->source) : x;
+  // The residual's low-pass (parallel filtering: measured and predicted torque filtered alike) of x,
+  // whose samples are those of kin.t from `from` on.
+  std::vector<double> Filter(const std::vector<double>& x, size_t from = 0) const {
+    if (!(hz > 0)) return x;
+    if (from == 0 && x.size() == kin.t.size()) return LowPassOnTimeBase(kin.t, x, hz, data->source);
+    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
+    return LowPassOnTimeBase(t, x, hz, data->source);
   }
   std::function<std::vector<double>(const std::vector<double>&)> FilterFn() const {
     if (!(hz > 0)) return {};
@@ -52,28 +54,15 @@ struct Rec {
   }
 };
 
-std::string Num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof(b), "%g", v);
-  return b;
+// Autocorrelation length (in rows) of a residual of 2m rows (hip block, knee block): the longer.
+double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
+  return std::max(AutocorrelationLength(e.data(), m), AutocorrelationLength(e.data() + m, m));
 }
 
-// Integrated autocorrelation length (in rows) of a residual (2m rows: hip block, knee block).
-double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
-  double worst = 1.0;
-  for (int j = 0; j < 2; ++j) {
-    const Eigen::VectorXd x = e.segment(j * m, m).array() - e.segment(j * m, m).mean();
-    const double v = x.squaredNorm();
-    if (v <= 0) continue;
-    double tau = 1.0;
-    for (size_t lag = 1; lag < std::min<size_t>(m / 4, 2000); ++lag) {
-      const double rho = x.head(m - lag).dot(x.tail(m - lag)) / v;
-      if (rho < 0.05) break;
-      tau += 2 * rho;
-    }
-    worst = std::max(worst, tau);
-  }
-  return worst;
+// Held-out scores from the sums of squares before / after over `count` samples.
+JointScore ScoreOf(double sse_before, double sse_after, double count) {
+  return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
+          sse_before > 0 ? 100 * (1 - std::sqrt(sse_after / sse_before)) : 0};
 }
 
 // Records of one device: the same columns the analysis reads, and sample rates within a factor 5.
@@ -99,8 +88,8 @@ void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
     }
     const double r = MedianStep(b.t) / dta;
     if (!(r < 5 && r > 0.2))
-      throw InputError(b.source + ": median time step " + Num(MedianStep(b.t)) + " s against " +
-                       Num(dta) + " s in " + a.source +
+      throw InputError(b.source + ": median time step " + NumberText(MedianStep(b.t)) + " s against " +
+                       NumberText(dta) + " s in " + a.source +
                        ", expected records of one device in the same time unit (s)");
   }
 }
@@ -125,7 +114,7 @@ double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, 
   for (int j = 0; j < 2; ++j) {
     std::vector<double> e(b - a);
     for (size_t i = 0; i < b - a; ++i) e[i] = rc.raw[j][a + i] - ts[j][i];
-    if (rc.hz > 0) e = LowPassOnTimeBase(k.t, e, rc.hz, rc.data->source);
+    e = rc.Filter(e, a);
     for (size_t i = lo; i + lo < b - a; ++i) s += std::pow(w[j] * e[i], 2);
   }
   return s;
@@ -195,7 +184,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   // 1. The derivative cutoff (chosen from the data unless given) and the parallel filter.
   if (opt.cutoff_hz > 0) {
     D.cutoff.hz = opt.cutoff_hz;
-    D.cutoff.why = "given (--cutoff " + Num(opt.cutoff_hz) + ")";
+    D.cutoff.why = "given (--cutoff " + NumberText(opt.cutoff_hz) + ")";
   } else {
     D.cutoff = ChooseCutoff(records, params.L1, params.g);
   }
@@ -210,12 +199,10 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     Rec& rc = recs[r];
     rc.data = &data;
     // Parallel filtering (as in robot identification practice): the residual is low-passed at the
-    // chosen cutoff fc, the derivatives are taken at kDerivativeFactor fc, so that the derivative
-    // filter is flat where the residual filter passes and measured and predicted torque see one
-    // and the same filter.
-    const double fs = 1.0 / MedianStep(data.t);
+    // chosen cutoff fc, the angles differentiated at DerivativeCutoffHz(fc), flat where fc passes,
+    // so that measured and predicted torque see one and the same filter.
     const Kinematics full = DeriveKinematics(
-        data, D.cutoff.from_columns ? 20.0 : std::min(kDerivativeFactor * D.cutoff.hz, 0.4 * fs));
+        data, D.cutoff.from_columns ? 20.0 : DerivativeCutoffHz(D.cutoff.hz, 1.0 / MedianStep(data.t)));
     const bool filtered = full.derivative_source != "measured columns";
     rc.hz = filtered ? D.cutoff.hz : 0.0;
     const std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
@@ -315,13 +302,11 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       for (size_t r = 0; r < R; ++r) {
         const Rec& rc = recs[r];
         ColumnBank& b = banks[r];
-        const size_t m = b.sample.size();
         std::vector<double> tq(rc.n());
         for (size_t i = 0; i < rc.n(); ++i) tq[i] = rc.kin.t[i] - d;
         const std::vector<double> shifted = Interpolate(rc.kin.t, rc.tau_S[j], tq);
         std::vector<double> v[2] = {std::vector<double>(rc.n(), 0.0), std::vector<double>(rc.n(), 0.0)};
         for (size_t i = 0; i < rc.n(); ++i) v[j][i] = (shifted[i] - rc.tau_S[j][i]) / d;
-        (void)m;
         SetColumn(b, c.cols[0], w, v);
       }
     }
@@ -352,34 +337,30 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     for (int j = 0; j < 2; ++j) {
       scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
       scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
-      double msum = 0, mcnt = 0;
+      // Means over every record (strided): the twin's M_jj, the compliant part's J_c (the human when
+      // there is one, else the whole chain), and the motion's effective angular frequency
+      // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
+      // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
+      const LumpedParams& compliant = params.human ? *params.human : tot;
+      double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
       for (const Rec& rc : recs) {
-        const size_t stride = std::max<size_t>(1, rc.n() / 4000);
         for (size_t i = 0; i < rc.n(); ++i) {
           scale.q_min[j] = std::min(scale.q_min[j], rc.kin.q[j][i]);
           scale.q_max[j] = std::max(scale.q_max[j], rc.kin.q[j][i]);
           scale.tau_max[j] = std::max(scale.tau_max[j], std::abs(rc.meas[j][i]));
         }
+        const size_t stride = std::max<size_t>(1, rc.n() / 4000);
         for (size_t i = 0; i < rc.n(); i += stride) {
-          msum += MassMatrix(tot, params.L1, rc.kin.q[1][i])(j, j), mcnt += 1;
-          const Eigen::Vector2d tc = CompliantPartTorque(
-              rigid, {rc.kin.q[0][i], rc.kin.q[1][i]}, {rc.kin.qd[0][i], rc.kin.qd[1][i]},
-              {rc.kin.qdd[0][i], rc.kin.qdd[1][i]});
-          scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(tc[j]));
+          const Eigen::Vector2d q(rc.kin.q[0][i], rc.kin.q[1][i]), qd(rc.kin.qd[0][i], rc.kin.qd[1][i]),
+              qdd(rc.kin.qdd[0][i], rc.kin.qdd[1][i]);
+          msum += MassMatrix(tot, params.L1, q[1])(j, j);
+          jc += MassMatrix(compliant, params.L1, q[1])(j, j);
+          v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
+          scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
         }
       }
-      scale.M_jj[j] = msum / std::max(mcnt, 1.0);
-      // The strap's neglected dynamics: J_c w^2, with J_c the compliant part's mean diagonal
-      // inertia and w = RMS(qdd) / RMS(qd) the motion's effective angular frequency (of the
-      // velocity: a link that spins through many turns has a slow angle but a fast velocity).
-      double jc = 0, v2 = 0, a2 = 0, cn = 0;
-      for (const Rec& rc : recs)
-        for (size_t i = 0; i < rc.n(); ++i) {
-          jc += MassMatrix(params.human ? *params.human : tot, params.L1, rc.kin.q[1][i])(j, j);
-          v2 += rc.kin.qd[j][i] * rc.kin.qd[j][i], a2 += rc.kin.qdd[j][i] * rc.kin.qdd[j][i];
-          cn += 1;
-        }
-      scale.strap_dynamics[j] = v2 > 0 ? jc / cn * a2 / v2 : 0.0;
+      scale.M_jj[j] = msum / cnt;
+      scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
     }
   }
   const Fit f0 = FitCols(g, {});
@@ -401,10 +382,11 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       const Candidate& c = bank.candidates[order[i].second];
       D.scores.push_back({c.Label(), f.ok ? f.bic - f0.bic : 0, 100 * gain(f),
                           std::find(chosen.begin(), chosen.end(), static_cast<int>(order[i].second)) != chosen.end()});
+      if (!f.ok || !(f.bic < f0.bic - kBicMargin)) continue;
+      const DiagnosedEffect e = ToEffect(c, f);
       std::string why;
-      if (f.ok && f.bic < f0.bic - kBicMargin && !Plausible(ToEffect(c, f), scale, &why))
-        D.implausible.push_back(c.Label() + " = " + Num(ToEffect(c, f).effect.value) + " " +
-                                ToEffect(c, f).effect.unit + ": " + why);
+      if (!Plausible(e, scale, &why))
+        D.implausible.push_back(c.Label() + " = " + NumberText(e.effect.value) + " " + e.effect.unit + ": " + why);
     }
     if (!chosen.empty()) {
       std::string label;
@@ -457,10 +439,9 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   }
   // Share of the held-out residual each effect removes (joint linear model, leave-one-effect-out).
   for (size_t k = 0; k < chosen.size(); ++k) {
-    std::vector<int> cols;
-    for (size_t l = 0; l < chosen.size(); ++l)
-      if (l != k) cols.insert(cols.end(), bank.candidates[chosen[l]].cols.begin(), bank.candidates[chosen[l]].cols.end());
-    const Fit fr = FitCols(g, cols);
+    std::vector<int> rest = chosen;
+    rest.erase(rest.begin() + static_cast<long>(k));
+    const Fit fr = FitCols(g, ColumnsOf(bank, rest));
     D.effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
   }
   Lap("refinement");
@@ -471,11 +452,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
     ext_plant.SetParams(D.extended);
     double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
-    auto hz_filter = [](const Rec& rc, size_t from, const std::vector<double>& x) {
-      if (!(rc.hz > 0)) return x;
-      const std::vector<double> t(rc.kin.t.begin() + from, rc.kin.t.end());
-      return LowPassOnTimeBase(t, x, rc.hz, rc.data->source);
-    };
+    const std::vector<int> cols = ColumnsOf(bank, chosen);
     for (size_t r = 0; r < R; ++r) {
       const Rec& rc = recs[r];
       const size_t n = rc.n();
@@ -490,14 +467,13 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       for (int j = 0; j < 2; ++j) {
         std::vector<double> ea(n - warm);
         for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
-        ea = hz_filter(rc, warm, ea);
+        ea = rc.Filter(ea, warm);
         double b = 0, a = 0;
         for (size_t i = rc.split; i < n; ++i) {
           b += std::pow(rc.resid[j][i], 2);
           a += std::pow(ea[i - warm], 2);
         }
-        const double c = static_cast<double>(std::max<size_t>(1, n - rc.split));
-        rs.split[j] = {std::sqrt(b / c), std::sqrt(a / c), b > 0 ? 100 * (1 - std::sqrt(a / b)) : 0};
+        rs.split[j] = ScoreOf(b, a, static_cast<double>(std::max<size_t>(1, n - rc.split)));
         sb[j] += b, sa[j] += a;
         if (r == 0) {
           D.measured[j] = rc.meas[j];
@@ -510,10 +486,6 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       cnt += static_cast<double>(n - rc.split);
       if (D.leave_one_out) {
         LegParams p = params;
-        std::vector<int> cols;
-        for (int c : chosen) cols.insert(cols.end(), bank.candidates[c].cols.begin(), bank.candidates[c].cols.end());
-        std::sort(cols.begin(), cols.end());
-        cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
         const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
         if (!cols.empty() && x.size() == 0)
           throw InputError(rc.data->source + ": without this record the chosen effects are not identifiable");
@@ -531,7 +503,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
           ea = rc.Filter(ea);
           double b = 0, a = 0;
           for (size_t i = 0; i < n; ++i) b += std::pow(rc.resid[j][i], 2), a += std::pow(ea[i], 2);
-          rs.left_out[j] = {std::sqrt(b / n), std::sqrt(a / n), b > 0 ? 100 * (1 - std::sqrt(a / b)) : 0};
+          rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
           lb[j] += b, la[j] += a;
         }
         lcnt += static_cast<double>(n);
@@ -539,11 +511,8 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       D.records.push_back(rs);
     }
     for (int j = 0; j < 2; ++j) {
-      D.joints[j].rmse_before = std::sqrt(sb[j] / cnt);
-      D.joints[j].rmse_after = std::sqrt(sa[j] / cnt);
-      D.joints[j].gain_pct = sb[j] > 0 ? 100 * (1 - std::sqrt(sa[j] / sb[j])) : 0;
-      if (D.leave_one_out)
-        D.left_out[j] = {std::sqrt(lb[j] / lcnt), std::sqrt(la[j] / lcnt), lb[j] > 0 ? 100 * (1 - std::sqrt(la[j] / lb[j])) : 0};
+      D.joints[j] = ScoreOf(sb[j], sa[j], cnt);
+      if (D.leave_one_out) D.left_out[j] = ScoreOf(lb[j], la[j], lcnt);
     }
   }
   // Effects in order of what they explain.
@@ -557,8 +526,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   Lap("extended twin");
   // Unexplained structure: 5 Hz low-passed held-out residual of the extended twin vs the noise.
   {
-    const Diagnosis& Dc = D;
-    const Kinematics& kin = Dc.kin;
+    const Kinematics& kin = D.kin;
     const size_t n = kin.t.size();
     const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
     const double fs = 1.0 / dt;
@@ -595,9 +563,12 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   }
   Lap("unexplained");
   std::ostringstream m_os;
-  m_os << "derivatives and torque filtered alike (zero-phase 2nd-order Butterworth, "
-       << (D.cutoff.from_columns ? std::string("measured qd/qdd columns") : Num(D.cutoff.hz) + " Hz")
-       << "); time split: fit on the first " << 100 * (1 - opt.holdout_fraction)
+  m_os << (D.cutoff.from_columns
+               ? std::string("derivatives from the measured qd/qdd columns, no filter")
+               : "measured minus predicted torque low-passed at " + NumberText(D.cutoff.hz) +
+                     " Hz (zero-phase 2nd-order Butterworth, parallel filtering), angles differentiated at " +
+                     NumberText(kDerivativeCutoffFactor * D.cutoff.hz) + " Hz (at most 0.4 fs)")
+       << "; time split: fit on the first " << 100 * (1 - opt.holdout_fraction)
        << " % of every record, rmse by the extended twin (predict) on the last " << 100 * opt.holdout_fraction
        << " %" << (D.leave_one_out ? "; every whole record also left out in turn" : "")
        << "; every DESIGN effect per joint as a linearized least-squares candidate (ripple frequency"
@@ -605,8 +576,8 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
           " exact model); forward selection with backward elimination of up to " << opt.max_effects
        << " effects fitted together, each significant (|t| > " << kMinT << "), inside its physical range,"
           " lowering BIC (effective sample size from the residual autocorrelation) by more than "
-       << kBicMargin << " and the held-out error by at least " << 100 * kMinHeldoutGain
-       << " %; fewer parameters preferred unless the richer effect lowers the held-out error by more than "
+       << kBicMargin << " and the held-out error at its joint by at least " << 100 * kMinHeldoutGain
+       << " % and by (" << 100 * kMinTorqueShare << " % of the torque RMS)^2; fewer parameters preferred unless the richer effect lowers the held-out error by more than "
        << 100 * kParsimony << " %";
   D.method = m_os.str();
   return D;

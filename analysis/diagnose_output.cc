@@ -36,10 +36,10 @@ std::string DiagnosisJson(const Diagnosis& d) {
                                                {"corr_time", u.corr_t}}},
                                 {"hint", u.hint}});
   const char* names[2] = {"hip", "knee"};
-  for (int k = 0; k < 2; ++k)
-    j["joints"][names[k]] = {{"rmse_before", d.joints[k].rmse_before},
-                             {"rmse_after", d.joints[k].rmse_after},
-                             {"gain_pct", d.joints[k].gain_pct}};
+  auto score = [](const JointScore& s) {
+    return json{{"rmse_before", s.rmse_before}, {"rmse_after", s.rmse_after}, {"gain_pct", s.gain_pct}};
+  };
+  for (int k = 0; k < 2; ++k) j["joints"][names[k]] = score(d.joints[k]);
   j["validation"] = {{"method", d.method}, {"holdout_fraction", d.holdout_fraction},
                      {"leave_one_record_out", d.leave_one_out}};
   j["noise"] = {{"hip", d.noise[0]}, {"knee", d.noise[1]}, {"autocorrelation_rows", d.tau_eff}};
@@ -56,20 +56,13 @@ std::string DiagnosisJson(const Diagnosis& d) {
   for (const auto& r : d.records) {
     json x = {{"source", r.source}, {"samples", r.samples}};
     for (int k = 0; k < 2; ++k) {
-      x["split"][names[k]] = {{"rmse_before", r.split[k].rmse_before}, {"rmse_after", r.split[k].rmse_after},
-                              {"gain_pct", r.split[k].gain_pct}};
-      if (d.leave_one_out)
-        x["left_out"][names[k]] = {{"rmse_before", r.left_out[k].rmse_before},
-                                   {"rmse_after", r.left_out[k].rmse_after},
-                                   {"gain_pct", r.left_out[k].gain_pct}};
+      x["split"][names[k]] = score(r.split[k]);
+      if (d.leave_one_out) x["left_out"][names[k]] = score(r.left_out[k]);
     }
     j["records"].push_back(x);
   }
   if (d.leave_one_out)
-    for (int k = 0; k < 2; ++k)
-      j["left_out"][names[k]] = {{"rmse_before", d.left_out[k].rmse_before},
-                                 {"rmse_after", d.left_out[k].rmse_after},
-                                 {"gain_pct", d.left_out[k].gain_pct}};
+    for (int k = 0; k < 2; ++k) j["left_out"][names[k]] = score(d.left_out[k]);
   return j.dump(2) + "\n";
 }
 

@@ -118,10 +118,12 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<h1>exotwin diagnosis</h1><p>Twin: <code>" << Esc(params_path) << "</code>, measured: <code>"
     << Esc(measured_path) << "</code>, " << n << " samples, " << Fmt(k.t.back() - k.t.front(), 4)
     << " s; derivatives: " << Esc(k.derivative_source) << ".</p>\n";
-  o << "<h2>Filtering</h2><p>Angles and measured torque are low-passed alike before residuals are "
-       "formed (parallel filtering): " << Esc(d.cutoff.why) << ".</p>";
+  o << "<h2>Filtering</h2><p>Measured and predicted torque are low-passed alike before residuals are "
+       "formed (parallel filtering), the angles differentiated below that filter's cutoff: "
+    << Esc(d.cutoff.why) << ".</p>";
   if (!d.cutoff.candidates_hz.empty()) {
-    o << "<table><tr><th>cutoff (Hz)</th><th>held-out rmse hip (N m)</th><th>held-out rmse knee (N m)</th></tr>";
+    o << "<table><tr><th>cutoff (Hz)</th><th>generic fit, held-out rmse hip (N m)</th>"
+         "<th>generic fit, held-out rmse knee (N m)</th></tr>";
     for (size_t i = 0; i < d.cutoff.candidates_hz.size(); ++i)
       o << "<tr><td>" << (d.cutoff.candidates_hz[i] == d.cutoff.hz ? "<b>" : "") << Fmt(d.cutoff.candidates_hz[i])
         << (d.cutoff.candidates_hz[i] == d.cutoff.hz ? "</b>" : "") << "</td><td>" << Fmt(d.cutoff.heldout_rmse[0][i], 4)

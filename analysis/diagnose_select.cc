@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <set>
 
 #include <Eigen/Eigenvalues>
+
+#include "analysis/number_text.h"
 
 namespace exotwin {
 namespace {
@@ -15,11 +16,7 @@ namespace {
 const char* kJoint[2] = {"hip", "knee"};
 constexpr double kStrapDynamics = 0.25;  // (motion frequency / strap resonance)^2: resonance >= 2x
 
-std::string Num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof(b), "%.4g", v);
-  return b;
-}
+std::string Num(double v) { return NumberText(v, 4); }
 
 // Solves the normalized normal equations of `cols`; false when nearly singular.
 bool Solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd* x, Eigen::MatrixXd* Ainv) {
@@ -144,6 +141,14 @@ Eigen::VectorXd FitLeavingOut(const Grams& g, const std::vector<int>& cols, size
   return x;
 }
 
+std::vector<int> ColumnsOf(const ColumnBank& bank, const std::vector<int>& set) {
+  std::vector<int> cols;
+  for (int c : set) cols.insert(cols.end(), bank.candidates[c].cols.begin(), bank.candidates[c].cols.end());
+  std::sort(cols.begin(), cols.end());
+  cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+  return cols;
+}
+
 double CoefOf(const Fit& f, int col) {
   for (size_t i = 0; i < f.cols.size(); ++i)
     if (f.cols[i] == col) return f.coef[i];
@@ -217,9 +222,6 @@ bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* wh
       no = "rest angle q0 " + Num(q0) + " rad outside the recorded range widened by 0.5 rad";
   }
   if (e.name == "backlash" && !(v > 0 && v <= 0.1)) no = "dead band outside (0, 0.1] rad";
-  if (e.name == "series_compliance" && std::getenv("EXOTWIN_DIAG_DEBUG"))
-    std::fprintf(stderr, "DEBUG compliance %s k=%g defl=%g range=%g ratio=%g dyn=%g\n", e.joint.c_str(), v,
-                 s.tau_C_max[j] / v, range, s.tau_C_max[j] / v / range, s.strap_dynamics[j] / v);
   if (e.name == "series_compliance" && !(v > 0 && s.tau_C_max[j] / v <= 0.5 * range))
     no = "strap deflection " + Num(v > 0 ? s.tau_C_max[j] / v : 0) + " rad beyond half the motion range";
   else if (e.name == "series_compliance" && !(s.strap_dynamics[j] / v <= kStrapDynamics))
@@ -259,12 +261,6 @@ bool Conflicts(const Candidate& a, const Candidate& b) {
   return false;
 }
 
-std::vector<int> ColsOf(const ColumnBank& bank, const std::vector<int>& set) {
-  std::vector<int> cols;
-  for (int c : set) cols.insert(cols.end(), bank.candidates[c].cols.begin(), bank.candidates[c].cols.end());
-  return cols;
-}
-
 bool AllAdmissible(const ColumnBank& bank, const std::vector<int>& set, const Fit& f, const PhysicalScale& s) {
   if (!f.ok) return false;
   for (int c : set)
@@ -283,7 +279,8 @@ std::string Label(const ColumnBank& bank, const std::vector<int>& set) {
 std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale,
                                int max_effects, bool loo, Fit* fit, SelectionTrace* trace) {
   std::vector<int> set;
-  Fit cur = FitCols(g, {});
+  const Fit rigid = FitCols(g, {});
+  Fit cur = rigid;
   std::set<std::vector<int>> seen{{}};
   // The held-out error at joint j drops by at least `frac` of its value under `ref`.
   auto held_ok = [&](const Fit& f, const Fit& ref, int j, double frac) {
@@ -296,7 +293,7 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
   };
   std::string last_rejected;
   auto score = [&](const Fit& f) {
-    std::string s = "BIC " + Num(f.bic - FitCols(g, {}).bic) + ", held-out SSE " + Num(f.sse_te);
+    std::string s = "BIC " + Num(f.bic - rigid.bic) + ", held-out SSE " + Num(f.sse_te);
     if (loo) s += ", left-out records SSE " + Num(f.sse_loo);
     return s;
   };
@@ -315,7 +312,7 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
         continue;
       std::vector<int> next = set;
       next.push_back(c);
-      Fit f = FitCols(g, ColsOf(bank, next));
+      Fit f = FitCols(g, ColumnsOf(bank, next));
       if (!f.ok || !(f.bic < cur.bic - kBicMargin)) continue;
       const int j = bank.candidates[c].joint;
       if (!held_ok(f, cur, j, kMinHeldoutGain) || !material(f, cur, j)) {
@@ -324,7 +321,8 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
           last_rejected = bank.candidates[c].Label() + " (BIC " + Num(f.bic - cur.bic) + ") lowers the held-out " +
                           "error at the " + kJoint[j] + " by " + Num(100 * (1 - f.sse_te_j[j] / cur.sse_te_j[j])) +
                           " %" + (loo ? " and on left-out records by " + Num(100 * (1 - f.sse_loo_j[j] / cur.sse_loo_j[j])) + " %" : "") +
-                          ", less than " + Num(100 * kMinHeldoutGain) + " %";
+                          " (needed: " + Num(100 * kMinHeldoutGain) + " % and (" + Num(100 * kMinTorqueShare) +
+                          " % of the torque RMS)^2)";
         continue;
       }
       if (!AllAdmissible(bank, next, f, scale)) continue;
@@ -361,7 +359,7 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
       for (size_t k = 0; k < set.size(); ++k) {
         std::vector<int> less = set;
         less.erase(less.begin() + static_cast<long>(k));
-        Fit f = FitCols(g, ColsOf(bank, less));
+        Fit f = FitCols(g, ColumnsOf(bank, less));
         if (!AllAdmissible(bank, less, f, scale)) continue;
         if (f.bic < cur.bic + kBicMargin && (worst < 0 || f.bic < worst_fit.bic)) worst = static_cast<int>(k), worst_fit = f;
       }

@@ -66,6 +66,9 @@ Fit FitCols(const Grams& g, std::vector<int> cols);
 // Coefficients of `cols` fitted on all rows of every record but `left_out` (leave-one-record-out).
 Eigen::VectorXd FitLeavingOut(const Grams& g, const std::vector<int>& cols, size_t left_out);
 
+// The columns of the candidates `set` (indices into bank.candidates), sorted, without repeats.
+std::vector<int> ColumnsOf(const ColumnBank& bank, const std::vector<int>& set);
+
 double CoefOf(const Fit& f, int col);
 double SeOf(const Fit& f, int col);
 

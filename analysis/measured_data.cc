@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analysis/number_text.h"
 #include "dsp/butterworth.h"
 #include "model/input_error.h"
 
@@ -23,13 +24,6 @@ bool IsMeasuredColumn(const std::string& n) {
 }
 
 namespace {
-
-// %g (std::to_string prints 1e300 as 301 digits).
-std::string Short(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 // "<file>:<line>: column '<name>': " (the sample's index when the table was built without lines).
 std::string Where(const std::string& source, const CsvTable& t, size_t row, const std::string& column) {
@@ -65,7 +59,7 @@ MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t
       if (!std::isfinite(v))
         throw InputError(Where(source, t, r, n) + "value is not finite, expected a finite number");
       if (std::abs(v) > limit)
-        throw InputError(Where(source, t, r, n) + "value " + Short(v) + " out of range, expected |x| <= " +
+        throw InputError(Where(source, t, r, n) + "value " + NumberText(v) + " out of range, expected |x| <= " +
                          std::to_string(limit) + " " + unit);
     }
   }
@@ -99,7 +93,7 @@ void CheckHumanJointRange(const MeasuredData& data) {
   for (const auto& [name, q] : angles)
     for (size_t r = 0; r < q->size(); ++r)
       if (std::abs((*q)[r]) > kMaxHumanJointAngle)
-        throw InputError(Where(data.source, data.table, r, name) + "angle " + Short((*q)[r]) +
+        throw InputError(Where(data.source, data.table, r, name) + "angle " + NumberText((*q)[r]) +
                          " rad is beyond a human joint's range, expected |q| <= " +
                          std::to_string(kMaxHumanJointAngle) +
                          " rad (2 pi) for a model with a human: block (a record of the device alone may "
@@ -137,7 +131,7 @@ SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, dou
   const size_t n = t.size();
   s.dt = MedianStep(t);
   if (!(s.dt >= 1e-6))
-    throw InputError(source + ": column 't': median sample period " + Short(s.dt) +
+    throw InputError(source + ": column 't': median sample period " + NumberText(s.dt) +
                      " s, expected at least 1e-6 s (a sample rate up to 1 MHz)");
   for (size_t i = 0; i + 1 < n; ++i)
     if (std::abs(t[i + 1] - t[i] - s.dt) > 0.01 * s.dt) { s.uniform = false; break; }
@@ -148,7 +142,7 @@ SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, dou
     const double points = std::floor(span / s.dt) + 1;
     if (!(points <= std::max(100.0 * static_cast<double>(n), 1e6)))
       throw InputError(source + ": column 't': sampling too irregular to resample (median step " +
-                       Short(s.dt) + " s over " + Short(span) + " s needs " + Short(points) +
+                       NumberText(s.dt) + " s over " + NumberText(span) + " s needs " + NumberText(points) +
                        " grid points for " + std::to_string(n) +
                        " samples), expected roughly uniform sampling without long gaps");
     const size_t m = static_cast<size_t>(points);
@@ -156,9 +150,9 @@ SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, dou
     for (size_t i = 0; i < m; ++i) s.grid[i] = t.front() + s.dt * static_cast<double>(i);
   }
   if (!(cutoff_hz < 0.5 / s.dt))
-    throw InputError(source + ": sample period " + Short(s.dt) + " s is too long for the " +
-                     Short(cutoff_hz) + " Hz derivative filter, expected a sample rate above " +
-                     Short(2 * cutoff_hz) + " Hz");
+    throw InputError(source + ": sample period " + NumberText(s.dt) + " s is too long for the " +
+                     NumberText(cutoff_hz) + " Hz derivative filter, expected a sample rate above " +
+                     NumberText(2 * cutoff_hz) + " Hz");
   return s;
 }
 
@@ -214,8 +208,7 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
     k.qd[j] = qd ? *qd : v;
     k.qdd[j] = qdd ? *qdd : a;
   }
-  k.derivative_source = "butterworth " + Short(cutoff_hz) + " Hz";
-  k.cutoff_hz = cutoff_hz;
+  k.derivative_source = "butterworth " + NumberText(cutoff_hz) + " Hz";
   return k;
 }
 

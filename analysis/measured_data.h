@@ -52,7 +52,6 @@ struct Kinematics {
   std::vector<double> q[2], qd[2], qdd[2];  // [0] hip, [1] knee; rad, rad/s, rad/s^2
   bool resampled = false;                    // the input was non-uniform and went through a grid
   std::string derivative_source;             // "measured columns" or "butterworth 20 Hz"
-  double cutoff_hz = 0;                      // the derivative filter's cutoff, 0 for measured columns
   std::map<std::string, std::vector<double>> emg;  // emg_<channel> columns (V) by channel, e.g. "VM"
 };
 

@@ -18,6 +18,25 @@ double Pearson(const std::vector<double>& x, const std::vector<double>& y, size_
   return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
 }
 
+double AutocorrelationLength(const double* x, size_t n) {
+  if (n < 2) return 1.0;
+  double mean = 0;
+  for (size_t i = 0; i < n; ++i) mean += x[i];
+  mean /= static_cast<double>(n);
+  double v = 0;
+  for (size_t i = 0; i < n; ++i) v += (x[i] - mean) * (x[i] - mean);
+  if (!(v > 0)) return 1.0;
+  double tau = 1.0;
+  for (size_t lag = 1; lag < std::min<size_t>(n / 4, 2000); ++lag) {
+    double c = 0;
+    for (size_t i = 0; i + lag < n; ++i) c += (x[i] - mean) * (x[i + lag] - mean);
+    const double rho = c / v;
+    if (rho < 0.05) break;
+    tau += 2 * rho;
+  }
+  return std::max(tau, 1.0);
+}
+
 double Percentile(const std::vector<double>& sorted, double p) {
   if (sorted.empty()) return std::nan("");
   const double pos = p * static_cast<double>(sorted.size() - 1);

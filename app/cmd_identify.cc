@@ -125,14 +125,12 @@ CommandRunner RegisterIdentify(CLI::App& app) {
     if (!o->known.empty())  // steps 3-4: the records are of a human wearing the device
       for (const MeasuredData& f : files) CheckHumanJointRange(f);
     const double L1 = o->L1 != 0.0 ? o->L1 : 0.41;
-    opt.cutoff_hz = ParseCutoffOption(o->cutoff, "identify --cutoff");
-    if (opt.cutoff_hz == 0) {
-      std::vector<const MeasuredData*> recs;
-      for (const MeasuredData& f : files) recs.push_back(&f);
-      const CutoffChoice c = ChooseCutoff(recs, L1, 9.81);
-      opt.cutoff_hz = c.from_columns ? 20.0 : c.hz;
-      std::fprintf(stderr, "identify: derivative cutoff %s\n", c.why.c_str());
-    }
+    std::vector<const MeasuredData*> recs;
+    for (const MeasuredData& f : files) recs.push_back(&f);
+    std::string cutoff_why;
+    opt.cutoff_hz = ResolveCutoffOption(o->cutoff, "--cutoff", recs, L1,
+                                        o->known.empty() ? LegParams{}.g : known.g, &cutoff_why);
+    if (o->cutoff == "auto") std::fprintf(stderr, "identify: derivative cutoff %s\n", cutoff_why.c_str());
     const IdentificationResult r = Identify(files, o->known.empty() ? nullptr : &known, L1, opt);
 
     std::string header = "exotwin identify: Hwang & Jeon 2015 ";

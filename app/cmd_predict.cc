@@ -48,12 +48,9 @@ CommandRunner RegisterPredict(CLI::App& app) {
     if (params.human) CheckHumanJointRange(data);
     Plant plant(o->mjcf.empty() ? DefaultModelFor(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
-    double cutoff = ParseCutoffOption(o->cutoff, "predict --cutoff");
-    if (cutoff == 0) {
-      const CutoffChoice c = ChooseCutoff({&data}, params.L1, params.g);
-      cutoff = c.from_columns ? 20.0 : c.hz;
-      std::fprintf(stderr, "predict: derivative cutoff %s\n", c.why.c_str());
-    }
+    std::string why;
+    const double cutoff = ResolveCutoffOption(o->cutoff, "--cutoff", {&data}, params.L1, params.g, &why);
+    if (o->cutoff == "auto") std::fprintf(stderr, "predict: derivative cutoff %s\n", why.c_str());
     const Kinematics kin = DeriveKinematics(data, cutoff);
     if (kin.resampled)
       std::fprintf(stderr,

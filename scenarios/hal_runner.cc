@@ -199,8 +199,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   // torque at t needs the acceleration a(t) of this step (Hal3Plant::interaction_torque: semi-implicit
   // Euler, a(t) from the state at t and the torques held over [t, t + dt]), so the step is computed
   // before the tick: everything it uses is fixed at t, and the controller sees the plant only
-  // through the bus. (Until this was settled, the frame of t + dt paired th(t + dt) with the frame
-  // torque of [t, t + dt]: a 1-sample skew.)
+  // through the bus.
   double tau_motor = 0;  // the driver's output at t = 0: no command yet
   for (long k = 0; k < n_steps; ++k) {
     const double th_t = plant.th();

@@ -374,9 +374,7 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
     //    MuJoCo's semi-implicit Euler, qd(t+dt) = qd(t) + dt a(t), q(t+dt) = q(t) + dt qd(t+dt), so
     //    q(t+dt) - 2 q(t) + q(t-dt) = dt^2 a(t) and a(t) follows from the torque held over [t, t + dt]:
     //    the central differences of the logged angles meet inverse dynamics on the logged torque with
-    //    no lag. (Until this was settled the plant held over [t, t + dt] the drivers' output at t + dt,
-    //    a command issued at t + dt/2 acting from t, and each frame paired q(t + dt) with that torque:
-    //    a 1-sample skew that `diagnose` named as a 1 ms sensor_delay.)
+    //    no lag.
     double tau[2] = {0, 0};  // the drivers' output at t = 0: no command yet
     const long n_steps = std::lround(s.protocol.duration / dt);
     const long log_every = std::max(1L, std::lround(1.0 / (s.log_rate_hz * dt)));

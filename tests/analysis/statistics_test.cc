@@ -1,5 +1,6 @@
 // Pearson correlation against closed forms: exact lines give +-1 whatever their offset and scale,
 // a constant gives 0, orthogonal centred signals give 0, and the sample range is honoured.
+#include "analysis/seeded_rng.h"
 #include "analysis/statistics.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,22 @@
 
 namespace exotwin {
 namespace {
+
+// AR(1) x_k = phi x_(k-1) + white noise: rho(k) = phi^k, so 1 + 2 sum phi^k = (1 + phi) / (1 - phi)
+// (truncated where phi^k < 0.05: within 2 * 0.05 / (1 - phi) of it, plus the sampling error).
+TEST(Statistics, AutocorrelationLengthOfAnAr1ProcessIsItsClosedForm) {
+  for (double phi : {0.0, 0.5, 0.8}) {
+    SeededRng rng(3);
+    std::vector<double> x(200000);
+    double v = 0;
+    for (double& s : x) s = v = phi * v + rng.Normal();
+    const double exact = (1 + phi) / (1 - phi);
+    const double truncation = 2 * 0.05 / (1 - phi);
+    EXPECT_NEAR(AutocorrelationLength(x.data(), x.size()), exact, truncation + 0.05 * exact) << phi;
+  }
+  const std::vector<double> constant(100, 2.0);
+  EXPECT_EQ(AutocorrelationLength(constant.data(), constant.size()), 1.0);
+}
 
 TEST(Statistics, PearsonAgainstClosedForms) {
   std::vector<double> x, up, down, flat, s, c;

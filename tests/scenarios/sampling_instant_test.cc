@@ -36,17 +36,11 @@ std::string Named(const Diagnosis& d) {
 }
 
 // Skew 0 (default): the logged angles and torques belong to one instant, so the exact twin explains
-// the record without a lag. Before the fix the frame of t + dt paired q(t + dt) with the torque held
-// over [t, t + dt] and diagnose named sensor_delay = 1.0 ms at both joints (60 s run: held-out error
-// before any extension 0.345 N m at the hip, 0.095 at the knee). Now the held-out error is about
-// 0.06 / 0.03 N m and no delay is named. What diagnose may still name at the hip is not timing: a
-// sensor_gain of ~0.1 % (the torque sensor's modelled 0.03 % FS cubic non-linearity, TorqueSensorSpec)
-// and an inertia_error of ~0.003 kg m^2 (0.06 % of J1: the 20 Hz zero-phase derivative filter acts on
-// the angles and not on the torque; with exact central differences of the plant's angles the same
-// record leaves 0.026 N m at the hip, the sensor noise, and diagnose names nothing).
-TEST(SamplingInstant, CleanClosedLoopGaitHasNoSensorDelay) {
+// the record without a lag: diagnose names nothing, and the held-out error is at the sensors' level
+// (a 1-sample skew leaves 0.345 / 0.095 N m, hip / knee).
+TEST(SamplingInstant, CleanClosedLoopGaitNamesNothing) {
   const Diagnosis d = DiagnoseGait(0, "skew0");
-  for (const DiagnosedEffect& e : d.effects) EXPECT_NE(e.effect.name, "sensor_delay") << Named(d);
+  EXPECT_TRUE(d.effects.empty()) << Named(d);
   EXPECT_LT(d.joints[0].rmse_before, 0.10) << "hip";
   EXPECT_LT(d.joints[1].rmse_before, 0.05) << "knee";
 }
