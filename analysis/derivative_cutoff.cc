@@ -53,12 +53,14 @@ double ResolveCutoffOption(const std::string& value, const std::string& what,
     if (why) *why = "given (" + what + " " + NumberText(hz) + ")";
     return hz;
   }
-  const CutoffChoice c = ChooseCutoff(records, L1, g);
+  const CutoffChoice c = ChooseCutoff(records, L1, g, CutoffUse::kDerivatives);
   if (why) *why = c.why;
   return c.from_columns ? 20.0 : c.hz;
 }
 
-CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g) {
+CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g,
+                          CutoffUse use) {
+  const bool parallel = use == CutoffUse::kParallel;
   CutoffChoice c;
   if (records.empty()) throw InputError("cutoff choice: no record");
   double fs_min = 1e300;
@@ -91,9 +93,9 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   }
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
   for (double fc : c.candidates_hz) {
-    // Per record, on every stride-th sample: the regressor from the angles differentiated at
-    // DerivativeCutoffHz(fc), each column and the torque low-passed at fc (parallel filtering),
-    // and the raw torque the score is taken against.
+    // Per record, on every stride-th sample: the regressor (parallel: from the angles differentiated
+    // at DerivativeCutoffHz(fc), each column and the torque low-passed at fc; else differentiated at
+    // fc), and the raw torque the score is taken against.
     struct Rows {
       std::vector<Eigen::Matrix<double, 2, kCols>> Y;
       std::vector<Eigen::Vector2d> u_f, u_raw;
@@ -105,7 +107,8 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     for (size_t r = 0; r < records.size(); ++r) {
       const MeasuredData& d = *records[r];
       const size_t n = d.size();
-      const Kinematics k = DeriveKinematics(d, DerivativeCutoffHz(fc, 1.0 / MedianStep(d.t)));
+      const Kinematics k = DeriveKinematics(d, parallel ? DerivativeCutoffHz(fc, 1.0 / MedianStep(d.t)) : fc);
+      auto filter = [&](const std::vector<double>& x) { return parallel ? LowPassOnTimeBase(d.t, x, fc, d.source) : x; };
       const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 / MedianStep(d.t)));  // filter edges
       const size_t split = static_cast<size_t>(kTrainFraction * static_cast<double>(n));
       const size_t stride = std::max<size_t>(1, n / kMaxRowsPerRecord);
@@ -120,11 +123,11 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       for (int j = 0; j < 2; ++j) {
         for (int col = 0; col < kCols; ++col) {
           for (size_t i = 0; i < n; ++i) x[i] = full[i](j, col);
-          const std::vector<double> xf = LowPassOnTimeBase(d.t, x, fc, d.source);
+          const std::vector<double> xf = filter(x);
           for (size_t a = 0; a < at.size(); ++a) R.Y[a](j, col) = xf[at[a]];
         }
         const std::vector<double>& tau = j == 0 ? d.tau_hip : d.tau_knee;
-        const std::vector<double> tf = LowPassOnTimeBase(d.t, tau, fc, d.source);
+        const std::vector<double> tf = filter(tau);
         for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -tf[at[a]], R.u_raw[a][j] = -tau[at[a]];
       }
       for (size_t a = 0; a < at.size(); ++a) {
@@ -177,8 +180,8 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   }
   c.hz = c.candidates_hz[pick];
   c.why = "lowest cutoff within one standard error (paired, on the same rows) of the least held-out error of a "
-          "generic rigid two-link + friction + offset fit filtered alike (last 30 % of each record, "
-          "against the raw torque): " + NumberText(c.hz) + " Hz (held-out rmse hip " + NumberText(c.heldout_rmse[0][pick]) + ", knee " +
+          "generic rigid two-link + friction + offset fit" + std::string(parallel ? " filtered alike" : "") +
+          " (last 30 % of each record, against the raw torque): " + NumberText(c.hz) + " Hz (held-out rmse hip " + NumberText(c.heldout_rmse[0][pick]) + ", knee " +
           NumberText(c.heldout_rmse[1][pick]) + " N m; best " + NumberText(c.candidates_hz[at_best]) + " Hz, 20 Hz " +
           [&] {
             for (size_t i = 0; i < c.candidates_hz.size(); ++i)

@@ -4,16 +4,16 @@
 // encoder at 500 Hz the 20 Hz filter of Hwang & Jeon sec. 3.2 leaves more noise in qdd than the
 // effects have signal (shared/data/real_rig/README.md), while on a clean 1 kHz record a low cutoff
 // distorts the motion itself. The choice is the classic bias-variance trade-off, settled by held-out
-// prediction error of the pipeline `diagnose` runs (parallel filtering, as in robot identification
-// practice):
-//   for each candidate cutoff fc (1.5 .. 50 Hz, below fs / 4), the angles are differentiated at
-//   DerivativeCutoffHz(fc) (a zero-phase filter flat where fc passes), and a generic linear model of
-//   the joint torques is fitted by least squares on the first 70 % (in time) of every record, its
-//   columns and the measured torque both low-passed at fc: the rigid two-link regressor in the lumped
-//   parameters (FullRegressor: M qdd + V + G, any device with that structure), plus per joint a
-//   torque offset, Coulomb (sign qd) and viscous (qd) friction. Its filtered prediction is scored on
-//   the last 30 % against the raw, unfiltered measured torque, whose own noise is the same for
-//   every fc. The score is the sum over joints of the
+// prediction error of the pipeline that will use the cutoff (CutoffUse):
+//   for each candidate cutoff fc (1.5 .. 50 Hz, below fs / 4), a generic linear model of the joint
+//   torques is fitted by least squares on the first 70 % (in time) of every record: the rigid
+//   two-link regressor in the lumped parameters (FullRegressor: M qdd + V + G, any device with that
+//   structure), plus per joint a torque offset, Coulomb (sign qd) and viscous (qd) friction.
+//   kDerivatives (predict, identify): the angles differentiated at fc, the torque as measured.
+//   kParallel (diagnose; parallel filtering, as in robot identification practice): the angles
+//   differentiated at DerivativeCutoffHz(fc) (flat where fc passes), the regressor's columns and the
+//   torque both low-passed at fc. Its prediction is scored on the last 30 % against the raw,
+//   unfiltered measured torque, whose own noise is the same for every fc. The score is the sum over joints of the
 //   held-out mean square error divided by that joint's torque variance. The chosen cutoff is the
 //   lowest (the most filtering, the most regularized model) whose score is within one standard
 //   error of the best: the one-standard-error rule of cross-validation (Hastie, Tibshirani &
@@ -43,7 +43,9 @@ struct CutoffChoice {
 // Chooses the cutoff for records of one device (each at least 200 samples). L1 (m) and g (m/s^2)
 // enter the regressor's coupling and gravity columns. Throws InputError when no candidate fits the
 // records' sample rate (fs / 4 <= 1.5 Hz).
-CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g);
+enum class CutoffUse { kDerivatives, kParallel };
+CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g,
+                          CutoffUse use);
 
 // The angles' derivative cutoff under a residual low-pass at fc: 4 fc (the zero-phase 2nd-order
 // Butterworth then passes 99 % at fc, so measured and predicted torque see one filter), at most
@@ -55,9 +57,9 @@ double DerivativeCutoffHz(double fc, double fs);
 // Throws InputError naming `what` (the option) otherwise.
 double ParseCutoffOption(const std::string& value, const std::string& what);
 
-// The cutoff (Hz) a `--cutoff` value asks for on `records`: a frequency as given, "auto" through
-// ChooseCutoff (20 Hz, unused, when the records carry their own qd/qdd columns). *why (optional)
-// says how it was chosen.
+// The derivative cutoff (Hz) a `--cutoff` value asks for on `records`: a frequency as given, "auto"
+// through ChooseCutoff(kDerivatives) (20 Hz, unused, when the records carry their own qd/qdd
+// columns). *why (optional) says how it was chosen.
 double ResolveCutoffOption(const std::string& value, const std::string& what,
                            const std::vector<const MeasuredData*>& records, double L1, double g,
                            std::string* why = nullptr);

@@ -186,7 +186,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     D.cutoff.hz = opt.cutoff_hz;
     D.cutoff.why = "given (--cutoff " + NumberText(opt.cutoff_hz) + ")";
   } else {
-    D.cutoff = ChooseCutoff(records, params.L1, params.g);
+    D.cutoff = ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel);
   }
   Lap("cutoff choice");
 

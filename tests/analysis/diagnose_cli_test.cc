@@ -18,13 +18,6 @@ using testing::RunExotwin;
 using testing::TempDir;
 using testing::WriteText;
 
-std::string Read(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 const std::string kS1 = std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml";
 
 TEST(DiagnoseCli, FindsTheHiddenEffectAndPredictLoadsTheExtendedModel) {
@@ -36,7 +29,7 @@ TEST(DiagnoseCli, FindsTheHiddenEffectAndPredictLoadsTheExtendedModel) {
   ASSERT_EQ(truth.effects.size(), 1u);
   r = RunExotwin("diagnose --params " + kS1 + " --measured " + d + "/data.csv --out " + d + "/out");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto j = nlohmann::json::parse(Read(d + "/out/diagnosis.json"));
+  const auto j = nlohmann::json::parse(testing::ReadText(d + "/out/diagnosis.json"));
   ASSERT_EQ(j["effects"].size(), 1u) << j.dump(2);
   EXPECT_EQ(j["effects"][0]["name"], "coulomb_friction");
   EXPECT_EQ(j["effects"][0]["joint"], "knee");
@@ -44,7 +37,7 @@ TEST(DiagnoseCli, FindsTheHiddenEffectAndPredictLoadsTheExtendedModel) {
   EXPECT_GE(j["joints"]["knee"]["gain_pct"].get<double>(), 50.0);
   EXPECT_EQ(j["validation"]["holdout_fraction"].get<double>(), 0.3);
   EXPECT_TRUE(j["unexplained"].is_array());
-  const std::string html = Read(d + "/out/report.html");
+  const std::string html = testing::ReadText(d + "/out/report.html");
   EXPECT_NE(html.find("<svg"), std::string::npos);
   EXPECT_NE(html.find("spectrum"), std::string::npos);
   // extended.yaml is a model file every command loads: predict runs the extended twin.

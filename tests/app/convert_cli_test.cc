@@ -21,16 +21,9 @@ using testing::WriteText;
 const std::string kDir = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/";
 const std::string kMap = kDir + "dfki_double_pendulum_A0.map.yaml";
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // The file without its '#' comment lines.
 std::string Data(const std::string& path) {
-  std::istringstream in(Slurp(path));
+  std::istringstream in(testing::ReadText(path));
   std::string out, line;
   while (std::getline(in, line))
     if (line.rfind("#", 0) != 0) out += line + "\n";
@@ -51,7 +44,7 @@ TEST(ConvertCli, OutputRereadsAsWhatTheMapGives) {
   const MeasuredData mapped = ApplyColumnMap(ReadColumnMap(kMap), ReadCsv(in), in);
   EXPECT_EQ(converted.table.names, mapped.table.names);
   EXPECT_EQ(converted.table.columns, mapped.table.columns);  // bit for bit (%.17g)
-  const std::string text = Slurp(dir + "/data.csv");
+  const std::string text = testing::ReadText(dir + "/data.csv");
   EXPECT_NE(text.find("# source: " + in), std::string::npos);
   EXPECT_NE(text.find("# map: " + kMap), std::string::npos);
 }
@@ -89,7 +82,7 @@ TEST(ConvertCli, HumanModelRefusesARecordBeyondAHumanJointsRange) {
 
 TEST(ConvertCli, BadMapExitsTwoAndWritesNothing) {
   const std::string dir = TempDir("convert_bad");
-  std::string map = Slurp(kMap);
+  std::string map = testing::ReadText(kMap);
   map.replace(map.find("sign: -1}"), 9, "scale: 0}");
   WriteText(dir + "/bad.yaml", map);
   const auto r = RunExotwin("convert --map " + dir + "/bad.yaml " + kDir + "trajectory_11.csv --out " + dir +

@@ -85,6 +85,22 @@ TEST_F(IdentifyCli, ExoThenHumanWithKnown) {
     EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
 }
 
+// --cutoff: a number sets the derivative filter (the file records it), 'auto' chooses it from the
+// files and says so; either way the exo is recovered within the same 2 %; a bad value exits 2.
+TEST_F(IdentifyCli, CutoffOption) {
+  const std::string files = "--measured " + D() + "/exo --L1 0.41 --out ";
+  for (const char* c : {"10", "auto"}) {
+    const auto r = RunExotwin("identify " + files + D() + "/exo_c.yaml --cutoff " + c);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    if (std::string(c) == "auto") EXPECT_NE(r.output.find("derivative cutoff"), std::string::npos) << r.output;
+    else EXPECT_NE(testing::ReadText(D() + "/exo_c.yaml").find("Butterworth 10"), std::string::npos);
+    const LegParams e = ReadModelFile(D() + "/exo_c.yaml");
+    EXPECT_NEAR(e.exo.J1, 3.02, 0.02 * 3.02) << c;
+    EXPECT_NEAR(e.exo.X2, 1.74, 0.02 * 1.74) << c;
+  }
+  ExpectBadInput(RunExotwin("identify " + files + D() + "/exo_c.yaml --cutoff -1"), "--cutoff");
+}
+
 // The exo recordings as a foreign rig would log them (time in ms, angles in degrees, torques with the
 // actuator's sign, other names), in a folder: one --map applies to every --measured file, and the
 // identification equals the one on the schema files.

@@ -12,13 +12,6 @@
 namespace exotwin::testing {
 namespace {
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Replaces the first `from` by `to`; fails the test if `from` is absent.
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
@@ -40,7 +33,7 @@ std::string Shipped(const std::string& rel) { return std::string(EXOTWIN_SOURCE_
 
 // Gait at 4 s (1 s ramp) instead of 60 s.
 std::string ShortGait() {
-  return Replace(Replace(Slurp(Shipped("gait_2kmh.yaml")), "duration: 60", "duration: 4"), "ramp: 2.0", "ramp: 1.0");
+  return Replace(Replace(testing::ReadText(Shipped("gait_2kmh.yaml")), "duration: 60", "duration: 4"), "ramp: 2.0", "ramp: 1.0");
 }
 
 TEST(RegressCli, UnchangedControllerPassesDetunedGainIsCaught) {
@@ -54,7 +47,7 @@ TEST(RegressCli, UnchangedControllerPassesDetunedGainIsCaught) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ASSERT_TRUE(std::filesystem::exists(suite + "/baselines/gait_2kmh.json")) << r.output;
   ASSERT_TRUE(std::filesystem::exists(suite + "/baselines/fault_sensor_stuck.json"));
-  EXPECT_EQ(Slurp(suite + "/baselines/gait_2kmh.json").find("wall_time_s"), std::string::npos);
+  EXPECT_EQ(testing::ReadText(suite + "/baselines/gait_2kmh.json").find("wall_time_s"), std::string::npos);
 
   r = RunExotwin("regress --suite " + suite + " --out " + dir + "/o2");
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -68,7 +61,7 @@ TEST(RegressCli, UnchangedControllerPassesDetunedGainIsCaught) {
   EXPECT_NE(r.output.find("tracking_rms_knee_deg"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("REGRESSED"), std::string::npos) << r.output;
   EXPECT_TRUE(HasLine(r.output, "fault_sensor_stuck", " ok (")) << r.output;  // the other scenario passes
-  const std::string report = Slurp(dir + "/o3/regress.json");
+  const std::string report = testing::ReadText(dir + "/o3/regress.json");
   EXPECT_NE(report.find("\"passed\": false"), std::string::npos);
 
   // Restored: passes again (the baselines were not touched by the failing run).

@@ -13,13 +13,6 @@
 namespace exotwin::testing {
 namespace {
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos) << "'" << from << "' not in the scenario";
@@ -31,10 +24,10 @@ std::string Shipped(const std::string& rel) { return std::string(EXOTWIN_SOURCE_
 
 // Two short scenarios (gait 2 s, knee sensor stuck at 1.5 s of 2 s) in dir.
 std::string TwoScenarios(const std::string& dir) {
-  WriteText(dir + "/gait.yaml", Replace(Replace(Slurp(Shipped("gait_2kmh.yaml")), "duration: 60", "duration: 2"),
+  WriteText(dir + "/gait.yaml", Replace(Replace(testing::ReadText(Shipped("gait_2kmh.yaml")), "duration: 60", "duration: 2"),
                                         "ramp: 2.0", "ramp: 0.5"));
   WriteText(dir + "/stuck.yaml",
-            Replace(Replace(Slurp(Shipped("faults/sensor_stuck.yaml")), "duration: 5", "duration: 2"), "at: 3.0",
+            Replace(Replace(testing::ReadText(Shipped("faults/sensor_stuck.yaml")), "duration: 5", "duration: 2"), "at: 3.0",
                     "at: 1.5"));
   return "--scenario " + dir + "/gait.yaml --scenario " + dir + "/stuck.yaml";
 }
@@ -52,18 +45,18 @@ TEST(SweepCli, ShardedAndMergedEqualsUnsharded) {
   r = RunExotwin("merge " + dir + "/part2 " + dir + "/part0 " + dir + "/part1 --out " + dir + "/merged");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* f : {"sweep.csv", "summary.json", "sweep.json", "plots/gait_2kmh.svg", "plots/fault_sensor_stuck.svg"}) {
-    const std::string a = Slurp(dir + "/whole/" + f), b = Slurp(dir + "/merged/" + f);
+    const std::string a = testing::ReadText(dir + "/whole/" + f), b = testing::ReadText(dir + "/merged/" + f);
     EXPECT_FALSE(a.empty()) << f;
     EXPECT_EQ(a, b) << f << " differs between the unsharded and the merged sweep";
   }
   // One row per scenario x subject, completed, with subject characteristics and metrics.
-  const std::string csv = Slurp(dir + "/whole/sweep.csv");
+  const std::string csv = testing::ReadText(dir + "/whole/sweep.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 10);
   EXPECT_NE(csv.find("subject_weight_kg"), std::string::npos);
   EXPECT_NE(csv.find("tracking_rms_knee_deg"), std::string::npos);
   EXPECT_EQ(csv.find("wall_time_s"), std::string::npos);
   EXPECT_EQ(csv.find("diverged"), std::string::npos);
-  const auto j = nlohmann::json::parse(Slurp(dir + "/whole/summary.json"));
+  const auto j = nlohmann::json::parse(testing::ReadText(dir + "/whole/summary.json"));
   const auto& st = j["scenarios"]["gait_2kmh"]["metrics"]["tracking_rms_hip_deg"];
   EXPECT_EQ(st["n"], 5);
   for (const char* k : {"mean", "sd", "min", "max", "p5", "p95"}) EXPECT_TRUE(st.contains(k)) << k;
@@ -71,7 +64,7 @@ TEST(SweepCli, ShardedAndMergedEqualsUnsharded) {
   EXPECT_LE(st["p95"].get<double>(), st["max"].get<double>());
   EXPECT_GT(st["sd"].get<double>(), 0.0);  // the subjects differ
   // The part holds only its own subjects.
-  EXPECT_EQ(Slurp(dir + "/part1/sweep.json").find("\"shard\": \"1/3\"") != std::string::npos, true);
+  EXPECT_EQ(testing::ReadText(dir + "/part1/sweep.json").find("\"shard\": \"1/3\"") != std::string::npos, true);
 }
 
 TEST(SweepCli, BadInputExits2) {
