@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "analysis/csv_table.h"
 #include "analysis/diagnose.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
@@ -69,6 +70,53 @@ TEST(DiagnoseCli, BadInputIsExitTwoNamingTheFile) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = RunExotwin("generate --params " + kS1 + " --seed 1 --duration -3 --out " + d + "/x.csv");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+// Several records of one device; records of another device (other columns, another time unit), a bad
+// --cutoff or --max-effects exit 2 naming the file or option, and nothing is written to --out.
+TEST(DiagnoseCli, SeveralRecordsOfOneDeviceAndRecordsOfAnother) {
+  const std::string d = TempDir("diagmulti");
+  // One device: the second record's truth is the first's (its hidden friction), another motion.
+  ASSERT_EQ(RunExotwin("generate --params " + kS1 + " --seed 1 --effect coulomb_friction --joint knee"
+                       " --duration 20 --rate 500 --out " + d + "/rec1.csv --truth " + d + "/truth.yaml").exit_code, 0);
+  ASSERT_EQ(RunExotwin("generate --params " + d + "/truth.yaml --seed 2 --effects 0 --duration 20 --rate 500 --out " +
+                       d + "/rec2.csv").exit_code, 0);
+  const auto ok = RunExotwin("diagnose --params " + kS1 + " --measured " + d + "/rec1.csv --measured " + d +
+                             "/rec2.csv --out " + d + "/both");
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("whole records left out"), std::string::npos) << ok.output;
+  const auto j = nlohmann::json::parse(testing::ReadText(d + "/both/diagnosis.json"));
+  ASSERT_EQ(j["records"].size(), 2u);
+  EXPECT_TRUE(j["validation"]["leave_one_record_out"].get<bool>());
+  EXPECT_GT(j["left_out"]["knee"]["gain_pct"].get<double>(), 50.0);
+  EXPECT_GT(j["records"][1]["left_out"]["knee"]["gain_pct"].get<double>(), 50.0);
+  // Another device: the EMG columns dropped; the same record in milliseconds.
+  const CsvTable t = ReadCsv(d + "/rec2.csv");
+  std::vector<double> ms = t.columns[t.Find("t")];
+  for (double& v : ms) v *= 1e3;
+  const std::vector<const std::vector<double>*> five = {&t.columns[t.Find("t")], &t.columns[t.Find("q_hip")],
+                                                        &t.columns[t.Find("q_knee")], &t.columns[t.Find("tau_hip")],
+                                                        &t.columns[t.Find("tau_knee")]};
+  WriteCsv(d + "/noemg.csv", {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"}, five);
+  std::vector<const std::vector<double>*> in_ms = five;
+  in_ms[0] = &ms;
+  std::vector<std::string> names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+  std::vector<const std::vector<double>*> cols = in_ms;
+  for (size_t c = 0; c < t.names.size(); ++c)
+    if (t.names[c].rfind("emg_", 0) == 0) names.push_back(t.names[c]), cols.push_back(&t.columns[c]);
+  WriteCsv(d + "/ms.csv", names, cols);
+  for (const char* other : {"noemg.csv", "ms.csv"}) {
+    const auto r = RunExotwin("diagnose --params " + kS1 + " --measured " + d + "/rec1.csv --measured " + d + "/" +
+                              other + " --out " + d + "/o_" + other);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(other), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("expected records of one device"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::ifstream(d + "/o_" + other + "/diagnosis.json").good()) << other;
+  }
+  for (const char* opt : {"--cutoff slow", "--max-effects 9"}) {
+    const auto r = RunExotwin("diagnose --params " + kS1 + " --measured " + d + "/rec1.csv --out " + d + "/o " + opt);
+    EXPECT_EQ(r.exit_code, 2) << opt << ": " << r.output;
+  }
 }
 
 // Beyond the leg: a planar two-joint arm-like chain, no human, other length and masses.
