@@ -11,28 +11,19 @@
 #include <limits>
 
 #include "app/bench_probes.h"
-#include "scenarios/fork_pool.h"
-#include "scenarios/runner.h"
-#include "scenarios/scenario_job.h"
-#include "scenarios/sweep_plan.h"
+#include "runner/fork_pool.h"
+#include "runner/runner.h"
+#include "runner/scenario_job.h"
+#include "runner/sweep_plan.h"
 #include "sim/plant.h"
 #include "sim/subjects.h"
 
-#if __has_include("renders/video_renderer.h")
-#define EXOTWIN_BENCH_RENDER 1
-#include "renders/video_renderer.h"
-#endif
-#if __has_include("analysis/identification.h") && __has_include("analysis/identification_data.h")
-#define EXOTWIN_BENCH_IDENTIFY 1
+#include "render/video_renderer.h"
 #include "analysis/identification.h"
 #include "analysis/identification_data.h"
-#endif
-#if __has_include("analysis/diagnose.h") && __has_include("analysis/generate.h")
-#define EXOTWIN_BENCH_DIAGNOSE 1
 #include "analysis/diagnose.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
-#endif
 
 namespace exotwin {
 namespace {
@@ -121,7 +112,6 @@ json BenchClosedLoop(const BenchConfig& c) {
 }
 
 json BenchRender(const BenchConfig& c) {
-#ifdef EXOTWIN_BENCH_RENDER
   const double seconds = c.quick ? 1.0 : 3.0;
   Plant plant(ShippedModelPath("leg_exowheel.xml"));
   auto video = [&](bool overlays) {
@@ -166,14 +156,9 @@ json BenchRender(const BenchConfig& c) {
   } catch (const std::exception& e) {
     return Unavailable(std::string("renderer failed: ") + e.what());
   }
-#else
-  (void)c;
-  return Unavailable("renders/ is not part of this build");
-#endif
 }
 
 json BenchIdentification(const BenchConfig& c) {
-#ifdef EXOTWIN_BENCH_IDENTIFY
   LegParams truth;
   truth.L1 = 0.41;
   truth.exo = {3.02, 0.74, 3.85, 1.74, 0.15, 0.16};
@@ -201,14 +186,9 @@ json BenchIdentification(const BenchConfig& c) {
               {"x_realtime", data_s / t},
               {"simulate_data_s", t_sim},
               {"ratio_identify_to_simulation", t / t_sim}};
-#else
-  (void)c;
-  return Unavailable("analysis/identification.h is not part of this build");
-#endif
 }
 
 json BenchDiagnosis(const BenchConfig& c) {
-#ifdef EXOTWIN_BENCH_DIAGNOSE
   GenerateOptions g;
   g.seed = 2024;
   g.duration = c.quick ? 20 : 60;
@@ -229,10 +209,6 @@ json BenchDiagnosis(const BenchConfig& c) {
               {"x_realtime", g.duration / t},
               {"generate_data_s", t_gen},
               {"ratio_diagnose_to_generation", t / t_gen}};
-#else
-  (void)c;
-  return Unavailable("analysis/diagnose.h is not part of this build");
-#endif
 }
 
 json BenchSweep(const BenchConfig& c) {

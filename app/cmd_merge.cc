@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "app/commands.h"
-#include "scenarios/sweep_table.h"
+#include "runner/sweep_table.h"
 
 namespace exotwin {
 namespace {

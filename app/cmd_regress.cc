@@ -13,9 +13,9 @@
 #include "analysis/csv_table.h"
 #include "app/commands.h"
 #include "model/input_error.h"
-#include "scenarios/fork_pool.h"
-#include "scenarios/progress_bar.h"
-#include "scenarios/regress.h"
+#include "runner/fork_pool.h"
+#include "runner/progress_bar.h"
+#include "runner/regress.h"
 
 namespace exotwin {
 namespace {

@@ -15,7 +15,7 @@
 #include "app/commands.h"
 #include "dsp/butterworth.h"
 #include "model/input_error.h"
-#include "renders/video_renderer.h"
+#include "render/video_renderer.h"
 #include "sim/plant.h"
 
 namespace exotwin {

@@ -3,8 +3,8 @@
 #include <cstdio>
 
 #include "app/commands.h"
-#include "scenarios/runner.h"
-#include "scenarios/scenario.h"
+#include "runner/runner.h"
+#include "runner/scenario.h"
 
 namespace exotwin {
 namespace {

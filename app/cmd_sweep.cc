@@ -11,8 +11,8 @@
 
 #include "app/commands.h"
 #include "model/input_error.h"
-#include "scenarios/progress_bar.h"
-#include "scenarios/sweep_run.h"
+#include "runner/progress_bar.h"
+#include "runner/sweep_run.h"
 
 namespace exotwin {
 namespace {

@@ -12,7 +12,7 @@
 #include "analysis/table5.h"
 #include "app/commands.h"
 #include "model/input_error.h"
-#include "scenarios/table5_protocol.h"
+#include "runner/table5_protocol.h"
 #include "sim/subjects.h"
 
 namespace exotwin {

@@ -13,7 +13,7 @@
 
 #include <filesystem>
 
-#include "scenarios/runner.h"
+#include "runner/runner.h"
 #include "sim/muscles.h"
 #include "sim/synthetic_emg.h"
 #include "sim/plant.h"

@@ -1,4 +1,4 @@
-// Render + encode speed of renders/ at 1280x720 against real time (30 fps of simulated time).
+// Render + encode speed of render/ at 1280x720 against real time (30 fps of simulated time).
 // Each iteration writes a 3 s video (90 frames) fed with 1 kHz states, including the final flush.
 // Counters: fps = frames per wall-clock second; x_realtime = fps / 30 (> 1 is faster than real time);
 // cpu_ms_frame = CPU time of all threads (llvmpipe, x264, caller) per frame, which bounds the fps an
@@ -12,8 +12,8 @@
 #include <filesystem>
 #include <string>
 
-#include "renders/scene_renderer.h"
-#include "renders/video_renderer.h"
+#include "render/scene_renderer.h"
+#include "render/video_renderer.h"
 #include "sim/plant.h"
 
 namespace exotwin {

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "model/input_error.h"
-#include "scenarios/scenario.h"
+#include "runner/scenario.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

@@ -1,6 +1,6 @@
 // The exotwin CAN frame protocol (classic CAN 2.0A, 1 Mbit/s, little-endian/Intel signals) between
 // the controller, the EXOwheel joint modules (hip, knee), the HAL-3 knee unit and the EMG amplifier.
-// hwsim/exotwin.dbc describes every signal (bits, scale, offset, unit); tests/protocol/dbc_agreement
+// protocol/exotwin.dbc describes every signal (bits, scale, offset, unit); tests/protocol/dbc_agreement
 // checks that this codec and the DBC agree. Lower IDs win arbitration, so IDs follow criticality:
 // heartbeat/faults < torque commands < sensor status < EMG.
 // Encoding saturates each value to its field's range and encodes NaN as 0 (plain functions, no

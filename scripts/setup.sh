@@ -8,8 +8,8 @@ PKGS=(
   build-essential cmake pkg-config
   libmujoco-dev libqhull-dev          # physics (find_package(mujoco) needs qhull's CMake config)
   libeigen3-dev                       # linear algebra
-  libosmesa6-dev                      # off-screen OpenGL for renders/
-  libopencv-dev                       # video encoding (renders/)
+  libosmesa6-dev                      # off-screen OpenGL for render/
+  libopencv-dev                       # video encoding (render/)
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   can-utils                           # log2asc for the candump round-trip test

@@ -15,7 +15,7 @@ export ASAN_OPTIONS="${ASAN_OPTIONS:-halt_on_error=1:detect_leaks=1:abort_on_err
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
 # Leaks inside third-party libraries we do not build (found with this suite, nothing of ours):
 #   libOSMesa.so: Mesa keeps ~0.5 kB per context made current (OSMesaMakeCurrent) after
-#   OSMesaDestroyContext; renders/osmesa_context.cc does destroy its context.
+#   OSMesaDestroyContext; render/osmesa_context.cc does destroy its context.
 cat > build-asan/lsan.supp <<'SUPP'
 leak:libOSMesa.so
 SUPP

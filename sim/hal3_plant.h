@@ -1,4 +1,4 @@
-// The MuJoCo plant of the HAL-3 seated knee (models/hal3_knee.xml, Hayashi et al.; Lee & Sankai):
+// The MuJoCo plant of the HAL-3 seated knee (mjcf/hal3_knee.xml, Hayashi et al.; Lee & Sankai):
 // one hinge "knee" carrying HAL's shank frame (body hal_shank, with the actuator) and the operator's
 // lower leg (body human_shank, welded to it: no cuff compliance). HAL's convention: th = 0 hanging,
 // positive = extension. The link obeys Hayashi eq. (4) with sigma = 0:
@@ -44,7 +44,7 @@ Hal3PlantParams Hal3ParamsForSubject(const Subject& s);
 
 class Hal3Plant {
  public:
-  // Loads the MJCF (default models/hal3_knee.xml). It needs one hinge "knee", bodies hal_shank and
+  // Loads the MJCF (default mjcf/hal3_knee.xml). It needs one hinge "knee", bodies hal_shank and
   // human_shank, and one gear-1 motor on the knee. Throws InputError otherwise.
   explicit Hal3Plant(const std::string& mjcf_path = ShippedModelPath("hal3_knee.xml"));
   ~Hal3Plant();

@@ -56,7 +56,7 @@ std::string FirstBadModelValue(const mjModel* m) {
 }  // namespace
 
 std::string ShippedModelPath(const std::string& file) {
-  return std::string(EXOTWIN_SOURCE_DIR) + "/models/" + file;
+  return std::string(EXOTWIN_SOURCE_DIR) + "/mjcf/" + file;
 }
 
 Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {

@@ -1,5 +1,5 @@
-// The MuJoCo plant of the two-joint leg + exoskeleton (models/leg_exowheel.xml or
-// models/exowheel_exo_only.xml) with the lumped parameters of a MODEL.yaml written into it.
+// The MuJoCo plant of the two-joint leg + exoskeleton (mjcf/leg_exowheel.xml or
+// mjcf/exowheel_exo_only.xml) with the lumped parameters of a MODEL.yaml written into it.
 // Immutable-after-setup model, mutable data; every physics call checks for divergence.
 #pragma once
 #include <memory>
@@ -26,7 +26,7 @@ class SimulationError : public std::runtime_error {
   double time_;
 };
 
-// Path of a model shipped in models/ (e.g. "leg_exowheel.xml").
+// Path of a model shipped in mjcf/ (e.g. "leg_exowheel.xml").
 std::string ShippedModelPath(const std::string& file);
 
 class Plant {

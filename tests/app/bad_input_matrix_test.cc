@@ -78,7 +78,7 @@ std::string MapReplace(const std::string& from, const std::string& to) {
   return p == std::string::npos ? "pattern not found: " + from : m.replace(p, from.size(), to);
 }
 
-std::string ShippedMjcf() { return testing::ReadText(std::string(EXOTWIN_SOURCE_DIR) + "/models/leg_exowheel.xml"); }
+std::string ShippedMjcf() { return testing::ReadText(std::string(EXOTWIN_SOURCE_DIR) + "/mjcf/leg_exowheel.xml"); }
 std::string MjcfReplace(const std::string& from, const std::string& to) {
   std::string x = ShippedMjcf();
   const size_t p = x.find(from);

@@ -10,7 +10,7 @@
 
 namespace {
 
-const std::regex kForbidden(R"(^\s*#\s*include\s*[<"](mujoco|opencv2?|sim/|hwsim/|renders/|scenarios/))");
+const std::regex kForbidden(R"(^\s*#\s*include\s*[<"](mujoco|opencv2?|sim/|hwsim/|render/|runner/))");
 
 bool Forbidden(const std::string& line) { return std::regex_search(line, kForbidden); }
 

@@ -1,4 +1,4 @@
-// hwsim/exotwin.dbc and the codec (protocol/messages.h) describe the same protocol: for every DBC
+// protocol/exotwin.dbc and the codec (protocol/messages.h) describe the same protocol: for every DBC
 // signal, a value encoded by the codec decodes to the same physical value with the DBC definition,
 // and bytes packed from the DBC definition decode to the same values with the codec.
 #include <gtest/gtest.h>
@@ -107,7 +107,7 @@ std::map<std::pair<std::string, std::string>, Field> CodecFields() {
   return f;
 }
 
-DbcDatabase Load() { return LoadDbc(std::string(EXOTWIN_SOURCE_DIR) + "/hwsim/exotwin.dbc"); }
+DbcDatabase Load() { return LoadDbc(std::string(EXOTWIN_SOURCE_DIR) + "/protocol/exotwin.dbc"); }
 
 TEST(DbcAgreement, EverySignalHasACodecFieldAndViceVersa) {
   const DbcDatabase db = Load();

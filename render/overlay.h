@@ -1,0 +1,53 @@
+// Overlays drawn on each video frame with OpenCV: time, joint angles, strip charts of measured vs
+// estimated torque (per joint), EMG envelopes, and a list of fault events.
+#pragma once
+#include <deque>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "render/render_options.h"
+
+namespace exotwin {
+
+// What the overlays show at one instant (SI units; NaN in tau_est = no estimate).
+struct OverlaySample {
+  double t = 0;                     // s
+  double q_hip = 0, q_knee = 0;     // rad
+  double tau_meas[2] = {0, 0};      // measured torque (sensor), N m; [0] hip, [1] knee
+  double tau_est[2] = {0, 0};       // the twin's estimate, N m
+  std::vector<double> emg;          // EMG envelopes, V (optional; labels in RenderOptions::emg_names)
+  std::string event;                // non-empty: a fault event raised at t
+};
+
+// The recent past the strip charts need (decimated to about one point per chart pixel).
+class OverlayHistory {
+ public:
+  explicit OverlayHistory(const RenderOptions& opt) : opt_(opt) {}
+  // Appends a sample (t non-decreasing), drops points older than the chart window, records events.
+  void Add(const OverlaySample& s);
+  // Draws every overlay for the latest sample onto a BGR frame (CV_8UC3) of any size.
+  void Draw(cv::Mat& frame) const;
+
+ private:
+  struct Point {
+    double t;
+    float tau_meas[2], tau_est[2];
+    std::vector<float> emg;
+  };
+  struct Event {
+    double t;
+    std::string text;
+  };
+  void DrawChart(cv::Mat& f, const cv::Rect& r, const std::string& title, int joint) const;
+  void DrawEmgChart(cv::Mat& f, const cv::Rect& r) const;
+
+  RenderOptions opt_;
+  std::deque<Point> points_;
+  std::vector<Event> events_;
+  OverlaySample last_;
+  bool has_last_ = false;
+};
+
+}  // namespace exotwin

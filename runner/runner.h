@@ -1,0 +1,79 @@
+// The scenario runner: builds the twin (plant + virtual hardware + the real controller) from a
+// scenario, runs it in lockstep, logs the measured data, computes metrics and evaluates the checks.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hwsim/virtual_can_bus.h"
+#include "model/lumped_params.h"
+#include "protocol/candump.h"
+#include "runner/scenario.h"
+#include "sim/muscles.h"
+#include "sim/subjects.h"
+
+namespace exotwin {
+
+struct RunOptions {
+  std::string out_dir = "out";
+  std::optional<uint64_t> seed;  // overrides the scenario's seed
+  std::string can_log;           // candump log of every frame on the bus ("" = none)
+  bool progress = false;         // progress bar on stderr
+  std::string video_path;        // MP4 of the first trial (side view + overlays); "" = none
+  // Called once per logged sample with (t, q_true[2], tau_applied[2]) (e.g. a video renderer).
+  std::function<void(double, const double*, const double*)> on_sample;
+};
+
+struct CheckResult {
+  std::string name, metric, op;
+  double value = 0, limit = 0;
+  bool passed = false;
+};
+
+struct RunResult {
+  std::string scenario;
+  uint64_t seed = 0;
+  std::map<std::string, double> metrics;
+  std::vector<CheckResult> checks;
+  std::vector<std::string> files;  // written files
+  std::vector<std::string> events; // fault events "t=... type joint"
+  bool all_passed() const;
+};
+
+// The subject's parameters as the twin's ground truth (preset, population draw or MODEL.yaml),
+// with the scenario's passive model; exo alone for the exo-only device.
+LegParams ResolveSubject(const Scenario& s);
+
+// The subject's characteristics (weight, segment lengths) for a preset or population draw; none for a
+// MODEL.yaml subject or the exo alone.
+std::optional<Subject> ScenarioSubject(const Scenario& s);
+
+// The contraction programme of an isometric_hip / isometric_knee behaviour (h.programme_seed, else
+// run_seed): the runner plays it, and the EMG calibration protocol reads its blocks (s, fraction of MVC).
+ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed);
+
+// Runs every trial of the scenario; writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
+// encoder angles, torque-sensor readings, commands) and DIR/truth[_trialN].csv (plant state and applied
+// torque). Throws InputError on bad scenario content and SimulationError on divergence (the logs
+// written so far stay on disk).
+RunResult RunScenario(const Scenario& s, const RunOptions& opt);
+
+// The virtual CAN bus of a scenario's hardware (bitrate, latency, jitter, drop rate) with `seed`.
+hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed);
+
+// With a log (may be null: nothing), every frame on `bus` is written to it with its time shifted by
+// `epoch` s (successive trials follow each other in one candump file). `log` must outlive the bus.
+void TapToCandump(hwsim::VirtualCanBus& bus, CandumpWriter* log, double epoch);
+
+// End of a run: evaluates the checks on result.metrics, writes result.json at `path`, then throws
+// InputError if a check names a metric the run did not produce (that check is written as failed with
+// value null, so the metrics of a long run are kept on disk before the exit code 2).
+void FinishRun(const Scenario& s, RunResult& result, const std::string& path);
+
+// Writes result.json (atomically).
+void WriteResultJson(const RunResult& r, const std::string& path);
+
+}  // namespace exotwin

@@ -1,0 +1,237 @@
+#include "runner/sweep_table.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <iterator>
+#include <tuple>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "analysis/csv_table.h"
+#include "analysis/statistics.h"
+#include "model/input_error.h"
+#include "runner/sweep_plots.h"
+
+namespace exotwin {
+namespace {
+
+const char* const kFixed[] = {"scenario", "subject", "subject_seed", "status", "checks_failed"};
+
+std::string Num(double v) {
+  if (std::isnan(v)) return "nan";
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, r.ptr);
+}
+
+std::string Quote(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+// Splits one CSV line (RFC 4180 quotes, no embedded newlines).
+std::vector<std::string> SplitLine(const std::string& line) {
+  std::vector<std::string> f(1);
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') f.back() += '"', ++i;
+      else if (c == '"') quoted = false;
+      else f.back() += c;
+    } else if (c == '"') quoted = true;
+    else if (c == ',') f.emplace_back();
+    else f.back() += c;
+  }
+  return f;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path + ": cannot open");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+void SortRows(const SweepManifest& m, std::vector<SweepRow>* rows) {
+  std::map<std::string, size_t> order;
+  for (size_t i = 0; i < m.scenarios.size(); ++i) order.emplace(m.scenarios[i], i);
+  auto key = [&](const SweepRow& r) {
+    auto it = order.find(r.scenario);
+    return std::make_tuple(it != order.end() ? it->second : order.size(), r.scenario, r.subject);
+  };
+  std::stable_sort(rows->begin(), rows->end(), [&](const SweepRow& a, const SweepRow& b) { return key(a) < key(b); });
+}
+
+std::string SweepCsv(const std::vector<SweepRow>& rows) {
+  std::set<std::string> cols;
+  for (const SweepRow& r : rows)
+    for (const auto& kv : r.values) cols.insert(kv.first);
+  std::string out;
+  for (const char* f : kFixed) out += std::string(out.empty() ? "" : ",") + f;
+  for (const std::string& c : cols) out += "," + Quote(c);
+  out += "\n";
+  for (const SweepRow& r : rows) {
+    out += Quote(r.scenario) + "," + std::to_string(r.subject) + "," + std::to_string(r.subject_seed) + "," +
+           Quote(r.status) + "," + std::to_string(r.checks_failed);
+    for (const std::string& c : cols) {
+      auto it = r.values.find(c);
+      out += "," + (it != r.values.end() ? Num(it->second) : std::string());
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::vector<SweepRow> ParseSweepCsv(const std::string& text, const std::string& source) {
+  std::vector<SweepRow> rows;
+  std::istringstream in(text);
+  std::string line;
+  std::vector<std::string> header;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    const auto f = SplitLine(line);
+    auto fail = [&](const std::string& what) {
+      throw InputError(source + ":" + std::to_string(lineno) + ": " + what);
+    };
+    if (header.empty()) {
+      header = f;
+      for (size_t i = 0; i < std::size(kFixed); ++i)
+        if (header.size() <= i || header[i] != kFixed[i])
+          fail(std::string("expected the sweep header starting scenario,subject,subject_seed,status,checks_failed"));
+      continue;
+    }
+    if (f.size() != header.size())
+      fail(std::to_string(f.size()) + " fields, expected " + std::to_string(header.size()) + " as in the header");
+    SweepRow r;
+    r.scenario = f[0];
+    try {
+      size_t pos = 0;
+      r.subject = std::stoi(f[1], &pos);
+      if (pos != f[1].size() || r.subject < 0) throw std::invalid_argument("");
+      r.subject_seed = std::stoull(f[2], &pos);
+      if (pos != f[2].size()) throw std::invalid_argument("");
+      r.checks_failed = std::stoi(f[4], &pos);
+      if (pos != f[4].size()) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      fail("subject, subject_seed and checks_failed: expected non-negative integers");
+    }
+    r.status = f[3];
+    for (size_t i = std::size(kFixed); i < f.size(); ++i) {
+      if (f[i].empty()) continue;
+      double v = 0;
+      if (f[i] == "nan") v = std::nan("");
+      else {
+        auto res = std::from_chars(f[i].data(), f[i].data() + f[i].size(), v);
+        if (res.ec != std::errc() || res.ptr != f[i].data() + f[i].size())
+          fail("column " + header[i] + ": '" + f[i] + "', expected a number");
+      }
+      r.values[header[i]] = v;
+    }
+    rows.push_back(std::move(r));
+  }
+  if (header.empty()) throw InputError(source + ": empty, expected a sweep CSV with a header row");
+  return rows;
+}
+
+std::string SweepSummaryJson(const SweepManifest& m, const std::vector<SweepRow>& rows) {
+  nlohmann::ordered_json j;
+  j["subjects"] = m.subjects;
+  j["seed"] = m.seed;
+  j["scenarios"] = nlohmann::ordered_json::object();
+  for (const std::string& sc : m.scenarios) {
+    nlohmann::ordered_json s;
+    std::map<std::string, int> statuses;
+    std::map<std::string, std::vector<double>> cols;
+    int runs = 0;
+    for (const SweepRow& r : rows) {
+      if (r.scenario != sc) continue;
+      ++runs;
+      ++statuses[r.status];
+      if (r.status != "ok" && r.status != "check_failed") continue;
+      for (const auto& kv : r.values)
+        if (!std::isnan(kv.second)) cols[kv.first].push_back(kv.second);
+    }
+    s["runs"] = runs;
+    s["status"] = statuses;
+    s["metrics"] = nlohmann::ordered_json::object();
+    for (auto& [name, v] : cols) {
+      double sum = 0;
+      for (double x : v) sum += x;
+      const double mean = sum / v.size();
+      double ss = 0;
+      for (double x : v) ss += (x - mean) * (x - mean);
+      std::vector<double> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      nlohmann::ordered_json st;
+      st["n"] = v.size();
+      st["mean"] = mean;
+      st["sd"] = v.size() > 1 ? std::sqrt(ss / (v.size() - 1)) : 0.0;
+      st["min"] = sorted.front();
+      st["max"] = sorted.back();
+      st["p5"] = Percentile(sorted, 0.05);
+      st["p95"] = Percentile(sorted, 0.95);
+      s["metrics"][name] = st;
+    }
+    j["scenarios"][sc] = s;
+  }
+  return j.dump(2) + "\n";
+}
+
+std::string ManifestJson(const SweepManifest& m, size_t rows) {
+  nlohmann::ordered_json j;
+  j["scenarios"] = m.scenarios;
+  j["files"] = m.files;
+  j["subjects"] = m.subjects;
+  j["seed"] = m.seed;
+  j["shard"] = m.shard ? nlohmann::ordered_json(m.shard->ToString()) : nlohmann::ordered_json(nullptr);
+  j["rows"] = rows;
+  return j.dump(2) + "\n";
+}
+
+SweepManifest ParseManifestJson(const std::string& text, const std::string& source) {
+  SweepManifest m;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    m.scenarios = j.at("scenarios").get<std::vector<std::string>>();
+    m.files = j.at("files").get<std::vector<std::string>>();
+    m.subjects = j.at("subjects").get<int>();
+    m.seed = j.at("seed").get<uint64_t>();
+    if (!j.at("shard").is_null()) m.shard = ParseShard(j.at("shard").get<std::string>());
+  } catch (const InputError& e) {
+    throw InputError(source + ": shard: " + e.what());
+  } catch (const std::exception& e) {
+    throw InputError(source + ": expected a sweep manifest {scenarios, files, subjects, seed, shard} (" + e.what() + ")");
+  }
+  return m;
+}
+
+void WriteSweepAggregate(const std::string& dir, const SweepManifest& m, std::vector<SweepRow> rows) {
+  SortRows(m, &rows);
+  std::filesystem::create_directories(dir + "/plots");
+  WriteFileAtomic(dir + "/sweep.csv", SweepCsv(rows));
+  WriteFileAtomic(dir + "/summary.json", SweepSummaryJson(m, rows));
+  WriteFileAtomic(dir + "/sweep.json", ManifestJson(m, rows.size()));
+  for (const std::string& sc : m.scenarios)
+    WriteFileAtomic(dir + "/plots/" + PlotFileName(sc), SweepHistogramsSvg(sc, rows));
+}
+
+void ReadSweepAggregate(const std::string& dir, SweepManifest* m, std::vector<SweepRow>* rows) {
+  *m = ParseManifestJson(ReadFile(dir + "/sweep.json"), dir + "/sweep.json");
+  *rows = ParseSweepCsv(ReadFile(dir + "/sweep.csv"), dir + "/sweep.csv");
+}
+
+}  // namespace exotwin
