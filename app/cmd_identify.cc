@@ -17,6 +17,7 @@
 #include "analysis/identification.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
+#include "analysis/number_text.h"
 #include "app/commands.h"
 #include "model/input_error.h"
 #include "sim/realizability.h"
@@ -124,7 +125,24 @@ CommandRunner RegisterIdentify(CLI::App& app) {
     for (const std::string& m : o->measured) ReadMeasuredArg(m, o->map, &files);
     if (!o->known.empty())  // steps 3-4: the records are of a human wearing the device
       for (const MeasuredData& f : files) CheckHumanJointRange(f);
-    const double L1 = o->L1 != 0.0 ? o->L1 : 0.41;
+    const double L1 = o->L1 != 0.0 ? o->L1 : o->known.empty() ? 0.41 : known.L1;
+    // Every default the identification rests on, L1 first (a wrong thigh length biases every step).
+    std::string L1_source;
+    if (o->L1 != 0.0)
+      L1_source = "L1 = " + NumberText(L1, 4) + " m (--L1)";
+    else if (o->known.empty())
+      L1_source = "L1 = 0.41 m assumed (no --L1, no --known): give --L1 if this rig's thigh length differs";
+    else
+      L1_source = "L1 = " + NumberText(L1, 4) + " m from " + o->known;
+    std::vector<std::string> assumed;
+    if (o->L1 == 0.0) assumed.push_back(L1_source);
+    if (!sub->count("--cutoff")) assumed.push_back("derivative cutoff 20 Hz (--cutoff HZ|auto)");
+    if (!sub->count("--trim")) assumed.push_back("0.1 s trimmed at both ends of every file (--trim)");
+    if (!o->known.empty() && !sub->count("--passive"))
+      assumed.push_back("passive elastic torque riener1999 subtracted (--passive)");
+    if (!o->known.empty() && o->thresholds.empty() && !sub->count("--emg-reference"))
+      assumed.push_back("EMG activation threshold from the first 2 s of each file (--emg-reference, --emg-threshold)");
+    for (const std::string& a : assumed) std::fprintf(stderr, "identify: assumed: %s\n", a.c_str());
     std::vector<const MeasuredData*> recs;
     for (const MeasuredData& f : files) recs.push_back(&f);
     std::string cutoff_why;
@@ -135,14 +153,14 @@ CommandRunner RegisterIdentify(CLI::App& app) {
 
     std::string header = "exotwin identify: Hwang & Jeon 2015 ";
     header += o->known.empty() ? "steps 1-2 (exoskeleton alone)" : "steps 3-4 (subject; exo from " + o->known + ")";
-    if (o->known.empty() && o->L1 == 0.0) header += "\nL1 = 0.41 m assumed (give --L1 for this rig)";
+    if (o->known.empty() && o->L1 == 0.0) header += "\n" + L1_source;
     std::string why;
     const LumpedParams& id = r.params.human ? *r.params.human : r.params.exo;
     if (!IsRealizable(id, r.params.L1, &why)) {
       std::fprintf(stderr, "identify: warning: identified %s parameters have no physically consistent "
-                   "realization (%s); predict will refuse them\n",
-                   r.params.human ? "human" : "exo", why.c_str());
-      header += "\nwarning: no physically consistent realization: " + why;
+                   "realization (%s); predict will refuse them. They rest on %s\n",
+                   r.params.human ? "human" : "exo", why.c_str(), L1_source.c_str());
+      header += "\nwarning: no physically consistent realization: " + why + "; " + L1_source;
     }
     for (const StepEstimate& s : r.steps)
       std::fprintf(stderr, "identify: step %d (%s): %zu of %zu samples, condition number %.2f, "

@@ -195,5 +195,36 @@ TEST_F(IdentifyCli, BadEmgThreshold) {
                  "--emg-threshold 'VM=abc'");
 }
 
+
+// Every default identify rests on is printed, L1 first, and a warning it leads to names it (issue 18:
+// another device's thigh length went through quietly).
+TEST_F(IdentifyCli, PrintsEveryAssumedDefaultL1FirstAndNamesItInWarnings) {
+  const auto r = RunExotwin("identify --measured " + D() + "/exo --out " + D() + "/exo_default.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const size_t l1 = r.output.find("identify: assumed: L1 = 0.41 m assumed (no --L1, no --known)");
+  ASSERT_NE(l1, std::string::npos) << r.output;
+  EXPECT_EQ(l1, r.output.find("identify: assumed:")) << "L1 must be the first assumption: " << r.output;
+  EXPECT_NE(r.output.find("assumed: derivative cutoff 20 Hz"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("assumed: 0.1 s trimmed"), std::string::npos) << r.output;
+  // Given explicitly, nothing is assumed.
+  const auto g = RunExotwin("identify --measured " + D() + "/exo --L1 0.41 --cutoff 20 --trim 0.1 --out " + D() +
+                            "/exo_given.yaml");
+  ASSERT_EQ(g.exit_code, 0) << g.output;
+  EXPECT_EQ(g.output.find("assumed:"), std::string::npos) << g.output;
+
+  // The subject step on the other device's thigh length: L1 0.41 m where the rig has 0.60 m makes the
+  // set unrealizable, and the warning says which L1 it rests on and where it came from.
+  const auto k = RunExotwin("identify --measured " + D() + "/exo --L1 0.6 --out " + D() + "/exo_long.yaml");
+  ASSERT_EQ(k.exit_code, 0) << k.output;
+  const auto h = RunExotwin("identify --measured " + D() + "/human --known " + D() + "/exo_long.yaml --out " +
+                            D() + "/human_long.yaml");
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  EXPECT_NE(h.output.find("identify: assumed: L1 = 0.6 m from " + D() + "/exo_long.yaml"), std::string::npos)
+      << h.output;
+  EXPECT_NE(h.output.find("warning: identified human parameters have no physically consistent realization"),
+            std::string::npos) << h.output;
+  EXPECT_NE(h.output.find("They rest on L1 = 0.6 m from"), std::string::npos) << h.output;
+}
+
 }  // namespace
 }  // namespace exotwin
