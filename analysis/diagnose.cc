@@ -19,7 +19,7 @@
 #include "analysis/predict.h"
 #include "analysis/statistics.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 #include "sim/plant.h"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 

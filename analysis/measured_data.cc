@@ -6,7 +6,7 @@
 
 #include "analysis/number_text.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

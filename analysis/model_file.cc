@@ -4,8 +4,8 @@
 #include <set>
 #include <sstream>
 
-#include "analysis/yaml_fields.h"
-#include "model/input_error.h"
+#include "core/yaml_fields.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

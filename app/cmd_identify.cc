@@ -18,7 +18,7 @@
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/realizability.h"
 
 namespace exotwin {

@@ -14,7 +14,7 @@
 #include "analysis/predict.h"
 #include "app/commands.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "render/video_renderer.h"
 #include "sim/plant.h"
 

@@ -6,7 +6,7 @@
 #include <regex>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "analysis/csv_table.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

@@ -15,7 +15,7 @@
 #include "analysis/measured_data.h"
 #include "analysis/statistics.h"
 #include "hwsim/emg_amplifier.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
 #include "sim/synthetic_emg.h"

@@ -15,7 +15,7 @@
 #include "hwsim/emg_node.h"
 #include "hwsim/hal3_knee_node.h"
 #include "hwsim/virtual_can_bus.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "protocol/candump.h"
 #include "runner/hal_emg_calibration.h"
 #include "runner/sweep_plots.h"

@@ -20,7 +20,7 @@
 #include "controller/exo_controller.h"
 #include "hwsim/joint_module.h"
 #include "hwsim/virtual_can_bus.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "protocol/candump.h"
 #include "render/video_renderer.h"
 #include "dsp/butterworth.h"

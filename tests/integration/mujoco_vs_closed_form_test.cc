@@ -11,7 +11,7 @@
 
 #include "model/leg_dynamics.h"
 #include "model/regressors.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/plant.h"
 
 namespace exotwin {
