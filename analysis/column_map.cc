@@ -6,9 +6,9 @@
 
 #include "analysis/number_text.h"
 #include "analysis/statistics.h"
+#include "core/error.h"
 #include "core/units.h"
 #include "core/yaml_fields.h"
-#include "core/error.h"
 
 namespace exotwin {
 namespace {

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dsp/butterworth.h"
 #include "core/error.h"
+#include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 

@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "analysis/number_text.h"
-#include "dsp/butterworth.h"
 #include "core/error.h"
+#include "dsp/butterworth.h"
 
 namespace exotwin {
 

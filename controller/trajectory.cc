@@ -3,11 +3,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <utility>
 
 #include "core/error.h"
+#include "core/file_text.h"
 #include "core/rng.h"
 #include "core/units.h"
 
@@ -81,7 +81,7 @@ ExcitationSpec ExcitationSpec::PaperHip() {
   s.q_min = 5.0 * kRadPerDeg;
   s.q_max = 40.0 * kRadPerDeg;
   s.qd_max = 120.0 * kRadPerDeg;
-  s.qdd_max = 1000.0 * M_PI / 180;
+  s.qdd_max = 1000.0 * kRadPerDeg;
   return s;
 }
 
@@ -323,8 +323,7 @@ GaitTrajectory GaitTrajectory::FromWinterFile(const std::string& path, const Gai
   if (!Finite(spec.hip_offset) || !Finite(spec.knee_offset)) bad_spec("offsets must be finite");
   if (!(Finite(spec.amplitude_scale) && spec.amplitude_scale > 0)) bad_spec("amplitude_scale must be > 0");
 
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open Winter marker table");
+  std::istringstream in(ReadTextFile(path, "Winter marker table", "a text marker table"));
   std::vector<double> time, hip, knee;
   std::string line;
   int line_no = 0;

@@ -2,7 +2,6 @@
 // time stamp averaged / kept first / rejected, counted and located; the time step and its jitter
 // reported; the shipped map of examples/real_rig/ on its shipped records gives the README's mapping;
 // bad maps throw InputError naming the map file, the key and what was expected.
-#include "core/units.h"
 #include "tests/temp_dir.h"
 #include "analysis/column_map.h"
 
@@ -15,6 +14,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/units.h"
 
 namespace exotwin {
 namespace {

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/rng.h"
 #include "core/units.h"
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
