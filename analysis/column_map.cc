@@ -6,8 +6,9 @@
 
 #include "analysis/number_text.h"
 #include "analysis/statistics.h"
-#include "analysis/yaml_fields.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
+#include "core/yaml_fields.h"
 
 namespace exotwin {
 namespace {
@@ -17,7 +18,6 @@ const char kTargets[] =
     "t, q_hip, q_knee, tau_hip, tau_knee, qd_hip, qd_knee, qdd_hip, qdd_knee, cmd_hip, cmd_knee, emg_<channel>";
 // Beyond this a column declared in degrees holds something else (encoder counts, centi-degrees, ...).
 constexpr double kMaxDegrees = 720.0;
-constexpr double kRadPerDeg = M_PI / 180.0;
 
 bool IsTarget(const std::string& name) {
   if (name.rfind("emg_", 0) == 0)

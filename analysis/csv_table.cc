@@ -10,7 +10,8 @@
 #include <set>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/file_text.h"
 
 namespace exotwin {
 
@@ -34,12 +35,8 @@ std::string Where(const std::string& path, int line) { return path + ":" + std::
 }  // namespace
 
 CsvTable ReadCsv(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open file (" + std::strerror(errno) + ")");
-  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string content = ReadTextFile(path, "", "a text CSV file");
   if (content.empty()) throw InputError(path + ": file is empty, expected a CSV header row");
-  if (content.find('\0') != std::string::npos)
-    throw InputError(path + ": binary data (NUL byte), expected a text CSV file");
 
   CsvTable t;
   if (content.rfind(kStreamMarker, 0) == 0 && content.back() != '\n') {

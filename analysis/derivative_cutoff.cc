@@ -8,7 +8,7 @@
 
 #include "analysis/number_text.h"
 #include "analysis/statistics.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/regressors.h"
 
 namespace exotwin {

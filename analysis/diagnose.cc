@@ -18,8 +18,8 @@
 #include "analysis/number_text.h"
 #include "analysis/predict.h"
 #include "analysis/statistics.h"
+#include "core/error.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
 #include "model/leg_dynamics.h"
 #include "sim/plant.h"
 

@@ -10,7 +10,7 @@
 #include "analysis/diagnose.h"
 #include "analysis/diagnose_report.h"
 #include "analysis/model_file.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

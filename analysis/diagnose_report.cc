@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/units.h"
+
 namespace exotwin {
 namespace {
 
@@ -212,7 +214,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
     o << Chart("measured vs predicted torque (held-out)", "t (s)", "tau_S (N m)", {m, b, a});
     std::vector<double> rb(n), ra(n);
     for (size_t i = 0; i < n; ++i) rb[i] = d.measured[j][i] - d.before[j][i], ra[i] = d.measured[j][i] - d.after[j][i];
-    const std::vector<double> qdeg = [&] { std::vector<double> v(n); for (size_t i = 0; i < n; ++i) v[i] = k.q[j][i] * 180 / M_PI; return v; }();
+    const std::vector<double> qdeg = [&] { std::vector<double> v(n); for (size_t i = 0; i < n; ++i) v[i] = k.q[j][i] * kDegPerRad; return v; }();
     struct Axis { const std::vector<double>* x; const char* label; } axes[4] = {
         {&qdeg, "angle (deg)"}, {&k.qd[j], "velocity (rad/s)"}, {&k.qdd[j], "acceleration (rad/s^2)"}, {&k.t, "t (s)"}};
     for (const auto& ax : axes) {

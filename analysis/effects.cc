@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 

@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 #include <Eigen/Dense>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "core/units.h"
 #include "model/leg_dynamics.h"
 #include "model/regressors.h"
 
@@ -14,17 +15,9 @@ namespace exotwin {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr int kGrid = 2000;  // samples per period (200 Hz for f0 = 0.1 Hz)
 
 double HeldAngle(IdConfiguration c) { return c == IdConfiguration::kKneeSwing ? M_PI / 2 : -M_PI / 2; }
-
-// Standard normal from raw mt19937_64 bits (Box-Muller; portable, unlike std::normal_distribution).
-double Normal(std::mt19937_64& rng) {
-  const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-  const double u2 = static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
 
 // Joint state (q, qd, qdd) of both joints at sample i of one period.
 void StateAt(const HarmonicTrajectory& tr, IdConfiguration c, int i, Eigen::Vector2d* q,
@@ -59,14 +52,14 @@ void HarmonicTrajectory::Eval(double t, double* q, double* qd, double* qdd) cons
 JointLimits DefaultLimits(IdConfiguration c) {
   JointLimits l;
   if (c == IdConfiguration::kHipSwing) {
-    l.q_min = 5 * kDeg;
-    l.q_max = 40 * kDeg;
-    l.qd_max = 120 * kDeg;
+    l.q_min = 5 * kRadPerDeg;
+    l.q_max = 40 * kRadPerDeg;
+    l.qd_max = 120 * kRadPerDeg;
     l.tau_max = 100;
   } else {
-    l.q_min = -70 * kDeg;
-    l.q_max = -5 * kDeg;
-    l.qd_max = 165 * kDeg;
+    l.q_min = -70 * kRadPerDeg;
+    l.q_max = -5 * kRadPerDeg;
+    l.qd_max = 165 * kRadPerDeg;
     l.tau_max = 70;
   }
   return l;
@@ -96,9 +89,9 @@ HarmonicTrajectory DefaultExcitation(IdConfiguration c, uint64_t seed) {
   HarmonicTrajectory s;
   s.f0 = 0.1;
   s.k = {3, 5, 8, 11, 15};
-  std::mt19937_64 rng(seed);
+  Rng rng(seed);
   for (int k : s.k) {
-    const double phase = 2.0 * M_PI * static_cast<double>(rng() >> 11) / 9007199254740992.0;
+    const double phase = 2.0 * M_PI * rng.Uniform();
     s.a.push_back(std::cos(phase) / k);
     s.b.push_back(std::sin(phase) / k);
   }
@@ -187,13 +180,13 @@ ExcitationDesign DesignExcitation(IdConfiguration c, const ExcitationDesignOptio
   HarmonicTrajectory best_fit;
   double best = cost(start, &best_fit);
   out.initial_condition = ExcitationCondition(DefaultExcitation(c), c, opt.nominal.L1, opt.nominal.g);
-  std::mt19937_64 rng(opt.seed);
+  NormalRng<NormalBoxMuller<BoxMullerU1::kMidpoint>> rng(opt.seed);
   for (int r = 0; r <= opt.restarts; ++r) {
     HarmonicTrajectory x = start;
     if (r > 0)
       for (size_t i = 0; i < nh; ++i) {
-        x.a[i] = Normal(rng);
-        x.b[i] = Normal(rng);
+        x.a[i] = rng.Normal();
+        x.b[i] = rng.Normal();
       }
     HarmonicTrajectory fx_traj;
     double fx = cost(x, &fx_traj);
@@ -205,8 +198,8 @@ ExcitationDesign DesignExcitation(IdConfiguration c, const ExcitationDesignOptio
       norm = std::sqrt(norm / static_cast<double>(2 * nh));
       HarmonicTrajectory y = x;
       for (size_t i = 0; i < nh; ++i) {
-        y.a[i] += sigma * norm * Normal(rng);
-        y.b[i] += sigma * norm * Normal(rng);
+        y.a[i] += sigma * norm * rng.Normal();
+        y.b[i] += sigma * norm * rng.Normal();
       }
       HarmonicTrajectory fy_traj;
       const double fy = cost(y, &fy_traj);

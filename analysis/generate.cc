@@ -6,8 +6,9 @@
 #include "analysis/csv_table.h"
 #include "analysis/effects.h"
 #include "analysis/predict.h"
-#include "analysis/seeded_rng.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "core/units.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -26,9 +27,8 @@ std::string ShippedModelFor(const LegParams& params) {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 const char* kEmgChannels[] = {"GMAX", "RF", "VM", "ST", "GAS"};
-constexpr double kJointLo[2] = {5 * kDeg, -70 * kDeg}, kJointHi[2] = {40 * kDeg, -5 * kDeg};
+constexpr double kJointLo[2] = {5 * kRadPerDeg, -70 * kRadPerDeg}, kJointHi[2] = {40 * kRadPerDeg, -5 * kRadPerDeg};
 
 struct Harmonic {
   double amp, omega, phase;
@@ -36,7 +36,6 @@ struct Harmonic {
 
 }  // namespace
 
-template <class Rng>
 Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
   Effect e;
   e.name = name;
@@ -54,7 +53,7 @@ Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
     e.value = rng.Uniform(3.0, 15.0), e.unit = "N m/rad";
     e.fields["q0"] = rng.Uniform(kJointLo[joint], kJointHi[joint]);
   } else if (name == "backlash") {
-    e.value = rng.Uniform(0.3, 1.7) * kDeg, e.unit = "rad";
+    e.value = rng.Uniform(0.3, 1.7) * kRadPerDeg, e.unit = "rad";
   } else if (name == "series_compliance") {
     // The quasi-static strap model holds well below the strap's resonance sqrt(k / J_c): at the
     // hip J_c is the whole leg's (~2.5 kg m^2 against ~0.4 at the knee), so for the same margin
@@ -79,7 +78,6 @@ Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
   }
   return e;
 }
-template Effect DrawEffect<SeededRng>(SeededRng&, const std::string&, int);
 
 GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& opt) {
   if (!(opt.duration > 2.0 && opt.duration <= 7200.0))
@@ -98,7 +96,7 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
     throw InputError("--effects: " + std::to_string(opt.effects) + " distinct effects from " +
                      std::to_string(pool.size()) + " allowed names");
 
-  SeededRng rng(opt.seed);
+  NormalRng<NormalBoxMuller<BoxMullerU1::kOneMinusUniform>> rng(opt.seed);
   GeneratedData g;
   g.truth = params;
   // Trajectory: three harmonics per joint, amplitudes summing to 70-100 % of the half range.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "analysis/measured_data.h"
+#include "core/rng.h"
 #include "model/lumped_params.h"
 
 namespace exotwin {
@@ -34,7 +35,6 @@ const std::vector<std::string>& AllEffectNames();
 // 800-3000 at the hip (resonance at least twice the motion's frequency, DESIGN.md's range), ripple
 // 0.2-1 N m at 2-8 cycles/rad, offset +-(0.2-2) N m, gain +-(2-10) %, delay 5-30 ms, muscle
 // weights 3-10 N m/V.
-template <class Rng>
 Effect DrawEffect(Rng& rng, const std::string& name, int joint);
 
 // Generates the record: trajectory of three harmonics (0.3-1.5 Hz) per joint inside hip 5..40 deg,

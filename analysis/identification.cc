@@ -6,7 +6,8 @@
 
 #include <Eigen/Dense>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 #include "model/passive_torque.h"
 #include "model/regressors.h"
 
@@ -14,7 +15,6 @@ namespace exotwin {
 
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
 
 std::string Fmt(const char* f, double v) {
   char b[64];
@@ -23,8 +23,8 @@ std::string Fmt(const char* f, double v) {
 }
 
 std::string RangeText(const JointRanges& r, int j) {
-  return Fmt("%.1f", r.min[j] * kDeg) + ".." + Fmt("%.1f", r.max[j] * kDeg) + " deg (range " +
-         Fmt("%.1f", (r.max[j] - r.min[j]) * kDeg) + ", mean " + Fmt("%.1f", r.mean[j] * kDeg) + ")";
+  return Fmt("%.1f", r.min[j] * kDegPerRad) + ".." + Fmt("%.1f", r.max[j] * kDegPerRad) + " deg (range " +
+         Fmt("%.1f", (r.max[j] - r.min[j]) * kDegPerRad) + ", mean " + Fmt("%.1f", r.mean[j] * kDegPerRad) + ")";
 }
 
 }  // namespace
@@ -56,8 +56,8 @@ IdConfiguration ClassifyConfiguration(const MeasuredData& data, const Identifica
     return IdConfiguration::kHipSwing;
   throw InputError(data.source + ": fits neither identification configuration: hip " +
                    RangeText(r, 0) + ", knee " + RangeText(r, 1) +
-                   "; expected one joint moving over at least " + Fmt("%.1f", opt.moving_min_range * kDeg) +
-                   " deg while the other is held within " + Fmt("%.1f", opt.held_max_range * kDeg) +
+                   "; expected one joint moving over at least " + Fmt("%.1f", opt.moving_min_range * kDegPerRad) +
+                   " deg while the other is held within " + Fmt("%.1f", opt.held_max_range * kDegPerRad) +
                    " deg (knee swing with the hip at 90 deg, or hip swing with the knee at -90 deg)");
 }
 
@@ -292,7 +292,7 @@ std::string IdentificationYaml(const IdentificationResult& r, const Identificati
     os << "      std_error: " << List(s.se) << "\n";
     os << "      condition_number: " << Num(s.condition_number) << "\n";
     os << "      residual_rms: " << Num(s.residual_rms) << "   # N m\n";
-    os << "      held_joint_mean_deg: " << Num(s.held_mean * kDeg) << "   # "
+    os << "      held_joint_mean_deg: " << Num(s.held_mean * kDegPerRad) << "   # "
        << (knee ? "hip" : "knee") << "\n";
     os << "      samples_used: " << s.samples_used << "\n";
     os << "      samples_total: " << s.samples_total << "\n";

@@ -33,6 +33,7 @@
 
 #include "analysis/measured_data.h"
 #include "analysis/passive_selection.h"
+#include "core/units.h"
 #include "model/lumped_params.h"
 #include "model/regressors.h"
 
@@ -43,8 +44,8 @@ enum class IdConfiguration { kKneeSwing, kHipSwing };
 const char* ConfigurationName(IdConfiguration c);
 
 struct IdentificationOptions {
-  double moving_min_range = 10.0 * M_PI / 180;  // rad, least range (max - min) of the moving joint
-  double held_max_range = 5.0 * M_PI / 180;     // rad, largest range of the held joint
+  double moving_min_range = 10.0 * kRadPerDeg;  // rad, least range (max - min) of the moving joint
+  double held_max_range = 5.0 * kRadPerDeg;     // rad, largest range of the held joint
   double trim_s = 0.1;          // s dropped at both ends of every file (derivative-filter edges)
   double cutoff_hz = 20.0;      // Hz, zero-phase Butterworth of the derivatives (sec. 3.2)
   PassiveModel passive = PassiveModel::kRiener1999;  // P^ subtracted in steps 3-4 (eq. 16-17)

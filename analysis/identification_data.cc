@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 #include "analysis/csv_table.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
 #include "model/leg_dynamics.h"
 #include "sim/plant.h"
 #include "sim/realization.h"
@@ -15,37 +15,6 @@ namespace exotwin {
 namespace {
 
 const char* const kEmgNames[5] = {"emg_GMAX", "emg_VM", "emg_RF", "emg_ST", "emg_GAS"};
-
-// Portable normal variates from raw mt19937_64 bits (Box-Muller with a cached spare).
-class Normal {
- public:
-  explicit Normal(uint64_t seed) : rng_(seed) {}
-  double operator()() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    const double u1 = (static_cast<double>(rng_() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-    const double u2 = static_cast<double>(rng_() >> 11) * (1.0 / 9007199254740992.0);
-    const double r = std::sqrt(-2.0 * std::log(u1));
-    spare_ = r * std::sin(2.0 * M_PI * u2);
-    has_spare_ = true;
-    return r * std::cos(2.0 * M_PI * u2);
-  }
-
- private:
-  std::mt19937_64 rng_;
-  bool has_spare_ = false;
-  double spare_ = 0.0;
-};
-
-// SplitMix64 finalizer: independent-looking seeds for every (configuration, trial).
-uint64_t Mix(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 double Quantize(double v, double step) { return step > 0 ? std::round(v / step) * step : v; }
 
@@ -62,7 +31,9 @@ LumpedParams Scaled(const LumpedParams& p, double s) {
 
 MeasuredData SimulateTrial(Plant& plant, const LegParams& ff, bool knee_swing, int trial,
                            const ProtocolOptions& opt) {
-  Normal normal(Mix(opt.seed * 1000003ULL + (knee_swing ? 0 : 500) + static_cast<uint64_t>(trial)));
+  // Sensor and EMG noise of this (configuration, trial).
+  NormalRng<NormalBoxMullerPair<BoxMullerU1::kMidpoint>> rng(
+      MixSeed(opt.seed * 1000003ULL + (knee_swing ? 0 : 500) + static_cast<uint64_t>(trial)));
   const double dt = plant.timestep();
   const size_t n = static_cast<size_t>(std::llround(opt.trial_s / dt));
   const int m = knee_swing ? 1 : 0;  // moving joint
@@ -109,12 +80,12 @@ MeasuredData SimulateTrial(Plant& plant, const LegParams& ff, bool knee_swing, i
     tab.columns[1][i] = q_enc[0];
     tab.columns[2][i] = q_enc[1];
     for (int j = 0; j < 2; ++j) {
-      const double v = std::clamp(-tau[j] + sm.offset + sm.noise_sd * normal(), -sm.range, sm.range);
+      const double v = std::clamp(-tau[j] + sm.offset + sm.noise_sd * rng.Normal(), -sm.range, sm.range);
       tab.columns[3 + j][i] = Quantize(v, sm.resolution);  // tau_S = -tau_R, eq. (8)
       tab.columns[5 + j][i] = tau[j];
     }
     if (emg)
-      for (int c = 0; c < 5; ++c) tab.columns[7 + c][i] = emg_rms * normal();
+      for (int c = 0; c < 5; ++c) tab.columns[7 + c][i] = emg_rms * rng.Normal();
     plant.Step(tau, tau_ext);
   }
   const std::string name = std::string(knee_swing ? "knee_" : "hip_") + std::to_string(trial + 1);
@@ -147,12 +118,12 @@ MeasuredData WithTorqueSensor(const MeasuredData& d, const TorqueSensorModel& sm
   const int cmd[2] = {d.table.Find("cmd_hip"), d.table.Find("cmd_knee")};
   if (cmd[0] < 0 || cmd[1] < 0)
     throw InputError(d.source + ": no cmd_hip / cmd_knee columns, expected a synthetic recording");
-  Normal normal(Mix(seed));
+  NormalRng<NormalBoxMullerPair<BoxMullerU1::kMidpoint>> rng(MixSeed(seed));
   CsvTable tab = d.table;
   const int tau[2] = {tab.Find("tau_hip"), tab.Find("tau_knee")};
   for (size_t i = 0; i < tab.rows(); ++i)
     for (int j = 0; j < 2; ++j) {
-      const double v = std::clamp(-tab.columns[cmd[j]][i] + sm.offset + sm.noise_sd * normal(),
+      const double v = std::clamp(-tab.columns[cmd[j]][i] + sm.offset + sm.noise_sd * rng.Normal(),
                                   -sm.range, sm.range);
       tab.columns[tau[j]][i] = Quantize(v, sm.resolution);
     }

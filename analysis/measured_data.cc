@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "analysis/number_text.h"
+#include "core/error.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
 
 namespace exotwin {
 

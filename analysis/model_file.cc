@@ -4,8 +4,8 @@
 #include <set>
 #include <sstream>
 
-#include "analysis/yaml_fields.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/yaml_fields.h"
 
 namespace exotwin {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

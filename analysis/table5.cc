@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
 #include "sim/paper_tables.h"

@@ -14,7 +14,7 @@
 #include "analysis/csv_table.h"
 #include "app/bench_probes.h"
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

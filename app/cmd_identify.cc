@@ -19,7 +19,7 @@
 #include "analysis/model_file.h"
 #include "analysis/number_text.h"
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/realizability.h"
 
 namespace exotwin {

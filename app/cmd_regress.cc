@@ -12,7 +12,7 @@
 
 #include "analysis/csv_table.h"
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/fork_pool.h"
 #include "runner/progress_bar.h"
 #include "runner/regress.h"

@@ -13,8 +13,8 @@
 #include "analysis/model_file.h"
 #include "analysis/predict.h"
 #include "app/commands.h"
+#include "core/error.h"
 #include "dsp/butterworth.h"
-#include "model/input_error.h"
 #include "render/video_renderer.h"
 #include "sim/plant.h"
 

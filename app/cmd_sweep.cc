@@ -10,7 +10,7 @@
 #include <cstdio>
 
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/progress_bar.h"
 #include "runner/sweep_run.h"
 

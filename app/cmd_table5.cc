@@ -11,7 +11,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/table5.h"
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/table5_protocol.h"
 #include "sim/subjects.h"
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/plant.h"
 
 int main(int argc, char** argv) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin::controller {
 

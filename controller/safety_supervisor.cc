@@ -4,12 +4,12 @@
 #include <cmath>
 #include <string>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 
 namespace exotwin::controller {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 void Validate(const JointSafetyLimits& l, const std::string& name) {
   auto bad = [&](const std::string& what) { throw InputError("SafetyConfig." + name + ": " + what); };
@@ -38,18 +38,18 @@ double DampingTorque(const JointSafetyLimits& l, double qd) {
 SafetyConfig SafetyConfig::Default() {
   SafetyConfig c;
   JointSafetyLimits j;
-  j.q_margin = 3 * kDeg;
-  j.qd_max = 300 * kDeg;
+  j.q_margin = 3 * kRadPerDeg;
+  j.qd_max = 300 * kRadPerDeg;
   j.tau_sensor_max = 60;
   j.tau_cmd_max = 40;
   j.damping = 2;
   j.tau_damp_max = 20;
   c.hip = j;
-  c.hip.q_min = -30 * kDeg;
-  c.hip.q_max = 120 * kDeg;
+  c.hip.q_min = -30 * kRadPerDeg;
+  c.hip.q_max = 120 * kRadPerDeg;
   c.knee = j;
-  c.knee.q_min = -120 * kDeg;
-  c.knee.q_max = 5 * kDeg;
+  c.knee.q_min = -120 * kRadPerDeg;
+  c.knee.q_max = 5 * kRadPerDeg;
   return c;
 }
 

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin::controller {
 namespace {

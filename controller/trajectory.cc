@@ -3,21 +3,18 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <random>
 #include <sstream>
 #include <utility>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/file_text.h"
+#include "core/rng.h"
+#include "core/units.h"
 
 namespace exotwin::controller {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-
-// Uniform in [0, 1) from the top 53 bits of one 64-bit draw (same on every standard library, unlike
-// std::uniform_real_distribution).
-double Uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 bool Finite(double x) { return std::isfinite(x); }
 
@@ -81,19 +78,19 @@ double FourierSeries::DerivativeBound(int n) const {
 
 ExcitationSpec ExcitationSpec::PaperHip() {
   ExcitationSpec s;
-  s.q_min = 5.0 * M_PI / 180;
-  s.q_max = 40.0 * M_PI / 180;
-  s.qd_max = 120.0 * M_PI / 180;
-  s.qdd_max = 1000.0 * M_PI / 180;
+  s.q_min = 5.0 * kRadPerDeg;
+  s.q_max = 40.0 * kRadPerDeg;
+  s.qd_max = 120.0 * kRadPerDeg;
+  s.qdd_max = 1000.0 * kRadPerDeg;
   return s;
 }
 
 ExcitationSpec ExcitationSpec::PaperKnee() {
   ExcitationSpec s;
-  s.q_min = -70.0 * M_PI / 180;
-  s.q_max = -5.0 * M_PI / 180;
-  s.qd_max = 165.0 * M_PI / 180;
-  s.qdd_max = 1500.0 * M_PI / 180;
+  s.q_min = -70.0 * kRadPerDeg;
+  s.q_max = -5.0 * kRadPerDeg;
+  s.qd_max = 165.0 * kRadPerDeg;
+  s.qdd_max = 1500.0 * kRadPerDeg;
   return s;
 }
 
@@ -139,13 +136,13 @@ HarmonicTrajectory HarmonicTrajectory::Design(const ExcitationSpec& spec, uint64
     bad("harmonics k f0 must lie in [band_lo_hz, band_hi_hz]");
   if (!(spec.fill > 0 && spec.fill <= 1)) bad("fill must be in (0, 1]");
 
-  std::mt19937_64 rng(seed);
+  Rng rng(seed);
   const int n = spec.k_max - spec.k_min + 1;
   std::vector<double> a(n), b(n);
   for (int i = 0; i < n; ++i) {
     const int k = spec.k_min + i;
-    a[i] = (2.0 * Uniform01(rng) - 1.0) / k;
-    b[i] = (2.0 * Uniform01(rng) - 1.0) / k;
+    a[i] = (2.0 * rng.Uniform() - 1.0) / k;
+    b[i] = (2.0 * rng.Uniform() - 1.0) / k;
   }
   // Start at rest: project onto sum_k k a_k = 0 (qd(0) = 0) and sum_k k^2 b_k = 0 (qdd(0) = 0),
   // minimal-norm correction x <- x - (c.x / c.c) c.
@@ -274,7 +271,7 @@ double DetectPeriodFrames(const std::vector<double>& hip, const std::vector<doub
     if (e < best_e) { best_e = e; best = lag; }
   }
   // A real repetition gives a mismatch of a few degrees at most (both joints together).
-  const double limit = std::pow(5.0 * M_PI / 180, 2);
+  const double limit = std::pow(5.0 * kRadPerDeg, 2);
   if (best == lag_lo || best == lag_hi || best_e > limit)
     throw InputError(path + ": no repeating stride found in the recording; set data_stride_period_s");
   const double em = mismatch(best - 1), ep = mismatch(best + 1);
@@ -326,8 +323,7 @@ GaitTrajectory GaitTrajectory::FromWinterFile(const std::string& path, const Gai
   if (!Finite(spec.hip_offset) || !Finite(spec.knee_offset)) bad_spec("offsets must be finite");
   if (!(Finite(spec.amplitude_scale) && spec.amplitude_scale > 0)) bad_spec("amplitude_scale must be > 0");
 
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open Winter marker table");
+  std::istringstream in(ReadTextFile(path, "Winter marker table", "a text marker table"));
   std::vector<double> time, hip, knee;
   std::string line;
   int line_no = 0;

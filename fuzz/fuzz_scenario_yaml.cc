@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/scenario.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -9,7 +9,7 @@
 
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin::fuzz {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "protocol/candump.h"
 
 namespace exotwin::fuzz {

@@ -7,7 +7,7 @@
 #pragma once
 #include <cstdint>
 
-#include "hwsim/rng.h"
+#include "core/rng.h"
 #include "hwsim/sensors.h"
 #include "protocol/can_bus.h"
 #include "protocol/messages.h"
@@ -64,7 +64,7 @@ class Hal3KneeNode {
  private:
   Hal3KneeNodeSpec spec_;
   CanBus* bus_;
-  Rng rng_;
+  NormalRng<NormalBoxMullerPair<BoxMullerU1::kNonzeroUniform>> rng_;  // sensor noise
   MotorDriver driver_;
   SampleSkew strain_skew_, angle_skew_;  // delay lines of torque_sensor_skew (one of them is 0)
   double angle_ = 0, strain_ = 0;

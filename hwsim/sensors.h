@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <deque>
 
-#include "hwsim/rng.h"
+#include "core/rng.h"
 
 namespace exotwin::hwsim {
 
@@ -33,7 +33,7 @@ class TorqueSensor {
 
  private:
   TorqueSensorSpec spec_;
-  Rng rng_;
+  NormalRng<NormalBoxMullerPair<BoxMullerU1::kNonzeroUniform>> rng_;  // sensor noise
   SensorFault fault_ = SensorFault::kNone;
   double last_ = 0.0;
 };

@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "hwsim/rng.h"
+#include "core/rng.h"
 #include "protocol/can_bus.h"
 
 namespace exotwin::hwsim {

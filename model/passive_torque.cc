@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/units.h"
+
 namespace exotwin {
 
 // The original law (Riener & Edrich 1999), angles in degrees, each moment positive in the direction of
@@ -28,9 +30,8 @@ double RienerKneeMoment(double A, double K, double H) {
 
 Eigen::Vector2d PassiveElasticTorque(PassiveModel model, const Eigen::Vector2d& q) {
   if (model == PassiveModel::kNone) return Eigen::Vector2d::Zero();
-  constexpr double kDeg = 180.0 / M_PI;
-  const double H = q[0] * kDeg;
-  const double K = -q[1] * kDeg;
+  const double H = q[0] * kDegPerRad;
+  const double K = -q[1] * kDegPerRad;
   return Eigen::Vector2d(-RienerHipMoment(H, K), RienerKneeMoment(0.0, K, H));
 }
 

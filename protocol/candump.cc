@@ -6,7 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

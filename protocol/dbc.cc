@@ -2,11 +2,11 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <regex>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/file_text.h"
 
 namespace exotwin {
 namespace {
@@ -179,8 +179,7 @@ DbcDatabase ParseDbc(std::istream& in, const std::string& source) {
 }
 
 DbcDatabase LoadDbc(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open DBC file");
+  std::istringstream in(ReadTextFile(path, "DBC", "a text DBC file"));
   return ParseDbc(in, path);
 }
 

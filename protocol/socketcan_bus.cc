@@ -15,7 +15,7 @@
 #include <cstring>
 #include <ctime>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

@@ -6,6 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/units.h"
+
 namespace exotwin {
 namespace {
 
@@ -139,9 +141,9 @@ void OverlayHistory::Draw(cv::Mat& f) const {
   char buf[96];
   std::snprintf(buf, sizeof buf, "t = %7.3f s", last_.t);
   Text(f, buf, {int(24 * sc), int(44 * sc)}, 0.8 * sc, kWhite, std::max(1, int(2 * sc)));
-  std::snprintf(buf, sizeof buf, "hip  %+7.1f deg", last_.q_hip * 180.0 / M_PI);
+  std::snprintf(buf, sizeof buf, "hip  %+7.1f deg", last_.q_hip * kDegPerRad);
   Text(f, buf, {int(24 * sc), int(78 * sc)}, 0.65 * sc, kWhite);
-  std::snprintf(buf, sizeof buf, "knee %+7.1f deg", last_.q_knee * 180.0 / M_PI);
+  std::snprintf(buf, sizeof buf, "knee %+7.1f deg", last_.q_knee * kDegPerRad);
   Text(f, buf, {int(24 * sc), int(108 * sc)}, 0.65 * sc, kWhite);
 
   // Strip charts, right-hand side: hip, knee, then EMG if any channel is present.

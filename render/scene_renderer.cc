@@ -10,6 +10,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/units.h"
 #include "render/osmesa_context.h"
 
 namespace exotwin {
@@ -105,11 +106,11 @@ void SceneRenderer::FrameCamera() {
       reach = std::max(reach, mju_norm3(diff) + m_->geom_rbound[g]);
     }
     if (reach <= 0) reach = m_->stat.extent;
-    const double fovy = m_->vis.global.fovy * M_PI / 180.0;
+    const double fovy = m_->vis.global.fovy * kRadPerDeg;
     cam.distance = 0.8 * reach / std::tan(0.5 * fovy);
     const double half_w = 0.8 * reach * opt_.width / opt_.height;
     // Image "right" is -x for the default azimuth: shift lookat backward so the hip sits left of centre.
-    const double az = opt_.azimuth_deg * M_PI / 180.0;
+    const double az = opt_.azimuth_deg * kRadPerDeg;
     const double right[3] = {std::sin(az), -std::cos(az), 0.0};  // forward x up, elevation ignored
     for (int i = 0; i < 3; ++i) cam.lookat[i] = hip[i] + 0.16 * half_w * right[i];
     cam.lookat[2] = hip[2] - 0.3 * reach;

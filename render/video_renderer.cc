@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "render/mp4_writer.h"
 #include "render/scene_renderer.h"
 

@@ -4,19 +4,18 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include "analysis/csv_table.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/file_text.h"
 
 namespace exotwin {
 
 Baseline ReadBaseline(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError(path + ": cannot open baseline file");
+  const std::string text = ReadTextFile(path, "baseline", "a JSON text file");
   nlohmann::json j;
   try {
-    f >> j;
+    j = nlohmann::json::parse(text);
   } catch (const std::exception& e) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <map>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

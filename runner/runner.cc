@@ -18,9 +18,10 @@
 #include "analysis/csv_table.h"
 #include "analysis/model_file.h"
 #include "controller/exo_controller.h"
+#include "core/error.h"
+#include "core/units.h"
 #include "hwsim/joint_module.h"
 #include "hwsim/virtual_can_bus.h"
-#include "model/input_error.h"
 #include "protocol/candump.h"
 #include "render/video_renderer.h"
 #include "dsp/butterworth.h"
@@ -96,7 +97,7 @@ std::shared_ptr<const LegTrajectory> BuildTrajectory(const Scenario& s, int tria
       g.stride_period_s = p.stride_period;
       // Winter's knee reaches +2 deg (hyperextension) in stance; the exoskeleton stops at 0, so
       // the pattern is shifted by -3 deg at the knee.
-      g.knee_offset = -3.0 * M_PI / 180.0;
+      g.knee_offset = -3.0 / kDegPerRad;  // the double nearest -3 pi / 180 (-3 * kRadPerDeg is 1 ulp off)
       inner = std::make_shared<GaitTrajectory>(GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), g));
       break;
     }
@@ -245,6 +246,8 @@ void ApplyFaults(std::vector<FaultSwitch>& faults, double t, hwsim::JointModule*
   }
 }
 
+// rad -> deg as (rad * 180) / pi, the rounding the tracking metrics' baselines hold bit for bit
+// (rad * kDegPerRad differs in the last bit for about a quarter of the values).
 double Deg(double rad) { return rad * 180.0 / M_PI; }
 
 struct Accum {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/plant.h"
 #include "runner/hal_runner.h"
 

@@ -1,7 +1,7 @@
 // MergeSweepParts (sweep_table.h): joins the folders of `exotwin sweep --shard K/N` runs.
 #include <set>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/sweep_table.h"
 
 namespace exotwin {

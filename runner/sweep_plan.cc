@@ -2,22 +2,10 @@
 
 #include <cstdlib>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
 
 namespace exotwin {
-namespace {
-
-// The SplitMix64 finaliser of sim/subjects.cc (DrawSubject seeds its engine with
-// SplitMix64(seed ^ SplitMix64(index))); tests/runner/sweep_plan_test.cc pins the equivalence.
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-}  // namespace
-
 std::string Shard::ToString() const { return std::to_string(k) + "/" + std::to_string(n); }
 
 Shard ParseShard(const std::string& text) {
@@ -37,7 +25,7 @@ Shard ParseShard(const std::string& text) {
 }
 
 uint64_t SubjectSeed(uint64_t sweep_seed, int index) {
-  return sweep_seed ^ SplitMix64(static_cast<uint64_t>(index)) ^ SplitMix64(0);
+  return sweep_seed ^ MixSeed(static_cast<uint64_t>(index)) ^ MixSeed(0);
 }
 
 Scenario WithPopulationSubject(Scenario s, uint64_t sweep_seed, int index) {

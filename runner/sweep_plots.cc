@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "analysis/statistics.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/sweep_table.h"
 
 namespace exotwin {

@@ -3,7 +3,7 @@
 #include <chrono>
 #include <set>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/fork_pool.h"
 #include "runner/progress_bar.h"
 #include "sim/subjects.h"

@@ -14,7 +14,8 @@
 
 #include "analysis/csv_table.h"
 #include "analysis/statistics.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/file_text.h"
 #include "runner/sweep_plots.h"
 
 namespace exotwin {
@@ -51,14 +52,6 @@ std::vector<std::string> SplitLine(const std::string& line) {
     else f.back() += c;
   }
   return f;
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path + ": cannot open");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 }  // namespace
@@ -230,8 +223,8 @@ void WriteSweepAggregate(const std::string& dir, const SweepManifest& m, std::ve
 }
 
 void ReadSweepAggregate(const std::string& dir, SweepManifest* m, std::vector<SweepRow>* rows) {
-  *m = ParseManifestJson(ReadFile(dir + "/sweep.json"), dir + "/sweep.json");
-  *rows = ParseSweepCsv(ReadFile(dir + "/sweep.csv"), dir + "/sweep.csv");
+  *m = ParseManifestJson(ReadTextFile(dir + "/sweep.json", "sweep manifest", "a JSON text file"), dir + "/sweep.json");
+  *rows = ParseSweepCsv(ReadTextFile(dir + "/sweep.csv", "sweep table", "a text CSV file"), dir + "/sweep.csv");
 }
 
 }  // namespace exotwin

@@ -9,7 +9,7 @@
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
 #include "analysis/csv_table.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
 #include "sim/subjects.h"

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <string>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 // Which rule reproduces Table 4's anthropometric columns (search done for this file, ~15 candidate
 // rules: De Leva Table 1 / male / female tables, Dempster Table 1 / Winter's adaptation / Winter's

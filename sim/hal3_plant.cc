@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/subjects.h"
 
 namespace exotwin {

@@ -24,9 +24,9 @@ constexpr int kSign[kNumMuscles][2] = {
 double Clip01(double x) { return std::min(1.0, std::max(0.0, x)); }
 
 // Normal draw of mean/sd, redrawn while below 20 % of the mean (keeps signs physical).
-double DrawPositive(SeededNormal& z, double mean, double sd) {
+double DrawPositive(MuscleRng& z, double mean, double sd) {
   for (int i = 0; i < 100; ++i) {
-    const double v = mean + sd * z();
+    const double v = mean + sd * z.Normal();
     if (v >= 0.2 * mean) return v;
   }
   return 0.2 * mean;
@@ -47,34 +47,6 @@ const char* MuscleName(Muscle m) {
 
 int ActionSign(Muscle m, int joint) { return kSign[static_cast<int>(m)][joint]; }
 
-uint64_t MixSeed(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-SeededNormal::SeededNormal(uint64_t seed) : engine_(MixSeed(seed)) {}
-
-double SeededNormal::Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-
-double SeededNormal::operator()() {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
-  }
-  double u, v, s;
-  do {
-    u = 2.0 * Uniform() - 1.0;
-    v = 2.0 * Uniform() - 1.0;
-    s = u * u + v * v;
-  } while (s >= 1.0 || s == 0.0);
-  const double f = std::sqrt(-2.0 * std::log(s) / s);
-  spare_ = v * f;
-  has_spare_ = true;
-  return u * f;
-}
-
 MuscleParams PaperMeanMuscleParams() {
   MuscleParams p;
   const auto G = [](Muscle m) { return static_cast<int>(m); };
@@ -93,7 +65,7 @@ MuscleParams PaperMeanMuscleParams() {
 }
 
 MuscleParams DrawMuscleParams(uint64_t seed) {
-  SeededNormal z(seed ^ 0x6d75736373ULL);  // "muscs"
+  MuscleRng z(MixSeed(seed ^ 0x6d75736373ULL));  // "muscs"
   MuscleParams p;
   const auto G = [](Muscle m) { return static_cast<int>(m); };
   p.alpha(G(Muscle::kRF), 0) = 100 * DrawPositive(z, 1.88, 0.76);
@@ -200,7 +172,7 @@ double ContractionProgramme::duration() const {
 
 ContractionProgramme IsometricProgramme(int joint, int n, double lo, double hi, double cocontraction,
                                         uint64_t seed, double t0, double rest) {
-  SeededNormal z(seed ^ 0x69736f6dULL);  // "isom"
+  MuscleRng z(MixSeed(seed ^ 0x69736f6dULL));  // "isom"
   std::vector<ContractionBlock> blocks;
   double t = t0;
   for (int k = 0; k < n; ++k) {

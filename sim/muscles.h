@@ -22,10 +22,12 @@
 #include <cstdint>
 #include <vector>
 #include <functional>
-#include <random>
 #include <string>
 
 #include <Eigen/Core>
+
+#include "core/rng.h"
+#include "core/units.h"
 
 namespace exotwin {
 
@@ -42,24 +44,11 @@ inline Muscle MuscleAt(int i) { return static_cast<Muscle>(i); }
 // -1 along -q_j, 0 does not span the joint (eq. 23-24).
 int ActionSign(Muscle m, int joint);
 
-// Standard normal deviates reproducible bit for bit: Marsaglia's polar method on 53-bit uniforms
-// taken from the raw bits of std::mt19937_64 (std::normal_distribution is library-dependent).
-class SeededNormal {
- public:
-  explicit SeededNormal(uint64_t seed);
-  double operator()();      // N(0, 1)
-  double Uniform();         // [0, 1), 53 bits
- private:
-  std::mt19937_64 engine_;
-  double spare_ = 0;
-  bool has_spare_ = false;
-};
-
-// SplitMix64 finaliser: decorrelates derived seeds (seed ^ stream id).
-uint64_t MixSeed(uint64_t x);
+// The random stream of the muscle and EMG models: Marsaglia's polar method (core/rng.h). Seed it with
+// MixSeed(seed ^ stream id).
+using MuscleRng = NormalRng<NormalPolar>;
 
 // Conversions from the paper's units (Table 7 gives 10^-3 of these).
-constexpr double kDegPerRad = 57.29577951308232;
 inline double BetaFromPerDeg(double beta_per_deg) { return beta_per_deg * kDegPerRad; }       // 1/rad
 inline double GammaFromPerDegPerS(double g_per_deg_s) { return g_per_deg_s * kDegPerRad; }  // s/rad
 

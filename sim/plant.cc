@@ -7,15 +7,11 @@
 #include <sstream>
 #include <type_traits>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/passive_torque.h"
 #include "sim/realizability.h"
 
 namespace exotwin {
-
-SimulationError::SimulationError(double t, const std::string& cause)
-    : std::runtime_error("simulation diverged at t = " + std::to_string(t) + " s: " + cause),
-      time_(t) {}
 
 namespace {
 

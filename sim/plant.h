@@ -3,11 +3,11 @@
 // Immutable-after-setup model, mutable data; every physics call checks for divergence.
 #pragma once
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include <Eigen/Core>
 
+#include "core/error.h"  // SimulationError, thrown by Plant
 #include "model/lumped_params.h"
 #include "sim/realization.h"
 
@@ -15,16 +15,6 @@ struct mjModel_;
 struct mjData_;
 
 namespace exotwin {
-
-// Raised when the simulation diverges (NaN/inf state, MuJoCo warning). Carries the time and cause.
-class SimulationError : public std::runtime_error {
- public:
-  SimulationError(double t, const std::string& cause);
-  double time() const { return time_; }
-
- private:
-  double time_;
-};
 
 // Path of a model shipped in mjcf/ (e.g. "leg_exowheel.xml").
 std::string ShippedModelPath(const std::string& file);

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

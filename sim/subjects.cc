@@ -1,13 +1,13 @@
 #include "sim/subjects.h"
 
 #include <cmath>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Dense>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
 #include "sim/paper_tables.h"
 #include "sim/realizability.h"
 
@@ -24,7 +24,7 @@
 // A draw is rejected and redrawn unless W, L1, L2, height > 0 and both human and exo lumped
 // parameters are realizable for L1 (realizability.h). Normals: Marsaglia's polar method on 53-bit
 // uniforms from std::mt19937_64 (both fully specified, so the bits do not depend on the standard
-// library; std::normal_distribution would). Each (seed, index) seeds its own engine via SplitMix64.
+// library; std::normal_distribution would). Each (seed, index) seeds its own engine via MixSeed (SplitMix64).
 
 namespace exotwin {
 namespace {
@@ -32,45 +32,15 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
+// Standard normals by the polar method (core/rng.h).
+using SubjectRng = NormalRng<NormalPolar>;
+
+// n standard normals, drawn in index order.
+VectorXd Normals(SubjectRng& z, int n) {
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v[i] = z.Normal();
+  return v;
 }
-
-// Standard normal deviates, reproducible bit for bit.
-class NormalSource {
- public:
-  explicit NormalSource(uint64_t seed) : engine_(seed) {}
-  double Next() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    double u, v, s;
-    do {
-      u = 2.0 * Uniform() - 1.0;
-      v = 2.0 * Uniform() - 1.0;
-      s = u * u + v * v;
-    } while (s >= 1.0 || s == 0.0);
-    const double f = std::sqrt(-2.0 * std::log(s) / s);
-    spare_ = v * f;
-    has_spare_ = true;
-    return u * f;
-  }
-  VectorXd Next(int n) {
-    VectorXd z(n);
-    for (int i = 0; i < n; ++i) z[i] = Next();
-    return z;
-  }
-
- private:
-  double Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
-  std::mt19937_64 engine_;
-  bool has_spare_ = false;
-  double spare_ = 0;
-};
 
 // F with F F^T = C for a symmetric positive semi-definite C (eigen-decomposition, negative
 // round-off eigenvalues clamped to 0).
@@ -101,10 +71,10 @@ class ConditionalGaussian {
       F_ = CovarianceFactor(S);
     }
   }
-  VectorXd Draw(const VectorXd& given, NormalSource& z) const {
+  VectorXd Draw(const VectorXd& given, SubjectRng& z) const {
     VectorXd m = mu_d_;
     if (ng_ > 0) m += B_ * (given - mu_g_);
-    return m + F_ * z.Next(static_cast<int>(F_.cols()));
+    return m + F_ * Normals(z, static_cast<int>(F_.cols()));
   }
 
  private:
@@ -187,7 +157,7 @@ Subject PresetSubject(const std::string& name) {
 Subject DrawSubject(uint64_t seed, int index) {
   if (index < 0) throw InputError("subject: index = " + std::to_string(index) + ", expected >= 0");
   const PopulationModel& pop = Population();
-  NormalSource z(SplitMix64(seed ^ SplitMix64(static_cast<uint64_t>(index))));
+  SubjectRng z(MixSeed(seed ^ MixSeed(static_cast<uint64_t>(index))));
   constexpr int kMaxAttempts = 10000;  // acceptance is > 95 %, so this is never reached
   for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
     const VectorXd b = pop.body.Draw(VectorXd(), z);

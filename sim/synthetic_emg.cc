@@ -59,24 +59,24 @@ SyntheticEmg::SyntheticEmg(const SyntheticEmgConfig& config, uint64_t seed) : cf
   for (int c = 0; c < kNumMuscles; ++c) {
     shape_.emplace_back(shape_sos_);
     base_.emplace_back(base_sos_);
-    z_muscle_.emplace_back(MixSeed(seed ^ (0x100ULL + c)));
-    z_base_.emplace_back(MixSeed(seed ^ (0x200ULL + c)));
+    z_muscle_.emplace_back(MixSeed(MixSeed(seed ^ (0x100ULL + c))));
+    z_base_.emplace_back(MixSeed(MixSeed(seed ^ (0x200ULL + c))));
   }
-  SeededNormal ph(MixSeed(seed ^ 0x300ULL));
+  MuscleRng ph(MixSeed(MixSeed(seed ^ 0x300ULL)));
   mains_phase_ = 2 * kPi * ph.Uniform();
 }
 
 MuscleVec SyntheticEmg::Sample(const MuscleVec& e) {
   MuscleVec src, x;
   for (int m = 0; m < kNumMuscles; ++m) {
-    const double n = shape_gain_ * shape_[m].Step(z_muscle_[m]());
+    const double n = shape_gain_ * shape_[m].Step(z_muscle_[m].Normal());
     src[m] = std::min(1.0, std::max(0.0, e[m])) * cfg_.mvc_rms[m] * n;
   }
   x = cfg_.crosstalk * src;
   const double mains =
       cfg_.mains_amplitude * std::sin(2 * kPi * cfg_.mains_freq * t_ + mains_phase_);
   for (int c = 0; c < kNumMuscles; ++c)
-    x[c] += cfg_.baseline_rms[c] * base_gain_ * base_[c].Step(z_base_[c]()) + mains;
+    x[c] += cfg_.baseline_rms[c] * base_gain_ * base_[c].Step(z_base_[c].Normal()) + mains;
   ++k_;
   t_ = static_cast<double>(k_) / cfg_.fs;
   return x;

@@ -11,7 +11,7 @@
 // A_m: RMS at full activation (MVC), V; B_c: RMS of the relaxed baseline (noise band-limited 20-450
 //      Hz), V; X: crosstalk matrix (X(c, c) = 1, X(c, m) the share of muscle m seen on channel c);
 // mains: optional interference (amplitude M = 0 by default).
-// Every draw comes from the seed (SeededNormal: std::mt19937_64 raw bits); same seed, same bits.
+// Every draw comes from the seed (MuscleRng: std::mt19937_64 raw bits, core/rng.h); same seed, same bits.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -75,7 +75,7 @@ class SyntheticEmg {
   std::vector<dsp::Biquad> shape_sos_, base_sos_;
   double shape_gain_ = 1, base_gain_ = 1;  // 1 / RMS of the filters' output for unit white input
   std::vector<dsp::SosFilter> shape_, base_;
-  std::vector<SeededNormal> z_muscle_, z_base_;
+  std::vector<MuscleRng> z_muscle_, z_base_;
   double mains_phase_ = 0;
   double t_ = 0;
   long k_ = 0;

@@ -13,7 +13,8 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 
 namespace exotwin {
 namespace {
@@ -64,7 +65,7 @@ TEST(ColumnMap, RenameScaleOffsetUnitsAndSignAgainstHandComputedValues) {
   EXPECT_EQ(d.table.names, (std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "emg_VM"}));
   for (int i = 0; i < 30; ++i) {
     EXPECT_DOUBLE_EQ(d.t[i], 2e-3 * i);
-    EXPECT_NEAR(d.q_hip[i], (10.0 + i - 90.0) * M_PI / 180.0, 1e-15);  // offset in degrees, then to rad
+    EXPECT_NEAR(d.q_hip[i], (10.0 + i - 90.0) * kRadPerDeg, 1e-15);  // offset in degrees, then to rad
     EXPECT_DOUBLE_EQ(d.q_knee[i], 2 * 0.01 * i + 0.1);
     EXPECT_DOUBLE_EQ(d.tau_hip[i], -0.5 * i);
     EXPECT_DOUBLE_EQ(d.tau_knee[i], 0.125 * i);

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

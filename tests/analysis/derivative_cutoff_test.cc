@@ -10,7 +10,7 @@
 #include "analysis/derivative_cutoff.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 
 namespace exotwin {

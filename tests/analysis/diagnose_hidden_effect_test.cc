@@ -13,7 +13,7 @@
 #include "analysis/diagnose.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
-#include "analysis/seeded_rng.h"
+#include "core/rng.h"
 
 namespace exotwin {
 namespace {
@@ -146,7 +146,7 @@ TEST(DiagnoseHiddenEffect, OffsetAndFrictionTogetherAreBothNamed) {
   const int seeds = EnvInt("EXOTWIN_DIAG_PAIR_SEEDS", 10);
   int both = 0;
   for (int s = 0; s < seeds; ++s) {
-    SeededRng rng(7000 + s);
+    Rng rng(7000 + s);
     const int oj = s % 2, fj = (s / 2) % 2;  // every joint combination
     LegParams truth = base;
     truth.effects.push_back({"sensor_offset", oj == 0 ? "hip" : "knee", rng.Sign() * rng.Uniform(0.2, 2.0), "N m", {}, ""});

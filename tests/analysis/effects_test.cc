@@ -7,7 +7,8 @@
 #include "analysis/effects.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 #include "model/leg_dynamics.h"
 
 namespace exotwin {
@@ -120,8 +121,8 @@ TEST(Generate, SameSeedSameBitsOtherSeedOtherData) {
   g.seed = 43;
   EXPECT_NE(GenerateMeasured(S1(), g).data.tau_knee, a.data.tau_knee);
   // Angles stay in the stated ranges.
-  for (double q : a.data.q_hip) EXPECT_TRUE(q > 4.9 * M_PI / 180 && q < 40.1 * M_PI / 180);
-  for (double q : a.data.q_knee) EXPECT_TRUE(q > -70.1 * M_PI / 180 && q < -4.9 * M_PI / 180);
+  for (double q : a.data.q_hip) EXPECT_TRUE(q > 4.9 * kRadPerDeg && q < 40.1 * kRadPerDeg);
+  for (double q : a.data.q_knee) EXPECT_TRUE(q > -70.1 * kRadPerDeg && q < -4.9 * kRadPerDeg);
 }
 
 TEST(Generate, RejectsBadOptions) {

@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/rng.h"
+#include "core/units.h"
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
 #include "sim/subjects.h"
@@ -104,7 +106,7 @@ Calibrated CalibrateIsometric(uint64_t seed) {
   Calibrated c;
   c.truth = DrawMuscleParams(seed);
   c.mvc = MeasureMvc(c.truth, seed * 100, &c.peak_over_plateau);
-  SeededNormal noise(seed ^ 0x5e);
+  MuscleRng noise(MixSeed(seed ^ 0x5e));
   for (int j = 0; j < 2; ++j) {
     ContractionProgramme prog = IsometricProgramme(j, 8, 0.1, 0.5, 0.1, seed + j);  // paper: 5-8
     Record r = RunTrial(c.truth, prog, prog.duration() + 1, [&](double, Eigen::Vector2d& q, Eigen::Vector2d& qd) {
@@ -113,7 +115,7 @@ Calibrated CalibrateIsometric(uint64_t seed) {
     }, seed * 100 + 10 + j);
     Normalize(r, c.mvc);
     std::vector<double> tau;
-    for (const auto& t : r.tau) tau.push_back(t[j] + 0.3 * noise());  // torque sensor noise 0.3 N m
+    for (const auto& t : r.tau) tau.push_back(t[j] + 0.3 * noise.Normal());  // torque sensor noise 0.3 N m
     c.fit[j] = FitIsometricAlpha(j, r.le, tau);
     // Table 6 reports flexion and extension separately: quality over each direction's contractions.
     for (int d = 0; d < 2; ++d) {
@@ -240,7 +242,7 @@ DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
   MuscleVec mvc = MeasureMvc(truth, seed * 100, nullptr, kb.envelope_hz, &rest);
   if (!kb.rest_subtracted || kb.oracle_le) rest.setZero();
   if (kb.oracle_le) mvc.setOnes();
-  SeededNormal noise(seed ^ 0x5e);
+  MuscleRng noise(MixSeed(seed ^ 0x5e));
   AlphaFit fit[2];
   for (int j = 0; j < 2; ++j) {
     ContractionProgramme prog = IsometricProgramme(j, 8, 0.1, 0.5, 0.1, seed + j);
@@ -252,7 +254,7 @@ DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
     }, seed * 100 + 10 + j, kb.envelope_hz, kb.oracle_le);
     Normalize(r, mvc, rest);
     std::vector<double> tau;
-    for (const auto& t : r.tau) tau.push_back(t[j] + noise_sd * noise());
+    for (const auto& t : r.tau) tau.push_back(t[j] + noise_sd * noise.Normal());
     fit[j] = FitIsometricAlpha(j, r.le, tau);
   }
   // Gait on the exoskeleton: 2 s stride (2 km/h), relaxed 5 s then exaggerated (section 4.3).
@@ -273,7 +275,7 @@ DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
   Normalize(r, mvc, rest);
   g_cfg = saved;
   const std::vector<LegParams> models = Table7Models();
-  SeededNormal sn(seed ^ 0x77);
+  MuscleRng sn(MixSeed(seed ^ 0x77));
   DynamicOutcome o{};
   const size_t k0 = static_cast<size_t>(5.5 / kDt);
   for (int j = 0; j < 2; ++j) {
@@ -284,7 +286,7 @@ DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
   std::vector<Eigen::Vector2d> tau_S;
   for (size_t k = 0; k < r.tau.size(); ++k)  // sensor (eq. 8), the identified model as the plant
     tau_S.push_back(r.tau[k] - ActuatorTorque(models[0], r.q[k], r.qd[k], kin_acc(k * kDt)) +
-                    noise_sd * Eigen::Vector2d(sn(), sn()));
+                    noise_sd * Eigen::Vector2d(sn.Normal(), sn.Normal()));
   for (int mi = 0; mi < 3; ++mi) {
     for (int j = 0; j < 2; ++j) {
       std::vector<MuscleVec> le;

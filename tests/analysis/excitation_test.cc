@@ -12,13 +12,13 @@
 #include <cstdio>
 
 #include "analysis/identification_data.h"
+#include "core/units.h"
 #include "sim/paper_tables.h"
 #include "tests/analysis/identification_test_util.h"
 
 namespace exotwin {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
 
 // Nominal model for the design (a patient is not identified yet): Table 3 + Table 4 means.
 LegParams Nominal() {
@@ -65,7 +65,7 @@ TEST(Excitation, DesignImprovesCriterionWithinLimits) {
       std::printf("%s, %s: cond %.2f -> %.2f, relative error %.3f -> %.3f, peak %.0f deg/s, %.1f N m\n",
                   ConfigurationName(c), k == ExcitationCriterion::kCondition ? "min cond" : "min rel. error",
                   d.initial_condition, d.condition, d.initial_relative_error, d.relative_error,
-                  d.peak_speed * kDeg, d.peak_torque);
+                  d.peak_speed * kDegPerRad, d.peak_torque);
       if (k == ExcitationCriterion::kCondition) EXPECT_LT(d.condition, 0.9 * d.initial_condition);
       else EXPECT_LT(d.relative_error, 0.9 * d.initial_relative_error);
       ExpectWithinLimits(d.trajectory, c);

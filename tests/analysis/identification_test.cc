@@ -9,7 +9,8 @@
 #include <random>
 
 #include "analysis/identification_data.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 
@@ -114,7 +115,7 @@ TEST(Identification, ExactRecoveryWithImperfectlyHeldJoint) {
   LegParams exo_only = truth;
   exo_only.human.reset();
   exo_only.passive = PassiveModel::kNone;
-  const double wobble = 2.0 * M_PI / 180;
+  const double wobble = 2.0 * kRadPerDeg;
   std::vector<MeasuredData> exo_files = {ClosedFormRecording(exo_only, false, wobble),
                                          ClosedFormRecording(exo_only, true, wobble)};
   IdentificationOptions opt;

@@ -12,7 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
 #include "model/lumped_params.h"
 #include "sim/realization.h"
 
@@ -88,12 +89,8 @@ inline bool Realizable(const LumpedParams& p, double L1) {
 // kept only when RealizeLumped accepts both the human and the exo.
 inline std::vector<NamedSubject> RandomSubjects(int n, uint64_t seed) {
   const auto base = PaperSubjects();
-  std::mt19937_64 rng(seed);
-  auto normal = [&rng]() {
-    const double u1 = (static_cast<double>(rng() >> 11) + 0.5) / 9007199254740992.0;
-    const double u2 = static_cast<double>(rng() >> 11) / 9007199254740992.0;
-    return std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
-  };
+  NormalRng<NormalBoxMuller<BoxMullerU1::kMidpoint>> rng(seed);
+  auto normal = [&rng]() { return rng.Normal(); };
   std::vector<NamedSubject> out;
   for (int tries = 0; static_cast<int>(out.size()) < n && tries < 100 * n; ++tries) {
     const NamedSubject& b = base[out.size() % base.size()];

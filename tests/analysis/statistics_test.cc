@@ -1,12 +1,13 @@
 // Pearson correlation against closed forms: exact lines give +-1 whatever their offset and scale,
 // a constant gives 0, orthogonal centred signals give 0, and the sample range is honoured.
-#include "analysis/seeded_rng.h"
 #include "analysis/statistics.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
+
+#include "core/rng.h"
 
 namespace exotwin {
 namespace {
@@ -15,7 +16,7 @@ namespace {
 // (truncated where phi^k < 0.05: within 2 * 0.05 / (1 - phi) of it, plus the sampling error).
 TEST(Statistics, AutocorrelationLengthOfAnAr1ProcessIsItsClosedForm) {
   for (double phi : {0.0, 0.5, 0.8}) {
-    SeededRng rng(3);
+    NormalRng<NormalBoxMuller<BoxMullerU1::kOneMinusUniform>> rng(3);
     std::vector<double> x(200000);
     double v = 0;
     for (double& s : x) s = v = phi * v + rng.Normal();

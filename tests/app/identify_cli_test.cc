@@ -10,6 +10,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/identification_data.h"
 #include "analysis/model_file.h"
+#include "core/units.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin {
@@ -109,7 +110,7 @@ TEST_F(IdentifyCli, OneMapForEveryMeasuredFile) {
   for (const char* name : {"knee_1", "knee_2", "hip_1", "hip_2"}) {
     const CsvTable t = ReadCsv(D() + "/exo/" + name + ".csv");
     std::vector<double> c[5];
-    const double scale[5] = {1e3, 180 / M_PI, 180 / M_PI, -1, -1};
+    const double scale[5] = {1e3, kDegPerRad, kDegPerRad, -1, -1};
     const char* from[5] = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
     for (int k = 0; k < 5; ++k)
       for (double v : t.columns[t.Find(from[k])]) c[k].push_back(scale[k] * v);

@@ -8,12 +8,12 @@
 #include <cmath>
 
 #include "controller/state_estimator.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 
 namespace exotwin::controller {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 TEST(JointPdController, ControlLawAndSaturation) {
   const JointPdController pd({100.0, 5.0, 20.0});
@@ -104,9 +104,9 @@ TEST(JointPdController, TracksExcitingTrajectoryWithEstimatedVelocity) {
     p.Step(tau, dt);
   }
   const double rms = std::sqrt(sq / n);
-  std::printf("tracking rms %.3f deg, max %.3f deg\n", rms / kDeg, max_err / kDeg);
-  EXPECT_LT(rms, 0.5 * kDeg);
-  EXPECT_LT(max_err, 1.5 * kDeg);
+  std::printf("tracking rms %.3f deg, max %.3f deg\n", rms / kRadPerDeg, max_err / kRadPerDeg);
+  EXPECT_LT(rms, 0.5 * kRadPerDeg);
+  EXPECT_LT(max_err, 1.5 * kRadPerDeg);
 }
 
 }  // namespace

@@ -9,12 +9,12 @@
 #include <limits>
 #include <random>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 
 namespace exotwin::controller {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 // Stable bus values.
 static_assert(static_cast<int>(SafetyState::kRunning) == 0);
@@ -37,8 +37,8 @@ struct Feed {
   SafetyInput in;
   uint32_t counter = 0;
   Feed() {
-    in.hip = {45 * kDeg, 0.5, 3.0, 2.0, 0.001, 0};
-    in.knee = {-40 * kDeg, -0.8, -1.0, -1.5, 0.001, 0};
+    in.hip = {45 * kRadPerDeg, 0.5, 3.0, 2.0, 0.001, 0};
+    in.knee = {-40 * kRadPerDeg, -0.8, -1.0, -1.5, 0.001, 0};
   }
   SafetyInput& Next() {
     ++counter;
@@ -140,7 +140,7 @@ TEST_F(SafetyTest, NonFiniteAngleOrVelocityTurnsTorqueOff) {
   feed.Next().hip.q = NAN;
   ExpectTrips(SafetyState::kSafeTorqueOff, FaultCode::kNonFiniteMeasurement, kHipBit);
   sup.Reset();
-  feed.in.hip.q = 45 * kDeg;
+  feed.in.hip.q = 45 * kRadPerDeg;
   feed.Next().knee.qd = INFINITY;
   ExpectTrips(SafetyState::kSafeTorqueOff, FaultCode::kNonFiniteMeasurement, kKneeBit);
 }

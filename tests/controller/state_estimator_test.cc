@@ -12,7 +12,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin::controller {
 namespace {

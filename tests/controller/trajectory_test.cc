@@ -12,12 +12,12 @@
 #include <random>
 #include <memory>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/units.h"
 
 namespace exotwin::controller {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 // Central differences of q and qd against the analytic qd and qdd.
 void ExpectDerivativesMatch(const std::function<JointSetpoint(double)>& f, double t0, double t1,
@@ -136,7 +136,7 @@ TEST(HarmonicTrajectory, DesignRejectsBadSpecs) {
 TEST(Composition, KneeSwingsWithHipHeldAt90Degrees) {
   auto knee = std::make_shared<HarmonicTrajectory>(
       HarmonicTrajectory::Design(ExcitationSpec::PaperKnee(), 3));
-  auto hip = std::make_shared<HoldTrajectory>(90 * kDeg);
+  auto hip = std::make_shared<HoldTrajectory>(90 * kRadPerDeg);
   JointwiseTrajectory leg(hip, knee);
   for (double t : {0.0, 1.3, 7.7}) {
     JointSetpoint h, k;
@@ -194,9 +194,9 @@ TEST(GaitTrajectory, WinterStrideDetectedAndFitted) {
   // Right heel contacts at frames 28 and 97 of Winter's table: 69 frames of 1.501/105 s.
   EXPECT_NEAR(g.data_stride_period_s(), 69 * 1.501 / 105, 0.015);
   std::printf("Winter stride %.4f s, fit rms hip %.2f deg, knee %.2f deg\n", g.data_stride_period_s(),
-              g.fit_rms_hip() / kDeg, g.fit_rms_knee() / kDeg);
-  EXPECT_LT(g.fit_rms_hip(), 1.5 * kDeg);
-  EXPECT_LT(g.fit_rms_knee(), 1.5 * kDeg);
+              g.fit_rms_hip() / kRadPerDeg, g.fit_rms_knee() / kRadPerDeg);
+  EXPECT_LT(g.fit_rms_hip(), 1.5 * kRadPerDeg);
+  EXPECT_LT(g.fit_rms_knee(), 1.5 * kRadPerDeg);
 }
 
 TEST(GaitTrajectory, RangesAreWintersNormalGait) {
@@ -213,19 +213,19 @@ TEST(GaitTrajectory, RangesAreWintersNormalGait) {
     kqd = std::max(kqd, std::abs(k.qd));
   }
   std::printf("hip %.1f..%.1f deg, knee %.1f..%.1f deg, max speed hip %.0f knee %.0f deg/s\n",
-              hmin / kDeg, hmax / kDeg, kmin / kDeg, kmax / kDeg, hqd / kDeg, kqd / kDeg);
+              hmin / kRadPerDeg, hmax / kRadPerDeg, kmin / kRadPerDeg, kmax / kRadPerDeg, hqd / kRadPerDeg, kqd / kRadPerDeg);
   // Thigh angle roughly -10..+25 deg (here -17..26), knee flexion roughly 0..65 deg.
-  EXPECT_GT(hmin, -22 * kDeg);
-  EXPECT_LT(hmin, -8 * kDeg);
-  EXPECT_GT(hmax, 20 * kDeg);
-  EXPECT_LT(hmax, 30 * kDeg);
-  EXPECT_GT(kmin, -70 * kDeg);
-  EXPECT_LT(kmin, -55 * kDeg);
-  EXPECT_GT(kmax, -5 * kDeg);
-  EXPECT_LT(kmax, 5 * kDeg);
+  EXPECT_GT(hmin, -22 * kRadPerDeg);
+  EXPECT_LT(hmin, -8 * kRadPerDeg);
+  EXPECT_GT(hmax, 20 * kRadPerDeg);
+  EXPECT_LT(hmax, 30 * kRadPerDeg);
+  EXPECT_GT(kmin, -70 * kRadPerDeg);
+  EXPECT_LT(kmin, -55 * kRadPerDeg);
+  EXPECT_GT(kmax, -5 * kRadPerDeg);
+  EXPECT_LT(kmax, 5 * kRadPerDeg);
   // Winter's ~1 s natural stride slowed to 2 s halves the speeds: hip ~120, knee ~200 deg/s.
-  EXPECT_LT(hqd, 150 * kDeg);
-  EXPECT_LT(kqd, 250 * kDeg);
+  EXPECT_LT(hqd, 150 * kRadPerDeg);
+  EXPECT_LT(kqd, 250 * kRadPerDeg);
 }
 
 TEST(GaitTrajectory, MatchesDirectMarkerComputationAtFrames) {
@@ -246,14 +246,14 @@ TEST(GaitTrajectory, MatchesDirectMarkerComputationAtFrames) {
     JointSetpoint h, k;
     g.Sample(t_out, &h, &k);
     SCOPED_TRACE(r.t);
-    EXPECT_NEAR(h.q, thigh, 2.5 * kDeg);
-    EXPECT_NEAR(k.q, knee, 2.5 * kDeg);
+    EXPECT_NEAR(h.q, thigh, 2.5 * kRadPerDeg);
+    EXPECT_NEAR(k.q, knee, 2.5 * kRadPerDeg);
   }
   // Signs at known events: heel contact hip flexed ~20 deg, knee nearly straight; swing knee flexed.
   JointSetpoint h, k;
   g.Sample(0.0, &h, &k);
-  EXPECT_NEAR(h.q, 20 * kDeg, 3 * kDeg);
-  EXPECT_NEAR(k.q, 0.0, 5 * kDeg);
+  EXPECT_NEAR(h.q, 20 * kRadPerDeg, 3 * kRadPerDeg);
+  EXPECT_NEAR(k.q, 0.0, 5 * kRadPerDeg);
 }
 
 TEST(GaitTrajectory, PeriodicDerivativesAndOptions) {
@@ -261,7 +261,7 @@ TEST(GaitTrajectory, PeriodicDerivativesAndOptions) {
   spec.stride_period_s = 2.5;
   spec.harmonics = 8;
   spec.amplitude_scale = 0.5;
-  spec.knee_offset = -5 * kDeg;
+  spec.knee_offset = -5 * kRadPerDeg;
   const GaitTrajectory g = GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), spec);
   GaitSpec ref_spec;
   ref_spec.harmonics = 8;
@@ -275,7 +275,7 @@ TEST(GaitTrajectory, PeriodicDerivativesAndOptions) {
     // Half the excursion about the stride mean, time-scaled, offset.
     ref.Sample(t * 2.0 / 2.5, &hr, &kr);
     EXPECT_NEAR(h0.q - g.hip().c0(), 0.5 * (hr.q - ref.hip().c0()), 1e-12);
-    EXPECT_NEAR(g.knee().c0(), ref.knee().c0() - 5 * kDeg, 1e-12);
+    EXPECT_NEAR(g.knee().c0(), ref.knee().c0() - 5 * kRadPerDeg, 1e-12);
   }
   for (int joint = 0; joint < 2; ++joint)
     ExpectDerivativesMatch(

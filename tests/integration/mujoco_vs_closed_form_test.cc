@@ -9,9 +9,9 @@
 #include <cmath>
 #include <random>
 
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 #include "model/regressors.h"
-#include "model/input_error.h"
 #include "sim/plant.h"
 
 namespace exotwin {

@@ -4,10 +4,11 @@
 
 #include <cmath>
 
+#include "core/units.h"
+
 namespace exotwin {
 namespace {
 
-constexpr double kRad = M_PI / 180.0;
 
 // Magnitudes of the original law (papers/README.md, checked against two public implementations):
 // hip 0, ankle 0: M_K = +10.4, -2.7, -4.5, -6.2 N m at knee flexion 0, 30, 60, 90 deg.
@@ -28,7 +29,7 @@ TEST(PassiveTorque, RienerHipMagnitudes) {
 
 // Convention mapping: H = deg(th1), K = -deg(th2), P1 = -M_H, P2 = +M_K.
 TEST(PassiveTorque, ConventionMapping) {
-  const Eigen::Vector2d q(20 * kRad, -45 * kRad);
+  const Eigen::Vector2d q(20 * kRadPerDeg, -45 * kRadPerDeg);
   const Eigen::Vector2d P = PassiveElasticTorque(PassiveModel::kRiener1999, q);
   EXPECT_NEAR(P[0], -RienerHipMoment(20, 45), 1e-12);
   EXPECT_NEAR(P[1], RienerKneeMoment(0, 45, 20), 1e-12);
@@ -45,7 +46,7 @@ TEST(PassiveTorque, BoundedOverGaitRange) {
   double max_hip = 0, max_knee = 0;
   for (double h = -10; h <= 25; h += 1)
     for (double k = 5; k <= 65; k += 1) {
-      const Eigen::Vector2d P = PassiveElasticTorque(PassiveModel::kRiener1999, {h * kRad, -k * kRad});
+      const Eigen::Vector2d P = PassiveElasticTorque(PassiveModel::kRiener1999, {h * kRadPerDeg, -k * kRadPerDeg});
       max_hip = std::max(max_hip, std::abs(P[0]));
       max_knee = std::max(max_knee, std::abs(P[1]));
     }
@@ -54,7 +55,7 @@ TEST(PassiveTorque, BoundedOverGaitRange) {
   double max_knee_mid = 0;
   for (double k = 15; k <= 65; k += 1)
     max_knee_mid = std::max(max_knee_mid, std::abs(PassiveElasticTorque(
-                                              PassiveModel::kRiener1999, {10 * kRad, -k * kRad})[1]));
+                                              PassiveModel::kRiener1999, {10 * kRadPerDeg, -k * kRadPerDeg})[1]));
   EXPECT_LT(max_knee_mid, 5.0);
   EXPECT_GT(max_hip, 1.0);  // not identically zero
 }

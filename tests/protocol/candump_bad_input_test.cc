@@ -9,7 +9,7 @@
 
 #include <unistd.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "protocol/candump.h"
 
 namespace exotwin {

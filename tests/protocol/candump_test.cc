@@ -10,7 +10,7 @@
 #include <map>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "protocol/candump_replay_bus.h"
 #include "protocol/messages.h"
 

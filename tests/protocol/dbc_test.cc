@@ -5,7 +5,7 @@
 
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

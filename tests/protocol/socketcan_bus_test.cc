@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

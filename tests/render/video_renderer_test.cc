@@ -11,7 +11,7 @@
 
 #include <opencv2/videoio.hpp>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "render/scene_renderer.h"
 #include "sim/plant.h"
 #include "tests/render/render_test_util.h"

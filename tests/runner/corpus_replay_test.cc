@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/scenario.h"
 
 namespace exotwin {

@@ -16,7 +16,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/emg_calibration.h"
 #include "analysis/measured_data.h"
-#include "model/input_error.h"
+#include "core/error.h"
 #include "model/leg_dynamics.h"
 #include "runner/runner.h"
 #include "runner/table5_protocol.h"

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "analysis/csv_table.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

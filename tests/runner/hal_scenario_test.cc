@@ -1,7 +1,7 @@
 // The optional hal: block of a scenario file (device: hal3): every field, and strict rejection.
 #include <gtest/gtest.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/scenario.h"
 
 namespace exotwin {

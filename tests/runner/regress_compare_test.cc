@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <set>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "runner/sweep_plots.h"
 #include "runner/sweep_table.h"
 #include "sim/subjects.h"

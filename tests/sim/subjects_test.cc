@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "sim/paper_tables.h"
 #include "sim/realizability.h"
 

@@ -1,12 +1,22 @@
-#include "analysis/yaml_fields.h"
+#include "core/yaml_fields.h"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/file_text.h"
 
 namespace exotwin {
+
+namespace {
+
+std::string List(const std::set<std::string>& items) {
+  std::string list;
+  for (const auto& a : items) list += (list.empty() ? "" : ", ") + a;
+  return list;
+}
+
+}  // namespace
 
 void YamlContext::Fail(const std::string& key, const std::string& what) const {
   throw InputError(source + ": " + key + ": " + what);
@@ -26,14 +36,35 @@ double YamlNumber(const YamlContext& c, const YAML::Node& n, const std::string& 
   } catch (const YAML::Exception&) {
     c.Fail(key, "'" + n.Scalar() + "' is not a number" + YamlLine(n));
   }
-  if (!std::isfinite(v)) c.Fail(key, "expected a finite number, got " + n.Scalar() + YamlLine(n));
-  if (v < lo || v > hi) {
-    std::ostringstream os;
-    os << "value " << v << " out of range, expected " << lo << " .. " << hi << (unit.empty() ? "" : " ") << unit
-       << YamlLine(n);
-    c.Fail(key, os.str());
-  }
+  std::ostringstream range;
+  range << "expected " << lo << " .. " << hi << (unit.empty() ? "" : " ") << unit;
+  if (!std::isfinite(v)) c.Fail(key, "expected a finite number, got " + n.Scalar() + " (" + range.str() + ")" + YamlLine(n));
+  if (v < lo || v > hi) c.Fail(key, "value " + n.Scalar() + " out of range, " + range.str() + YamlLine(n));
   return v;
+}
+
+void YamlNumberPair(const YamlContext& c, const YAML::Node& n, const std::string& key, double out[2], double lo,
+                    double hi) {
+  if (!n.IsSequence() || n.size() != 2) c.Fail(key, "expected [hip, knee]" + YamlLine(n));
+  out[0] = YamlNumber(c, n[0], key + "[0]", lo, hi);
+  out[1] = YamlNumber(c, n[1], key + "[1]", lo, hi);
+}
+
+std::string YamlString(const YamlContext& c, const YAML::Node& n, const std::string& key,
+                       const std::set<std::string>& allowed) {
+  if (!n || !n.IsScalar()) c.Fail(key, "expected a string" + YamlLine(n));
+  const std::string s = n.Scalar();
+  if (!allowed.empty() && !allowed.count(s)) c.Fail(key, "'" + s + "' is not one of: " + List(allowed) + YamlLine(n));
+  return s;
+}
+
+bool YamlBool(const YamlContext& c, const YAML::Node& n, const std::string& key) {
+  if (!n || !n.IsScalar()) c.Fail(key, "expected true or false" + YamlLine(n));
+  try {
+    return n.as<bool>();
+  } catch (const YAML::Exception&) {
+    c.Fail(key, "'" + n.Scalar() + "' is not true/false" + YamlLine(n));
+  }
 }
 
 void YamlCheckKeys(const YamlContext& c, const YAML::Node& map, const std::string& key,
@@ -52,20 +83,11 @@ void YamlCheckKeys(const YamlContext& c, const YAML::Node& map, const std::strin
 
 void YamlCheckKeys(const YamlContext& c, const YAML::Node& map, const std::string& key,
                    const std::set<std::string>& allowed) {
-  std::string list;
-  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-  YamlCheckKeys(c, map, key, [&](const std::string& k) { return allowed.count(k) > 0; }, list);
+  YamlCheckKeys(c, map, key, [&](const std::string& k) { return allowed.count(k) > 0; }, List(allowed));
 }
 
 std::string ReadYamlText(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open " + what + " file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
-  if (text.find('\0') != std::string::npos)
-    throw InputError(path + ": binary data (NUL byte), expected a YAML text file");
-  return text;
+  return ReadTextFile(path, what, "a YAML text file");
 }
 
 YAML::Node ParseYaml(const std::string& text, const std::string& source) {
