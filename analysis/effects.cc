@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "dsp/butterworth.h"
+#include "dsp/emg_envelope.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 
@@ -38,25 +39,13 @@ std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<
   static thread_local std::vector<dsp::Biquad> hp, lp;
   if (fs != cached_fs) {
     hp = dsp::DesignButterworth(2, dsp::BandType::kHighPass, fs, 20.0);
-    lp = dsp::DesignButterworth(4, dsp::BandType::kLowPass, fs, 2.0);
+    lp = dsp::EnvelopeLowPassDesign(fs, 2.0);
     cached_fs = fs;
   }
   // Odd reflection of up to 1 s at both ends before filtering keeps the start-up transients of
   // the 2 Hz low-pass out of the record.
-  const size_t n = emg.size(), pad = std::min(n - 1, static_cast<size_t>(fs));
-  auto padded = [&](const std::vector<double>& x) {
-    std::vector<double> y;
-    y.reserve(n + 2 * pad);
-    for (size_t k = pad; k >= 1; --k) y.push_back(2 * x[0] - x[k]);
-    y.insert(y.end(), x.begin(), x.end());
-    for (size_t k = 1; k <= pad; ++k) y.push_back(2 * x[n - 1] - x[n - 1 - k]);
-    return y;
-  };
-  std::vector<double> x = dsp::FiltFilt(hp, padded(emg));
-  x = std::vector<double>(x.begin() + pad, x.begin() + pad + n);
-  for (double& v : x) v = std::abs(v);
-  x = dsp::FiltFilt(lp, padded(x));
-  return std::vector<double>(x.begin() + pad, x.begin() + pad + n);
+  const size_t pad = std::min(emg.size() - 1, static_cast<size_t>(fs));
+  return dsp::ZeroPhaseEnvelope(hp, lp, emg, pad);
 }
 
 Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,

@@ -40,9 +40,10 @@ int EffectJoint(const Effect& e);
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
                   std::vector<double> tau_S[2]);
 
-// EMG envelope (V): zero-phase 2nd-order 20 Hz high-pass, full-wave rectification, zero-phase
-// 4th-order 2 Hz low-pass. t strictly increasing with a sample rate above 40 Hz (median step).
-// Throws InputError otherwise.
+// EMG envelope (V) of a measured column: dsp::ZeroPhaseEnvelope with a 2nd-order 20 Hz high-pass
+// (not the 20-450 Hz band-pass: a measured record may be sampled below 900 Hz) and the 4th-order 2 Hz
+// envelope low-pass, padded by up to 1 s at both ends. t strictly increasing with a sample rate above
+// 40 Hz (median step). Throws InputError otherwise.
 std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg);
 
 // Torque (N m) the series-compliant part needs: human rigid dynamics + P(q) when params.human,

@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-#include "dsp/butterworth.h"
+#include "dsp/mvc.h"
 
 namespace exotwin {
 
@@ -29,22 +29,6 @@ FitQuality Quality(const std::vector<double>& y, const std::vector<double>& yhat
   return q;
 }
 
-std::vector<double> OfflineLinearEnvelope(const std::vector<double>& x, double fs, double lowpass_hz) {
-  std::vector<double> y = dsp::FiltFilt(dsp::DesignButterworth(2, dsp::BandType::kBandPass, fs, 20, 450), x);
-  for (double& v : y) v = std::abs(v);
-  return dsp::FiltFilt(dsp::DesignButterworth(4, dsp::BandType::kLowPass, fs, lowpass_hz), y);
-}
-
-double MvcOfTrials(const std::vector<double>& env, const std::vector<std::pair<size_t, size_t>>& trials) {
-  if (trials.empty()) throw std::invalid_argument("MvcOfTrials: no trials");
-  double s = 0;
-  for (const auto& [a, b] : trials) {
-    if (!(b > a) || b > env.size()) throw std::invalid_argument("MvcOfTrials: bad window");
-    s += *std::max_element(env.begin() + a, env.begin() + b);
-  }
-  return s / trials.size();
-}
-
 double RestLevel(const std::vector<double>& env, size_t a, size_t b) {
   if (!(b > a) || b > env.size()) throw std::invalid_argument("RestLevel: bad window");
   double s = 0;
@@ -55,7 +39,7 @@ double RestLevel(const std::vector<double>& env, size_t a, size_t b) {
 MuscleVec NormalizedEnvelope(const std::vector<std::vector<double>>& env, size_t k, const MuscleVec& rest,
                              const MuscleVec& mvc) {
   MuscleVec le;
-  for (int c = 0; c < kNumMuscles; ++c) le[c] = (env[c][k] - rest[c]) / (mvc[c] - rest[c]);
+  for (int c = 0; c < kNumMuscles; ++c) le[c] = dsp::NormalizeToMvc(env[c][k], rest[c], mvc[c]);
   return le;
 }
 

@@ -1,6 +1,7 @@
 // EMG-to-torque calibration of Hwang & Jeon 2015 (after Olney & Winter 1985), issue 6 item 5:
 // isometric alpha by least squares (eq. 23-25), dynamic beta and gamma given alpha (eq. 26-28), and
-// the R^2 / normalized RMS figures of Tables 6-7. Off-line: whole records, one sample per 1/fs.
+// the R^2 / normalized RMS figures of Tables 6-7. Off-line: whole records, one sample per 1/fs. The
+// envelopes (dsp::LinearEnvelopeZeroPhase) and the MVC (dsp::MvcOfTrials) are dsp/'s.
 //
 // Units (see sim/muscles.h): LE = envelope / MVC (fraction of MVC, 0..1), alpha in N m at MVC (the
 // paper's alpha x 100 if its LE is in % MVC), beta in 1/rad, gamma in s/rad (BetaPerDeg / GammaPerDegS
@@ -23,20 +24,10 @@ struct FitQuality {
 // Precondition: same non-zero length, measured not constant.
 FitQuality Quality(const std::vector<double>& measured, const std::vector<double>& predicted);
 
-// Off-line EMG chain of the paper for one channel of AMPLIFIED EMG (V): zero-phase 4th-order
-// band-pass 20-450 Hz, full-wave rectification, zero-phase 4th-order 2 Hz low-pass (section 4.3).
-// fs: sample rate (Hz); lowpass_hz: envelope cut-off (Hz; the paper's 2 Hz unless studying it).
-std::vector<double> OfflineLinearEnvelope(const std::vector<double>& amplified, double fs = 1000.0,
-                                          double lowpass_hz = 2.0);
-
-// MVC value: the mean of the maxima of `env` inside each [start, end) sample window (one window per
-// MVC trial; the paper averages the three highest peaks of three trials). Windows non-empty.
-double MvcOfTrials(const std::vector<double>& env, const std::vector<std::pair<size_t, size_t>>& trials);
-
 // Resting level of a linear envelope (V): its mean over the relaxed samples [a, b) (a < b <= size).
 double RestLevel(const std::vector<double>& env, size_t a, size_t b);
 
-// Normalized linear envelope LE (fraction of MVC) of each channel at sample k:
+// Normalized linear envelope LE (fraction of MVC, dsp::NormalizeToMvc) of each channel at sample k:
 //   LE = (env - rest) / (mvc - rest)   (env: one envelope per channel in Muscle order, V)
 // rest = 0 gives the paper's plain env / MVC. A relaxed electrode/amplifier floor left in LE reads as a
 // constant phantom torque alpha x rest / MVC in eq. (23)-(27) (see tests/analysis/emg_calibration_test.cc).

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "analysis/number_text.h"
 #include "core/error.h"
 #include "dsp/butterworth.h"
+#include "dsp/derivatives.h"
 
 namespace exotwin {
 
@@ -192,15 +194,13 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
   }
   const SampleGrid s = MakeGrid(data.t, data.source, cutoff_hz);
   k.resampled = !s.uniform;
-  const double dt = s.dt;
-  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, cutoff_hz);
   for (int j = 0; j < 2; ++j) {
     const auto* qd = data.Column(std::string("qd_") + names[j]);
     const auto* qdd = data.Column(std::string("qdd_") + names[j]);
     const std::vector<double> qg = s.uniform ? k.q[j] : Interpolate(data.t, k.q[j], s.grid);
-    const std::vector<double> qf = dsp::FiltFilt(sos, qg);
-    std::vector<double> v = dsp::Gradient(qf, dt);
-    std::vector<double> a = dsp::Gradient(v, dt);
+    dsp::Derivatives der = dsp::ZeroPhaseDerivatives(qg, s.dt, cutoff_hz);
+    std::vector<double> v = std::move(der.first);
+    std::vector<double> a = std::move(der.second);
     if (!s.uniform) {
       v = Interpolate(s.grid, v, data.t);
       a = Interpolate(s.grid, a, data.t);

@@ -57,7 +57,7 @@ struct Kinematics {
 
 // Uses qd_*/qdd_* columns when present, else derives them as in Hwang & Jeon sec. 3.2: the angle is
 // filtered by a zero-phase 2nd-order Butterworth low-pass at 20 Hz (forward-backward) and
-// differentiated by central differences. Non-uniform sampling (any step off the median by more than
+// differentiated by central differences (dsp::ZeroPhaseDerivatives). Non-uniform sampling (any step off the median by more than
 // 1 %) is handled by resampling the angles onto a uniform grid at the median step (linear
 // interpolation), differentiating there, and interpolating back onto the measured times.
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz = 20.0);

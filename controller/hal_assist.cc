@@ -7,9 +7,9 @@
 
 #include <Eigen/Dense>
 
-#include "dsp/butterworth.h"
+#include "dsp/derivatives.h"
 
-namespace exotwin {
+namespace exotwin::controller {
 
 LinearFit FitEmgToTorque(const std::vector<double>& E, const std::vector<double>& tau) {
   if (E.size() != tau.size() || E.size() < 2) throw std::invalid_argument("FitEmgToTorque: sizes");
@@ -45,9 +45,10 @@ OneLinkPassive IdentifyOneLinkPassive(const std::vector<double>& th, const std::
                                       double dt, double fc) {
   if (th.size() != tau.size() || th.size() < 16 || !(dt > 0))
     throw std::invalid_argument("IdentifyOneLinkPassive: sizes or dt");
-  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, fc);
-  const std::vector<double> f = dsp::FiltFilt(sos, th);
-  const std::vector<double> v = dsp::Gradient(f, dt), a = dsp::Gradient(v, dt);
+  const dsp::Derivatives d = dsp::ZeroPhaseDerivatives(th, dt, fc);
+  const std::vector<double>& f = d.filtered;
+  const std::vector<double>& v = d.first;
+  const std::vector<double>& a = d.second;
   const size_t skip = std::min<size_t>(th.size() / 8, 50);  // filter edges
   const size_t n = th.size() - 2 * skip;
   Eigen::MatrixXd A(n, 3);
@@ -169,4 +170,4 @@ HalAssistOutput HalAssistController::Step(double th, double E_e, double E_f, dou
   return o;
 }
 
-}  // namespace exotwin
+}  // namespace exotwin::controller

@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 
-namespace exotwin {
+namespace exotwin::controller {
 
 // Straight line y = a x + b.
 struct LinearFit {
@@ -181,4 +181,4 @@ class HalAssistController {
   bool started_ = false;
 };
 
-}  // namespace exotwin
+}  // namespace exotwin::controller

@@ -12,10 +12,10 @@
 #pragma once
 #include <cstdint>
 
-#include "controller/emg_processing.h"
 #include "controller/hal_assist.h"
 #include "controller/state_estimator.h"
 #include "controller/virtual_impedance.h"
+#include "dsp/emg_envelope.h"
 #include "protocol/can_bus.h"
 
 namespace exotwin::controller {
@@ -64,7 +64,7 @@ class HalLoop {
   HalLoopConfig cfg_;
   CanBus* bus_;
   HalAssistController assist_;
-  RmsEnvelope rms_e_, rms_f_;
+  dsp::RmsEnvelope rms_e_, rms_f_;
   JointStateEstimator est_;
   HalTelemetry tel_;
   double last_status_t_ = -1e9;

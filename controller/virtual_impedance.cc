@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-namespace exotwin {
+namespace exotwin::controller {
 
 VirtualImpedanceConfig LeeSankaiSetting(const OneLinkImpedance& actual, double b_v) {
   VirtualImpedanceConfig c;
@@ -27,4 +27,4 @@ double FeltImpedanceTorque(const VirtualImpedanceConfig& c, double th, double th
   return exo - CompensationTorque(c, th, thd, thdd);
 }
 
-}  // namespace exotwin
+}  // namespace exotwin::controller

@@ -8,7 +8,7 @@
 // It is also Hayashi's tau_c of eq. (6) with I_v = 0, B_v = 0, mgl_v = mgl, C_v = 0.
 #pragma once
 
-namespace exotwin {
+namespace exotwin::controller {
 
 struct OneLinkImpedance {
   double I = 0;    // kg m^2
@@ -35,4 +35,4 @@ double CompensationTorque(const VirtualImpedanceConfig& cfg, double th, double t
 // compensation on: the virtual impedance it feels (exact when thdd is exact).
 double FeltImpedanceTorque(const VirtualImpedanceConfig& cfg, double th, double thd, double thdd);
 
-}  // namespace exotwin
+}  // namespace exotwin::controller

@@ -168,14 +168,4 @@ std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<d
   return std::vector<double>(ext.begin() + pad, ext.begin() + pad + n);
 }
 
-std::vector<double> Gradient(const std::vector<double>& x, double dt) {
-  const size_t n = x.size();
-  std::vector<double> d(n, 0.0);
-  if (n < 2) return d;
-  d[0] = (x[1] - x[0]) / dt;
-  d[n - 1] = (x[n - 1] - x[n - 2]) / dt;
-  for (size_t i = 1; i + 1 < n; ++i) d[i] = (x[i + 1] - x[i - 1]) / (2.0 * dt);
-  return d;
-}
-
 }  // namespace exotwin::dsp

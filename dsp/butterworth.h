@@ -43,8 +43,4 @@ class SosFilter {
 // length use the whole signal as the pad.
 std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x);
 
-// Numerical derivative with central differences (second order inside, one-sided at the ends).
-// dt > 0 uniform sample period. Size >= 2.
-std::vector<double> Gradient(const std::vector<double>& x, double dt);
-
 }  // namespace exotwin::dsp

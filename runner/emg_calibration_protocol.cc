@@ -14,7 +14,10 @@
 #include "analysis/emg_calibration.h"
 #include "analysis/measured_data.h"
 #include "analysis/statistics.h"
+#include "controller/muscular_torque.h"
 #include "core/error.h"
+#include "dsp/emg_envelope.h"
+#include "dsp/mvc.h"
 #include "hwsim/emg_amplifier.h"
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
@@ -46,7 +49,7 @@ std::vector<std::vector<double>> Envelopes(const CsvTable& t, const std::string&
     const std::string name = std::string("emg_") + MuscleName(MuscleAt(c));
     const int i = t.Find(name);
     if (i < 0) throw InputError(source + ": no column " + name + " (the EMG amplifier was not recorded)");
-    env.push_back(OfflineLinearEnvelope(t.columns[i], 1.0 / kDt));
+    env.push_back(dsp::LinearEnvelopeZeroPhase(t.columns[i], 1.0 / kDt));
   }
   return env;
 }
@@ -89,7 +92,7 @@ double RecordMvc(const MuscleParams& mp, Muscle m, int trials, const Eigen::Vect
   const std::vector<double>& time = t.columns[t.Find("t")];
   std::vector<std::pair<size_t, size_t>> w;
   for (const ContractionBlock& b : prog.blocks()) w.push_back(Window(time, b.t_start, b.t_start + 2 * b.ramp + b.hold));
-  return MvcOfTrials(env[static_cast<int>(m)], w);
+  return dsp::MvcOfTrials(env[static_cast<int>(m)], w);
 }
 
 // Runs a sub-trial through the EXOwheel runner into DIR/<tag>; returns its result (checks dropped).
@@ -112,29 +115,30 @@ struct IsometricResult {
   FitQuality dir[2];  // flexion, extension (Table 6)
 };
 
-// The whole protocol for one subject (s.subject, s.human.muscle_seed) into opt.out_dir: files and
-// metrics, no result.json.
-RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t seed) {
-  const EmgCalibrationSpec& cal = *s.emg_calibration;
-  RunResult result;
-  result.scenario = s.name;
-  result.seed = seed;
-  fs::create_directories(opt.out_dir);
-  const std::optional<Subject> subject = ScenarioSubject(s);
-  if (!subject) throw InputError(s.source + ": subject: emg_calibration needs preset or random_seed");
-  const MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
-  auto& m = result.metrics;
+// The runner trials' totals over the stages: worst safe state, logged samples, peak torques.
+struct TrialTotals {
   double safe = 0, torque_max[2] = {0, 0}, samples = 0;
-  auto absorb = [&](const RunResult& r, const std::string& tag) {
+  // Adds trial r (written under DIR/<tag>) to the totals and its files and events to `result`.
+  void Absorb(const RunResult& r, const std::string& tag, RunResult& result) {
     safe = std::max(safe, r.metrics.at("safe_state_entered"));
     samples += r.metrics.at("samples");
     for (int j = 0; j < 2; ++j)
       torque_max[j] = std::max(torque_max[j], r.metrics.at(std::string("torque_max_") + kJoint[j]));
     for (const std::string& f : r.files) result.files.push_back(tag + "/" + f);
     for (const std::string& e : r.events) result.events.push_back(tag + ": " + e);
-  };
+  }
+};
 
-  // 1. MVC: GMAX, RF, ST at the hip pose (standing), VM, GAS at the knee pose (seated).
+// LE = envelope / MVC at sample k, as the paper (no resting-level subtraction; see the Table 7 error
+// budget in tests/analysis/emg_calibration_test.cc).
+MuscleVec Normalized(const std::vector<std::vector<double>>& env, size_t k, const MuscleVec& mvc) {
+  return NormalizedEnvelope(env, k, MuscleVec::Zero(), mvc);
+}
+
+// Stage 1: MVC trials of every muscle (GMAX, RF, ST at the hip pose, standing; VM, GAS at the knee
+// pose, seated) into DIR/mvc/; returns the MVC per muscle (V), adds files and mvc_* metrics to result.
+MuscleVec MvcStage(const Scenario& s, const MuscleParams& mp, const RunOptions& opt, RunResult& result) {
+  const EmgCalibrationSpec& cal = *s.emg_calibration;
   fs::create_directories(opt.out_dir + "/mvc");
   MuscleVec mvc;
   for (int c = 0; c < kNumMuscles; ++c) {
@@ -148,177 +152,206 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
                            std::to_string(result.seed));
     if (!(mvc[c] > 0)) throw InputError(s.source + ": MVC of " + MuscleName(mu) + " is zero (no EMG recorded)");
     result.files.push_back(file);
-    m[std::string("mvc_") + MuscleName(mu) + "_V"] = mvc[c];
+    result.metrics[std::string("mvc_") + MuscleName(mu) + "_V"] = mvc[c];
   }
-  // LE = envelope / MVC, as the paper (no resting-level subtraction; see the Table 7 error budget in
-  // tests/analysis/emg_calibration_test.cc).
-  auto normalized = [&](const std::vector<std::vector<double>>& env, size_t k) {
-    return NormalizedEnvelope(env, k, MuscleVec::Zero(), mvc);
-  };
+  return mvc;
+}
 
-  // 2. Isometric trials, the exoskeleton holding the pose (eq. 23-25, Table 6).
-  IsometricResult iso[2];
-  double r2_sum = 0, nrms_sum = 0, r2_min = 1, nrms_max = 0;
-  for (int j = 0; j < 2; ++j) {
-    Scenario sub = s;
-    const double* pose = j == 0 ? cal.hip_pose : cal.knee_pose;
-    sub.fixed_joints = {{"hip", pose[0]}, {"knee", pose[1]}};
-    sub.protocol.trajectory = TrajectoryKind::kHold;
-    sub.protocol.ramp = kHoldRamp;
-    sub.human.behaviour = j == 0 ? "isometric_hip" : "isometric_knee";
-    sub.human.programme_seed = MixSeed(result.seed ^ (0x69736full + j));
-    // Levels scaled down (all blocks alike) so that no contraction asks for more than the torque
-    // budget at either joint (eq. 23-24 at the programme's peaks; biarticular RF / ST load both).
-    double peak_torque = 0;
-    const ContractionProgramme planned = IsometricProgrammeOf(sub.human, 0);
-    for (const ContractionBlock& blk : planned.blocks())
-      for (int jj = 0; jj < 2; ++jj)
-        peak_torque = std::max(peak_torque, std::abs(IsometricTorque(jj, mp.alpha.col(jj), blk.peak)));
-    const double scale = std::min(1.0, kIsometricTorqueBudget / peak_torque);
-    sub.human.levels[0] *= scale;
-    sub.human.levels[1] *= scale;
-    m[std::string("iso_level_scale_") + kJoint[j]] = scale;
-    const ContractionProgramme prog = IsometricProgrammeOf(sub.human, 0);
-    sub.protocol.duration = prog.duration() + kTail;
-    const std::string tag = std::string("isometric_") + kJoint[j];
-    const RunResult r = RunTrial(sub, tag, MixSeed(result.seed ^ (0x69736f00ull + j)), opt);
-    absorb(r, tag);
-    const std::string path = opt.out_dir + "/" + tag + "/measured.csv";
-    const MeasuredData d = ReadMeasuredCsv(path);
-    const std::vector<std::vector<double>> env = Envelopes(d.table, path);
-    const std::vector<double>& tau_S = j == 0 ? d.tau_hip : d.tau_knee;
-    // The sensor reads gravity of the held leg plus the muscles: its relaxed reading before the
-    // first contraction is subtracted, so tau^ISO is the muscular torque alone (sec. 4.3).
-    const auto base = Window(d.t, kHoldRamp + 0.1, prog.blocks().front().t_start);
-    if (base.second - base.first < 100) throw InputError(s.source + ": isometric trial: no relaxed lead-in");
-    const double offset = RestLevel(tau_S, base.first, base.second);  // mean relaxed reading
-    const auto all = Window(d.t, kHoldRamp + 0.1, prog.duration() + 0.5);
-    std::vector<MuscleVec> le;
-    std::vector<double> tau;
-    for (size_t k = all.first; k < all.second; ++k) {
-      le.push_back(normalized(env, k));
-      tau.push_back(tau_S[k] - offset);
-    }
-    iso[j].fit = FitIsometricAlpha(j, le, tau);  // eq. (25)
-    // Table 6 per direction: the contractions of that direction (even blocks act along +q).
-    for (int dir = 0; dir < 2; ++dir) {
-      std::vector<double> y, yhat;
-      for (size_t b = 0; b < prog.blocks().size(); ++b) {
-        const ContractionBlock& blk = prog.blocks()[b];
-        const bool plus_q = b % 2 == 0;
-        const bool flexion = j == 0 ? plus_q : !plus_q;  // hip flexion +q, knee flexion -q
-        if (flexion != (dir == 0)) continue;
-        const auto w = Window(d.t, blk.t_start, blk.t_start + 2 * blk.ramp + blk.hold);
-        for (size_t k = w.first; k < w.second; ++k) {
-          y.push_back(tau_S[k] - offset);
-          yhat.push_back(IsometricTorque(j, iso[j].fit.alpha, normalized(env, k)));
-        }
+// Stage 2, joint j: isometric trial with the exoskeleton holding the pose, eq. (23)-(25) alpha
+// against tau_S minus its relaxed reading, Table 6 R^2 / NRMS per direction; iso_* and alpha_* metrics.
+IsometricResult IsometricStage(const Scenario& s, int j, const MuscleParams& mp, const MuscleVec& mvc,
+                               const RunOptions& opt, RunResult& result, TrialTotals& totals) {
+  const EmgCalibrationSpec& cal = *s.emg_calibration;
+  auto& m = result.metrics;
+  IsometricResult iso;
+  Scenario sub = s;
+  const double* pose = j == 0 ? cal.hip_pose : cal.knee_pose;
+  sub.fixed_joints = {{"hip", pose[0]}, {"knee", pose[1]}};
+  sub.protocol.trajectory = TrajectoryKind::kHold;
+  sub.protocol.ramp = kHoldRamp;
+  sub.human.behaviour = j == 0 ? "isometric_hip" : "isometric_knee";
+  sub.human.programme_seed = MixSeed(result.seed ^ (0x69736full + j));
+  // Levels scaled down (all blocks alike) so that no contraction asks for more than the torque
+  // budget at either joint (eq. 23-24 at the programme's peaks; biarticular RF / ST load both).
+  double peak_torque = 0;
+  const ContractionProgramme planned = IsometricProgrammeOf(sub.human, 0);
+  for (const ContractionBlock& blk : planned.blocks())
+    for (int jj = 0; jj < 2; ++jj)
+      peak_torque = std::max(peak_torque, std::abs(IsometricTorque(jj, mp.alpha.col(jj), blk.peak)));
+  const double scale = std::min(1.0, kIsometricTorqueBudget / peak_torque);
+  sub.human.levels[0] *= scale;
+  sub.human.levels[1] *= scale;
+  m[std::string("iso_level_scale_") + kJoint[j]] = scale;
+  const ContractionProgramme prog = IsometricProgrammeOf(sub.human, 0);
+  sub.protocol.duration = prog.duration() + kTail;
+  const std::string tag = std::string("isometric_") + kJoint[j];
+  const RunResult r = RunTrial(sub, tag, MixSeed(result.seed ^ (0x69736f00ull + j)), opt);
+  totals.Absorb(r, tag, result);
+  const std::string path = opt.out_dir + "/" + tag + "/measured.csv";
+  const MeasuredData d = ReadMeasuredCsv(path);
+  const std::vector<std::vector<double>> env = Envelopes(d.table, path);
+  const std::vector<double>& tau_S = j == 0 ? d.tau_hip : d.tau_knee;
+  // The sensor reads gravity of the held leg plus the muscles: its relaxed reading before the
+  // first contraction is subtracted, so tau^ISO is the muscular torque alone (sec. 4.3).
+  const auto base = Window(d.t, kHoldRamp + 0.1, prog.blocks().front().t_start);
+  if (base.second - base.first < 100) throw InputError(s.source + ": isometric trial: no relaxed lead-in");
+  const double offset = RestLevel(tau_S, base.first, base.second);  // mean relaxed reading
+  const auto all = Window(d.t, kHoldRamp + 0.1, prog.duration() + 0.5);
+  std::vector<MuscleVec> le;
+  std::vector<double> tau;
+  for (size_t k = all.first; k < all.second; ++k) {
+    le.push_back(Normalized(env, k, mvc));
+    tau.push_back(tau_S[k] - offset);
+  }
+  iso.fit = FitIsometricAlpha(j, le, tau);  // eq. (25)
+  // Table 6 per direction: the contractions of that direction (even blocks act along +q).
+  for (int dir = 0; dir < 2; ++dir) {
+    std::vector<double> y, yhat;
+    for (size_t b = 0; b < prog.blocks().size(); ++b) {
+      const ContractionBlock& blk = prog.blocks()[b];
+      const bool plus_q = b % 2 == 0;
+      const bool flexion = j == 0 ? plus_q : !plus_q;  // hip flexion +q, knee flexion -q
+      if (flexion != (dir == 0)) continue;
+      const auto w = Window(d.t, blk.t_start, blk.t_start + 2 * blk.ramp + blk.hold);
+      for (size_t k = w.first; k < w.second; ++k) {
+        y.push_back(tau_S[k] - offset);
+        yhat.push_back(IsometricTorque(j, iso.fit.alpha, Normalized(env, k, mvc)));
       }
-      if (y.empty()) throw InputError(s.source + ": human.contractions: expected at least 2 (one per direction)");
-      iso[j].dir[dir] = Quality(y, yhat);
-      const std::string key = std::string(kJoint[j]) + (dir == 0 ? "_flexion" : "_extension");
-      m["iso_r2_" + key] = iso[j].dir[dir].r2;
-      m["iso_nrms_" + key + "_pct"] = iso[j].dir[dir].nrms_pct;
+    }
+    if (y.empty()) throw InputError(s.source + ": human.contractions: expected at least 2 (one per direction)");
+    iso.dir[dir] = Quality(y, yhat);
+    const std::string key = std::string(kJoint[j]) + (dir == 0 ? "_flexion" : "_extension");
+    m["iso_r2_" + key] = iso.dir[dir].r2;
+    m["iso_nrms_" + key + "_pct"] = iso.dir[dir].nrms_pct;
+  }
+  m[std::string("iso_r2_") + kJoint[j]] = iso.fit.quality.r2;
+  m[std::string("iso_nrms_") + kJoint[j] + "_pct"] = iso.fit.quality.nrms_pct;
+  for (int c = 0; c < kNumMuscles; ++c)
+    if (ActionSign(MuscleAt(c), j) != 0)
+      m[std::string("alpha_") + MuscleName(MuscleAt(c)) + "_" + kJoint[j]] = iso.fit.alpha[c];
+  return iso;
+}
+
+// Table 6 summary over both joints and directions: iso_r2_mean, iso_nrms_mean_pct, iso_r2_min,
+// iso_nrms_max_pct.
+void IsometricSummary(const IsometricResult iso[2], RunResult& result) {
+  double r2_sum = 0, nrms_sum = 0, r2_min = 1, nrms_max = 0;
+  for (int j = 0; j < 2; ++j)
+    for (int dir = 0; dir < 2; ++dir) {
       r2_sum += iso[j].dir[dir].r2;
       nrms_sum += iso[j].dir[dir].nrms_pct;
       r2_min = std::min(r2_min, iso[j].dir[dir].r2);
       nrms_max = std::max(nrms_max, iso[j].dir[dir].nrms_pct);
     }
-    m[std::string("iso_r2_") + kJoint[j]] = iso[j].fit.quality.r2;
-    m[std::string("iso_nrms_") + kJoint[j] + "_pct"] = iso[j].fit.quality.nrms_pct;
-    for (int c = 0; c < kNumMuscles; ++c)
-      if (ActionSign(MuscleAt(c), j) != 0)
-        m[std::string("alpha_") + MuscleName(MuscleAt(c)) + "_" + kJoint[j]] = iso[j].fit.alpha[c];
-  }
+  auto& m = result.metrics;
   m["iso_r2_mean"] = r2_sum / 4;
   m["iso_nrms_mean_pct"] = nrms_sum / 4;
   m["iso_r2_min"] = r2_min;
   m["iso_nrms_max_pct"] = nrms_max;
+}
 
-  // 3. Exaggerated gait (eq. 9, 26-28, Table 7) with three parameter sets for tau_PAS.
-  BetaGammaFit dyn[3][2];
-  if (cal.dynamic) {
-    Scenario sub = s;
-    sub.protocol.trajectory = TrajectoryKind::kGait;
-    sub.protocol.stride_period = kStride;
-    sub.protocol.ramp = kGaitRamp;
-    sub.human.behaviour = "exaggerated_gait";
-    const double t_end = s.human.active_from + cal.strides * kStride;
-    sub.protocol.duration = t_end + kTail;
-    const RunResult r = RunTrial(sub, "gait", MixSeed(result.seed ^ 0x67616974ull), opt);
-    absorb(r, "gait");
-    m["gait_tracking_rms_hip_deg"] = r.metrics.at("tracking_rms_hip_deg");
-    m["gait_tracking_rms_knee_deg"] = r.metrics.at("tracking_rms_knee_deg");
-    const std::string path = opt.out_dir + "/gait/measured.csv";
-    const MeasuredData d = ReadMeasuredCsv(path);
-    const Kinematics kin = DeriveKinematics(d);  // zero-phase 20 Hz Butterworth, as sec. 3.2
-    const std::vector<std::vector<double>> env = Envelopes(d.table, path);
-    LegParams model[3];
-    model[0] = ResolveSubject(s);  // the subject's identified parameters (Table 4; twin truth)
-    model[0].passive = PassiveModel::kRiener1999;
-    model[1] = model[2] = model[0];
-    model[1].human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, subject->weight, model[0].L1, subject->L2);
-    model[2].human = Table4AnthropometricLumped(AnthropometricModel::kDempster, subject->weight, model[0].L1, subject->L2);
-    // Fitted window: the exaggerated strides, or the whole trial after the gait fade-in (fit_window).
-    const double t_fit = cal.fit_window == "trial" ? std::min(kGaitRamp, s.human.active_from) : s.human.active_from;
-    const auto w = Window(d.t, t_fit, t_end);
-    m["dyn_fit_window_s"] = t_end - t_fit;
-    std::vector<MuscleVec> le;
-    std::vector<double> q[2], qd[2], tau_M[3][2];
-    for (size_t k = w.first; k < w.second; ++k) {
-      le.push_back(normalized(env, k));
-      const Eigen::Vector2d qk(kin.q[0][k], kin.q[1][k]), qdk(kin.qd[0][k], kin.qd[1][k]),
-          qddk(kin.qdd[0][k], kin.qdd[1][k]);
-      for (int j = 0; j < 2; ++j) {
-        q[j].push_back(qk[j]);
-        qd[j].push_back(qdk[j]);
-      }
-      for (int mi = 0; mi < 3; ++mi) {
-        // Eq. (9)-(10): tau_M = tau_S - tau_PAS, tau_PAS = -(the actuator torque the relaxed leg needs).
-        const Eigen::Vector2d tm = Eigen::Vector2d(d.tau_hip[k], d.tau_knee[k]) + ActuatorTorque(model[mi], qk, qdk, qddk);
-        for (int j = 0; j < 2; ++j) tau_M[mi][j].push_back(tm[j]);
-      }
-    }
+// Samples of the fitted window of the gait trial: LE per sample, q (rad), qd (rad/s) per joint, and
+// tau_M of eq. (9) (N m) per parameter set (kModel order) and joint.
+struct GaitSamples {
+  std::vector<MuscleVec> le;
+  std::vector<double> q[2], qd[2], tau_M[3][2];
+};
+
+// Stage 3: the exaggerated gait at 2 km/h through the runner into DIR/gait/; returns the fitted
+// window's samples, tau_M = eq. (9) with the identified, De Leva and Dempster parameter sets.
+GaitSamples DynamicTrialStage(const Scenario& s, const Subject& subject, const MuscleVec& mvc,
+                              const RunOptions& opt, RunResult& result, TrialTotals& totals) {
+  const EmgCalibrationSpec& cal = *s.emg_calibration;
+  auto& m = result.metrics;
+  Scenario sub = s;
+  sub.protocol.trajectory = TrajectoryKind::kGait;
+  sub.protocol.stride_period = kStride;
+  sub.protocol.ramp = kGaitRamp;
+  sub.human.behaviour = "exaggerated_gait";
+  const double t_end = s.human.active_from + cal.strides * kStride;
+  sub.protocol.duration = t_end + kTail;
+  const RunResult r = RunTrial(sub, "gait", MixSeed(result.seed ^ 0x67616974ull), opt);
+  totals.Absorb(r, "gait", result);
+  m["gait_tracking_rms_hip_deg"] = r.metrics.at("tracking_rms_hip_deg");
+  m["gait_tracking_rms_knee_deg"] = r.metrics.at("tracking_rms_knee_deg");
+  const std::string path = opt.out_dir + "/gait/measured.csv";
+  const MeasuredData d = ReadMeasuredCsv(path);
+  const Kinematics kin = DeriveKinematics(d);  // zero-phase 20 Hz Butterworth, as sec. 3.2
+  const std::vector<std::vector<double>> env = Envelopes(d.table, path);
+  LegParams model[3];
+  model[0] = ResolveSubject(s);  // the subject's identified parameters (Table 4; twin truth)
+  model[0].passive = PassiveModel::kRiener1999;
+  model[1] = model[2] = model[0];
+  model[1].human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, subject.weight, model[0].L1, subject.L2);
+  model[2].human = Table4AnthropometricLumped(AnthropometricModel::kDempster, subject.weight, model[0].L1, subject.L2);
+  // Fitted window: the exaggerated strides, or the whole trial after the gait fade-in (fit_window).
+  const double t_fit = cal.fit_window == "trial" ? std::min(kGaitRamp, s.human.active_from) : s.human.active_from;
+  const auto w = Window(d.t, t_fit, t_end);
+  m["dyn_fit_window_s"] = t_end - t_fit;
+  GaitSamples g;
+  for (size_t k = w.first; k < w.second; ++k) {
+    g.le.push_back(Normalized(env, k, mvc));
+    const Eigen::Vector2d qk(kin.q[0][k], kin.q[1][k]), qdk(kin.qd[0][k], kin.qd[1][k]),
+        qddk(kin.qdd[0][k], kin.qdd[1][k]);
     for (int j = 0; j < 2; ++j) {
-      std::vector<double> yhat_identified;  // eq. (27) with the identified set's beta, gamma
-      for (int mi = 0; mi < 3; ++mi) {
-        dyn[mi][j] = FitDynamicBetaGamma(j, iso[j].fit.alpha, mp.theta_c[j], le, q[j], qd[j], tau_M[mi][j]);
-        const std::string key = std::string(kModel[mi]) + "_" + kJoint[j];
-        m["dyn_r2_" + key] = dyn[mi][j].quality.r2;
-        m["dyn_nrms_" + key + "_pct"] = dyn[mi][j].quality.nrms_pct;
-        m["dyn_beta_" + key + "_e3_per_deg"] = 1e3 * dyn[mi][j].beta_per_deg();
-        m["dyn_gamma_" + key + "_e3_per_deg_s"] = 1e3 * dyn[mi][j].gamma_per_deg_s();
-        if (mi == 0) {
-          for (size_t k = 0; k < le.size(); ++k)
-            yhat_identified.push_back(DynamicTorque(j, iso[j].fit.alpha, dyn[0][j].beta, dyn[0][j].gamma,
-                                                    mp.theta_c[j], le[k], q[j][k], qd[j][k]));
-          continue;
-        }
-        m["r2_margin_" + key] = dyn[0][j].quality.r2 - dyn[mi][j].quality.r2;
-        // How far the anthropometric model moves tau_M from the identified one, how much of that
-        // shift is a copy of the effort itself (correlation with tau_M), and the R^2 the set would
-        // get without refitting beta, gamma (the identified set's): the refit's share of the margin.
-        double e2 = 0;
-        std::vector<double> shift;
-        for (size_t k = 0; k < tau_M[0][j].size(); ++k) {
-          shift.push_back(tau_M[mi][j][k] - tau_M[0][j][k]);
-          e2 += shift.back() * shift.back();
-        }
-        m["tau_M_shift_rms_" + key] = std::sqrt(e2 / tau_M[0][j].size());
-        m["tau_M_shift_effort_corr_" + key] = Pearson(shift, tau_M[0][j]);
-        m["r2_margin_fixed_beta_gamma_" + key] = dyn[0][j].quality.r2 - Quality(tau_M[mi][j], yhat_identified).r2;
-      }
-      double s2 = 0;
-      for (double v : tau_M[0][j]) s2 += v * v;
-      m[std::string("tau_M_rms_identified_") + kJoint[j]] = std::sqrt(s2 / tau_M[0][j].size());
+      g.q[j].push_back(qk[j]);
+      g.qd[j].push_back(qdk[j]);
+    }
+    for (int mi = 0; mi < 3; ++mi) {
+      // Eq. (9)-(10): tau_M = tau_S - tau_PAS, tau_PAS = -(the actuator torque the relaxed leg needs).
+      const Eigen::Vector2d tm =
+          controller::MuscularTorque(model[mi], qk, qdk, qddk, Eigen::Vector2d(d.tau_hip[k], d.tau_knee[k]));
+      for (int j = 0; j < 2; ++j) g.tau_M[mi][j].push_back(tm[j]);
     }
   }
-  m["safe_state_entered"] = safe;
-  m["samples"] = samples;  // logged by the runner trials (the MVC records are not counted)
-  m["torque_max_hip"] = torque_max[0];
-  m["torque_max_knee"] = torque_max[1];
+  return g;
+}
 
-  // calibration.csv: one row per stage, joint and parameter set; calibration.json: the same + MVC.
+// Stage 4: eq. (28) beta, gamma per parameter set and joint on the gait samples (Table 7), into
+// fit[model][joint]; dyn_*, r2_margin_*, tau_M_* metrics.
+void DynamicFitStage(const GaitSamples& g, const IsometricResult iso[2], const MuscleParams& mp,
+                     BetaGammaFit fit[3][2], RunResult& result) {
+  auto& m = result.metrics;
+  const std::vector<MuscleVec>& le = g.le;
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> yhat_identified;  // eq. (27) with the identified set's beta, gamma
+    for (int mi = 0; mi < 3; ++mi) {
+      fit[mi][j] = FitDynamicBetaGamma(j, iso[j].fit.alpha, mp.theta_c[j], le, g.q[j], g.qd[j], g.tau_M[mi][j]);
+      const std::string key = std::string(kModel[mi]) + "_" + kJoint[j];
+      m["dyn_r2_" + key] = fit[mi][j].quality.r2;
+      m["dyn_nrms_" + key + "_pct"] = fit[mi][j].quality.nrms_pct;
+      m["dyn_beta_" + key + "_e3_per_deg"] = 1e3 * fit[mi][j].beta_per_deg();
+      m["dyn_gamma_" + key + "_e3_per_deg_s"] = 1e3 * fit[mi][j].gamma_per_deg_s();
+      if (mi == 0) {
+        for (size_t k = 0; k < le.size(); ++k)
+          yhat_identified.push_back(DynamicTorque(j, iso[j].fit.alpha, fit[0][j].beta, fit[0][j].gamma,
+                                                  mp.theta_c[j], le[k], g.q[j][k], g.qd[j][k]));
+        continue;
+      }
+      m["r2_margin_" + key] = fit[0][j].quality.r2 - fit[mi][j].quality.r2;
+      // How far the anthropometric model moves tau_M from the identified one, how much of that
+      // shift is a copy of the effort itself (correlation with tau_M), and the R^2 the set would
+      // get without refitting beta, gamma (the identified set's): the refit's share of the margin.
+      double e2 = 0;
+      std::vector<double> shift;
+      for (size_t k = 0; k < g.tau_M[0][j].size(); ++k) {
+        shift.push_back(g.tau_M[mi][j][k] - g.tau_M[0][j][k]);
+        e2 += shift.back() * shift.back();
+      }
+      m["tau_M_shift_rms_" + key] = std::sqrt(e2 / g.tau_M[0][j].size());
+      m["tau_M_shift_effort_corr_" + key] = Pearson(shift, g.tau_M[0][j]);
+      m["r2_margin_fixed_beta_gamma_" + key] = fit[0][j].quality.r2 - Quality(g.tau_M[mi][j], yhat_identified).r2;
+    }
+    double s2 = 0;
+    for (double v : g.tau_M[0][j]) s2 += v * v;
+    m[std::string("tau_M_rms_identified_") + kJoint[j]] = std::sqrt(s2 / g.tau_M[0][j].size());
+  }
+}
+
+// Stage 5: DIR/calibration.csv (one row per stage, joint and parameter set) and DIR/calibration.json
+// (the same + MVC); dyn null when the dynamic stage did not run. Adds both files to result.
+void ReportStage(const Scenario& s, const MuscleVec& mvc, const IsometricResult iso[2], const BetaGammaFit (*dyn)[2],
+                 const RunOptions& opt, RunResult& result) {
   std::vector<std::string> names = {"stage", "joint", "model"};
   for (int c = 0; c < kNumMuscles; ++c) names.push_back(std::string("alpha_") + MuscleName(MuscleAt(c)));
   for (const char* n : {"beta", "gamma", "r2", "nrms_pct"}) names.push_back(n);
@@ -347,7 +380,7 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
     for (int dir = 0; dir < 2; ++dir)
       ij[dir == 0 ? "flexion" : "extension"] = {{"r2", iso[j].dir[dir].r2}, {"nrms_pct", iso[j].dir[dir].nrms_pct}};
   }
-  if (cal.dynamic)
+  if (dyn)
     for (int mi = 0; mi < 3; ++mi)
       for (int j = 0; j < 2; ++j) {
         row(1, j, mi, iso[j].fit.alpha, dyn[mi][j].beta, dyn[mi][j].gamma, dyn[mi][j].quality);
@@ -362,6 +395,34 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
   WriteFileAtomic(opt.out_dir + "/calibration.json", js.dump(2) + "\n");
   result.files.push_back("calibration.csv");
   result.files.push_back("calibration.json");
+}
+
+// The whole protocol for one subject (s.subject, s.human.muscle_seed) into opt.out_dir: files and
+// metrics, no result.json. Stages 1-5 above, in order.
+RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t seed) {
+  RunResult result;
+  result.scenario = s.name;
+  result.seed = seed;
+  fs::create_directories(opt.out_dir);
+  const std::optional<Subject> subject = ScenarioSubject(s);
+  if (!subject) throw InputError(s.source + ": subject: emg_calibration needs preset or random_seed");
+  const MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
+  TrialTotals totals;
+
+  const MuscleVec mvc = MvcStage(s, mp, opt, result);
+  IsometricResult iso[2];
+  for (int j = 0; j < 2; ++j) iso[j] = IsometricStage(s, j, mp, mvc, opt, result, totals);
+  IsometricSummary(iso, result);
+  BetaGammaFit dyn[3][2];
+  const bool dynamic = s.emg_calibration->dynamic;
+  if (dynamic) DynamicFitStage(DynamicTrialStage(s, *subject, mvc, opt, result, totals), iso, mp, dyn, result);
+
+  auto& m = result.metrics;
+  m["safe_state_entered"] = totals.safe;
+  m["samples"] = totals.samples;  // logged by the runner trials (the MVC records are not counted)
+  m["torque_max_hip"] = totals.torque_max[0];
+  m["torque_max_knee"] = totals.torque_max[1];
+  ReportStage(s, mvc, iso, dynamic ? dyn : nullptr, opt, result);
   return result;
 }
 

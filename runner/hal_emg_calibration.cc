@@ -5,12 +5,12 @@
 #include <cmath>
 #include <vector>
 
-#include "controller/emg_processing.h"
+#include "dsp/emg_envelope.h"
 #include "hwsim/emg_amplifier.h"
 
 namespace exotwin {
 
-HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConfig& emg_cfg,
+controller::HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConfig& emg_cfg,
                                    const HalEmgCalibrationSpec& spec, uint64_t seed) {
   // Blocks: extension (VM + RF) and flexion (ST + GAS) alternating; within a group the drive is
   // proportional to alpha, as the operator's own allocation of a knee torque (sim/muscles.h).
@@ -40,7 +40,7 @@ HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConf
   MuscleModel muscles(p, 1e-3);
   SyntheticEmg emg(emg_cfg, seed);
   hwsim::EmgAmplifier amp;
-  RmsEnvelope rms_e(1000.0, spec.rms_window), rms_f(1000.0, spec.rms_window);
+  dsp::RmsEnvelope rms_e(1000.0, spec.rms_window), rms_f(1000.0, spec.rms_window);
   const Eigen::Vector2d q(1.5707963267948966, -1.5707963267948966), qd(0, 0);  // th_HAL = 0
   std::vector<double> Ee, te, Ef, tf;
   double pe = 0, pf = 0;  // summed envelope power at rest, V^2
@@ -62,15 +62,15 @@ HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConf
     if (tau >= 0) Ee.push_back(E_e), te.push_back(tau);
     if (tau <= 0) Ef.push_back(E_f), tf.push_back(-tau);
   }
-  HalEmgCoefficients c;
+  controller::HalEmgCoefficients c;
   if (spec.noise_correction && n_rest > 0) {
     c.baseline_e = std::sqrt(pe / n_rest);
     c.baseline_f = std::sqrt(pf / n_rest);
-    for (double& E : Ee) E = NoiseCorrectedEnvelope(E, c.baseline_e);
-    for (double& E : Ef) E = NoiseCorrectedEnvelope(E, c.baseline_f);
+    for (double& E : Ee) E = controller::NoiseCorrectedEnvelope(E, c.baseline_e);
+    for (double& E : Ef) E = controller::NoiseCorrectedEnvelope(E, c.baseline_f);
   }
-  c.extensor = FitEmgToTorque(Ee, te);
-  c.flexor = FitEmgToTorque(Ef, tf);
+  c.extensor = controller::FitEmgToTorque(Ee, te);
+  c.flexor = controller::FitEmgToTorque(Ef, tf);
   return c;
 }
 

@@ -29,7 +29,7 @@ struct HalEmgCalibrationSpec {
 // Runs the calibration exercise with the subject's muscles `p` and EMG `emg` (seeded by `seed`);
 // returns the eq. (2) coefficients (a in N m/V, b in N m) and the relaxed baselines (V).
 // Deterministic for a seed.
-HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConfig& emg,
+controller::HalEmgCoefficients CalibrateHalEmg(const MuscleParams& p, const SyntheticEmgConfig& emg,
                                    const HalEmgCalibrationSpec& spec, uint64_t seed);
 
 }  // namespace exotwin

@@ -84,7 +84,7 @@ MuscleParams OperatorMuscles(const Scenario& s) {
 }
 
 controller::HalLoopConfig LoopConfig(const Scenario& s, const Hal3PlantParams& pp,
-                                     const HalEmgCoefficients& emg, double B_v) {
+                                     const controller::HalEmgCoefficients& emg, double B_v) {
   controller::HalLoopConfig c;
   const std::string& mode = s.hal.mode;
   c.mode = mode == "none" ? controller::HalMode::kNone
@@ -100,7 +100,7 @@ controller::HalLoopConfig LoopConfig(const Scenario& s, const Hal3PlantParams& p
   // is not compensated (I_v = I: a causal acceleration estimate from a potentiometer is too noisy).
   c.impedance.actual = {pp.hal_I(), pp.R, pp.hal_mgl(), pp.C};
   c.impedance.target = {pp.hal_I(), B_v, pp.hal_mgl(), 0.0};
-  HalAssistConfig& a = c.assist;
+  controller::HalAssistConfig& a = c.assist;
   a.dt = 1.0 / s.controller.rate_hz;
   a.alpha_mu = s.hal.alpha_mu;
   a.alpha_zeta = s.hal.alpha_zeta;
@@ -139,7 +139,7 @@ TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, doubl
   const SyntheticEmgConfig emg_cfg = DefaultSyntheticEmgConfig();
   const HalEmgCalibrationSpec cal{kExt, kFlex, kRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
                                   s.hal.calibration_rest};
-  const HalEmgCoefficients coeffs = CalibrateHalEmg(mp, emg_cfg, cal, seed + 11);
+  const controller::HalEmgCoefficients coeffs = CalibrateHalEmg(mp, emg_cfg, cal, seed + 11);
   MuscleModel muscles(mp, dt);
   TrackingGains gains = KneeSwingBehaviour::KneeSwingGains();
   gains.inertia[1] = pp.I();  // a rehearsed operator knows its leg + HAL (Hayashi sec. III)

@@ -16,6 +16,8 @@
 
 #include "core/rng.h"
 #include "core/units.h"
+#include "dsp/emg_envelope.h"
+#include "dsp/mvc.h"
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
 #include "sim/subjects.h"
@@ -57,7 +59,7 @@ Record RunTrial(const MuscleParams& p, Behaviour& b, double T, Kin kin, uint64_t
     r.q.push_back(q);
     r.qd.push_back(qd);
   }
-  for (int c = 0; c < kNumMuscles; ++c) r.env.push_back(OfflineLinearEnvelope(amp[c], 1000.0, envelope_hz));
+  for (int c = 0; c < kNumMuscles; ++c) r.env.push_back(dsp::LinearEnvelopeZeroPhase(amp[c], 1000.0, envelope_hz));
   if (oracle)
     for (int c = 0; c < kNumMuscles; ++c) r.env[c] = e_true[c];
   return r;
@@ -81,7 +83,7 @@ MuscleVec MeasureMvc(const MuscleParams& p, uint64_t seed, MuscleVec* peak_over_
     std::vector<std::pair<size_t, size_t>> w;
     for (const auto& b : prog.blocks())
       w.push_back({static_cast<size_t>(b.t_start / kDt), static_cast<size_t>((b.t_start + 2 * b.ramp + b.hold) / kDt)});
-    mvc[m] = MvcOfTrials(r.env[m], w);
+    mvc[m] = dsp::MvcOfTrials(r.env[m], w);
     if (rest) (*rest)[m] = RestLevel(r.env[m], 200, 700);  // relaxed before the first trial (t0 = 1 s)
     double s = 0;
     size_t n = 0;

@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-namespace exotwin {
+namespace exotwin::controller {
 namespace {
 
 struct Knee {  // I thdd + (D + R) thd + K th + mgl sin th = u
@@ -326,4 +326,4 @@ TEST(HalAssist, AssistLowersExtensorEffortInSwingUp) {
 }
 
 }  // namespace
-}  // namespace exotwin
+}  // namespace exotwin::controller

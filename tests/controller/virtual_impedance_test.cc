@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-namespace exotwin {
+namespace exotwin::controller {
 namespace {
 
 TEST(VirtualImpedance, LeeSankaiCriteria) {
@@ -54,4 +54,4 @@ TEST(VirtualImpedance, CompensatedLinkBehavesAsTheVirtualImpedance) {
 }
 
 }  // namespace
-}  // namespace exotwin
+}  // namespace exotwin::controller

@@ -17,6 +17,7 @@
 #include "analysis/emg_calibration.h"
 #include "analysis/measured_data.h"
 #include "core/error.h"
+#include "dsp/emg_envelope.h"
 #include "model/leg_dynamics.h"
 #include "runner/runner.h"
 #include "runner/table5_protocol.h"
@@ -113,7 +114,7 @@ TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
   for (int c = 0; c < kNumMuscles; ++c) {
     const Muscle mu = MuscleAt(c);
     const CsvTable t = ReadCsv(out + "/mvc/mvc_" + MuscleName(mu) + ".csv");
-    const std::vector<double> env = OfflineLinearEnvelope(t.columns[t.Find(std::string("emg_") + MuscleName(mu))]);
+    const std::vector<double> env = dsp::LinearEnvelopeZeroPhase(t.columns[t.Find(std::string("emg_") + MuscleName(mu))]);
     double plateau = 0;
     size_t n = 0;
     const ContractionProgramme prog = MvcProgramme(mu);

@@ -1,0 +1,26 @@
+// Zero-phase derivatives: see derivatives.h.
+#include "dsp/derivatives.h"
+
+#include "dsp/butterworth.h"
+
+namespace exotwin::dsp {
+
+std::vector<double> Gradient(const std::vector<double>& x, double dt) {
+  const size_t n = x.size();
+  std::vector<double> d(n, 0.0);
+  if (n < 2) return d;
+  d[0] = (x[1] - x[0]) / dt;
+  d[n - 1] = (x[n - 1] - x[n - 2]) / dt;
+  for (size_t i = 1; i + 1 < n; ++i) d[i] = (x[i + 1] - x[i - 1]) / (2.0 * dt);
+  return d;
+}
+
+Derivatives ZeroPhaseDerivatives(const std::vector<double>& x, double dt, double fc) {
+  Derivatives d;
+  d.filtered = FiltFilt(DesignButterworth(2, BandType::kLowPass, 1.0 / dt, fc), x);
+  d.first = Gradient(d.filtered, dt);
+  d.second = Gradient(d.first, dt);
+  return d;
+}
+
+}  // namespace exotwin::dsp
