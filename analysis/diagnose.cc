@@ -154,19 +154,9 @@ double DominantHz(const std::vector<double>& t, const std::vector<double>& x, si
   return best_f;
 }
 
-}  // namespace
-
-Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
-                   const DiagnoseOptions& opt) {
-  // EXOTWIN_DIAG_TIMING=1 prints the time of each stage to stderr.
-  const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
-  auto clock0 = std::chrono::steady_clock::now();
-  auto Lap = [&](const char* what) {
-    if (!timing) return;
-    const auto now = std::chrono::steady_clock::now();
-    std::fprintf(stderr, "diagnose: %-28s %8.3f s\n", what, std::chrono::duration<double>(now - clock0).count());
-    clock0 = now;
-  };
+// Stage 0: the records and options are fit for a diagnosis (>= 200 samples each, holdout 0.1..0.5,
+// 0..6 effects, one device); throws InputError otherwise.
+void CheckInputs(const std::vector<const MeasuredData*>& records, const DiagnoseOptions& opt) {
   if (records.empty()) throw InputError("diagnose: expected at least one measured record");
   for (const MeasuredData* d : records)
     if (d->size() < 200)
@@ -176,81 +166,105 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     throw InputError("holdout fraction: expected 0.1 .. 0.5");
   if (!(opt.max_effects >= 0 && opt.max_effects <= 6)) throw InputError("max effects: expected 0 .. 6");
   CheckSameDevice(records);
-  Diagnosis D;
-  D.holdout_fraction = opt.holdout_fraction;
-  const size_t R = records.size();
-  D.leave_one_out = R >= 2;
+}
 
-  // 1. The derivative cutoff (chosen from the data unless given) and the parallel filter.
+// Stage 1: the derivative cutoff (Hz), given by the options (> 0) or chosen from the data for
+// parallel filtering (derivative_cutoff.h, CutoffUse::kParallel).
+CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                           const DiagnoseOptions& opt) {
   if (opt.cutoff_hz > 0) {
-    D.cutoff.hz = opt.cutoff_hz;
-    D.cutoff.why = "given (--cutoff " + NumberText(opt.cutoff_hz) + ")";
-  } else {
-    D.cutoff = ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel);
+    CutoffChoice c;
+    c.hz = opt.cutoff_hz;
+    c.why = "given (--cutoff " + NumberText(opt.cutoff_hz) + ")";
+    return c;
   }
-  Lap("cutoff choice");
+  return ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel);
+}
 
-  // 2. Every record: kinematics, measured torque filtered alike, the twin, the residual.
-  Plant plant(opt.mjcf.empty() ? ShippedModelFor(params) : opt.mjcf);
-  plant.SetParams(params);  // validates the realization
-  std::vector<Rec> recs(R);
-  for (size_t r = 0; r < R; ++r) {
-    const MeasuredData& data = *records[r];
-    Rec& rc = recs[r];
-    rc.data = &data;
-    // Parallel filtering (as in robot identification practice): the residual is low-passed at the
-    // chosen cutoff fc, the angles differentiated at DerivativeCutoffHz(fc), flat where fc passes,
-    // so that measured and predicted torque see one and the same filter.
-    const Kinematics full = DeriveKinematics(
-        data, D.cutoff.from_columns ? 20.0 : DerivativeCutoffHz(D.cutoff.hz, 1.0 / MedianStep(data.t)));
-    const bool filtered = full.derivative_source != "measured columns";
-    rc.hz = filtered ? D.cutoff.hz : 0.0;
-    const std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
-    // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
-    const double T = full.t.back() - full.t.front();
-    const double edge = std::min(0.5, 0.05 * T);
-    const size_t a = static_cast<size_t>(
-        std::lower_bound(full.t.begin(), full.t.end(), full.t.front() + edge) - full.t.begin());
-    const size_t b = static_cast<size_t>(
-        std::upper_bound(full.t.begin(), full.t.end(), full.t.back() - edge) - full.t.begin());
-    rc.kin = Slice(full, a, b);
-    for (int j = 0; j < 2; ++j) {
-      rc.raw[j].assign(meas[j].begin() + a, meas[j].begin() + b);
-      rc.meas[j] = rc.Filter(rc.raw[j]);
-    }
-    const Kinematics& kin = rc.kin;
-    const size_t n = kin.t.size();
-    const double t_split = kin.t.front() + (1 - opt.holdout_fraction) * (kin.t.back() - kin.t.front());
-    rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
-    // The twin: eq. (5)-(7) + P(q) + the model's own effects, which equals predict's MuJoCo inverse
-    // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
-    // run below is predict itself.
-    for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
-                                                 {kin.qdd[0][i], kin.qdd[1][i]});
-      rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
-    }
-    std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
-    ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
-    for (int j = 0; j < 2; ++j) {
-      rc.resid[j].resize(n);
-      for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.raw[j][i] - rc.tau_S[j][i];
-      rc.resid[j] = rc.Filter(rc.resid[j]);
-    }
+// Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
+// transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of its time,
+// the twin's torque (eq. 5-7 + P + the model's effects) and the filtered residual.
+void PrepareRecord(const LegParams& params, const MeasuredData& data, const CutoffChoice& cutoff,
+                   double holdout_fraction, Rec* out) {
+  Rec& rc = *out;
+  rc.data = &data;
+  // Parallel filtering (as in robot identification practice): the residual is low-passed at the
+  // chosen cutoff fc, the angles differentiated at DerivativeCutoffHz(fc), flat where fc passes,
+  // so that measured and predicted torque see one and the same filter.
+  const Kinematics full = DeriveKinematics(
+      data, cutoff.from_columns ? 20.0 : DerivativeCutoffHz(cutoff.hz, 1.0 / MedianStep(data.t)));
+  const bool filtered = full.derivative_source != "measured columns";
+  rc.hz = filtered ? cutoff.hz : 0.0;
+  const std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
+  // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
+  const double T = full.t.back() - full.t.front();
+  const double edge = std::min(0.5, 0.05 * T);
+  const size_t a = static_cast<size_t>(
+      std::lower_bound(full.t.begin(), full.t.end(), full.t.front() + edge) - full.t.begin());
+  const size_t b = static_cast<size_t>(
+      std::upper_bound(full.t.begin(), full.t.end(), full.t.back() - edge) - full.t.begin());
+  rc.kin = Slice(full, a, b);
+  for (int j = 0; j < 2; ++j) {
+    rc.raw[j].assign(meas[j].begin() + a, meas[j].begin() + b);
+    rc.meas[j] = rc.Filter(rc.raw[j]);
   }
-  // Noise per joint (first differences of the residual, pooled) and the row weights.
-  double w[2];
+  const Kinematics& kin = rc.kin;
+  const size_t n = kin.t.size();
+  const double t_split = kin.t.front() + (1 - holdout_fraction) * (kin.t.back() - kin.t.front());
+  rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
+  // The twin: eq. (5)-(7) + P(q) + the model's own effects, which equals predict's MuJoCo inverse
+  // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
+  // run (ScoreExtendedTwin) is predict itself.
+  for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
+                                               {kin.qdd[0][i], kin.qdd[1][i]});
+    rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
+  }
+  std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
+  ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
+  for (int j = 0; j < 2; ++j) {
+    rc.resid[j].resize(n);
+    for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.raw[j][i] - rc.tau_S[j][i];
+    rc.resid[j] = rc.Filter(rc.resid[j]);
+  }
+}
+
+// Stage 2b: white noise per joint (N m, >= 1e-6) from the first differences of the residuals,
+// pooled over records, into noise[]; the row weights 1/noise into w[].
+void NoiseAndWeights(const std::vector<Rec>& recs, double noise[2], double w[2]) {
   for (int j = 0; j < 2; ++j) {
     double s = 0, cnt = 0;
     for (const Rec& rc : recs)
       for (size_t i = 1; i < rc.n(); ++i) s += std::pow(rc.resid[j][i] - rc.resid[j][i - 1], 2), cnt += 1;
-    D.noise[j] = std::max(1e-6, std::sqrt(s / (2.0 * std::max(cnt, 1.0))));
-    w[j] = 1.0 / D.noise[j];
+    noise[j] = std::max(1e-6, std::sqrt(s / (2.0 * std::max(cnt, 1.0))));
+    w[j] = 1.0 / noise[j];
   }
-  Lap("kinematics + twin");
+}
 
-  // 3. Candidates per record (same columns), the kitchen-sink residual, the ripple search.
+// Residual of every bank after the kitchen-sink fit: all candidate columns at once, least squares
+// pooled over the banks (lightly regularized).
+std::vector<Eigen::VectorXd> KitchenSinkResiduals(const std::vector<ColumnBank>& banks) {
+  const Eigen::Index C = banks[0].X.cols();
+  Eigen::MatrixXd Gr = Eigen::MatrixXd::Zero(C, C);
+  Eigen::VectorXd br = Eigen::VectorXd::Zero(C);
+  for (const ColumnBank& b : banks) {
+    Gr.selfadjointView<Eigen::Lower>().rankUpdate(b.X.transpose());
+    br += b.X.transpose() * b.r;
+  }
+  Gr = Gr.selfadjointView<Eigen::Lower>();
+  Gr.diagonal() += 1e-9 * Gr.diagonal().cwiseMax(1e-300);
+  const Eigen::VectorXd c = Gr.ldlt().solve(br);
+  std::vector<Eigen::VectorXd> out;
+  for (const ColumnBank& b : banks) out.push_back(b.r - b.X * c);
+  return out;
+}
+
+// Stage 3: the candidate columns of every record (the same columns in each bank, rows weighted by
+// w), with the ripple candidates' frequency searched.
+std::vector<ColumnBank> CandidateColumns(const LegParams& params, const std::vector<Rec>& recs,
+                                         const double w[2], const DiagnoseOptions& opt) {
+  const size_t R = recs.size();
   std::vector<ColumnBank> banks;
   std::vector<const Kinematics*> kins;
   for (const Rec& rc : recs) {
@@ -258,32 +272,21 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
                                  std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn()));
     kins.push_back(&rc.kin);
   }
-  auto kitchen_sink = [&](std::vector<Eigen::VectorXd>* resid_out) {
-    const Eigen::Index C = banks[0].X.cols();
-    Eigen::MatrixXd Gr = Eigen::MatrixXd::Zero(C, C);
-    Eigen::VectorXd br = Eigen::VectorXd::Zero(C);
-    for (const ColumnBank& b : banks) {
-      Gr.selfadjointView<Eigen::Lower>().rankUpdate(b.X.transpose());
-      br += b.X.transpose() * b.r;
-    }
-    Gr = Gr.selfadjointView<Eigen::Lower>();
-    Gr.diagonal() += 1e-9 * Gr.diagonal().cwiseMax(1e-300);
-    const Eigen::VectorXd c = Gr.ldlt().solve(br);
-    resid_out->clear();
-    for (const ColumnBank& b : banks) resid_out->push_back(b.r - b.X * c);
-  };
-  {
-    std::vector<Eigen::VectorXd> e, raw;
-    kitchen_sink(&e);
-    for (const ColumnBank& b : banks) raw.push_back(b.r);
-    // Ripple frequency searched on what the other candidates leave and on the raw residual (a slow
-    // ripple, ~1 cycle over the range, is otherwise absorbed by the stiffness/gravity columns).
-    AddRippleCandidates(banks, kins, e);
-    AddRippleCandidates(banks, kins, raw);
-  }
-  Lap("columns + ripple search");
-  // Delay: replace the derivative column by the secant (tau_S(t - d) - tau_S(t)) / d at the single
-  // fit's d (pooled over records), twice, so the second-order term is not left for sensor_gain.
+  std::vector<Eigen::VectorXd> raw;
+  const std::vector<Eigen::VectorXd> e = KitchenSinkResiduals(banks);
+  for (const ColumnBank& b : banks) raw.push_back(b.r);
+  // Ripple frequency searched on what the other candidates leave and on the raw residual (a slow
+  // ripple, ~1 cycle over the range, is otherwise absorbed by the stiffness/gravity columns).
+  AddRippleCandidates(banks, kins, e);
+  AddRippleCandidates(banks, kins, raw);
+  return banks;
+}
+
+// Stage 3b: every sensor_delay column replaced by the secant (tau_S(t - d) - tau_S(t)) / d at the
+// single fit's delay d (s, pooled over records; kept when 1e-4 < d < 0.5), twice, so the
+// second-order term is not left for sensor_gain.
+void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io) {
+  std::vector<ColumnBank>& banks = *banks_io;
   for (int pass = 0; pass < 2; ++pass) {
     for (const auto& c : banks[0].candidates) {
       if (c.name != "sensor_delay") continue;
@@ -299,7 +302,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       }
       const double d = xx > 0 ? xr / xx : 0;
       if (!(d > 1e-4 && d < 0.5)) continue;
-      for (size_t r = 0; r < R; ++r) {
+      for (size_t r = 0; r < recs.size(); ++r) {
         const Rec& rc = recs[r];
         ColumnBank& b = banks[r];
         std::vector<double> tq(rc.n());
@@ -311,113 +314,124 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
       }
     }
   }
+}
+
+// Stage 3c: the pooled Gram matrices of the banks, the measured torque's scale on the held-out rows
+// (materiality), and the effective sample size from the autocorrelation length (rows, *tau_eff) of
+// what no candidate explains.
+Grams PooledGrams(const std::vector<Rec>& recs, const std::vector<ColumnBank>& banks, const double w[2],
+                  double* tau_eff) {
   Grams g = MakeGrams(banks);
-  for (size_t r = 0; r < R; ++r)  // the measured torque's scale on the held-out rows (materiality)
+  for (size_t r = 0; r < recs.size(); ++r)
     for (size_t k = 0; k < banks[r].sample.size(); ++k)
       if (!banks[r].train[k])
         for (int j = 0; j < 2; ++j) g.tt_te[j] += std::pow(w[j] * recs[r].meas[j][banks[r].sample[k]], 2);
-  {
-    // Autocorrelation length of what no candidate explains: kitchen sink incl. ripple.
-    std::vector<Eigen::VectorXd> e;
-    kitchen_sink(&e);
-    D.tau_eff = 1;
-    for (size_t r = 0; r < R; ++r) D.tau_eff = std::max(D.tau_eff, AutocorrLength(e[r], banks[r].sample.size()));
-    g.n_eff = g.n_tr / D.tau_eff;
-  }
-  const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
-  Lap("grams + noise");
+  // Autocorrelation length of what no candidate explains: kitchen sink incl. ripple.
+  const std::vector<Eigen::VectorXd> e = KitchenSinkResiduals(banks);
+  *tau_eff = 1;
+  for (size_t r = 0; r < recs.size(); ++r)
+    *tau_eff = std::max(*tau_eff, AutocorrLength(e[r], banks[r].sample.size()));
+  g.n_eff = g.n_tr / *tau_eff;
+  return g;
+}
 
-  // 4. Physical scale of the ranges, and the joint selection.
+// Stage 4: the physical scale of the records (angle and torque ranges, mean M_jj, the strap's
+// neglected dynamics J_c w^2, the compliant part's torque) for the plausibility ranges.
+PhysicalScale ScaleOf(const LegParams& params, const std::vector<Rec>& recs) {
   PhysicalScale scale;
-  {
-    const LumpedParams tot = params.Total();
-    const double Xd[2] = {tot.X1, tot.X2}, Yd[2] = {tot.Y1, tot.Y2};
-    LegParams rigid = params;
-    rigid.effects.clear();
-    for (int j = 0; j < 2; ++j) {
-      scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
-      scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
-      // Means over every record (strided): the twin's M_jj, the compliant part's J_c (the human when
-      // there is one, else the whole chain), and the motion's effective angular frequency
-      // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
-      // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
-      const LumpedParams& compliant = params.human ? *params.human : tot;
-      double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
-      for (const Rec& rc : recs) {
-        for (size_t i = 0; i < rc.n(); ++i) {
-          scale.q_min[j] = std::min(scale.q_min[j], rc.kin.q[j][i]);
-          scale.q_max[j] = std::max(scale.q_max[j], rc.kin.q[j][i]);
-          scale.tau_max[j] = std::max(scale.tau_max[j], std::abs(rc.meas[j][i]));
-        }
-        const size_t stride = std::max<size_t>(1, rc.n() / 4000);
-        for (size_t i = 0; i < rc.n(); i += stride) {
-          const Eigen::Vector2d q(rc.kin.q[0][i], rc.kin.q[1][i]), qd(rc.kin.qd[0][i], rc.kin.qd[1][i]),
-              qdd(rc.kin.qdd[0][i], rc.kin.qdd[1][i]);
-          msum += MassMatrix(tot, params.L1, q[1])(j, j);
-          jc += MassMatrix(compliant, params.L1, q[1])(j, j);
-          v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
-          scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
-        }
+  const LumpedParams tot = params.Total();
+  const double Xd[2] = {tot.X1, tot.X2}, Yd[2] = {tot.Y1, tot.Y2};
+  LegParams rigid = params;
+  rigid.effects.clear();
+  for (int j = 0; j < 2; ++j) {
+    scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
+    scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
+    // Means over every record (strided): the twin's M_jj, the compliant part's J_c (the human when
+    // there is one, else the whole chain), and the motion's effective angular frequency
+    // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
+    // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
+    const LumpedParams& compliant = params.human ? *params.human : tot;
+    double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
+    for (const Rec& rc : recs) {
+      for (size_t i = 0; i < rc.n(); ++i) {
+        scale.q_min[j] = std::min(scale.q_min[j], rc.kin.q[j][i]);
+        scale.q_max[j] = std::max(scale.q_max[j], rc.kin.q[j][i]);
+        scale.tau_max[j] = std::max(scale.tau_max[j], std::abs(rc.meas[j][i]));
       }
-      scale.M_jj[j] = msum / cnt;
-      scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
+      const size_t stride = std::max<size_t>(1, rc.n() / 4000);
+      for (size_t i = 0; i < rc.n(); i += stride) {
+        const Eigen::Vector2d q(rc.kin.q[0][i], rc.kin.q[1][i]), qd(rc.kin.qd[0][i], rc.kin.qd[1][i]),
+            qdd(rc.kin.qdd[0][i], rc.kin.qdd[1][i]);
+        msum += MassMatrix(tot, params.L1, q[1])(j, j);
+        jc += MassMatrix(compliant, params.L1, q[1])(j, j);
+        v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
+        scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
+      }
     }
+    scale.M_jj[j] = msum / cnt;
+    scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
   }
-  const Fit f0 = FitCols(g, {});
-  Fit chosen_fit;
-  SelectionTrace trace;
-  const std::vector<int> chosen = SelectEffects(bank, g, scale, opt.max_effects, D.leave_one_out, &chosen_fit, &trace);
-  D.selection = trace.steps;
+  return scale;
+}
+
+// Stage 4b: the report's candidate table into D->scores (the 12 best single candidates by BIC, then
+// the chosen set), single fits outside their physical range into D->implausible, and nearly
+// collinear candidate pairs (|cos| > 0.95 of their first columns, train rows) into D->collinear.
+void ScoreCandidates(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale, const Fit& f0,
+                     const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D) {
   auto gain = [&](const Fit& f) { return f0.sse_te > 0 ? 1 - f.sse_te / f0.sse_te : 0.0; };
-  {
-    std::vector<std::pair<double, size_t>> order;
-    std::vector<Fit> singles;
-    for (size_t c = 0; c < bank.candidates.size(); ++c) {
-      singles.push_back(FitCols(g, bank.candidates[c].cols));
-      order.push_back({singles.back().ok ? singles.back().bic : 1e300, c});
-    }
-    std::sort(order.begin(), order.end());
-    for (size_t i = 0; i < order.size() && i < 12; ++i) {
-      const Fit& f = singles[order[i].second];
-      const Candidate& c = bank.candidates[order[i].second];
-      D.scores.push_back({c.Label(), f.ok ? f.bic - f0.bic : 0, 100 * gain(f),
-                          std::find(chosen.begin(), chosen.end(), static_cast<int>(order[i].second)) != chosen.end()});
-      if (!f.ok || !(f.bic < f0.bic - kBicMargin)) continue;
-      const DiagnosedEffect e = ToEffect(c, f);
-      std::string why;
-      if (!Plausible(e, scale, &why))
-        D.implausible.push_back(c.Label() + " = " + NumberText(e.effect.value) + " " + e.effect.unit + ": " + why);
-    }
-    if (!chosen.empty()) {
-      std::string label;
-      for (int c : chosen) label += (label.empty() ? "" : " + ") + bank.candidates[c].Label();
-      D.scores.push_back({label, chosen_fit.bic - f0.bic, 100 * gain(chosen_fit), true});
-    }
+  std::vector<std::pair<double, size_t>> order;
+  std::vector<Fit> singles;
+  for (size_t c = 0; c < bank.candidates.size(); ++c) {
+    singles.push_back(FitCols(g, bank.candidates[c].cols));
+    order.push_back({singles.back().ok ? singles.back().bic : 1e300, c});
   }
-  // Nearly collinear candidates (first columns, train rows).
+  std::sort(order.begin(), order.end());
+  for (size_t i = 0; i < order.size() && i < 12; ++i) {
+    const Fit& f = singles[order[i].second];
+    const Candidate& c = bank.candidates[order[i].second];
+    D->scores.push_back({c.Label(), f.ok ? f.bic - f0.bic : 0, 100 * gain(f),
+                         std::find(chosen.begin(), chosen.end(), static_cast<int>(order[i].second)) != chosen.end()});
+    if (!f.ok || !(f.bic < f0.bic - kBicMargin)) continue;
+    const DiagnosedEffect e = ToEffect(c, f);
+    std::string why;
+    if (!Plausible(e, scale, &why))
+      D->implausible.push_back(c.Label() + " = " + NumberText(e.effect.value) + " " + e.effect.unit + ": " + why);
+  }
+  if (!chosen.empty()) {
+    std::string label;
+    for (int c : chosen) label += (label.empty() ? "" : " + ") + bank.candidates[c].Label();
+    D->scores.push_back({label, chosen_fit.bic - f0.bic, 100 * gain(chosen_fit), true});
+  }
   for (size_t a = 0; a < bank.candidates.size(); ++a)
     for (size_t b = a + 1; b < bank.candidates.size(); ++b) {
       const int ca = bank.candidates[a].cols[0], cb = bank.candidates[b].cols[0];
       if (ca == cb) continue;
       const double r = g.Gtr(ca, cb) / std::sqrt(g.Gtr(ca, ca) * g.Gtr(cb, cb) + 1e-300);
       if (std::abs(r) > 0.95)
-        D.collinear.push_back(bank.candidates[a].Label() + " ~ " + bank.candidates[b].Label() +
-                              " (|cos| = " + std::to_string(std::abs(r)).substr(0, 5) + ")");
+        D->collinear.push_back(bank.candidates[a].Label() + " ~ " + bank.candidates[b].Label() +
+                               " (|cos| = " + std::to_string(std::abs(r)).substr(0, 5) + ")");
     }
-  Lap("selection");
+}
 
-  // 5. The extension; exact refinement of the first-order values (delay, backlash, straps).
-  D.extended = params;
+// Stage 5: the extension D->extended = params + the chosen effects (D->effects); delay, backlash
+// and strap stiffness refined by golden search on the exact model (fit rows); each effect's share of
+// the held-out residual (leave-one-effect-out). Returns each effect's refined / linear value ratio.
+std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
+                                    const ColumnBank& bank, const Grams& g, const Fit& f0,
+                                    const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D) {
+  const size_t R = recs.size();
+  D->extended = params;
   std::vector<double> refine_ratio(chosen.size(), 1.0);
-  for (int c : chosen) D.effects.push_back(ToEffect(bank.candidates[c], chosen_fit));
-  for (auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  for (size_t k = 0; k < D.effects.size(); ++k) {
-    const std::string& nm = D.effects[k].effect.name;
+  for (int c : chosen) D->effects.push_back(ToEffect(bank.candidates[c], chosen_fit));
+  for (auto& de : D->effects) D->extended.effects.push_back(de.effect);
+  for (size_t k = 0; k < D->effects.size(); ++k) {
+    const std::string& nm = D->effects[k].effect.name;
     if (nm != "sensor_delay" && nm != "backlash" && nm != "series_compliance") continue;
     const size_t idx = params.effects.size() + k;
-    const double v0 = D.extended.effects[idx].value;
+    const double v0 = D->extended.effects[idx].value;
     auto obj = [&](double v) {
-      LegParams p = D.extended;
+      LegParams p = D->extended;
       p.effects[idx].value = v;
       double s = 0;
       for (const Rec& rc : recs)
@@ -433,135 +447,138 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
     }
     const double v = 0.5 * (lo + hi);
     refine_ratio[k] = v / v0;
-    D.extended.effects[idx].value = v;
-    D.effects[k].effect.value = v;
-    D.effects[k].ci_lo *= v / v0, D.effects[k].ci_hi *= v / v0;
+    D->extended.effects[idx].value = v;
+    D->effects[k].effect.value = v;
+    D->effects[k].ci_lo *= v / v0, D->effects[k].ci_hi *= v / v0;
   }
   // Share of the held-out residual each effect removes (joint linear model, leave-one-effect-out).
   for (size_t k = 0; k < chosen.size(); ++k) {
     std::vector<int> rest = chosen;
     rest.erase(rest.begin() + static_cast<long>(k));
     const Fit fr = FitCols(g, ColumnsOf(bank, rest));
-    D.effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
+    D->effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
   }
-  Lap("refinement");
+  return refine_ratio;
+}
 
-  // 6. The extended twin (predict) on every record's held-out part; with several records, each
-  // whole record predicted by the effects fitted on the others.
-  {
-    Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
-    ext_plant.SetParams(D.extended);
-    double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
-    const std::vector<int> cols = ColumnsOf(bank, chosen);
-    for (size_t r = 0; r < R; ++r) {
-      const Rec& rc = recs[r];
-      const size_t n = rc.n();
-      RecordScore rs;
-      rs.source = rc.data->source;
-      rs.samples = rc.data->size();
-      // The held-out run starts 1 s early so that its filters (EMG envelope, delay) have settled;
-      // only the held-out samples are scored.
-      const size_t warm = static_cast<size_t>(
-          std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
-      const Prediction held = PredictTorque(ext_plant, Slice(rc.kin, warm, n));
+// Stage 6: the extended twin (predict with D->extended) on every record's held-out part: the scores
+// per record and pooled (D->records, D->joints) and the first record's plot series; with several
+// records, each whole record predicted by the effects fitted on the others (D->left_out).
+void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, const ColumnBank& bank,
+                       const Grams& g, const std::vector<int>& chosen, const std::vector<double>& refine_ratio,
+                       const DiagnoseOptions& opt, Diagnosis* D_out) {
+  Diagnosis& D = *D_out;
+  const size_t R = recs.size();
+  Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
+  ext_plant.SetParams(D.extended);
+  double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
+  const std::vector<int> cols = ColumnsOf(bank, chosen);
+  for (size_t r = 0; r < R; ++r) {
+    const Rec& rc = recs[r];
+    const size_t n = rc.n();
+    RecordScore rs;
+    rs.source = rc.data->source;
+    rs.samples = rc.data->size();
+    // The held-out run starts 1 s early so that its filters (EMG envelope, delay) have settled;
+    // only the held-out samples are scored.
+    const size_t warm = static_cast<size_t>(
+        std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
+    const Prediction held = PredictTorque(ext_plant, Slice(rc.kin, warm, n));
+    for (int j = 0; j < 2; ++j) {
+      std::vector<double> ea(n - warm);
+      for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
+      ea = rc.Filter(ea, warm);
+      double b = 0, a = 0;
+      for (size_t i = rc.split; i < n; ++i) {
+        b += std::pow(rc.resid[j][i], 2);
+        a += std::pow(ea[i - warm], 2);
+      }
+      rs.split[j] = ScoreOf(b, a, static_cast<double>(std::max<size_t>(1, n - rc.split)));
+      sb[j] += b, sa[j] += a;
+      if (r == 0) {
+        D.measured[j] = rc.meas[j];
+        D.before[j].resize(n);
+        for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - rc.resid[j][i];
+        D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
+        for (size_t i = rc.split; i < n; ++i) D.after[j][i] = rc.meas[j][i] - ea[i - warm];
+      }
+    }
+    cnt += static_cast<double>(n - rc.split);
+    if (D.leave_one_out) {
+      LegParams p = params;
+      const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
+      if (!cols.empty() && x.size() == 0)
+        throw InputError(rc.data->source + ": without this record the chosen effects are not identifiable");
+      for (size_t k = 0; k < chosen.size(); ++k) {
+        Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
+        e.value *= refine_ratio[k];
+        p.effects.push_back(e);
+      }
+      Plant loo_plant(opt.mjcf.empty() ? ShippedModelFor(p) : opt.mjcf);
+      loo_plant.SetParams(p);
+      const Prediction whole = PredictTorque(loo_plant, rc.kin);
       for (int j = 0; j < 2; ++j) {
-        std::vector<double> ea(n - warm);
-        for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
-        ea = rc.Filter(ea, warm);
+        std::vector<double> ea(n);
+        for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
+        ea = rc.Filter(ea);
         double b = 0, a = 0;
-        for (size_t i = rc.split; i < n; ++i) {
-          b += std::pow(rc.resid[j][i], 2);
-          a += std::pow(ea[i - warm], 2);
-        }
-        rs.split[j] = ScoreOf(b, a, static_cast<double>(std::max<size_t>(1, n - rc.split)));
-        sb[j] += b, sa[j] += a;
-        if (r == 0) {
-          D.measured[j] = rc.meas[j];
-          D.before[j].resize(n);
-          for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - rc.resid[j][i];
-          D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
-          for (size_t i = rc.split; i < n; ++i) D.after[j][i] = rc.meas[j][i] - ea[i - warm];
-        }
+        for (size_t i = 0; i < n; ++i) b += std::pow(rc.resid[j][i], 2), a += std::pow(ea[i], 2);
+        rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
+        lb[j] += b, la[j] += a;
       }
-      cnt += static_cast<double>(n - rc.split);
-      if (D.leave_one_out) {
-        LegParams p = params;
-        const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
-        if (!cols.empty() && x.size() == 0)
-          throw InputError(rc.data->source + ": without this record the chosen effects are not identifiable");
-        for (size_t k = 0; k < chosen.size(); ++k) {
-          Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
-          e.value *= refine_ratio[k];
-          p.effects.push_back(e);
-        }
-        Plant loo_plant(opt.mjcf.empty() ? ShippedModelFor(p) : opt.mjcf);
-        loo_plant.SetParams(p);
-        const Prediction whole = PredictTorque(loo_plant, rc.kin);
-        for (int j = 0; j < 2; ++j) {
-          std::vector<double> ea(n);
-          for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
-          ea = rc.Filter(ea);
-          double b = 0, a = 0;
-          for (size_t i = 0; i < n; ++i) b += std::pow(rc.resid[j][i], 2), a += std::pow(ea[i], 2);
-          rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
-          lb[j] += b, la[j] += a;
-        }
-        lcnt += static_cast<double>(n);
-      }
-      D.records.push_back(rs);
+      lcnt += static_cast<double>(n);
     }
-    for (int j = 0; j < 2; ++j) {
-      D.joints[j] = ScoreOf(sb[j], sa[j], cnt);
-      if (D.leave_one_out) D.left_out[j] = ScoreOf(lb[j], la[j], lcnt);
+    D.records.push_back(rs);
+  }
+  for (int j = 0; j < 2; ++j) {
+    D.joints[j] = ScoreOf(sb[j], sa[j], cnt);
+    if (D.leave_one_out) D.left_out[j] = ScoreOf(lb[j], la[j], lcnt);
+  }
+}
+
+// Stage 7: structure the extended twin leaves in the first record's held-out residual (5 Hz
+// low-passed rms above 4x the low-passed noise, 0.05 N m and 15 % of rmse_before) into
+// D->unexplained, with its dominant frequency and correlations. Needs D->kin, split, measured, after.
+void FindUnexplained(Diagnosis* D_out) {
+  Diagnosis& D = *D_out;
+  const Kinematics& kin = D.kin;
+  const size_t n = kin.t.size();
+  const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
+  const double fs = 1.0 / dt;
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> e(n - D.split);
+    for (size_t i = D.split; i < n; ++i) e[i - D.split] = D.measured[j][i] - D.after[j][i];
+    std::vector<double> elp = e;
+    if (fs > 12) elp = dsp::FiltFilt(dsp::DesignButterworth(2, dsp::BandType::kLowPass, fs, 5.0), e);
+    double mean = 0, rms = 0;
+    for (double v : elp) mean += v;
+    mean /= static_cast<double>(elp.size());
+    for (double v : elp) rms += (v - mean) * (v - mean);
+    rms = std::sqrt(rms / static_cast<double>(elp.size()));
+    const double white_lp = D.noise[j] * std::sqrt(std::min(1.0, 10.0 / fs));
+    if (rms > std::max(4.0 * white_lp, 0.05) && rms > 0.15 * D.joints[j].rmse_before) {
+      UnexplainedStructure u;
+      u.joint = kJoint[j];
+      u.rms = rms;
+      std::vector<double> full(n, 0.0);
+      for (size_t i = D.split; i < n; ++i) full[i] = D.measured[j][i] - D.after[j][i];
+      u.dominant_hz = DominantHz(kin.t, full, D.split, n);
+      u.corr_q = Pearson(full, kin.q[j], D.split, n);
+      u.corr_qd = Pearson(full, kin.qd[j], D.split, n);
+      u.corr_qdd = Pearson(full, kin.qdd[j], D.split, n);
+      u.corr_t = Pearson(full, kin.t, D.split, n);
+      const double cs[4] = {std::abs(u.corr_q), std::abs(u.corr_qd), std::abs(u.corr_qdd), std::abs(u.corr_t)};
+      const char* what[4] = {"angle", "velocity", "acceleration", "time (drift)"};
+      const int k = static_cast<int>(std::max_element(cs, cs + 4) - cs);
+      u.hint = cs[k] > 0.3 ? std::string("follows the ") + what[k]
+                           : "not a function of angle, velocity, acceleration or time alone";
+      D.unexplained.push_back(u);
     }
   }
-  // Effects in order of what they explain.
-  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
-    return a.explained_pct > b.explained_pct;
-  });
-  D.extended.effects.resize(params.effects.size());
-  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  D.kin = recs[0].kin;
-  D.split = recs[0].split;
-  Lap("extended twin");
-  // Unexplained structure: 5 Hz low-passed held-out residual of the extended twin vs the noise.
-  {
-    const Kinematics& kin = D.kin;
-    const size_t n = kin.t.size();
-    const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
-    const double fs = 1.0 / dt;
-    for (int j = 0; j < 2; ++j) {
-      std::vector<double> e(n - D.split);
-      for (size_t i = D.split; i < n; ++i) e[i - D.split] = D.measured[j][i] - D.after[j][i];
-      std::vector<double> elp = e;
-      if (fs > 12) elp = dsp::FiltFilt(dsp::DesignButterworth(2, dsp::BandType::kLowPass, fs, 5.0), e);
-      double mean = 0, rms = 0;
-      for (double v : elp) mean += v;
-      mean /= static_cast<double>(elp.size());
-      for (double v : elp) rms += (v - mean) * (v - mean);
-      rms = std::sqrt(rms / static_cast<double>(elp.size()));
-      const double white_lp = D.noise[j] * std::sqrt(std::min(1.0, 10.0 / fs));
-      if (rms > std::max(4.0 * white_lp, 0.05) && rms > 0.15 * D.joints[j].rmse_before) {
-        UnexplainedStructure u;
-        u.joint = kJoint[j];
-        u.rms = rms;
-        std::vector<double> full(n, 0.0);
-        for (size_t i = D.split; i < n; ++i) full[i] = D.measured[j][i] - D.after[j][i];
-        u.dominant_hz = DominantHz(kin.t, full, D.split, n);
-        u.corr_q = Pearson(full, kin.q[j], D.split, n);
-        u.corr_qd = Pearson(full, kin.qd[j], D.split, n);
-        u.corr_qdd = Pearson(full, kin.qdd[j], D.split, n);
-        u.corr_t = Pearson(full, kin.t, D.split, n);
-        const double cs[4] = {std::abs(u.corr_q), std::abs(u.corr_qd), std::abs(u.corr_qdd), std::abs(u.corr_t)};
-        const char* what[4] = {"angle", "velocity", "acceleration", "time (drift)"};
-        const int k = static_cast<int>(std::max_element(cs, cs + 4) - cs);
-        u.hint = cs[k] > 0.3 ? std::string("follows the ") + what[k]
-                             : "not a function of angle, velocity, acceleration or time alone";
-        D.unexplained.push_back(u);
-      }
-    }
-  }
-  Lap("unexplained");
+}
+
+// The method in words, for the report (D.cutoff, D.leave_one_out and the options).
+std::string MethodText(const Diagnosis& D, const DiagnoseOptions& opt) {
   std::ostringstream m_os;
   m_os << (D.cutoff.from_columns
                ? std::string("derivatives from the measured qd/qdd columns, no filter")
@@ -579,7 +596,72 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
        << kBicMargin << " and the held-out error at its joint by at least " << 100 * kMinHeldoutGain
        << " % and by (" << 100 * kMinTorqueShare << " % of the torque RMS)^2; fewer parameters preferred unless the richer effect lowers the held-out error by more than "
        << 100 * kParsimony << " %";
-  D.method = m_os.str();
+  return m_os.str();
+}
+
+}  // namespace
+
+// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time to stderr.
+Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                   const DiagnoseOptions& opt) {
+  const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
+  auto clock0 = std::chrono::steady_clock::now();
+  auto Lap = [&](const char* what) {
+    if (!timing) return;
+    const auto now = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s\n", what, std::chrono::duration<double>(now - clock0).count());
+    clock0 = now;
+  };
+  CheckInputs(records, opt);
+  Diagnosis D;
+  D.holdout_fraction = opt.holdout_fraction;
+  const size_t R = records.size();
+  D.leave_one_out = R >= 2;
+
+  D.cutoff = ResolveCutoff(params, records, opt);
+  Lap("cutoff choice");
+
+  Plant plant(opt.mjcf.empty() ? ShippedModelFor(params) : opt.mjcf);
+  plant.SetParams(params);  // validates the realization
+  std::vector<Rec> recs(R);  // in place: Rec::FilterFn captures its record
+  for (size_t r = 0; r < R; ++r) PrepareRecord(params, *records[r], D.cutoff, opt.holdout_fraction, &recs[r]);
+  double w[2];
+  NoiseAndWeights(recs, D.noise, w);
+  Lap("kinematics + twin");
+
+  std::vector<ColumnBank> banks = CandidateColumns(params, recs, w, opt);
+  Lap("columns + ripple search");
+  UseSecantDelayColumns(recs, w, &banks);
+  const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
+  const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
+  Lap("grams + noise");
+
+  const PhysicalScale scale = ScaleOf(params, recs);
+  const Fit f0 = FitCols(g, {});
+  Fit chosen_fit;
+  SelectionTrace trace;
+  const std::vector<int> chosen = SelectEffects(bank, g, scale, opt.max_effects, D.leave_one_out, &chosen_fit, &trace);
+  D.selection = trace.steps;
+  ScoreCandidates(bank, g, scale, f0, chosen, chosen_fit, &D);
+  Lap("selection");
+
+  const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
+  Lap("refinement");
+
+  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  // Effects in order of what they explain.
+  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
+    return a.explained_pct > b.explained_pct;
+  });
+  D.extended.effects.resize(params.effects.size());
+  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  D.kin = recs[0].kin;
+  D.split = recs[0].split;
+  Lap("extended twin");
+
+  FindUnexplained(&D);
+  Lap("unexplained");
+  D.method = MethodText(D, opt);
   return D;
 }
 

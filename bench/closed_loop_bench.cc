@@ -11,13 +11,13 @@
 #include <benchmark/benchmark.h>
 #include <mujoco/mujoco.h>
 
-#include <filesystem>
 
 #include "runner/runner.h"
 #include "sim/muscles.h"
 #include "sim/synthetic_emg.h"
 #include "sim/plant.h"
 #include "sim/subjects.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
@@ -57,7 +57,8 @@ void ClosedLoop(benchmark::State& state, bool logs, Human human = Human::kRelaxe
     s.human.active_from = 0.0;
   }
   RunOptions o;
-  o.out_dir = (std::filesystem::temp_directory_path() / "exotwin_bench_closed_loop").string();
+  const testing::ScopedTempDir tmp("bench_closed_loop");
+  o.out_dir = tmp.path();
   for (auto _ : state) {
     const RunResult r = RunScenario(s, o);
     benchmark::DoNotOptimize(r.metrics.size());

@@ -14,6 +14,7 @@
 
 #include "analysis/identification.h"
 #include "analysis/identification_data.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
@@ -55,8 +56,8 @@ void BM_IdentifyHuman(benchmark::State& st) {
 }
 
 void BM_IdentifyFromCsv(benchmark::State& st) {
-  const std::string dir = "/tmp/exotwin_identify_bench";
-  std::system(("mkdir -p " + dir).c_str());
+  const testing::ScopedTempDir tmp("identify_bench");
+  const std::string& dir = tmp.path();
   const ProtocolData& d = Data(true, static_cast<int>(st.range(0)));
   WriteProtocolCsv(d, dir);
   const LegParams known = S1(false);

@@ -9,12 +9,12 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <string>
 
 #include "render/scene_renderer.h"
 #include "render/video_renderer.h"
 #include "sim/plant.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
@@ -28,15 +28,10 @@ double ProcessCpuSeconds() {
   return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-std::string TempVideo() {
-  std::string tmpl = "/tmp/exotwin_render_bench_XXXXXX";
-  char* d = mkdtemp(tmpl.data());
-  return std::string(d ? d : "/tmp") + "/bench.mp4";
-}
-
 void RunVideo(benchmark::State& state, const RenderOptions& opt) {
   Plant plant(ShippedModelPath("leg_exowheel.xml"));
-  const std::string path = TempVideo();
+  const testing::ScopedTempDir tmp("render_bench");
+  const std::string path = tmp.File("bench.mp4");
   long frames = 0;
   const double cpu0 = ProcessCpuSeconds();
   for (auto _ : state) {
@@ -56,7 +51,6 @@ void RunVideo(benchmark::State& state, const RenderOptions& opt) {
     frames += video.frames();
   }
   const double cpu = ProcessCpuSeconds() - cpu0;
-  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
   state.counters["cpu_ms_frame"] = 1e3 * cpu / double(frames);
   state.counters["fps"] = benchmark::Counter(double(frames), benchmark::Counter::kIsRate);
   state.counters["x_realtime"] = benchmark::Counter(double(frames) / opt.fps, benchmark::Counter::kIsRate);

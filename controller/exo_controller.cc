@@ -35,12 +35,12 @@ void ExoController::Tick(double t) {
     const int j = static_cast<int>(s.joint);
     ++tel_.frames_received;
     tel_.have_status[j] = true;
-    rx_time_[j] = f.t;
     counter_[j] = s.counter;
     const bool torque_ok = !(s.flags & msg::kStatusTorqueSensorFault);
     const bool angle_ok = !(s.flags & msg::kStatusEncoderFault);
     tel_.tau_sensor[j] = torque_ok ? s.torque : std::numeric_limits<double>::quiet_NaN();
     if (angle_ok) {
+      rx_time_[j] = f.t;  // the age the supervisor sees is the angle's: an invalid angle is a lost one
       est_[j].Update(s.angle);
       new_sample_[j] = true;
     }

@@ -31,7 +31,7 @@ struct ControllerTelemetry {
   JointSetpoint est[2];      // estimated state
   double tau_sensor[2] = {0, 0};  // latest torque-sensor readings tau_S, N m (NaN if invalid)
   double tau_cmd[2] = {0, 0};     // torque sent to the modules, N m
-  double age[2] = {0, 0};         // s since the latest status frame per joint
+  double age[2] = {0, 0};         // s since the latest status frame with a valid angle, per joint
   SafetyOutput safety;
   double emg[5] = {0, 0, 0, 0, 0};  // latest EMG sample after the amplifier, V (GMAX, VM, RF, ST, GAS)
   uint32_t emg_samples = 0;          // EMG frames received

@@ -1,19 +1,17 @@
 // libFuzzer target: the measured-data CSV reader (ReadMeasuredCsv + DeriveKinematics).
 // Contract (fuzz/harness.h): any input either parses or throws InputError.
-#include <unistd.h>
-
 #include <cstdint>
 #include <cstdio>
 #include <string>
 
 #include "fuzz/harness.h"
+#include "tests/temp_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  // ReadMeasuredCsv reads a file: one scratch file per process (tmpfs when available).
-  static const std::string path = [] {
-    const char* dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
-    return std::string(dir) + "/exotwin_fuzz_csv_" + std::to_string(getpid()) + ".csv";
-  }();
+  // The reader reads a file: one scratch file in a folder of this process, removed at exit (set
+  // TMPDIR=/dev/shm for a tmpfs).
+  static const exotwin::testing::ScopedTempDir tmp("fuzz_csv");
+  static const std::string path = tmp.File("input.csv");
   FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) return 0;
   if (size) std::fwrite(data, 1, size, f);

@@ -20,7 +20,8 @@ namespace exotwin {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  static const std::string dir = testing::TempDir("map");
+  static const testing::ScopedTempDir tmp("map");  // the suite's folder, removed at exit
+  const std::string& dir = tmp.path();
   return dir + "/" + name;
 }
 

@@ -16,7 +16,8 @@ namespace exotwin {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  static const std::string dir = testing::TempDir("csv");
+  static const testing::ScopedTempDir tmp("csv");  // the suite's folder, removed at exit
+  const std::string& dir = tmp.path();
   return dir + "/" + name;
 }
 

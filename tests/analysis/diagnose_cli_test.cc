@@ -16,13 +16,13 @@ namespace exotwin {
 namespace {
 
 using testing::RunExotwin;
-using testing::TempDir;
 using testing::WriteText;
 
 const std::string kS1 = std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml";
 
 TEST(DiagnoseCli, FindsTheHiddenEffectAndPredictLoadsTheExtendedModel) {
-  const std::string d = TempDir("diag");
+  const testing::ScopedTempDir tmp("diag");
+  const std::string d = tmp.path();
   auto r = RunExotwin("generate --params " + kS1 + " --seed 11 --effect coulomb_friction --joint knee"
                       " --duration 30 --rate 500 --out " + d + "/data.csv --truth " + d + "/truth.yaml");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -49,7 +49,8 @@ TEST(DiagnoseCli, FindsTheHiddenEffectAndPredictLoadsTheExtendedModel) {
 }
 
 TEST(DiagnoseCli, MuscleActivityExtensionRunsInPredict) {
-  const std::string d = TempDir("diagemg");
+  const testing::ScopedTempDir tmp("diagemg");
+  const std::string d = tmp.path();
   ASSERT_EQ(RunExotwin("generate --params " + kS1 + " --seed 3 --effect muscle_activity --duration 30"
                        " --rate 500 --out " + d + "/data.csv").exit_code, 0);
   ASSERT_EQ(RunExotwin("diagnose --params " + kS1 + " --measured " + d + "/data.csv --out " + d + "/o").exit_code, 0);
@@ -61,7 +62,8 @@ TEST(DiagnoseCli, MuscleActivityExtensionRunsInPredict) {
 }
 
 TEST(DiagnoseCli, BadInputIsExitTwoNamingTheFile) {
-  const std::string d = TempDir("diagbad");
+  const testing::ScopedTempDir tmp("diagbad");
+  const std::string d = tmp.path();
   WriteText(d + "/short.csv", "t,q_hip,q_knee,tau_hip,tau_knee\n0,0.1,-0.2,1,1\n0.001,0.1,-0.2,1,1\n");
   auto r = RunExotwin("diagnose --params " + kS1 + " --measured " + d + "/short.csv --out " + d + "/o");
   EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -75,7 +77,8 @@ TEST(DiagnoseCli, BadInputIsExitTwoNamingTheFile) {
 // Several records of one device; records of another device (other columns, another time unit), a bad
 // --cutoff or --max-effects exit 2 naming the file or option, and nothing is written to --out.
 TEST(DiagnoseCli, SeveralRecordsOfOneDeviceAndRecordsOfAnother) {
-  const std::string d = TempDir("diagmulti");
+  const testing::ScopedTempDir tmp("diagmulti");
+  const std::string d = tmp.path();
   // One device: the second record's truth is the first's (its hidden friction), another motion.
   ASSERT_EQ(RunExotwin("generate --params " + kS1 + " --seed 1 --effect coulomb_friction --joint knee"
                        " --duration 20 --rate 500 --out " + d + "/rec1.csv --truth " + d + "/truth.yaml").exit_code, 0);

@@ -21,7 +21,8 @@ namespace exotwin {
 namespace {
 
 TEST(AbortKeepsLog, KilledRunLeavesReadableLog) {
-  const std::string dir = testing::TempDir("abort");
+  const testing::ScopedTempDir tmp("abort");
+  const std::string dir = tmp.path();
   const std::string bin = testing::ExotwinBin();
   const std::string scenario = std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/gait_2kmh.yaml";
   const pid_t pid = fork();
@@ -50,7 +51,8 @@ TEST(AbortKeepsLog, KilledRunLeavesReadableLog) {
 }
 
 TEST(AbortKeepsLog, UnknownCheckMetricKeepsTheMetrics) {
-  const std::string dir = testing::TempDir("unknown_metric");
+  const testing::ScopedTempDir tmp("unknown_metric");
+  const std::string dir = tmp.path();
   const std::string yaml = dir + "/s.yaml";
   std::ofstream(yaml) << "name: short\nseed: 1\ndevice: exowheel\nsubject: {preset: S1}\n"
                          "protocol: {trajectory: gait, stride_period: 2.0, duration: 1.0, ramp: 0.5}\n"

@@ -18,7 +18,6 @@ namespace exotwin {
 namespace {
 
 using testing::RunExotwin;
-using testing::TempDir;
 using testing::WriteText;
 
 const char kModel[] =
@@ -285,7 +284,8 @@ class BadInputMatrix : public ::testing::TestWithParam<Case> {};
 
 TEST_P(BadInputMatrix, ExitsTwoNamingPlaceAndExpectation) {
   const Case& k = GetParam();
-  const std::string dir = TempDir("badinput");
+  const testing::ScopedTempDir tmp("badinput");
+  const std::string dir = tmp.path();
   std::string bad = dir + (k.kind == Kind::kParams ? "/m.yaml"
                            : k.kind == Kind::kCsv  ? "/d.csv"
                            : k.kind == Kind::kMjcf ? "/x.xml"
@@ -325,7 +325,8 @@ INSTANTIATE_TEST_SUITE_P(Cases, BadInputMatrix, ::testing::ValuesIn(Cases()),
 
 // The map cases start from a foreign log and map that read fine.
 TEST(BadInputMatrixControl, ForeignCsvThroughTheBaseMapPredicts) {
-  const std::string dir = TempDir("badinput_control");
+  const testing::ScopedTempDir tmp("badinput_control");
+  const std::string dir = tmp.path();
   WriteText(dir + "/m.yaml", kModel);
   WriteText(dir + "/foreign.csv", ForeignCsv());
   WriteText(dir + "/map.yaml", kMap);

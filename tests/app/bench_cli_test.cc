@@ -12,7 +12,8 @@ namespace exotwin::testing {
 namespace {
 
 TEST(BenchCli, QuickJsonHasRatios) {
-  const std::string dir = TempDir("bench");
+  const testing::ScopedTempDir tmp("bench");
+  const std::string dir = tmp.path();
   const RunResult r = RunExotwin("bench --quick --repeat 1 --only closed_loop,sweep --out " + dir + "/b.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream f(dir + "/b.json");

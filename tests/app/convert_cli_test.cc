@@ -15,7 +15,6 @@ namespace exotwin {
 namespace {
 
 using testing::RunExotwin;
-using testing::TempDir;
 using testing::WriteText;
 
 const std::string kDir = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/";
@@ -31,7 +30,8 @@ std::string Data(const std::string& path) {
 }
 
 TEST(ConvertCli, OutputRereadsAsWhatTheMapGives) {
-  const std::string dir = TempDir("convert");
+  const testing::ScopedTempDir tmp("convert");
+  const std::string dir = tmp.path();
   const std::string in = kDir + "trajectory_11.csv";
   const auto r = RunExotwin("convert --map " + kMap + " " + in + " --out " + dir + "/data.csv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -50,7 +50,8 @@ TEST(ConvertCli, OutputRereadsAsWhatTheMapGives) {
 }
 
 TEST(ConvertCli, PredictWithMapEqualsPredictOnTheConvertedFile) {
-  const std::string dir = TempDir("convert_predict");
+  const testing::ScopedTempDir tmp("convert_predict");
+  const std::string dir = tmp.path();
   const std::string in = kDir + "trajectory_05.csv";
   ASSERT_EQ(RunExotwin("convert --map " + kMap + " " + in + " --out " + dir + "/data.csv").exit_code, 0);
   const auto a = RunExotwin("predict --params " + kDir + "model.yaml --measured " + in + " --map " + kMap +
@@ -67,7 +68,8 @@ TEST(ConvertCli, PredictWithMapEqualsPredictOnTheConvertedFile) {
 
 // trajectory_05's second link turns through 11 rad: fine for the rig alone (above), not for a leg.
 TEST(ConvertCli, HumanModelRefusesARecordBeyondAHumanJointsRange) {
-  const std::string dir = TempDir("convert_human");
+  const testing::ScopedTempDir tmp("convert_human");
+  const std::string dir = tmp.path();
   WriteText(dir + "/leg.yaml",
             "L1: 0.41\nexo:   {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
             "human: {J1: 1.69, J2: 0.37, X1: 4.54, X2: 1.20, Y1: -0.16, Y2: 0.42}\npassive: none\n");
@@ -81,7 +83,8 @@ TEST(ConvertCli, HumanModelRefusesARecordBeyondAHumanJointsRange) {
 }
 
 TEST(ConvertCli, BadMapExitsTwoAndWritesNothing) {
-  const std::string dir = TempDir("convert_bad");
+  const testing::ScopedTempDir tmp("convert_bad");
+  const std::string dir = tmp.path();
   std::string map = testing::ReadText(kMap);
   map.replace(map.find("sign: -1}"), 9, "scale: 0}");
   WriteText(dir + "/bad.yaml", map);

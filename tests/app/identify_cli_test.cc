@@ -30,7 +30,8 @@ LegParams Truth() {
 class IdentifyCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new std::string(testing::TempDir("identify"));
+    tmp_ = new testing::ScopedTempDir("identify");
+    dir_ = new std::string(tmp_->path());
     ProtocolOptions o;
     o.trials = 2;
     o.trial_s = 15;
@@ -44,6 +45,11 @@ class IdentifyCli : public ::testing::Test {
     WriteProtocolCsv(SimulateProtocol(Truth(), o), *dir_ + "/human");
     testing::WriteText(*dir_ + "/human/notes.csv", "a,b\n1,2\n");  // not measured data: skipped
   }
+  static void TearDownTestSuite() {
+    delete dir_;
+    delete tmp_;
+  }
+  static testing::ScopedTempDir* tmp_;
   static std::string* dir_;
   std::string D() const { return *dir_; }
   void ExpectBadInput(const testing::RunResult& r, const std::string& must_contain) {
@@ -52,6 +58,7 @@ class IdentifyCli : public ::testing::Test {
         << "message should contain '" << must_contain << "': " << r.output;
   }
 };
+testing::ScopedTempDir* IdentifyCli::tmp_ = nullptr;
 std::string* IdentifyCli::dir_ = nullptr;
 
 TEST_F(IdentifyCli, ExoThenHumanWithKnown) {

@@ -12,7 +12,6 @@ namespace exotwin {
 namespace {
 
 using testing::RunExotwin;
-using testing::TempDir;
 using testing::WriteText;
 
 const char kModel[] =
@@ -35,7 +34,6 @@ std::string GoodCsv(int n = 200, double dt = 0.001) {
 class PredictCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = TempDir("predict");
     WriteText(dir_ + "/model.yaml", kModel);
     WriteText(dir_ + "/data.csv", GoodCsv());
   }
@@ -52,7 +50,8 @@ class PredictCli : public ::testing::Test {
     EXPECT_NE(r.output.find(must_contain), std::string::npos)
         << "message should contain '" << must_contain << "': " << r.output;
   }
-  std::string dir_;
+  const testing::ScopedTempDir tmp_{"predict"};
+  const std::string dir_ = tmp_.path();
 };
 
 TEST_F(PredictCli, WritesPredictionWithContractColumns) {

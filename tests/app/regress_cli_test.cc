@@ -37,7 +37,8 @@ std::string ShortGait() {
 }
 
 TEST(RegressCli, UnchangedControllerPassesDetunedGainIsCaught) {
-  const std::string dir = TempDir("regress"), suite = dir + "/suite";
+  const testing::ScopedTempDir tmp("regress");
+  const std::string dir = tmp.path(), suite = dir + "/suite";
   std::filesystem::create_directories(suite + "/faults");
   const std::string gait = ShortGait();
   WriteText(suite + "/gait_2kmh.yaml", gait);
@@ -71,7 +72,8 @@ TEST(RegressCli, UnchangedControllerPassesDetunedGainIsCaught) {
 }
 
 TEST(RegressCli, FailedCheckOrMissingBaselineExits1) {
-  const std::string dir = TempDir("regress_check"), suite = dir + "/suite";
+  const testing::ScopedTempDir tmp("regress_check");
+  const std::string dir = tmp.path(), suite = dir + "/suite";
   std::filesystem::create_directories(suite);
   const std::string hold =
       "name: hold\ndevice: exowheel\nsubject: {preset: S1}\nprotocol: {trajectory: hold, duration: 1, ramp: 0.2}\n"
@@ -88,7 +90,8 @@ TEST(RegressCli, FailedCheckOrMissingBaselineExits1) {
 }
 
 TEST(RegressCli, BadInputExits2) {
-  const std::string dir = TempDir("regress_bad");
+  const testing::ScopedTempDir tmp("regress_bad");
+  const std::string dir = tmp.path();
   RunResult r = RunExotwin("regress --suite " + dir + "/missing");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("missing"), std::string::npos);

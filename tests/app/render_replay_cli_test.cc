@@ -48,15 +48,14 @@ long DecodedFrames(const std::string& path) {
 class RenderReplayCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = testing::TempDir("render_replay");
     WriteText(dir_ + "/model.yaml", kModel);
     WriteText(dir_ + "/data.csv", MeasuredCsv());
   }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string Args(const std::string& out) const {
     return "render-replay --params " + dir_ + "/model.yaml --measured " + dir_ + "/data.csv -o " + out;
   }
-  std::string dir_;
+  const testing::ScopedTempDir tmp_{"render_replay"};
+  const std::string dir_ = tmp_.path();
 };
 
 TEST_F(RenderReplayCli, WritesVideoWithTwinPrediction) {

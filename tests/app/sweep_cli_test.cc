@@ -33,7 +33,8 @@ std::string TwoScenarios(const std::string& dir) {
 }
 
 TEST(SweepCli, ShardedAndMergedEqualsUnsharded) {
-  const std::string dir = TempDir("sweep");
+  const testing::ScopedTempDir tmp("sweep");
+  const std::string dir = tmp.path();
   const std::string sc = TwoScenarios(dir);
   RunResult r = RunExotwin("sweep " + sc + " --subjects 5 --seed 3 --jobs 2 --out " + dir + "/whole");
   ASSERT_LE(r.exit_code, 1) << r.output;
@@ -68,7 +69,8 @@ TEST(SweepCli, ShardedAndMergedEqualsUnsharded) {
 }
 
 TEST(SweepCli, BadInputExits2) {
-  const std::string dir = TempDir("sweep_bad");
+  const testing::ScopedTempDir tmp("sweep_bad");
+  const std::string dir = tmp.path();
   const std::string sc = TwoScenarios(dir);
   for (const std::string& args :
        {sc + " --subjects 3 --shard 3/3 --out " + dir + "/o", sc + " --subjects 0 --out " + dir + "/o",

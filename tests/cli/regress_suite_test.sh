@@ -5,6 +5,6 @@
 set -euo pipefail
 EXO=$1
 SRC=$2
-T=$(mktemp -d /tmp/exotwin_regress_suite_XXXXXX)
+T=$(mktemp -d "${TMPDIR:-/tmp}"/exotwin_regress_suite_XXXXXX)
 trap 'rm -rf "$T"' EXIT
 "$EXO" regress --suite "$SRC/scenarios" --out "$T"

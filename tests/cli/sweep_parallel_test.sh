@@ -5,7 +5,7 @@ set -euo pipefail
 EXO=$1
 SRC=$2
 command -v parallel >/dev/null || { echo "FAIL: GNU parallel is not installed (scripts/setup.sh installs it)"; exit 1; }
-T=$(mktemp -d /tmp/exotwin_sweep_parallel_XXXXXX)
+T=$(mktemp -d "${TMPDIR:-/tmp}"/exotwin_sweep_parallel_XXXXXX)
 trap 'rm -rf "$T"' EXIT
 
 # The shipped gait scenario, 2 s instead of 60.

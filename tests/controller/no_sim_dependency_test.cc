@@ -1,6 +1,6 @@
 // The dependency rule of DESIGN.md, visible in the test suite: controller/ (the real controller
-// code) never includes MuJoCo, OpenCV or simulation code. The build enforces it too (configure-time
-// check and a shared library linked with --no-undefined, controller/CMakeLists.txt).
+// code) never includes MuJoCo, OpenCV or simulation code. The build enforces it too (the configure-time
+// layer check cmake/check_layers.cmake, and a shared library linked with --no-undefined).
 #include <gtest/gtest.h>
 
 #include <filesystem>

@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/units.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin::controller {
 namespace {
@@ -289,7 +290,8 @@ TEST(GaitTrajectory, PeriodicDerivativesAndOptions) {
 
 TEST(GaitTrajectory, BadFilesAreInputErrors) {
   EXPECT_THROW(GaitTrajectory::FromWinterFile("/nonexistent/winter.txt"), InputError);
-  const std::string path = ::testing::TempDir() + "/winter_bad.txt";
+  const testing::ScopedTempDir tmp("trajectory");
+  const std::string path = tmp.File("winter_bad.txt");
   {
     std::ofstream out(path);
     out << "'FRAME' 'TIME'\n1 0 1 2 3 4 5 6 7\n";

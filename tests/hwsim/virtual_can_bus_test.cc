@@ -3,13 +3,13 @@
 #include "hwsim/virtual_can_bus.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 
 #include "protocol/can_bits.h"
 #include "protocol/candump.h"
 #include "protocol/messages.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin::hwsim {
 namespace {
@@ -344,7 +344,8 @@ TEST(VirtualCanBus, SameSeedSameBytesAndTimes) {
 }
 
 TEST(VirtualCanBus, TapWritesACandumpLogOfTheWire) {
-  const std::string path = ::testing::TempDir() + "exotwin_tap_" + std::to_string(::getpid()) + ".log";
+  const testing::ScopedTempDir tmp("tap");
+  const std::string path = tmp.File("tap.log");
   VirtualCanBusConfig cfg;
   cfg.corrupt_probability = 0.2;
   cfg.seed = 3;
@@ -371,7 +372,6 @@ TEST(VirtualCanBus, TapWritesACandumpLogOfTheWire) {
     EXPECT_TRUE(SamePayload(back[i].frame, wire[i]));
     EXPECT_NEAR(back[i].frame.t, wire[i].t, 0.5e-6 + 1e-9);
   }
-  std::remove(path.c_str());
 }
 
 }  // namespace

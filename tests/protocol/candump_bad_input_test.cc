@@ -7,16 +7,17 @@
 #include <fstream>
 #include <string>
 
-#include <unistd.h>
-
 #include "core/error.h"
+#include <unistd.h>
 #include "protocol/candump.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
 
 std::string WriteLog(const std::string& tag, const std::string& content) {
-  const std::string path = "/tmp/exotwin_candump_bad_" + tag + "_" + std::to_string(getpid()) + ".log";
+  static const testing::ScopedTempDir tmp("candump_bad");  // the suite's folder, removed at exit
+  const std::string path = tmp.File(tag + ".log");
   std::ofstream(path, std::ios::binary) << content;
   return path;
 }

@@ -3,7 +3,6 @@
 #include "protocol/candump.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -13,12 +12,14 @@
 #include "core/error.h"
 #include "protocol/candump_replay_bus.h"
 #include "protocol/messages.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  return ::testing::TempDir() + "exotwin_" + std::to_string(::getpid()) + "_" + name;
+  static const testing::ScopedTempDir tmp("candump");  // the suite's folder, removed at exit
+  return tmp.File(name);
 }
 
 std::string ReadFile(const std::string& path) {

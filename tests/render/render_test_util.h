@@ -1,4 +1,4 @@
-// Helpers shared by the render/ tests: temporary folders, pixel colour classes, leg poses.
+// Helpers shared by the render/ tests: pixel colour classes, leg poses.
 #pragma once
 #include <mujoco/mujoco.h>
 
@@ -8,11 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "tests/temp_dir.h"
-
 namespace exotwin::testing {
-
-inline std::string RenderTempDir(const std::string& tag) { return TempDir("render_" + tag); }
 
 // Skin (human segments, rgba 0.93 0.76 0.62): red dominant over blue.
 inline bool IsSkin(const cv::Vec3b& bgr) {

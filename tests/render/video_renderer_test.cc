@@ -15,6 +15,7 @@
 #include "render/scene_renderer.h"
 #include "sim/plant.h"
 #include "tests/render/render_test_util.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
@@ -43,9 +44,7 @@ class VideoRendererTest : public ::testing::Test {
  protected:
   void SetUp() override {
     plant_ = std::make_unique<Plant>(ShippedModelPath("leg_exowheel.xml"));
-    dir_ = testing::RenderTempDir("video");
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // Simulated feed at 1 kHz over [0, duration): the test motion until t_move, then still; the
   // leg pose is written into the plant's mjData as the physics would.
@@ -70,7 +69,8 @@ class VideoRendererTest : public ::testing::Test {
   }
 
   std::unique_ptr<Plant> plant_;
-  std::string dir_;
+  const testing::ScopedTempDir tmp_{"render_video"};
+  const std::string dir_ = tmp_.path();
 };
 
 TEST_F(VideoRendererTest, DecodesWithDurationTimesFpsFramesAndH264) {

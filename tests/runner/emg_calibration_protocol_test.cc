@@ -29,11 +29,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Runs a shipped scenario into a fresh folder (out_dir) and expects every check to pass.
-RunResult RunShipped(const std::string& file, Scenario* s, std::string* out_dir) {
+// Runs a shipped scenario into the folder out_dir and expects every check to pass.
+RunResult RunShipped(const std::string& file, Scenario* s, const std::string& out_dir) {
   *s = ReadScenario(ShippedScenarioDir() + "/" + file);
   RunOptions ro;
-  ro.out_dir = *out_dir = testing::TempDir("emgcal");
+  ro.out_dir = out_dir;
   const RunResult r = RunScenario(*s, ro);
   for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << file << ": " << c.name << " = " << c.value;
   return r;
@@ -91,7 +91,8 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
   ExpectInputError("name: c\ndevice: exowheel\nsubject: {preset: S1}\nemg_calibration: {fit_window: all}\n",
                    "emg_calibration.fit_window");
   // Through the command line: exit 2 and the file named.
-  const std::string dir = testing::TempDir("emgcal_bad");
+  const testing::ScopedTempDir tmp("emgcal_bad");
+  const std::string dir = tmp.path();
   testing::WriteText(dir + "/bad.yaml", std::string(kHead) + "human: {levels: [0.5, 0.2]}\n");
   const testing::RunResult r = testing::RunExotwin("run " + dir + "/bad.yaml --out " + dir + "/out");
   EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -103,8 +104,9 @@ TEST(EmgCalibrationProtocol, RejectsBadInputNamingTheField) {
 // a peak, so alpha is the torque at that peak).
 TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
   Scenario s;
-  std::string out;
-  const RunResult r = RunShipped("exowheel_emg_isometric.yaml", &s, &out);
+  const testing::ScopedTempDir tmp_out("emgcal");
+  const std::string& out = tmp_out.path();
+  const RunResult r = RunShipped("exowheel_emg_isometric.yaml", &s, out);
   for (const char* f : {"mvc/mvc_VM.csv", "isometric_hip/measured.csv", "isometric_knee/measured.csv",
                         "calibration.csv", "calibration.json", "result.json"})
     EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
@@ -159,8 +161,9 @@ TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
 // Dempster sets move it by several N m (Table 5's size), and the shipped checks pass.
 TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
   Scenario s;
-  std::string out;
-  const RunResult r = RunShipped("exowheel_emg_dynamic.yaml", &s, &out);
+  const testing::ScopedTempDir tmp_out("emgcal");
+  const std::string& out = tmp_out.path();
+  const RunResult r = RunShipped("exowheel_emg_dynamic.yaml", &s, out);
   const MeasuredData d = ReadMeasuredCsv(out + "/gait/measured.csv");
   const Kinematics kin = DeriveKinematics(d);
   const CsvTable tr = ReadCsv(out + "/gait/truth.csv");
@@ -252,7 +255,8 @@ TEST(EmgCalibrationProtocol, PopulationModeAggregatesSubjectsAndRespectsTheTorqu
   s.human.muscle_seed = 1;
   s.checks.clear();
   RunOptions ro;
-  ro.out_dir = testing::TempDir("emgcal_pop");
+  const testing::ScopedTempDir tmp("emgcal_pop");
+  ro.out_dir = tmp.path();
   const RunResult r = RunScenario(s, ro);
   EXPECT_EQ(r.metrics.at("subjects"), 3.0);
   double mean = 0, sq = 0, worst = 1, tmax = 0;

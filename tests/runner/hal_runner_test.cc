@@ -20,11 +20,11 @@ namespace {
 
 std::string Shipped(const std::string& rel) { return std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/" + rel; }
 
-std::string TempDir(const std::string& tag) { return testing::TempDir("hal_" + tag); }
 
 RunResult RunShipped(const std::string& file, const std::string& tag) {
   RunOptions o;
-  o.out_dir = TempDir(tag);
+  const testing::ScopedTempDir tmp("hal_" + tag);
+  o.out_dir = tmp.path();
   return RunHalScenario(ReadScenario(Shipped(file)), o);
 }
 
@@ -109,7 +109,8 @@ TEST(HalRunner, RlsViscosityWithin20PercentStiffnessIsAKnownGap) {
 TEST(HalRunner, RlsTracksACoContractingOperatorWithin20Percent) {
   const Scenario s = ReadScenario(Shipped("hal3_rls_tracking.yaml"));
   RunOptions o;
-  o.out_dir = TempDir("rls");
+  const testing::ScopedTempDir tmp("hal_rls");
+  o.out_dir = tmp.path();
   const RunResult r = RunHalScenario(s, o);
   for (const CheckResult& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " = " << c.value;
   const auto& m = r.metrics;
@@ -119,7 +120,8 @@ TEST(HalRunner, RlsTracksACoContractingOperatorWithin20Percent) {
   EXPECT_DOUBLE_EQ(m.at("rls_I_hat"), m.at("plant_I"));  // 1 / (1 / I0): rounding only
   Scenario paper = s;
   paper.hal.rls_known_inertia = false;
-  o.out_dir = TempDir("rls_paper");
+  const testing::ScopedTempDir tmp_paper("hal_rls_paper");
+  o.out_dir = tmp_paper.path();
   const auto& mp = RunHalScenario(paper, o).metrics;
   std::printf("[hal] same with the four-parameter RLS: K^ %.3f (%.1f %%), I^ %.3f vs %.3f\n", mp.at("rls_K_mean"),
               mp.at("rls_K_err_pct"), mp.at("rls_I_hat"), mp.at("plant_I"));
@@ -128,7 +130,8 @@ TEST(HalRunner, RlsTracksACoContractingOperatorWithin20Percent) {
 
 TEST(HalRunner, WritesMeasuredCsvWithHalColumns) {
   RunOptions o;
-  o.out_dir = TempDir("csv");
+  const testing::ScopedTempDir tmp("hal_csv");
+  o.out_dir = tmp.path();
   Scenario s = ReadScenario(Shipped("hal3_exp1_no_assist.yaml"));
   s.protocol.duration = 1.0;
   s.hal.settle = 0.5;
@@ -145,7 +148,8 @@ TEST(HalRunner, WritesMeasuredCsvWithHalColumns) {
 TEST(HalRunner, RejectsNonHalDevice) {
   Scenario s = ReadScenario(Shipped("gait_2kmh.yaml"));
   RunOptions o;
-  o.out_dir = TempDir("bad");
+  const testing::ScopedTempDir tmp("hal_bad");
+  o.out_dir = tmp.path();
   EXPECT_THROW(RunHalScenario(s, o), InputError);
 }
 
@@ -153,7 +157,8 @@ TEST(HalRunner, RejectsNonHalDevice) {
 // scenarios/hal3_viscous_sweep.yaml for where the twin's trough falls and why.
 TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
   RunOptions o;
-  o.out_dir = TempDir("sweep");
+  const testing::ScopedTempDir tmp("hal_sweep");
+  o.out_dir = tmp.path();
   const RunResult r = RunHalScenario(ReadScenario(Shipped("hal3_viscous_sweep.yaml")), o);
   const Scenario s = ReadScenario(Shipped("hal3_viscous_sweep.yaml"));
   std::printf("[hal] B_v (N m s/rad)   J_tau_m (N m)   J_me   J_mf\n");
@@ -201,7 +206,8 @@ TEST(HalRunner, ViscousSweepHasNoTroughWithoutOperatorDelay) {
   s.hal.operator_delay = 0.0;
   s.checks.clear();
   RunOptions o;
-  o.out_dir = TempDir("sweep_nodelay");
+  const testing::ScopedTempDir tmp("hal_sweep_nodelay");
+  o.out_dir = tmp.path();
   const RunResult r = RunHalScenario(s, o);
   EXPECT_EQ(r.metrics.at("sweep_argmin_viscosity"), s.hal.sweep_viscosity.front());
 }
@@ -216,7 +222,8 @@ TEST(HalRunner, ViscousSweepTroughOverOperators) {
     s.human.muscle_seed = seed;
     s.checks.clear();
     RunOptions o;
-    o.out_dir = TempDir("sweep_ops");
+    const testing::ScopedTempDir tmp("hal_sweep_ops");
+    o.out_dir = tmp.path();
     argmin.push_back(RunHalScenario(s, o).metrics.at("sweep_argmin_viscosity"));
     std::printf("[hal] operator %d: trough at B_v = %.2f\n", static_cast<int>(seed), argmin.back());
     EXPECT_GT(argmin.back(), 0.0);

@@ -14,7 +14,6 @@
 namespace exotwin {
 namespace {
 
-std::string TempDir(const std::string& tag) { return testing::TempDir("regress_" + tag); }
 
 const MetricDelta& Find(const std::vector<MetricDelta>& v, const std::string& m) {
   for (const auto& d : v)
@@ -60,7 +59,8 @@ TEST(MetricTolerance, NanEqualsNan) {
 }
 
 TEST(Baseline, RoundTripKeepsBitsAndOverrides) {
-  const std::string dir = TempDir("baseline");
+  const testing::ScopedTempDir tmp("regress_baseline");
+  const std::string dir = tmp.path();
   Baseline b;
   b.scenario = "gait";
   b.source = "gait.yaml";
@@ -79,7 +79,8 @@ TEST(Baseline, RoundTripKeepsBitsAndOverrides) {
 }
 
 TEST(Baseline, BadContentNamesFileAndField) {
-  const std::string dir = TempDir("bad_baseline");
+  const testing::ScopedTempDir tmp("regress_bad_baseline");
+  const std::string dir = tmp.path();
   std::ofstream(dir + "/x.json") << R"({"metrics": {"a": 1}, "tolerance": {"a": {"abs": -1}}})";
   try {
     ReadBaseline(dir + "/x.json");
@@ -93,7 +94,8 @@ TEST(Baseline, BadContentNamesFileAndField) {
 }
 
 TEST(Suite, ListsRecursivelySkipsBaselinesRejectsDuplicateNames) {
-  const std::string dir = TempDir("suite");
+  const testing::ScopedTempDir tmp("regress_suite");
+  const std::string dir = tmp.path();
   std::filesystem::create_directories(dir + "/faults");
   std::filesystem::create_directories(dir + "/baselines");
   const std::string body = "device: exowheel\nsubject: {preset: S1}\nprotocol: {trajectory: hold, duration: 1}\n";
@@ -110,7 +112,8 @@ TEST(Suite, ListsRecursivelySkipsBaselinesRejectsDuplicateNames) {
 }
 
 TEST(Suite, EvaluateFlagsMissingBaselineAndFailedChecks) {
-  const std::string dir = TempDir("evaluate");
+  const testing::ScopedTempDir tmp("regress_evaluate");
+  const std::string dir = tmp.path();
   SuiteEntry e;
   e.scenario.name = "s";
   e.relative = "s.yaml";

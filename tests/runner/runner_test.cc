@@ -23,7 +23,6 @@ std::string Slurp(const std::string& path) {
 
 std::string Shipped(const std::string& rel) { return std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/" + rel; }
 
-std::string TempDir(const std::string& tag) { return testing::TempDir("runner_" + tag); }
 
 // PD tracking on the default gait (2 km/h, S1 relaxed, 20 s here instead of 60): the stated bound is
 // 1 deg RMS per joint and 3 deg peak after the 2 s ramp (measured: about 0.4 / 0.65 deg RMS).
@@ -31,7 +30,8 @@ TEST(Runner, GaitTrackingWithinStatedBound) {
   Scenario s = ReadScenario(Shipped("gait_2kmh.yaml"));
   s.protocol.duration = 20;
   RunOptions o;
-  o.out_dir = TempDir("gait");
+  const testing::ScopedTempDir tmp("runner_gait");
+  o.out_dir = tmp.path();
   const RunResult r = RunScenario(s, o);
   EXPECT_LT(r.metrics.at("tracking_rms_hip_deg"), 1.0);
   EXPECT_LT(r.metrics.at("tracking_rms_knee_deg"), 1.0);
@@ -57,7 +57,8 @@ class FaultScenario : public ::testing::TestWithParam<const char*> {};
 TEST_P(FaultScenario, ReachesSafeStateInTime) {
   const Scenario s = ReadScenario(Shipped(std::string("faults/") + GetParam() + ".yaml"));
   RunOptions o;
-  o.out_dir = TempDir(GetParam());
+  const testing::ScopedTempDir tmp(std::string("runner_") + GetParam());
+  o.out_dir = tmp.path();
   const RunResult r = RunScenario(s, o);
   for (const auto& c : r.checks) EXPECT_TRUE(c.passed) << c.name << ": " << c.value << " " << c.op << " " << c.limit;
   EXPECT_LE(r.metrics.at("torque_max_hip"), 120.0);
@@ -85,7 +86,8 @@ TEST(Runner, DeterministicForASeed) {
   std::string logs[3], can[3];
   for (int i = 0; i < 3; ++i) {
     RunOptions o;
-    o.out_dir = TempDir("det" + std::to_string(i));
+    const testing::ScopedTempDir tmp("runner_det" + std::to_string(i));
+    o.out_dir = tmp.path();
     o.seed = i < 2 ? 5 : 6;
     o.can_log = o.out_dir + "/can.log";
     RunScenario(s, o);

@@ -21,11 +21,11 @@ Diagnosis DiagnoseGait(int skew, const std::string& tag) {
   s.protocol.duration = 30;
   s.hardware.torque_sensor_skew = skew;
   RunOptions o;
-  o.out_dir = testing::TempDir("sampling_instant_" + tag);
+  const testing::ScopedTempDir tmp("sampling_instant_" + tag);
+  o.out_dir = tmp.path();
   RunScenario(s, o);
   const MeasuredData d = ReadMeasuredCsv(o.out_dir + "/measured.csv");
   const Diagnosis dg = Diagnose(ResolveSubject(s), d);
-  std::filesystem::remove_all(o.out_dir);
   return dg;
 }
 

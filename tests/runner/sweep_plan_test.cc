@@ -103,7 +103,8 @@ TEST(SweepTable, SummaryStatistics) {
 }
 
 TEST(SweepTable, MergeRejectsMissingAndDuplicateShards) {
-  const std::filesystem::path base = testing::TempDir("sweep_merge");
+  const testing::ScopedTempDir tmp("sweep_merge");
+  const std::filesystem::path base = tmp.path();
   SweepManifest m;
   m.scenarios = {"s"};
   m.files = {"s.yaml"};

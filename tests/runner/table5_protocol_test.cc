@@ -42,7 +42,8 @@ TEST(Table5Protocol, TwoSubjectsShortTrialsRecoverTruthAndBeatAnthropometry) {
   opt.trial_duration = 20.0;
   opt.strides = 4;
   opt.keep_logs = false;
-  opt.out_dir = testing::TempDir("table5");
+  const testing::ScopedTempDir tmp("table5");
+  opt.out_dir = tmp.path();
   for (const std::string subject : {"S1", "S7"}) {
     const Table5SubjectRun run = RunTable5Subject(subject, opt);
     const Table5Entry& e = run.entry;
@@ -55,7 +56,6 @@ TEST(Table5Protocol, TwoSubjectsShortTrialsRecoverTruthAndBeatAnthropometry) {
     ExpectPattern(e.knee, subject + " knee");
     EXPECT_GT(e.gait_samples, 7000);
   }
-  std::filesystem::remove_all(opt.out_dir);
 }
 
 }  // namespace
