@@ -23,7 +23,8 @@ std::string MessageOf(const std::string& path, const std::string& what, const st
 }
 
 TEST(FileText, ReadsTheWholeFileAsStored) {
-  const std::string dir = testing::TempDir("file_text");
+  const testing::ScopedTempDir tmp("file_text");
+  const std::string& dir = tmp.path();
   const std::string text = "a,b\r\n1,2\n\xc3\xa9 no final newline";
   std::ofstream(dir + "/t.csv", std::ios::binary) << text;
   EXPECT_EQ(ReadTextFile(dir + "/t.csv", "", "a text CSV file"), text);
@@ -32,7 +33,8 @@ TEST(FileText, ReadsTheWholeFileAsStored) {
 }
 
 TEST(FileText, MissingFileDirectoryAndNulAreInputErrorsNamingThePath) {
-  const std::string dir = testing::TempDir("file_text");
+  const testing::ScopedTempDir tmp("file_text");
+  const std::string& dir = tmp.path();
   EXPECT_EQ(MessageOf(dir + "/none.yaml", "model", "a YAML text file"),
             dir + "/none.yaml: cannot open model file (No such file or directory)");
   EXPECT_EQ(MessageOf(dir + "/none.csv", "", "a text CSV file"),
