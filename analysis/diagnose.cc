@@ -191,7 +191,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   Lap("cutoff choice");
 
   // 2. Every record: kinematics, measured torque filtered alike, the twin, the residual.
-  Plant plant(opt.mjcf.empty() ? ShippedModelFor(params) : opt.mjcf);
+  Plant plant(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);
   plant.SetParams(params);  // validates the realization
   std::vector<Rec> recs(R);
   for (size_t r = 0; r < R; ++r) {
@@ -449,7 +449,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   // 6. The extended twin (predict) on every record's held-out part; with several records, each
   // whole record predicted by the effects fitted on the others.
   {
-    Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
+    Plant ext_plant(opt.mjcf.empty() ? ExowheelMjcfPath(D.extended.human.has_value()) : opt.mjcf);
     ext_plant.SetParams(D.extended);
     double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
     const std::vector<int> cols = ColumnsOf(bank, chosen);
@@ -494,7 +494,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
           e.value *= refine_ratio[k];
           p.effects.push_back(e);
         }
-        Plant loo_plant(opt.mjcf.empty() ? ShippedModelFor(p) : opt.mjcf);
+        Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
         loo_plant.SetParams(p);
         const Prediction whole = PredictTorque(loo_plant, rc.kin);
         for (int j = 0; j < 2; ++j) {
