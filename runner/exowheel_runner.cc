@@ -2,201 +2,26 @@
 #include "runner/exowheel_runner.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <memory>
 
 #include "analysis/csv_table.h"
 #include "controller/exo_controller.h"
 #include "dsp/butterworth.h"
-#include "hwsim/joint_module.h"
 #include "model/leg_dynamics.h"
 #include "render/video_renderer.h"
 #include "runner/cosim_rig.h"
+#include "runner/exowheel_setup.h"
+#include "runner/fault_injection.h"
 #include "runner/progress_bar.h"
-#include "sim/anthropometry.h"
 #include "sim/muscles.h"
 #include "sim/plant.h"
-#include "sim/subjects.h"
 #include "sim/synthetic_emg.h"
 
 namespace exotwin {
 namespace {
-
-using controller::FadeInTrajectory;
-using controller::GaitSpec;
-using controller::GaitTrajectory;
-using controller::HarmonicTrajectory;
-using controller::HoldTrajectory;
-using controller::JointTrajectory;
-using controller::JointwiseTrajectory;
-using controller::LegTrajectory;
-
-// The reference of a trial: gait, excitation of the moving joint(s) with the others held, or hold.
-std::shared_ptr<const LegTrajectory> BuildTrajectory(const Scenario& s, int trial) {
-  const ProtocolSpec& p = s.protocol;
-  auto held = [&](const char* j, double dflt) {
-    auto it = s.fixed_joints.find(j);
-    return it != s.fixed_joints.end() ? it->second : dflt;
-  };
-  std::shared_ptr<const LegTrajectory> inner;
-  switch (p.trajectory) {
-    case TrajectoryKind::kGait: {
-      GaitSpec g;
-      g.stride_period_s = p.stride_period;
-      // Winter's knee reaches +2 deg (hyperextension) in stance; the exoskeleton stops at 0, so
-      // the pattern is shifted by -3 deg at the knee.
-      g.knee_offset = -3.0 * M_PI / 180.0;
-      inner = std::make_shared<GaitTrajectory>(GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), g));
-      break;
-    }
-    case TrajectoryKind::kExcitation: {
-      const uint64_t seed = p.excitation_seed * 1000003ull + static_cast<uint64_t>(trial);
-      std::shared_ptr<const JointTrajectory> hip, knee;
-      if (p.moving_joint == "hip" || p.moving_joint == "both")
-        hip = std::make_shared<HarmonicTrajectory>(
-            HarmonicTrajectory::Design(controller::ExcitationSpec::PaperHip(), seed));
-      else
-        hip = std::make_shared<HoldTrajectory>(held("hip", M_PI / 2));
-      if (p.moving_joint == "knee" || p.moving_joint == "both")
-        knee = std::make_shared<HarmonicTrajectory>(
-            HarmonicTrajectory::Design(controller::ExcitationSpec::PaperKnee(), seed + 7));
-      else
-        knee = std::make_shared<HoldTrajectory>(held("knee", -M_PI / 2));
-      inner = std::make_shared<JointwiseTrajectory>(hip, knee);
-      break;
-    }
-    case TrajectoryKind::kHold:
-      inner = std::make_shared<JointwiseTrajectory>(std::make_shared<HoldTrajectory>(held("hip", 0.3)),
-                                                    std::make_shared<HoldTrajectory>(held("knee", -0.5)));
-      break;
-  }
-  if (p.ramp > 0) inner = std::make_shared<FadeInTrajectory>(inner, p.ramp);
-  return inner;
-}
-
-// The controller's model for the feed-forward: the exoskeleton (known from its own identification)
-// plus, with a subject, the De Leva anthropometric estimate from the subject's weight and lengths:
-// what a rig knows before identifying the user.
-LegParams ControllerModel(const Scenario& s, const LegParams& truth) {
-  LegParams m;
-  m.L1 = truth.L1;
-  m.exo = truth.exo;
-  if (truth.human) {
-    double weight = 68.0, L2 = 0.53;
-    if (const std::optional<Subject> sub = ScenarioSubject(s)) {
-      weight = sub->weight;
-      L2 = sub->L2;
-    }
-    m.human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, weight, truth.L1, L2);
-    m.passive = PassiveModel::kRiener1999;
-  }
-  return m;
-}
-
-controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegParams& truth) {
-  controller::ExoControllerConfig c;
-  c.rate_hz = s.controller.rate_hz;
-  c.hip = {s.controller.kp[0], s.controller.kd[0], s.controller.torque_limit};
-  c.knee = {s.controller.kp[1], s.controller.kd[1], s.controller.torque_limit};
-  c.feedforward = s.controller.feedforward;
-  c.model = ControllerModel(s, truth);
-  c.estimator.sample_rate_hz = s.controller.rate_hz;
-  c.safety = controller::SafetyConfig::Default();
-  for (auto* lim : {&c.safety.hip, &c.safety.knee}) {
-    lim->tau_sensor_max = std::min(115.0, s.hardware.torque_limit);
-    lim->tau_cmd_max = s.controller.torque_limit + 1e-6;
-    lim->qd_max = 8.0;  // rad/s (460 deg/s): gait at 2 km/h peaks near 200 deg/s
-  }
-  return c;
-}
-
-// Mean posture of the gait pattern (Winter, fitted): about 5 deg hip, -25 deg knee (rad).
-const Eigen::Vector2d kGaitMeanPosture(0.09, -0.45);
-
-// The subject's behaviour for the trial (relaxed unless the scenario's human block says otherwise).
-std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams& mp,
-                                          const std::shared_ptr<const LegTrajectory>& trajectory,
-                                          uint64_t seed) {
-  const HumanSpec& h = s.human;
-  if (h.behaviour == "isometric_hip" || h.behaviour == "isometric_knee")
-    return std::make_unique<ContractionProgramme>(IsometricProgrammeOf(h, seed));
-  if (h.behaviour == "exaggerated_gait") {
-    IntendedMotion base = [trajectory](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
-      controller::JointSetpoint a, b;
-      trajectory->Sample(t, &a, &b);
-      q = {a.q, b.q};
-      qd = {a.qd, b.qd};
-      qdd = {a.qdd, b.qdd};
-    };
-    // The exoskeleton imposes the motion (PD 600/400 N m/rad), so the subject's damping term of the
-    // tracking law (TrackingGains::kd, sized to stabilise the FREE limb with 55 ms of loop delay) has
-    // nothing to stabilise; kept, it adds kd (gain - 1) qd of the pattern: a drive in phase with the
-    // velocity that bursts at the knee's 1-3 Hz swing harmonics (measured: knee R^2 of eq. 28 falls
-    // from 0.93 to 0.24 with kd = 15), unlike a person exaggerating a slow 2 km/h gait, whose effort
-    // follows the posture. kd = 0: the exaggeration is an amplitude intent, kp (gain - 1)(q* - mean).
-    TrackingGains gains;
-    gains.kd.setZero();
-    return std::make_unique<ExaggeratedGait>(mp, base, kGaitMeanPosture, h.gain, h.active_from, 0.02, gains,
-                                             h.outward_gate);
-  }
-  return std::make_unique<RelaxedBehaviour>();
-}
-
-// The posture the subject's co-contraction stiffens the joints about (MuscleParams::q_rest, rad).
-// Co-contraction raises the joint stiffness about the current equilibrium (Hogan 1984, IEEE TAC
-// 29(8)); the seated-hanging default of sim/muscles (Hayashi's K theta for the HAL knee swing) would
-// make a standing subject's co-contraction pull the knee towards -90 deg: a torque of -K (q - q_rest),
-// about -0.33 S N m in gait (S the co-contracted torque), that no EMG model sees. Isometric trials:
-// the held start pose; exaggerated gait: the pattern's mean posture (as tests/sim/muscles_test.cc).
-Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, const Eigen::Vector2d& start) {
-  if (s.human.behaviour == "exaggerated_gait") return kGaitMeanPosture;
-  if (s.human.behaviour == "isometric_hip" || s.human.behaviour == "isometric_knee") return start;
-  return mp.q_rest;
-}
-
-struct FaultSwitch {
-  FaultSpec spec;
-  bool active = false;
-};
-
-// Applies the scenario's faults that are active at time t to the modules and the bus.
-void ApplyFaults(std::vector<FaultSwitch>& faults, double t, hwsim::JointModule* modules[2],
-                 hwsim::VirtualCanBus& bus, hwsim::VirtualCanBus::Endpoint* controller_node,
-                 const HardwareSpec& hw, std::vector<std::string>* events) {
-  for (FaultSwitch& f : faults) {
-    const bool on = t >= f.spec.at && (f.spec.duration <= 0 || t < f.spec.at + f.spec.duration);
-    if (on == f.active) continue;
-    f.active = on;
-    char buf[160];
-    std::snprintf(buf, sizeof(buf), "t=%.3f %s %s %s", t, on ? "on" : "off", f.spec.type.c_str(),
-                  f.spec.joint.c_str());
-    events->push_back(buf);
-    for (int j = 0; j < 2; ++j) {
-      if (f.spec.joint != "all" && f.spec.joint != (j == 0 ? "hip" : "knee")) continue;
-      hwsim::JointModuleFaults& mf = modules[j]->faults();
-      if (f.spec.type == "sensor_stuck") mf.sensor_stuck = on;
-      if (f.spec.type == "sensor_stale") mf.stale = on;
-      if (f.spec.type == "encoder_glitch") mf.encoder_glitch = on;
-      if (f.spec.type == "nan_measurement") mf.sensor_nan = on;
-      if (f.spec.type == "command_loss") mf.drop_commands = on;
-    }
-    hwsim::VirtualCanBusConfig& bc = bus.config();
-    if (f.spec.type == "frame_drop")
-      bc.drop_probability = on ? (f.spec.value > 0 ? f.spec.value : 0.5) : hw.can_drop_rate;
-    if (f.spec.type == "frame_late") {
-      bc.spike_probability = on ? 1.0 : 0.0;  // every delivery late by `value` s (default 10 ms)
-      bc.spike_delay = f.spec.value > 0 ? f.spec.value : 0.01;
-    }
-    if (f.spec.type == "bus_off") {  // the controller's CAN controller goes bus-off
-      if (on) controller_node->ForceBusOff();
-      else controller_node->RecoverBusOff();
-    }
-  }
-}
 
 double Deg(double rad) { return rad * 180.0 / M_PI; }
 
@@ -221,26 +46,6 @@ struct ExowheelTotals {
   size_t samples = 0;
 };
 
-hwsim::JointModuleSpec ModuleSpec(const HardwareSpec& hw, int j) {
-  hwsim::JointModuleSpec ms;
-  ms.joint = static_cast<msg::Joint>(j);
-  ms.torque_sensor.offset = hw.torque_sensor_offset[j];
-  ms.torque_sensor.repeatability_fs = hw.torque_sensor_noise / ms.torque_sensor.range;
-  ms.encoder.bits = hw.encoder_bits;
-  ms.driver.lag = hw.motor_lag;
-  ms.driver.limit = hw.torque_limit;
-  ms.driver.watchdog = hw.watchdog;
-  ms.torque_sensor_skew = hw.torque_sensor_skew;
-  return ms;
-}
-
-// The subject's muscles (ground truth alpha, beta, gamma) stiffening about CoContractionPosture.
-MuscleParams TrialMuscles(const Scenario& s, const controller::JointSetpoint& h0, const controller::JointSetpoint& k0) {
-  MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
-  mp.q_rest = CoContractionPosture(s, mp, {h0.q, k0.q});
-  return mp;
-}
-
 // One trial of the EXOwheel on the rig: plant (shared across trials), joint modules, the subject
 // (muscles, behaviour, surface EMG), faults, logs and the metrics' accumulation.
 class ExowheelTrial : public CosimDevice {
@@ -253,14 +58,14 @@ class ExowheelTrial : public CosimDevice {
         rig_(BusConfigOf(s.hardware, seed_), can_log, trial * (s.protocol.duration + 1.0)),  // trials follow each other
         ctrl_ep_(rig_.bus().AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee, msg::kIdEmgSamples})),
         emg_ep_(rig_.bus().AddNode("emg_amplifier", {0x7FF})),  // sends only
-        hip_(ModuleSpec(s.hardware, 0), rig_.bus().AddNode("hip_module", {msg::kIdJointCommandHip}), seed_ + 1),
-        knee_(ModuleSpec(s.hardware, 1), rig_.bus().AddNode("knee_module", {msg::kIdJointCommandKnee}), seed_ + 2),
+        hip_(JointModuleSpecOf(s.hardware, 0), rig_.bus().AddNode("hip_module", {msg::kIdJointCommandHip}), seed_ + 1),
+        knee_(JointModuleSpecOf(s.hardware, 1), rig_.bus().AddNode("knee_module", {msg::kIdJointCommandKnee}), seed_ + 2),
         ctrl_cfg_(ControllerConfig(s, truth)),
         ctrl_(ctrl_cfg_, trajectory_, ctrl_ep_),
         human_(truth.human.has_value()),
         emg_on_(human_ && s.human.emg) {
     trajectory_->Sample(0.0, &h0_, &k0_);
-    const MuscleParams mp = TrialMuscles(s, h0_, k0_);
+    const MuscleParams mp = SubjectMuscles(s, {h0_.q, k0_.q});
     muscles_ = std::make_unique<MuscleModel>(mp, plant.timestep());
     behaviour_ = BuildBehaviour(s, mp, trajectory_, seed_ + 3);
     emg_ = std::make_unique<SyntheticEmg>(ExowheelSyntheticEmgConfig(), seed_ + 4);
@@ -337,7 +142,7 @@ class ExowheelTrial : public CosimDevice {
       // the other joint is bounded separately by torque_max_after_safe).
       bool faulted_joint = false;
       for (const auto& f : faults_)
-        faulted_joint |= f.active && (f.spec.joint == "all" || f.spec.joint == (j == 0 ? "hip" : "knee"));
+        faulted_joint |= f.active && FaultActsOn(f.spec, j);
       if (m.fault_time >= 0 && t > m.fault_time + 0.05 && faulted_joint)
         m.torque_after_fault = std::max(m.torque_after_fault, std::abs(applied_[j]));
     }
@@ -404,7 +209,7 @@ class ExowheelTrial : public CosimDevice {
   RunResult* result_;
   ExowheelTotals* totals_;
   const uint64_t seed_;
-  const std::shared_ptr<const LegTrajectory> trajectory_;
+  const std::shared_ptr<const controller::LegTrajectory> trajectory_;
   controller::JointSetpoint h0_, k0_;  // the reference at t = 0: the start pose
   CosimRig rig_;
   hwsim::VirtualCanBus::Endpoint* ctrl_ep_;

@@ -18,6 +18,7 @@
 #include "protocol/candump.h"
 #include "runner/cosim_rig.h"
 #include "runner/hal_emg_calibration.h"
+#include "runner/hal_setup.h"
 #include "runner/progress_bar.h"
 #include "runner/sweep_plots.h"
 #include "sim/hal3_plant.h"
@@ -29,9 +30,7 @@ namespace exotwin {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kExt = 1, kFlex = 3;  // EMG channels of HAL's two sensor units: VM, ST
 constexpr double kPaperViscousOptimum = 1.56;  // Lee & Sankai sec. 4.2, N m/(rad/s)
-constexpr double kRmsWindow = 0.1;  // s, T of eq. (1), controller and calibration alike
 
 struct Mean {
   double sum = 0;
@@ -66,74 +65,20 @@ class ProjectedViscoelasticity {
   double rho_, svv_ = 0, svp_ = 0, spp_ = 0, sv1_ = 0, sv2_ = 0;
 };
 
-Hal3PlantParams PlantParams(const Scenario& s) {
-  if (!s.subject.params_file.empty())
-    throw InputError(s.source + ": subject.params: device hal3 takes a preset or random_seed subject");
-  if (!s.subject.preset.empty()) return Hal3ParamsForSubject(PresetSubject(s.subject.preset));
-  if (s.subject.random_seed) return Hal3ParamsForSubject(DrawSubject(*s.subject.random_seed, 0));
-  return Hal3PlantParams();
-}
-
-// The operator's muscles: ground truth drawn from the seed, plus the relaxed knee's own passive
-// viscoelasticity about the hanging leg (our choice: K0 = 1.5 N m/rad, D0 = 0.3 N m s/rad, of the
-// order of pendulum-test values for a relaxed knee; Hayashi's D, K include it).
-MuscleParams OperatorMuscles(const Scenario& s) {
-  MuscleParams p = DrawMuscleParams(s.human.muscle_seed);
-  p.K0[1] = 1.5;
-  p.D0[1] = 0.3;
-  return p;
-}
-
-controller::HalLoopConfig LoopConfig(const Scenario& s, const Hal3PlantParams& pp,
-                                     const HalEmgCoefficients& emg, double B_v) {
-  controller::HalLoopConfig c;
-  const std::string& mode = s.hal.mode;
-  c.mode = mode == "none" ? controller::HalMode::kNone
-                          : (mode == "assist" ? controller::HalMode::kAssist : controller::HalMode::kImpedance);
-  c.rate_hz = s.controller.rate_hz;
-  c.rms_window = kRmsWindow;
-  c.tau_max = std::min(60.0, s.controller.torque_limit);
-  c.extensor_channel = kExt;
-  c.flexor_channel = kFlex;
-  c.velocity.sample_rate_hz = s.controller.rate_hz;
-  // tau_c (Lee & Sankai; Hayashi eq. 6): identified exoskeleton (eq. 15; the twin hands over its
-  // true values: identification itself is tested in tests/controller/hal_assist_test.cc). Inertia
-  // is not compensated (I_v = I: a causal acceleration estimate from a potentiometer is too noisy).
-  c.impedance.actual = {pp.hal_I(), pp.R, pp.hal_mgl(), pp.C};
-  c.impedance.target = {pp.hal_I(), B_v, pp.hal_mgl(), 0.0};
-  HalAssistConfig& a = c.assist;
-  a.dt = 1.0 / s.controller.rate_hz;
-  a.alpha_mu = s.hal.alpha_mu;
-  a.alpha_zeta = s.hal.alpha_zeta;
-  a.emg = emg;
-  a.tau_max = c.tau_max;
-  a.rls.dt = a.dt;
-  a.rls.R = pp.R;        // eq. (15)
-  a.rls.mgl = pp.mgl();  // eq. (14)
-  a.rls.I0 = pp.I();
-  a.rls.gravity_in_input = s.hal.rls_gravity_in_input;
-  a.rls.known_inertia = s.hal.rls_known_inertia;
-  if (s.hal.rls_friction_in_input) {  // the identified C of tau_c (eq. 15), smoothed as tau_c smooths it
-    a.friction_C = c.impedance.actual.C;
-    a.friction_eps = c.impedance.coulomb_eps;
-  }
-  return c;
-}
-
 // One run of the HAL-3 on the rig: plant, the operator (muscles, knee swing, surface EMG), the knee
 // node, the controller's HalLoop, logs and the run's metrics.
 class HalTrial : public CosimDevice {
  public:
   HalTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, double B_v, int run, int runs,
            RunResult* result, CandumpWriter* can_log, double epoch)
-      : s_(s), opt_(opt), pp_(PlantParams(s)) {
+      : s_(s), opt_(opt), pp_(Hal3PlantParamsOf(s)) {
     plant_.SetParams(pp_);
     dt_ = plant_.timestep();
     schedule_ = ScheduleOf(s, dt_, CosimClock::kPlant);
     ctrl_dt_ = 1.0 / s.controller.rate_hz;
     mp_ = OperatorMuscles(s);
     const SyntheticEmgConfig emg_cfg = DefaultSyntheticEmgConfig();
-    const HalEmgCalibrationSpec cal{kExt, kFlex, kRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
+    const HalEmgCalibrationSpec cal{kHalExtChannel, kHalFlexChannel, kHalRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
                                     s.hal.calibration_rest};
     coeffs_ = CalibrateHalEmg(mp_, emg_cfg, cal, seed + 11);
     muscles_ = std::make_unique<MuscleModel>(mp_, dt_);
@@ -155,7 +100,7 @@ class HalTrial : public CosimDevice {
     ks.driver.watchdog = s.hardware.watchdog;
     knee_ = std::make_unique<hwsim::Hal3KneeNode>(ks, knee_ep, seed + 1);
     rig_->AttachEmg(emg_ep, muscles_.get(), emg_.get());
-    loop_cfg_ = LoopConfig(s, pp_, coeffs_, B_v);
+    loop_cfg_ = HalLoopConfigOf(s, pp_, coeffs_, B_v);
     loop_ = std::make_unique<controller::HalLoop>(loop_cfg_, ctrl_ep);
 
     if (s.log_measured_csv)
@@ -226,14 +171,14 @@ class HalTrial : public CosimDevice {
       th_max_ = std::max(th_max_, th);
       th_min_ = std::min(th_min_, th);
       if (th > 0 && thd > 0) {
-        ext_up_.Add(tel.E_e), flex_up_.Add(tel.E_f), rect_up_.Add(std::abs(emg_node.last_output()[kExt]));
+        ext_up_.Add(tel.E_e), flex_up_.Add(tel.E_f), rect_up_.Add(std::abs(emg_node.last_output()[kHalExtChannel]));
         strain_up_.Add(knee_->last_strain()), mu_up_.Add(mu_ext);
       } else if (th > 0 && thd < 0) {
         ext_down_.Add(tel.E_e), flex_down_.Add(tel.E_f), strain_down_.Add(knee_->last_strain());
       }
       tau_m_.push_back(mu_);
-      m_e_.push_back(emg_node.last_output()[kExt]);
-      m_f_.push_back(emg_node.last_output()[kFlex]);
+      m_e_.push_back(emg_node.last_output()[kHalExtChannel]);
+      m_f_.push_back(emg_node.last_output()[kHalFlexChannel]);
       D_true_.Add(Dt_), K_true_.Add(Kt_);
       if (projected_->valid()) D_proj_.Add(projected_->D()), K_proj_.Add(projected_->K());
       D_hat_.Add(tel.assist.D), K_hat_.Add(tel.assist.K);
