@@ -469,7 +469,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
                        const DiagnoseOptions& opt, Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   const size_t R = recs.size();
-  Plant ext_plant(opt.mjcf.empty() ? ShippedModelFor(D.extended) : opt.mjcf);
+  Plant ext_plant(opt.mjcf.empty() ? ExowheelMjcfPath(D.extended.human.has_value()) : opt.mjcf);
   ext_plant.SetParams(D.extended);
   double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
   const std::vector<int> cols = ColumnsOf(bank, chosen);
@@ -514,7 +514,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
         e.value *= refine_ratio[k];
         p.effects.push_back(e);
       }
-      Plant loo_plant(opt.mjcf.empty() ? ShippedModelFor(p) : opt.mjcf);
+      Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
       loo_plant.SetParams(p);
       const Prediction whole = PredictTorque(loo_plant, rc.kin);
       for (int j = 0; j < 2; ++j) {
@@ -621,7 +621,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   D.cutoff = ResolveCutoff(params, records, opt);
   Lap("cutoff choice");
 
-  Plant plant(opt.mjcf.empty() ? ShippedModelFor(params) : opt.mjcf);
+  Plant plant(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);
   plant.SetParams(params);  // validates the realization
   std::vector<Rec> recs(R);  // in place: Rec::FilterFn captures its record
   for (size_t r = 0; r < R; ++r) PrepareRecord(params, *records[r], D.cutoff, opt.holdout_fraction, &recs[r]);

@@ -21,10 +21,6 @@ const std::vector<std::string>& AllEffectNames() {
   return k;
 }
 
-std::string ShippedModelFor(const LegParams& params) {
-  return ShippedModelPath(params.human ? "leg_exowheel.xml" : "exowheel_exo_only.xml");
-}
-
 namespace {
 
 const char* kEmgChannels[] = {"GMAX", "RF", "VM", "ST", "GAS"};
@@ -154,7 +150,7 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
   for (int c = 0; c < 5; ++c) kin.emg[kEmgChannels[c]] = emg[c];
   kin.derivative_source = "analytic";
 
-  Plant plant(ShippedModelFor(g.truth));
+  Plant plant(ExowheelMjcfPath(g.truth.human.has_value()));
   plant.SetParams(g.truth);
   const Prediction truth = PredictTorque(plant, kin);
 

@@ -47,7 +47,4 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
 // Writes the generated record as a measured-data CSV (comments name the seed, not the truth).
 void WriteGeneratedCsv(const GeneratedData& g, const std::string& path, uint64_t seed);
 
-// MJCF shipped for a parameter set: leg + exoskeleton with a human, else the exoskeleton alone.
-std::string ShippedModelFor(const LegParams& params);
-
 }  // namespace exotwin

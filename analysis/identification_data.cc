@@ -160,7 +160,7 @@ LegParams RegroupForRealization(const LegParams& p) {
 
 ProtocolData SimulateProtocol(const LegParams& truth, const ProtocolOptions& opt) {
   const bool human = truth.human.has_value();
-  Plant plant(ShippedModelPath(human ? "leg_exowheel.xml" : "exowheel_exo_only.xml"));
+  Plant plant(ExowheelMjcfPath(human));
   plant.SetParams(RegroupForRealization(truth));
   LegParams ff = truth;
   ff.exo = Scaled(truth.exo, opt.ff_scale);

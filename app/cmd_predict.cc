@@ -13,10 +13,6 @@
 
 namespace exotwin {
 
-std::string DefaultModelFor(bool has_human) {
-  return ShippedModelPath(has_human ? "leg_exowheel.xml" : "exowheel_exo_only.xml");
-}
-
 std::vector<CommandFactory>& CommandFactories() {
   static std::vector<CommandFactory> factories;
   return factories;
@@ -46,7 +42,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
     const MeasuredData data = ReadMeasured(o->measured, o->map, 20, &map_report);
     if (!o->map.empty()) std::fprintf(stderr, "predict: %s", map_report.Summary().c_str());
     if (params.human) CheckHumanJointRange(data);
-    Plant plant(o->mjcf.empty() ? DefaultModelFor(params.human.has_value()) : o->mjcf);
+    Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
     std::string why;
     const double cutoff = ResolveCutoffOption(o->cutoff, "--cutoff", {&data}, params.L1, params.g, &why);

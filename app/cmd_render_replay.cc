@@ -80,7 +80,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
     const MeasuredData data = ReadMeasuredCsv(o->measured);
-    Plant plant(o->mjcf.empty() ? DefaultModelFor(params.human.has_value()) : o->mjcf);
+    Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
 
     std::vector<double> est[2];

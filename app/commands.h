@@ -21,7 +21,4 @@ struct CommandRegistration {
   explicit CommandRegistration(CommandFactory f) { CommandFactories().push_back(f); }
 };
 
-// Chooses the shipped MJCF for a parameter set: with a human the leg + exo, else the exo alone.
-std::string DefaultModelFor(bool has_human);
-
 }  // namespace exotwin

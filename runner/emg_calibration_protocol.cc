@@ -106,6 +106,7 @@ RunResult RunTrial(Scenario sub, const std::string& tag, uint64_t seed, const Ru
   RunOptions ro;
   ro.out_dir = opt.out_dir + "/" + tag;
   ro.seed = seed;
+  ro.progress = opt.progress;
   fs::remove_all(ro.out_dir);
   return RunScenario(sub, ro);
 }

@@ -12,12 +12,14 @@
 #include "analysis/csv_table.h"
 #include "analysis/stress_metrics.h"
 #include "controller/hal_loop.h"
-#include "core/error.h"
 #include "hwsim/emg_node.h"
 #include "hwsim/hal3_knee_node.h"
-#include "hwsim/virtual_can_bus.h"
+#include "core/error.h"
 #include "protocol/candump.h"
+#include "runner/cosim_rig.h"
 #include "runner/hal_emg_calibration.h"
+#include "runner/hal_setup.h"
+#include "runner/progress_bar.h"
 #include "runner/sweep_plots.h"
 #include "sim/hal3_plant.h"
 #include "sim/muscles.h"
@@ -28,9 +30,7 @@ namespace exotwin {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kExt = 1, kFlex = 3;  // EMG channels of HAL's two sensor units: VM, ST
 constexpr double kPaperViscousOptimum = 1.56;  // Lee & Sankai sec. 4.2, N m/(rad/s)
-constexpr double kRmsWindow = 0.1;  // s, T of eq. (1), controller and calibration alike
 
 struct Mean {
   double sum = 0;
@@ -65,255 +65,218 @@ class ProjectedViscoelasticity {
   double rho_, svv_ = 0, svp_ = 0, spp_ = 0, sv1_ = 0, sv2_ = 0;
 };
 
-Hal3PlantParams PlantParams(const Scenario& s) {
-  if (!s.subject.params_file.empty())
-    throw InputError(s.source + ": subject.params: device hal3 takes a preset or random_seed subject");
-  if (!s.subject.preset.empty()) return Hal3ParamsForSubject(PresetSubject(s.subject.preset));
-  if (s.subject.random_seed) return Hal3ParamsForSubject(DrawSubject(*s.subject.random_seed, 0));
-  return Hal3PlantParams();
-}
+// One run of the HAL-3 on the rig: plant, the operator (muscles, knee swing, surface EMG), the knee
+// node, the controller's HalLoop, logs and the run's metrics.
+class HalTrial : public CosimDevice {
+ public:
+  HalTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, double B_v, int run, int runs,
+           RunResult* result, CandumpWriter* can_log, double epoch)
+      : s_(s), opt_(opt), pp_(Hal3PlantParamsOf(s)) {
+    plant_.SetParams(pp_);
+    dt_ = plant_.timestep();
+    schedule_ = ScheduleOf(s, dt_, CosimClock::kPlant);
+    ctrl_dt_ = 1.0 / s.controller.rate_hz;
+    mp_ = OperatorMuscles(s);
+    const SyntheticEmgConfig emg_cfg = DefaultSyntheticEmgConfig();
+    const HalEmgCalibrationSpec cal{kHalExtChannel, kHalFlexChannel, kHalRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
+                                    s.hal.calibration_rest};
+    coeffs_ = CalibrateHalEmg(mp_, emg_cfg, cal, seed + 11);
+    muscles_ = std::make_unique<MuscleModel>(mp_, dt_);
+    TrackingGains gains = KneeSwingBehaviour::KneeSwingGains();
+    gains.inertia[1] = pp_.I();  // a rehearsed operator knows its leg + HAL (Hayashi sec. III)
+    gains.feedback_delay = s.hal.operator_delay;
+    gains.cocontraction_synergy = s.hal.cc_synergy;
+    swing_ = std::make_unique<KneeSwingBehaviour>(mp_, s.hal.swing_freq, s.hal.cc_up, s.hal.cc_down, pp_.mgl(), gains);
+    emg_ = std::make_unique<SyntheticEmg>(emg_cfg, seed + 13);
 
-// The operator's muscles: ground truth drawn from the seed, plus the relaxed knee's own passive
-// viscoelasticity about the hanging leg (our choice: K0 = 1.5 N m/rad, D0 = 0.3 N m s/rad, of the
-// order of pendulum-test values for a relaxed knee; Hayashi's D, K include it).
-MuscleParams OperatorMuscles(const Scenario& s) {
-  MuscleParams p = DrawMuscleParams(s.human.muscle_seed);
-  p.K0[1] = 1.5;
-  p.D0[1] = 0.3;
-  return p;
-}
+    rig_ = std::make_unique<CosimRig>(BusConfigOf(s.hardware, seed), can_log, epoch);
+    auto* ctrl_ep = rig_->bus().AddNode("hal_controller", {msg::kIdHalKneeStatus, msg::kIdEmgSamples});
+    auto* knee_ep = rig_->bus().AddNode("hal_knee", {msg::kIdHalKneeCommand});
+    auto* emg_ep = rig_->bus().AddNode("emg_amplifier", {msg::kIdControllerHeartbeat});  // receives nothing used
+    hwsim::Hal3KneeNodeSpec ks;
+    ks.torque_sensor_skew = s.hardware.torque_sensor_skew;
+    ks.driver.lag = s.hardware.motor_lag;
+    ks.driver.limit = std::min(60.0, s.hardware.torque_limit);
+    ks.driver.watchdog = s.hardware.watchdog;
+    knee_ = std::make_unique<hwsim::Hal3KneeNode>(ks, knee_ep, seed + 1);
+    rig_->AttachEmg(emg_ep, muscles_.get(), emg_.get());
+    loop_cfg_ = HalLoopConfigOf(s, pp_, coeffs_, B_v);
+    loop_ = std::make_unique<controller::HalLoop>(loop_cfg_, ctrl_ep);
 
-controller::HalLoopConfig LoopConfig(const Scenario& s, const Hal3PlantParams& pp,
-                                     const controller::HalEmgCoefficients& emg, double B_v) {
-  controller::HalLoopConfig c;
-  const std::string& mode = s.hal.mode;
-  c.mode = mode == "none" ? controller::HalMode::kNone
-                          : (mode == "assist" ? controller::HalMode::kAssist : controller::HalMode::kImpedance);
-  c.rate_hz = s.controller.rate_hz;
-  c.rms_window = kRmsWindow;
-  c.tau_max = std::min(60.0, s.controller.torque_limit);
-  c.extensor_channel = kExt;
-  c.flexor_channel = kFlex;
-  c.velocity.sample_rate_hz = s.controller.rate_hz;
-  // tau_c (Lee & Sankai; Hayashi eq. 6): identified exoskeleton (eq. 15; the twin hands over its
-  // true values: identification itself is tested in tests/controller/hal_assist_test.cc). Inertia
-  // is not compensated (I_v = I: a causal acceleration estimate from a potentiometer is too noisy).
-  c.impedance.actual = {pp.hal_I(), pp.R, pp.hal_mgl(), pp.C};
-  c.impedance.target = {pp.hal_I(), B_v, pp.hal_mgl(), 0.0};
-  controller::HalAssistConfig& a = c.assist;
-  a.dt = 1.0 / s.controller.rate_hz;
-  a.alpha_mu = s.hal.alpha_mu;
-  a.alpha_zeta = s.hal.alpha_zeta;
-  a.emg = emg;
-  a.tau_max = c.tau_max;
-  a.rls.dt = a.dt;
-  a.rls.R = pp.R;        // eq. (15)
-  a.rls.mgl = pp.mgl();  // eq. (14)
-  a.rls.I0 = pp.I();
-  a.rls.gravity_in_input = s.hal.rls_gravity_in_input;
-  a.rls.known_inertia = s.hal.rls_known_inertia;
-  if (s.hal.rls_friction_in_input) {  // the identified C of tau_c (eq. 15), smoothed as tau_c smooths it
-    a.friction_C = c.impedance.actual.C;
-    a.friction_eps = c.impedance.coulomb_eps;
-  }
-  return c;
-}
+    if (s.log_measured_csv)
+      logs_ = OpenTrialLogs(opt.out_dir, run, runs,
+                            {"t", "q_knee", "tau_knee", "cmd_knee", "emg_GMAX", "emg_VM", "emg_RF", "emg_ST",
+                             "emg_GAS", "E_ext", "E_flex", "mu_hat", "D_hat", "K_hat"},
+                            {"t", "th", "thd", "tau_motor", "tau_muscle", "tau_interaction", "D_true", "K_true",
+                             "mu_contraction"},
+                            {"exotwin run " + s.name + " (HAL-3) mode " + s.hal.mode + " B_v " +
+                             std::to_string(B_v) + " seed " + std::to_string(result->seed)},
+                            &result->files);
 
-struct TrialOut {
-  std::map<std::string, double> m;
-};
-
-TrialOut RunTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, double B_v,
-                  const std::string& suffix, RunResult* result, CandumpWriter* can_log,
-                  double epoch) {
-  const Hal3PlantParams pp = PlantParams(s);
-  Hal3Plant plant;
-  plant.SetParams(pp);
-  const double dt = plant.timestep();
-  const double ctrl_dt = 1.0 / s.controller.rate_hz;
-  if (std::abs(ctrl_dt / dt - std::round(ctrl_dt / dt)) > 1e-9 || ctrl_dt < dt - 1e-12)
-    throw InputError(s.source + ": controller.rate_hz: expected the physics rate (1000 Hz) divided by an integer");
-  const int steps_per_tick = static_cast<int>(std::lround(ctrl_dt / dt));
-
-  const MuscleParams mp = OperatorMuscles(s);
-  const SyntheticEmgConfig emg_cfg = DefaultSyntheticEmgConfig();
-  const HalEmgCalibrationSpec cal{kExt, kFlex, kRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
-                                  s.hal.calibration_rest};
-  const controller::HalEmgCoefficients coeffs = CalibrateHalEmg(mp, emg_cfg, cal, seed + 11);
-  MuscleModel muscles(mp, dt);
-  TrackingGains gains = KneeSwingBehaviour::KneeSwingGains();
-  gains.inertia[1] = pp.I();  // a rehearsed operator knows its leg + HAL (Hayashi sec. III)
-  gains.feedback_delay = s.hal.operator_delay;
-  gains.cocontraction_synergy = s.hal.cc_synergy;
-  KneeSwingBehaviour swing(mp, s.hal.swing_freq, s.hal.cc_up, s.hal.cc_down, pp.mgl(), gains);
-  SyntheticEmg emg(emg_cfg, seed + 13);
-
-  hwsim::VirtualCanBus bus(BusConfigOf(s.hardware, seed));
-  TapToCandump(bus, can_log, epoch);
-  auto* ctrl_ep = bus.AddNode("hal_controller", {msg::kIdHalKneeStatus, msg::kIdEmgSamples});
-  auto* knee_ep = bus.AddNode("hal_knee", {msg::kIdHalKneeCommand});
-  auto* emg_ep = bus.AddNode("emg_amplifier", {msg::kIdControllerHeartbeat});  // receives nothing used
-  hwsim::Hal3KneeNodeSpec ks;
-  ks.torque_sensor_skew = s.hardware.torque_sensor_skew;
-  ks.driver.lag = s.hardware.motor_lag;
-  ks.driver.limit = std::min(60.0, s.hardware.torque_limit);
-  ks.driver.watchdog = s.hardware.watchdog;
-  hwsim::Hal3KneeNode knee(ks, knee_ep, seed + 1);
-  hwsim::EmgNode emg_node(hwsim::EmgAmplifierSpec{}, emg_ep);
-  const controller::HalLoopConfig loop_cfg = LoopConfig(s, pp, coeffs, B_v);
-  controller::HalLoop loop(loop_cfg, ctrl_ep);
-
-  std::unique_ptr<CsvStreamWriter> measured, truth_log;
-  if (s.log_measured_csv) {
-    const std::vector<std::string> comments = {
-        "exotwin run " + s.name + " (HAL-3) mode " + s.hal.mode + " B_v " + std::to_string(B_v) +
-        " seed " + std::to_string(result->seed)};
-    measured = std::make_unique<CsvStreamWriter>(
-        opt.out_dir + "/measured" + suffix + ".csv",
-        std::vector<std::string>{"t", "q_knee", "tau_knee", "cmd_knee", "emg_GMAX", "emg_VM", "emg_RF",
-                                 "emg_ST", "emg_GAS", "E_ext", "E_flex", "mu_hat", "D_hat", "K_hat"},
-        comments);
-    truth_log = std::make_unique<CsvStreamWriter>(
-        opt.out_dir + "/truth" + suffix + ".csv",
-        std::vector<std::string>{"t", "th", "thd", "tau_motor", "tau_muscle", "tau_interaction", "D_true",
-                                 "K_true", "mu_contraction"},
-        comments);
-    result->files.push_back("measured" + suffix + ".csv");
-    result->files.push_back("truth" + suffix + ".csv");
+    const double w = 2 * kPi * s.hal.swing_freq;
+    plant_.Reset(0.35, 0.65 * w, 0.0);
+    // Same memory as the RLS: its rho is per control tick, the sums here run per physics step.
+    projected_ = std::make_unique<ProjectedViscoelasticity>(std::pow(loop_cfg_.assist.rls.rho, dt_ / ctrl_dt_));
   }
 
-  const double w = 2 * kPi * s.hal.swing_freq;
-  plant.Reset(0.35, 0.65 * w, 0.0);
-  const long n_steps = std::lround(s.protocol.duration / dt);
-  const long log_every = std::max(1L, std::lround(1.0 / (s.log_rate_hz * dt)));
-  Mean ext_up, ext_down, flex_up, flex_down, rect_up, strain_up, strain_down, mu_up;
-  Mean D_hat, K_hat, D_true, K_true, D_proj, K_proj, track2;
-  // Same memory as the RLS: its rho is per control tick, the sums here run per physics step.
-  ProjectedViscoelasticity projected(std::pow(loop_cfg.assist.rls.rho, dt / ctrl_dt));
-  std::vector<double> tau_m, m_e, m_f;
-  double th_max = -10, th_min = 10, t = 0;
-  // Timing of one physics step [t, t + dt], as runner.cc's (DESIGN.md "Sampling instant of a joint
-  // node"): the plant holds the driver's output at t over [t, t + dt]; the knee node samples th(t)
-  // and the frame torque at t at one instant; the controller ticks at t + dt/2 on that frame, and its
-  // command shows in the driver's output at t + dt (one sample from sampling to torque). The frame
-  // torque at t needs the acceleration a(t) of this step (Hal3Plant::interaction_torque: semi-implicit
-  // Euler, a(t) from the state at t and the torques held over [t, t + dt]), so the step is computed
-  // before the tick: everything it uses is fixed at t, and the controller sees the plant only
-  // through the bus.
-  double tau_motor = 0;  // the driver's output at t = 0: no command yet
-  for (long k = 0; k < n_steps; ++k) {
-    const double th_t = plant.th();
-    const Eigen::Vector2d q(kPi / 2, th_t - kPi / 2), qd(0, plant.thd());
-    muscles.Step(swing.Excitation(t, q, qd));
-    const MuscleTorques mt = muscles.Torques(q, qd);
-    const double mu = mt.total()[1];
-    const double applied = tau_motor;  // held over [t, t + dt], for the metrics and truth.csv
-    plant.Step(tau_motor, mu);
-    knee.Sample(t, th_t, plant.interaction_torque());  // one instant: th(t) and the frame torque at t
-    if (k % steps_per_tick == 0) {
-      bus.AdvanceTo(t + 0.5 * dt);
-      loop.Tick(t + 0.5 * dt);
-    }
-    bus.AdvanceTo(t + 0.999 * dt);
-    tau_motor = knee.Applied(t + dt, dt);  // the driver at t + dt
-    t = plant.time();
-    const double th = plant.th(), thd = plant.thd();
-    const MuscleVec raw = emg.Sample(muscles.electrical_activation());
-    std::array<double, hwsim::EmgAmplifier::kChannels> v{};
-    for (int c = 0; c < kNumMuscles; ++c) v[c] = raw[c];
-    emg_node.Sample(t, v);
+  const CosimSchedule& schedule() const { return schedule_; }
 
+  // Runs the trial on the rig (DESIGN.md "Loop timing per 1 ms step"; the HAL knee node's frame torque
+  // at t needs the step's acceleration a(t): Hal3Plant::interaction_torque, semi-implicit Euler, so the
+  // node samples the instant t after the step, before the tick) and returns the run's metrics.
+  std::map<std::string, double> Run(const CosimProgress& progress) {
+    rig_->Run(schedule_, *this, [this](double t) { loop_->Tick(t); }, progress);
+    return Metrics();
+  }
+
+  double StepPlant(double t) override {
+    th_t_ = plant_.th();
+    const Eigen::Vector2d q(kPi / 2, th_t_ - kPi / 2), qd(0, plant_.thd());
+    muscles_->Step(swing_->Excitation(t, q, qd));
+    mt_ = muscles_->Torques(q, qd);
+    mu_ = mt_.total()[1];
+    applied_ = tau_motor_;  // held over [t, t + dt], for the metrics and truth.csv
+    plant_.Step(tau_motor_, mu_);
+    return plant_.time();
+  }
+
+  void SampleStepStart(double t) override {
+    knee_->Sample(t, th_t_, plant_.interaction_torque());  // one instant: th(t) and the frame torque at t
+  }
+
+  void LatchDrivers(double t, double dt) override { tau_motor_ = knee_->Applied(t, dt); }
+
+  void EndStep(double t) override {
+    const double th = plant_.th(), thd = plant_.thd();
+    const hwsim::EmgNode& emg_node = *rig_->emg_node();
     // Ground truth of Hayashi eq. (4): muscle torque = mu_c - D thd - K th with the contraction's
     // angle/velocity factors (eq. 26-27 structure, q_c = hanging) moved into D and K.
-    const MuscleVec& a = muscles.mechanical_activation();
-    double sum_alpha_a = 0, mu_c = 0, mu_ext = 0;
+    const MuscleVec& a = muscles_->mechanical_activation();
+    double sum_alpha_a = 0, mu_ext = 0;
+    mu_c_ = 0;
     for (int m = 0; m < kNumMuscles; ++m) {
       const int sg = ActionSign(MuscleAt(m), 1);
       if (!sg) continue;
-      sum_alpha_a += mp.alpha(m, 1) * a[m];
-      mu_c += sg * mp.alpha(m, 1) * a[m];
-      if (sg > 0) mu_ext += mp.alpha(m, 1) * a[m];
+      sum_alpha_a += mp_.alpha(m, 1) * a[m];
+      mu_c_ += sg * mp_.alpha(m, 1) * a[m];
+      if (sg > 0) mu_ext += mp_.alpha(m, 1) * a[m];
     }
-    const double Dt = mt.D[1] + mp.gamma[1] * sum_alpha_a, Kt = mt.K[1] - mp.beta[1] * sum_alpha_a;
-    projected.Add(mu - mu_c, thd, th);  // v = -D thd - K th (up to the ForceFactor clamp)
-    const controller::HalTelemetry& tel = loop.telemetry();
-    if (t >= s.hal.settle) {
+    Dt_ = mt_.D[1] + mp_.gamma[1] * sum_alpha_a, Kt_ = mt_.K[1] - mp_.beta[1] * sum_alpha_a;
+    projected_->Add(mu_ - mu_c_, thd, th);  // v = -D thd - K th (up to the ForceFactor clamp)
+    const controller::HalTelemetry& tel = loop_->telemetry();
+    if (t >= s_.hal.settle) {
       Eigen::Vector2d qs, qds, qdds;
-      KneeSwingBehaviour::Intended(t, s.hal.swing_freq, qs, qds, qdds);
-      track2.Add(std::pow(qs[1] + kPi / 2 - th, 2));
-      th_max = std::max(th_max, th);
-      th_min = std::min(th_min, th);
+      KneeSwingBehaviour::Intended(t, s_.hal.swing_freq, qs, qds, qdds);
+      track2_.Add(std::pow(qs[1] + kPi / 2 - th, 2));
+      th_max_ = std::max(th_max_, th);
+      th_min_ = std::min(th_min_, th);
       if (th > 0 && thd > 0) {
-        ext_up.Add(tel.E_e), flex_up.Add(tel.E_f), rect_up.Add(std::abs(emg_node.last_output()[kExt]));
-        strain_up.Add(knee.last_strain()), mu_up.Add(mu_ext);
+        ext_up_.Add(tel.E_e), flex_up_.Add(tel.E_f), rect_up_.Add(std::abs(emg_node.last_output()[kHalExtChannel]));
+        strain_up_.Add(knee_->last_strain()), mu_up_.Add(mu_ext);
       } else if (th > 0 && thd < 0) {
-        ext_down.Add(tel.E_e), flex_down.Add(tel.E_f), strain_down.Add(knee.last_strain());
+        ext_down_.Add(tel.E_e), flex_down_.Add(tel.E_f), strain_down_.Add(knee_->last_strain());
       }
-      tau_m.push_back(mu);
-      m_e.push_back(emg_node.last_output()[kExt]);
-      m_f.push_back(emg_node.last_output()[kFlex]);
-      D_true.Add(Dt), K_true.Add(Kt);
-      if (projected.valid()) D_proj.Add(projected.D()), K_proj.Add(projected.K());
-      D_hat.Add(tel.assist.D), K_hat.Add(tel.assist.K);
+      tau_m_.push_back(mu_);
+      m_e_.push_back(emg_node.last_output()[kHalExtChannel]);
+      m_f_.push_back(emg_node.last_output()[kHalFlexChannel]);
+      D_true_.Add(Dt_), K_true_.Add(Kt_);
+      if (projected_->valid()) D_proj_.Add(projected_->D()), K_proj_.Add(projected_->K());
+      D_hat_.Add(tel.assist.D), K_hat_.Add(tel.assist.K);
     }
-    if (measured && k % log_every == 0) {
-      const auto& o = emg_node.last_output();
+  }
+
+  void LogSample(double t) override {
+    const double th = plant_.th(), thd = plant_.thd();
+    if (logs_.measured) {
+      const controller::HalTelemetry& tel = loop_->telemetry();
+      const auto& o = rig_->emg_node()->last_output();
       const double row[] = {t, tel.th, tel.strain, tel.tau_cmd, o[0], o[1], o[2], o[3], o[4],
                             tel.E_e, tel.E_f, tel.assist.mu_hat, tel.assist.D, tel.assist.K};
-      measured->Row(row, 14);
-      const double trow[] = {t, th, thd, applied, mu, plant.interaction_torque(), Dt, Kt, mu_c};
-      truth_log->Row(trow, 9);
+      logs_.measured->Row(row, 14);
+      const double trow[] = {t, th, thd, applied_, mu_, plant_.interaction_torque(), Dt_, Kt_, mu_c_};
+      logs_.truth->Row(trow, 9);
     }
-    if (opt.on_sample && k % log_every == 0) {
-      const double qa[2] = {kPi / 2, th - kPi / 2}, ta[2] = {0, applied};
-      opt.on_sample(t, qa, ta);
+    if (opt_.on_sample) {
+      const double qa[2] = {kPi / 2, th - kPi / 2}, ta[2] = {0, applied_};
+      opt_.on_sample(t, qa, ta);
     }
   }
-  TrialOut out;
-  auto& m = out.m;
-  m["samples"] = static_cast<double>((n_steps + log_every - 1) / log_every);  // log-rate rows (k % log_every == 0)
-  m["emg_ext_up_V"] = ext_up.get();
-  m["emg_ext_down_V"] = ext_down.get();
-  m["emg_flex_up_V"] = flex_up.get();
-  m["emg_flex_down_V"] = flex_down.get();
-  m["emg_ext_up_rect_V"] = rect_up.get();
-  m["strain_up_Nm"] = strain_up.get();
-  m["strain_down_Nm"] = strain_down.get();
-  m["mu_ext_up_Nm"] = mu_up.get();
-  m["J_tau_m"] = tau_m.empty() ? 0.0 : MeanAbsMoment(tau_m, dt);  // Lee & Sankai eq. (12)
-  m["J_e"] = IntegratedMyoelectricity(m_e, dt);                   // eq. (16)
-  m["J_f"] = IntegratedMyoelectricity(m_f, dt);                   // eq. (15)
-  m["th_max"] = th_max;
-  m["th_min"] = th_min;
-  m["tracking_rms_rad"] = std::sqrt(track2.get());
-  m["plant_I"] = pp.I();
-  m["plant_mgl"] = pp.mgl();
-  m["emg_a_ext"] = coeffs.extensor.a;
-  m["emg_a_flex"] = coeffs.flexor.a;
-  m["emg_b_ext"] = coeffs.extensor.b;
-  m["emg_b_flex"] = coeffs.flexor.b;
-  m["emg_baseline_ext_V"] = coeffs.baseline_e;
-  m["emg_baseline_flex_V"] = coeffs.baseline_f;
-  if (s.hal.mode == "assist") {
-    m["rls_D_mean"] = D_hat.get();
-    m["rls_K_mean"] = K_hat.get();
-    m["truth_D_mean"] = D_proj.get();  // identifiable truth (ProjectedViscoelasticity)
-    m["truth_K_mean"] = K_proj.get();
-    m["truth_D_timemean"] = D_true.get();  // plain time means of D(t), K(t), for information
-    m["truth_K_timemean"] = K_true.get();
-    m["rls_D_err_pct"] = 100 * std::abs(D_hat.get() / D_proj.get() - 1);
-    m["rls_K_err_pct"] = 100 * std::abs(K_hat.get() / K_proj.get() - 1);
-    // The same error against the stiffness the RLS actually sees, K' = K + G(th) ~ K + Mgl (eq. 8):
-    // K is ~6 % of K' in the seated swing, so this says how close eq. (13) comes on its own scale.
-    m["rls_K_err_pct_of_Kprime"] = 100 * std::abs(K_hat.get() - K_proj.get()) / (K_proj.get() + pp.mgl());
-    m["rls_I_hat"] = loop.assist().rls().I();
+
+ private:
+  std::map<std::string, double> Metrics() const {
+    const double dt = dt_;
+    const long n_steps = schedule_.steps, log_every = schedule_.log_every;
+    std::map<std::string, double> m;
+    m["samples"] = static_cast<double>((n_steps + log_every - 1) / log_every);  // log-rate rows (k % log_every == 0)
+    m["emg_ext_up_V"] = ext_up_.get();
+    m["emg_ext_down_V"] = ext_down_.get();
+    m["emg_flex_up_V"] = flex_up_.get();
+    m["emg_flex_down_V"] = flex_down_.get();
+    m["emg_ext_up_rect_V"] = rect_up_.get();
+    m["strain_up_Nm"] = strain_up_.get();
+    m["strain_down_Nm"] = strain_down_.get();
+    m["mu_ext_up_Nm"] = mu_up_.get();
+    m["J_tau_m"] = tau_m_.empty() ? 0.0 : MeanAbsMoment(tau_m_, dt);  // Lee & Sankai eq. (12)
+    m["J_e"] = IntegratedMyoelectricity(m_e_, dt);                    // eq. (16)
+    m["J_f"] = IntegratedMyoelectricity(m_f_, dt);                    // eq. (15)
+    m["th_max"] = th_max_;
+    m["th_min"] = th_min_;
+    m["tracking_rms_rad"] = std::sqrt(track2_.get());
+    m["plant_I"] = pp_.I();
+    m["plant_mgl"] = pp_.mgl();
+    m["emg_a_ext"] = coeffs_.extensor.a;
+    m["emg_a_flex"] = coeffs_.flexor.a;
+    m["emg_b_ext"] = coeffs_.extensor.b;
+    m["emg_b_flex"] = coeffs_.flexor.b;
+    m["emg_baseline_ext_V"] = coeffs_.baseline_e;
+    m["emg_baseline_flex_V"] = coeffs_.baseline_f;
+    if (s_.hal.mode == "assist") {
+      m["rls_D_mean"] = D_hat_.get();
+      m["rls_K_mean"] = K_hat_.get();
+      m["truth_D_mean"] = D_proj_.get();  // identifiable truth (ProjectedViscoelasticity)
+      m["truth_K_mean"] = K_proj_.get();
+      m["truth_D_timemean"] = D_true_.get();  // plain time means of D(t), K(t), for information
+      m["truth_K_timemean"] = K_true_.get();
+      m["rls_D_err_pct"] = 100 * std::abs(D_hat_.get() / D_proj_.get() - 1);
+      m["rls_K_err_pct"] = 100 * std::abs(K_hat_.get() / K_proj_.get() - 1);
+      // The same error against the stiffness the RLS actually sees, K' = K + G(th) ~ K + Mgl (eq. 8):
+      // K is ~6 % of K' in the seated swing, so this says how close eq. (13) comes on its own scale.
+      m["rls_K_err_pct_of_Kprime"] = 100 * std::abs(K_hat_.get() - K_proj_.get()) / (K_proj_.get() + pp_.mgl());
+      m["rls_I_hat"] = loop_->assist().rls().I();
+    }
+    const hwsim::CanBusStatistics st = rig_->bus().Statistics();
+    m["bus_load_pct"] = st.mean_load_percent;
+    m["frames_dropped"] = static_cast<double>(st.drops);
+    m["emg_gaps"] = loop_->telemetry().emg_gaps;
+    return m;
   }
-  const hwsim::CanBusStatistics st = bus.Statistics();
-  m["bus_load_pct"] = st.mean_load_percent;
-  m["frames_dropped"] = static_cast<double>(st.drops);
-  m["emg_gaps"] = loop.telemetry().emg_gaps;
-  return out;
-}
+
+  const Scenario& s_;
+  const RunOptions& opt_;
+  const Hal3PlantParams pp_;
+  Hal3Plant plant_;
+  double dt_ = 0, ctrl_dt_ = 0;
+  CosimSchedule schedule_;
+  MuscleParams mp_;
+  controller::HalEmgCoefficients coeffs_;
+  std::unique_ptr<MuscleModel> muscles_;
+  std::unique_ptr<KneeSwingBehaviour> swing_;
+  std::unique_ptr<SyntheticEmg> emg_;
+  std::unique_ptr<CosimRig> rig_;
+  std::unique_ptr<hwsim::Hal3KneeNode> knee_;
+  controller::HalLoopConfig loop_cfg_;
+  std::unique_ptr<controller::HalLoop> loop_;
+  TrialLogs logs_;
+  std::unique_ptr<ProjectedViscoelasticity> projected_;
+  // The last step: angle at its start, muscle torques, the motor torque held over it and the truth.
+  double th_t_ = 0, mu_ = 0, applied_ = 0, mu_c_ = 0, Dt_ = 0, Kt_ = 0;
+  MuscleTorques mt_;
+  double tau_motor_ = 0;  // the driver's output at t (at t = 0: no command yet)
+  Mean ext_up_, ext_down_, flex_up_, flex_down_, rect_up_, strain_up_, strain_down_, mu_up_;
+  Mean D_hat_, K_hat_, D_true_, K_true_, D_proj_, K_proj_, track2_;
+  std::vector<double> tau_m_, m_e_, m_f_;
+  double th_max_ = -10, th_min_ = 10;
+};
 
 std::string Fmt(double v) {
   char b[32];
@@ -338,13 +301,19 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   const std::vector<double> values = sweep ? s.hal.sweep_viscosity : std::vector<double>{s.hal.virtual_viscosity};
   const int runs = sweep ? static_cast<int>(values.size()) : s.protocol.trials;
   std::vector<std::map<std::string, double>> per_run;
+  std::unique_ptr<ProgressBar> bar;  // over all runs' steps (the plant's step is known once one is built)
+  size_t done = 0;
   for (int i = 0; i < runs; ++i) {
     const double B_v = sweep ? values[i] : values[0];
     // A sweep keeps the same seed for every value (common random numbers): only B_v changes.
     const uint64_t seed = result.seed * 7919ull + static_cast<uint64_t>(sweep ? 0 : i);
-    const std::string suffix = runs > 1 ? "_trial" + std::to_string(i + 1) : "";
-    per_run.push_back(RunTrial(s, opt, seed, B_v, suffix, &result, can_log.get(), i * (s.protocol.duration + 1.0)).m);
+    HalTrial trial(s, opt, seed, B_v, i, runs, &result, can_log.get(), i * (s.protocol.duration + 1.0));
+    const size_t steps = static_cast<size_t>(trial.schedule().steps);
+    if (!bar) bar = std::make_unique<ProgressBar>(runs * steps, s.name, opt.progress);
+    per_run.push_back(trial.Run({bar.get(), done}));
+    done += steps;
   }
+  if (bar) bar->Update(done), bar->Finish();
   // Single run (or trials): the metrics of the last run; a sweep adds per-value metrics.
   for (const auto& kv : per_run.back()) m[kv.first] = kv.second;
   double samples = 0;

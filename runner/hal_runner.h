@@ -1,5 +1,5 @@
 // The HAL-3 scenario runner (device: hal3): Hayashi's seated knee swing and Lee & Sankai's virtual
-// impedance sweep, in lockstep co-simulation like scenarios/runner.cc:
+// impedance sweep, on the lockstep co-simulation rig (runner/cosim_rig.h) like the EXOwheel runner:
 //   Hal3Plant (MuJoCo) + MuscleModel/KneeSwingBehaviour (operator) + SyntheticEmg
 //   -> Hal3KneeNode (potentiometer, strain gauge) and EmgNode (amplifier) -> HalKneeStatus / EmgSamples
 //   -> controller::HalLoop (real controller code) -> HalKneeCommand -> motor driver -> plant.

@@ -1,5 +1,7 @@
 // The scenario runner: builds the twin (plant + virtual hardware + the real controller) from a
-// scenario, runs it in lockstep, logs the measured data, computes metrics and evaluates the checks.
+// scenario, runs it in lockstep on the co-simulation rig (runner/cosim_rig.h), logs the measured
+// data, computes metrics and evaluates the checks. RunScenario is the one place that chooses the
+// device runner for a scenario.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -8,9 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "hwsim/virtual_can_bus.h"
 #include "model/lumped_params.h"
-#include "protocol/candump.h"
 #include "runner/scenario.h"
 #include "sim/muscles.h"
 #include "sim/subjects.h"
@@ -55,18 +55,14 @@ std::optional<Subject> ScenarioSubject(const Scenario& s);
 // run_seed): the runner plays it, and the EMG calibration protocol reads its blocks (s, fraction of MVC).
 ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed);
 
-// Runs every trial of the scenario; writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
+// Runs the scenario with the runner of its kind: device hal3 -> RunHalScenario (hal_runner.h); an
+// emg_calibration block -> RunEmgCalibrationScenario (emg_calibration_protocol.h); otherwise the
+// EXOwheel closed loop (gait, identification excitation or hold) -> RunExowheelScenario
+// (exowheel_runner.h). Each writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
 // encoder angles, torque-sensor readings, commands) and DIR/truth[_trialN].csv (plant state and applied
 // torque). Throws InputError on bad scenario content and SimulationError on divergence (the logs
 // written so far stay on disk).
 RunResult RunScenario(const Scenario& s, const RunOptions& opt);
-
-// The virtual CAN bus of a scenario's hardware (bitrate, latency, jitter, drop rate) with `seed`.
-hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed);
-
-// With a log (may be null: nothing), every frame on `bus` is written to it with its time shifted by
-// `epoch` s (successive trials follow each other in one candump file). `log` must outlive the bus.
-void TapToCandump(hwsim::VirtualCanBus& bus, CandumpWriter* log, double epoch);
 
 // End of a run: evaluates the checks on result.metrics, writes result.json at `path`, then throws
 // InputError if a check names a metric the run did not produce (that check is written as failed with

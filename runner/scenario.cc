@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/yaml_fields.h"
+#include "sim/subjects.h"
 
 namespace exotwin {
 
@@ -22,6 +23,7 @@ const char* DeviceName(Device d) {
 }
 
 namespace {
+
 
 const std::set<std::string> kFaultTypes = {"sensor_stuck", "sensor_stale", "encoder_glitch", "frame_drop",
                                            "frame_late",   "bus_off",      "command_loss",   "nan_measurement"};
@@ -73,6 +75,194 @@ void ParseEmgCalibration(const YamlContext& r, const YAML::Node& n, Scenario& s)
   s.emg_calibration = c;
 }
 
+// The stages of ParseScenarioYaml, run in this order (a file with several errors reports the first
+// stage's). Each reads its block into s and throws InputError naming the key on bad content.
+
+// name (required), seed, device (required).
+void ParseHeader(const YamlContext& r, const YAML::Node& root, Scenario& s) {
+  if (!root["name"]) r.Fail("name", "missing, expected the scenario's name");
+  s.name = YamlString(r, root["name"], "name");
+  if (root["seed"]) s.seed = static_cast<uint64_t>(YamlNumber(r, root["seed"], "seed", 0, 1e15));
+
+  if (!root["device"]) r.Fail("device", "missing, expected exowheel, exowheel_exo_only or hal3");
+  const std::string dev = YamlString(r, root["device"], "device", {"exowheel", "exowheel_exo_only", "hal3"});
+  s.device = dev == "exowheel" ? Device::kExowheel
+                               : (dev == "hal3" ? Device::kHal3 : Device::kExowheelExoOnly);
+}
+
+// subject: exactly one of preset, random_seed, params (+ passive); required unless exowheel_exo_only.
+void ParseSubject(const YamlContext& r, const YAML::Node& root, Scenario& s) {
+  if (const YAML::Node n = root["subject"]) {
+    YamlCheckKeys(r, n, "subject", {"preset", "random_seed", "params", "passive"});
+    const int given = !!n["preset"] + !!n["random_seed"] + !!n["params"];
+    if (given != 1) r.Fail("subject", "expected exactly one of preset, random_seed, params");
+    if (n["preset"]) {
+      const std::vector<std::string> presets = PresetNames();
+      s.subject.preset = YamlString(r, n["preset"], "subject.preset", {presets.begin(), presets.end()});
+    }
+    if (n["random_seed"])
+      s.subject.random_seed = static_cast<uint64_t>(YamlNumber(r, n["random_seed"], "subject.random_seed", 0, 1e15));
+    if (n["params"]) s.subject.params_file = YamlString(r, n["params"], "subject.params");
+    if (n["passive"])
+      s.subject.passive = YamlString(r, n["passive"], "subject.passive", {"none", "riener1999"}) == "none"
+                              ? PassiveModel::kNone
+                              : PassiveModel::kRiener1999;
+  } else if (s.device != Device::kExowheelExoOnly) {
+    r.Fail("subject", "missing, expected {preset: S1} or {random_seed: N} or {params: FILE}");
+  }
+}
+
+// human: behaviour, its parameters, EMG and the muscles' ground-truth seed.
+void ParseHuman(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "human", {"behaviour", "active_from", "gain", "contractions", "levels", "cocontraction",
+                      "programme_seed", "emg", "muscle_seed", "outward_gate"});
+  HumanSpec& h = s.human;
+  if (n["behaviour"])
+    h.behaviour = YamlString(r, n["behaviour"], "human.behaviour",
+                        {"relaxed", "exaggerated_gait", "isometric_hip", "isometric_knee"});
+  if (n["active_from"]) h.active_from = YamlNumber(r, n["active_from"], "human.active_from", 0, 3600);
+  if (n["gain"]) h.gain = YamlNumber(r, n["gain"], "human.gain", 0.5, 3);
+  if (n["outward_gate"]) h.outward_gate = YamlNumber(r, n["outward_gate"], "human.outward_gate", 0, 100);
+  if (n["contractions"]) h.contractions = static_cast<int>(YamlNumber(r, n["contractions"], "human.contractions", 1, 100));
+  if (n["levels"]) {
+    const YAML::Node v = n["levels"];
+    if (!v.IsSequence() || v.size() != 2) r.Fail("human.levels", "expected [lo, hi] (fraction of MVC)" + YamlLine(v));
+    h.levels[0] = YamlNumber(r, v[0], "human.levels[0]", 0, 1);
+    h.levels[1] = YamlNumber(r, v[1], "human.levels[1]", 0, 1);
+    if (!(h.levels[0] <= h.levels[1])) r.Fail("human.levels", "expected [lo, hi] with lo <= hi (fraction of MVC)");
+  }
+  if (n["cocontraction"]) h.cocontraction = YamlNumber(r, n["cocontraction"], "human.cocontraction", 0, 1);
+  if (n["programme_seed"])
+    h.programme_seed = static_cast<uint64_t>(YamlNumber(r, n["programme_seed"], "human.programme_seed", 0, 1e15));
+  if (n["emg"]) h.emg = YamlBool(r, n["emg"], "human.emg");
+  if (n["muscle_seed"]) h.muscle_seed = static_cast<uint64_t>(YamlNumber(r, n["muscle_seed"], "human.muscle_seed", 0, 1e15));
+}
+
+// fixed_joints: held angles of the joints an excitation does not move (rad).
+void ParseFixedJoints(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "fixed_joints", {"hip", "knee"});
+  for (const auto& kv : n) {
+    const std::string j = kv.first.as<std::string>();
+    s.fixed_joints[j] = YamlNumber(r, kv.second, "fixed_joints." + j, -2.5, 2.5);
+  }
+}
+
+// protocol: trajectory, duration, trials and the excitation's settings.
+void ParseProtocol(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "protocol", {"trajectory", "duration", "trials", "stride_period", "moving_joint",
+                         "excitation_seed", "ramp"});
+  ProtocolSpec& p = s.protocol;
+  if (n["trajectory"]) {
+    const std::string t = YamlString(r, n["trajectory"], "protocol.trajectory", {"gait", "excitation", "hold"});
+    p.trajectory = t == "gait" ? TrajectoryKind::kGait
+                               : (t == "excitation" ? TrajectoryKind::kExcitation : TrajectoryKind::kHold);
+  }
+  if (n["duration"]) p.duration = YamlNumber(r, n["duration"], "protocol.duration", 0.01, 3600);
+  if (n["trials"]) p.trials = static_cast<int>(YamlNumber(r, n["trials"], "protocol.trials", 1, 100));
+  if (n["stride_period"]) p.stride_period = YamlNumber(r, n["stride_period"], "protocol.stride_period", 0.5, 10);
+  if (n["moving_joint"]) p.moving_joint = YamlString(r, n["moving_joint"], "protocol.moving_joint", {"hip", "knee", "both"});
+  if (n["excitation_seed"])
+    p.excitation_seed = static_cast<uint64_t>(YamlNumber(r, n["excitation_seed"], "protocol.excitation_seed", 0, 1e15));
+  if (n["ramp"]) p.ramp = YamlNumber(r, n["ramp"], "protocol.ramp", 0, 60);
+}
+
+// hardware: CAN bus, sensors, drivers (HardwareSpec).
+void ParseHardware(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "hardware", {"can_bitrate", "can_latency", "can_jitter", "can_drop_rate", "torque_sensor_noise",
+                         "torque_sensor_offset", "encoder_bits", "motor_lag", "torque_limit", "watchdog",
+                         "torque_sensor_skew"});
+  HardwareSpec& h = s.hardware;
+  if (n["can_bitrate"]) h.can_bitrate = YamlNumber(r, n["can_bitrate"], "hardware.can_bitrate", 10e3, 1e6);
+  if (n["can_latency"]) h.can_latency = YamlNumber(r, n["can_latency"], "hardware.can_latency", 0, 0.1);
+  if (n["can_jitter"]) h.can_jitter = YamlNumber(r, n["can_jitter"], "hardware.can_jitter", 0, 0.01);
+  if (n["can_drop_rate"]) h.can_drop_rate = YamlNumber(r, n["can_drop_rate"], "hardware.can_drop_rate", 0, 1);
+  if (n["torque_sensor_noise"])
+    h.torque_sensor_noise = YamlNumber(r, n["torque_sensor_noise"], "hardware.torque_sensor_noise", 0, 10);
+  if (n["torque_sensor_offset"])
+    YamlNumberPair(r, n["torque_sensor_offset"], "hardware.torque_sensor_offset", h.torque_sensor_offset, -120, 120);
+  if (n["encoder_bits"]) h.encoder_bits = static_cast<int>(YamlNumber(r, n["encoder_bits"], "hardware.encoder_bits", 8, 24));
+  if (n["motor_lag"]) h.motor_lag = YamlNumber(r, n["motor_lag"], "hardware.motor_lag", 0, 0.05);
+  if (n["torque_limit"]) h.torque_limit = YamlNumber(r, n["torque_limit"], "hardware.torque_limit", 1, 500);
+  if (n["watchdog"]) h.watchdog = YamlNumber(r, n["watchdog"], "hardware.watchdog", 0.002, 1);
+  if (n["torque_sensor_skew"]) {
+    const double k = YamlNumber(r, n["torque_sensor_skew"], "hardware.torque_sensor_skew", -100, 100);
+    if (k != std::round(k))
+      r.Fail("hardware.torque_sensor_skew", "expected a whole number of samples, found " + n["torque_sensor_skew"].Scalar() +
+                                                   YamlLine(n["torque_sensor_skew"]));
+    h.torque_sensor_skew = static_cast<int>(k);
+  }
+}
+
+// controller: rate, PD gains, feed-forward, supervisor torque limit.
+void ParseController(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "controller", {"rate_hz", "kp", "kd", "feedforward", "torque_limit"});
+  ControllerSpec& c = s.controller;
+  if (n["rate_hz"]) c.rate_hz = YamlNumber(r, n["rate_hz"], "controller.rate_hz", 100, 10000);
+  if (n["kp"]) YamlNumberPair(r, n["kp"], "controller.kp", c.kp, 0, 1e5);
+  if (n["kd"]) YamlNumberPair(r, n["kd"], "controller.kd", c.kd, 0, 1e4);
+  if (n["feedforward"]) c.feedforward = YamlBool(r, n["feedforward"], "controller.feedforward");
+  if (n["torque_limit"]) c.torque_limit = YamlNumber(r, n["torque_limit"], "controller.torque_limit", 1, 500);
+}
+
+// faults: a list of FaultSpec (null = none).
+void ParseFaults(const YamlContext& r, const YAML::Node& list, Scenario& s) {
+  if (!list.IsSequence()) r.Fail("faults", "expected a list");
+  int i = 0;
+  for (const auto& n : list) {
+    const std::string key = "faults[" + std::to_string(i++) + "]";
+    YamlCheckKeys(r, n, key, {"type", "joint", "at", "duration", "value"});
+    FaultSpec f;
+    if (!n["type"]) r.Fail(key + ".type", "missing");
+    f.type = YamlString(r, n["type"], key + ".type", kFaultTypes);
+    if (n["joint"]) f.joint = YamlString(r, n["joint"], key + ".joint", {"hip", "knee", "all"});
+    if (n["at"]) f.at = YamlNumber(r, n["at"], key + ".at", 0, 3600);
+    if (n["duration"]) f.duration = YamlNumber(r, n["duration"], key + ".duration", 0, 3600);
+    if (n["value"]) f.value = YamlNumber(r, n["value"], key + ".value", -1e6, 1e6);
+    s.faults.push_back(f);
+  }
+}
+
+// logs: measured_csv, rate_hz.
+void ParseLogs(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "logs", {"measured_csv", "rate_hz"});
+  if (n["measured_csv"]) s.log_measured_csv = YamlBool(r, n["measured_csv"], "logs.measured_csv");
+  if (n["rate_hz"]) s.log_rate_hz = YamlNumber(r, n["rate_hz"], "logs.rate_hz", 1, 10000);
+}
+
+// checks: a list of {metric, name, max | min} (null = none).
+void ParseChecks(const YamlContext& r, const YAML::Node& list, Scenario& s) {
+  if (!list.IsSequence()) r.Fail("checks", "expected a list");
+  int i = 0;
+  for (const auto& n : list) {
+    const std::string key = "checks[" + std::to_string(i++) + "]";
+    YamlCheckKeys(r, n, key, {"name", "metric", "max", "min"});
+    CheckSpec c;
+    if (!n["metric"]) r.Fail(key + ".metric", "missing, expected a metric name");
+    c.metric = YamlString(r, n["metric"], key + ".metric");
+    c.name = n["name"] ? YamlString(r, n["name"], key + ".name") : c.metric;
+    if (!!n["max"] == !!n["min"]) r.Fail(key, "expected exactly one of max, min");
+    if (n["max"]) { c.limit = YamlNumber(r, n["max"], key + ".max", -1e12, 1e12); c.op = "<="; }
+    else { c.limit = YamlNumber(r, n["min"], key + ".min", -1e12, 1e12); c.op = ">="; }
+    s.checks.push_back(c);
+  }
+}
+
+// With emg_calibration: the blocks it needs (subject with weight and lengths, EMG) and the ones it sets itself.
+void CheckEmgCalibration(const YamlContext& r, const YAML::Node& root, const Scenario& s) {
+  if (s.subject.preset.empty() && !s.subject.random_seed)
+    r.Fail("subject", "emg_calibration needs subject.preset or subject.random_seed (the anthropometric "
+                      "models of Table 7 take the subject's weight and segment lengths)");
+  if (!s.human.emg) r.Fail("human.emg", "emg_calibration needs the EMG amplifier (human.emg: true)");
+  if (root["protocol"])
+    r.Fail("protocol", "not used with emg_calibration (it sets the trials itself: MVC, isometric, gait)");
+  if (root["fixed_joints"])
+    r.Fail("fixed_joints", "not used with emg_calibration, expected emg_calibration.hip_pose / knee_pose");
+  if (s.human.contractions < 2)
+    r.Fail("human.contractions", "emg_calibration needs at least 2 (flexion and extension per joint)");
+  if (s.human.behaviour != "relaxed")
+    r.Fail("human.behaviour", "emg_calibration sets the behaviour of each trial itself; leave it out");
+}
+
 }  // namespace
 
 Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
@@ -84,181 +274,19 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
                     "hardware", "controller", "faults", "logs", "checks", "hal", "emg_calibration"});
   Scenario s;
   s.source = source;
-  if (!root["name"]) r.Fail("name", "missing, expected the scenario's name");
-  s.name = YamlString(r, root["name"], "name");
-  if (root["seed"]) s.seed = static_cast<uint64_t>(YamlNumber(r, root["seed"], "seed", 0, 1e15));
-
-  if (!root["device"]) r.Fail("device", "missing, expected exowheel, exowheel_exo_only or hal3");
-  const std::string dev = YamlString(r, root["device"], "device", {"exowheel", "exowheel_exo_only", "hal3"});
-  s.device = dev == "exowheel" ? Device::kExowheel
-                               : (dev == "hal3" ? Device::kHal3 : Device::kExowheelExoOnly);
-
-  if (root["subject"]) {
-    const YAML::Node n = root["subject"];
-    YamlCheckKeys(r, n, "subject", {"preset", "random_seed", "params", "passive"});
-    const int given = !!n["preset"] + !!n["random_seed"] + !!n["params"];
-    if (given != 1) r.Fail("subject", "expected exactly one of preset, random_seed, params");
-    if (n["preset"]) s.subject.preset = YamlString(r, n["preset"], "subject.preset");
-    if (n["random_seed"])
-      s.subject.random_seed = static_cast<uint64_t>(YamlNumber(r, n["random_seed"], "subject.random_seed", 0, 1e15));
-    if (n["params"]) s.subject.params_file = YamlString(r, n["params"], "subject.params");
-    if (n["passive"])
-      s.subject.passive = YamlString(r, n["passive"], "subject.passive", {"none", "riener1999"}) == "none"
-                              ? PassiveModel::kNone
-                              : PassiveModel::kRiener1999;
-  } else if (s.device != Device::kExowheelExoOnly) {
-    r.Fail("subject", "missing, expected {preset: S1} or {random_seed: N} or {params: FILE}");
-  }
-
-  if (root["human"]) {
-    const YAML::Node n = root["human"];
-    YamlCheckKeys(r, n, "human", {"behaviour", "active_from", "gain", "contractions", "levels", "cocontraction",
-                        "programme_seed", "emg", "muscle_seed", "outward_gate"});
-    HumanSpec& h = s.human;
-    if (n["behaviour"])
-      h.behaviour = YamlString(r, n["behaviour"], "human.behaviour",
-                          {"relaxed", "exaggerated_gait", "isometric_hip", "isometric_knee"});
-    if (n["active_from"]) h.active_from = YamlNumber(r, n["active_from"], "human.active_from", 0, 3600);
-    if (n["gain"]) h.gain = YamlNumber(r, n["gain"], "human.gain", 0.5, 3);
-    if (n["outward_gate"]) h.outward_gate = YamlNumber(r, n["outward_gate"], "human.outward_gate", 0, 100);
-    if (n["contractions"]) h.contractions = static_cast<int>(YamlNumber(r, n["contractions"], "human.contractions", 1, 100));
-    if (n["levels"]) {
-      const YAML::Node v = n["levels"];
-      if (!v.IsSequence() || v.size() != 2) r.Fail("human.levels", "expected [lo, hi] (fraction of MVC)" + YamlLine(v));
-      h.levels[0] = YamlNumber(r, v[0], "human.levels[0]", 0, 1);
-      h.levels[1] = YamlNumber(r, v[1], "human.levels[1]", 0, 1);
-      if (!(h.levels[0] <= h.levels[1])) r.Fail("human.levels", "expected [lo, hi] with lo <= hi (fraction of MVC)");
-    }
-    if (n["cocontraction"]) h.cocontraction = YamlNumber(r, n["cocontraction"], "human.cocontraction", 0, 1);
-    if (n["programme_seed"])
-      h.programme_seed = static_cast<uint64_t>(YamlNumber(r, n["programme_seed"], "human.programme_seed", 0, 1e15));
-    if (n["emg"]) h.emg = YamlBool(r, n["emg"], "human.emg");
-    if (n["muscle_seed"]) h.muscle_seed = static_cast<uint64_t>(YamlNumber(r, n["muscle_seed"], "human.muscle_seed", 0, 1e15));
-  }
-
+  ParseHeader(r, root, s);
+  ParseSubject(r, root, s);
+  if (root["human"]) ParseHuman(r, root["human"], s);
   if (root["hal"]) ParseHal(r, root["hal"], s);
   if (root["emg_calibration"]) ParseEmgCalibration(r, root["emg_calibration"], s);
-
-  if (root["fixed_joints"]) {
-    const YAML::Node n = root["fixed_joints"];
-    YamlCheckKeys(r, n, "fixed_joints", {"hip", "knee"});
-    for (const auto& kv : n) {
-      const std::string j = kv.first.as<std::string>();
-      s.fixed_joints[j] = YamlNumber(r, kv.second, "fixed_joints." + j, -2.5, 2.5);
-    }
-  }
-
-  if (root["protocol"]) {
-    const YAML::Node n = root["protocol"];
-    YamlCheckKeys(r, n, "protocol", {"trajectory", "duration", "trials", "stride_period", "moving_joint",
-                           "excitation_seed", "ramp"});
-    ProtocolSpec& p = s.protocol;
-    if (n["trajectory"]) {
-      const std::string t = YamlString(r, n["trajectory"], "protocol.trajectory", {"gait", "excitation", "hold"});
-      p.trajectory = t == "gait" ? TrajectoryKind::kGait
-                                 : (t == "excitation" ? TrajectoryKind::kExcitation : TrajectoryKind::kHold);
-    }
-    if (n["duration"]) p.duration = YamlNumber(r, n["duration"], "protocol.duration", 0.01, 3600);
-    if (n["trials"]) p.trials = static_cast<int>(YamlNumber(r, n["trials"], "protocol.trials", 1, 100));
-    if (n["stride_period"]) p.stride_period = YamlNumber(r, n["stride_period"], "protocol.stride_period", 0.5, 10);
-    if (n["moving_joint"]) p.moving_joint = YamlString(r, n["moving_joint"], "protocol.moving_joint", {"hip", "knee", "both"});
-    if (n["excitation_seed"])
-      p.excitation_seed = static_cast<uint64_t>(YamlNumber(r, n["excitation_seed"], "protocol.excitation_seed", 0, 1e15));
-    if (n["ramp"]) p.ramp = YamlNumber(r, n["ramp"], "protocol.ramp", 0, 60);
-  }
-
-  if (root["hardware"]) {
-    const YAML::Node n = root["hardware"];
-    YamlCheckKeys(r, n, "hardware", {"can_bitrate", "can_latency", "can_jitter", "can_drop_rate", "torque_sensor_noise",
-                           "torque_sensor_offset", "encoder_bits", "motor_lag", "torque_limit", "watchdog",
-                           "torque_sensor_skew"});
-    HardwareSpec& h = s.hardware;
-    if (n["can_bitrate"]) h.can_bitrate = YamlNumber(r, n["can_bitrate"], "hardware.can_bitrate", 10e3, 1e6);
-    if (n["can_latency"]) h.can_latency = YamlNumber(r, n["can_latency"], "hardware.can_latency", 0, 0.1);
-    if (n["can_jitter"]) h.can_jitter = YamlNumber(r, n["can_jitter"], "hardware.can_jitter", 0, 0.01);
-    if (n["can_drop_rate"]) h.can_drop_rate = YamlNumber(r, n["can_drop_rate"], "hardware.can_drop_rate", 0, 1);
-    if (n["torque_sensor_noise"])
-      h.torque_sensor_noise = YamlNumber(r, n["torque_sensor_noise"], "hardware.torque_sensor_noise", 0, 10);
-    if (n["torque_sensor_offset"])
-      YamlNumberPair(r, n["torque_sensor_offset"], "hardware.torque_sensor_offset", h.torque_sensor_offset, -120, 120);
-    if (n["encoder_bits"]) h.encoder_bits = static_cast<int>(YamlNumber(r, n["encoder_bits"], "hardware.encoder_bits", 8, 24));
-    if (n["motor_lag"]) h.motor_lag = YamlNumber(r, n["motor_lag"], "hardware.motor_lag", 0, 0.05);
-    if (n["torque_limit"]) h.torque_limit = YamlNumber(r, n["torque_limit"], "hardware.torque_limit", 1, 500);
-    if (n["watchdog"]) h.watchdog = YamlNumber(r, n["watchdog"], "hardware.watchdog", 0.002, 1);
-    if (n["torque_sensor_skew"]) {
-      const double k = YamlNumber(r, n["torque_sensor_skew"], "hardware.torque_sensor_skew", -100, 100);
-      if (k != std::round(k))
-        r.Fail("hardware.torque_sensor_skew", "expected a whole number of samples, found " + n["torque_sensor_skew"].Scalar() +
-                                                     YamlLine(n["torque_sensor_skew"]));
-      h.torque_sensor_skew = static_cast<int>(k);
-    }
-  }
-
-  if (root["controller"]) {
-    const YAML::Node n = root["controller"];
-    YamlCheckKeys(r, n, "controller", {"rate_hz", "kp", "kd", "feedforward", "torque_limit"});
-    ControllerSpec& c = s.controller;
-    if (n["rate_hz"]) c.rate_hz = YamlNumber(r, n["rate_hz"], "controller.rate_hz", 100, 10000);
-    if (n["kp"]) YamlNumberPair(r, n["kp"], "controller.kp", c.kp, 0, 1e5);
-    if (n["kd"]) YamlNumberPair(r, n["kd"], "controller.kd", c.kd, 0, 1e4);
-    if (n["feedforward"]) c.feedforward = YamlBool(r, n["feedforward"], "controller.feedforward");
-    if (n["torque_limit"]) c.torque_limit = YamlNumber(r, n["torque_limit"], "controller.torque_limit", 1, 500);
-  }
-
-  if (root["faults"] && !root["faults"].IsNull()) {
-    if (!root["faults"].IsSequence()) r.Fail("faults", "expected a list");
-    int i = 0;
-    for (const auto& n : root["faults"]) {
-      const std::string key = "faults[" + std::to_string(i++) + "]";
-      YamlCheckKeys(r, n, key, {"type", "joint", "at", "duration", "value"});
-      FaultSpec f;
-      if (!n["type"]) r.Fail(key + ".type", "missing");
-      f.type = YamlString(r, n["type"], key + ".type", kFaultTypes);
-      if (n["joint"]) f.joint = YamlString(r, n["joint"], key + ".joint", {"hip", "knee", "all"});
-      if (n["at"]) f.at = YamlNumber(r, n["at"], key + ".at", 0, 3600);
-      if (n["duration"]) f.duration = YamlNumber(r, n["duration"], key + ".duration", 0, 3600);
-      if (n["value"]) f.value = YamlNumber(r, n["value"], key + ".value", -1e6, 1e6);
-      s.faults.push_back(f);
-    }
-  }
-
-  if (root["logs"]) {
-    const YAML::Node n = root["logs"];
-    YamlCheckKeys(r, n, "logs", {"measured_csv", "rate_hz"});
-    if (n["measured_csv"]) s.log_measured_csv = YamlBool(r, n["measured_csv"], "logs.measured_csv");
-    if (n["rate_hz"]) s.log_rate_hz = YamlNumber(r, n["rate_hz"], "logs.rate_hz", 1, 10000);
-  }
-
-  if (root["checks"] && !root["checks"].IsNull()) {
-    if (!root["checks"].IsSequence()) r.Fail("checks", "expected a list");
-    int i = 0;
-    for (const auto& n : root["checks"]) {
-      const std::string key = "checks[" + std::to_string(i++) + "]";
-      YamlCheckKeys(r, n, key, {"name", "metric", "max", "min"});
-      CheckSpec c;
-      if (!n["metric"]) r.Fail(key + ".metric", "missing, expected a metric name");
-      c.metric = YamlString(r, n["metric"], key + ".metric");
-      c.name = n["name"] ? YamlString(r, n["name"], key + ".name") : c.metric;
-      if (!!n["max"] == !!n["min"]) r.Fail(key, "expected exactly one of max, min");
-      if (n["max"]) { c.limit = YamlNumber(r, n["max"], key + ".max", -1e12, 1e12); c.op = "<="; }
-      else { c.limit = YamlNumber(r, n["min"], key + ".min", -1e12, 1e12); c.op = ">="; }
-      s.checks.push_back(c);
-    }
-  }
-  if (s.emg_calibration) {
-    if (s.subject.preset.empty() && !s.subject.random_seed)
-      r.Fail("subject", "emg_calibration needs subject.preset or subject.random_seed (the anthropometric "
-                        "models of Table 7 take the subject's weight and segment lengths)");
-    if (!s.human.emg) r.Fail("human.emg", "emg_calibration needs the EMG amplifier (human.emg: true)");
-    if (root["protocol"])
-      r.Fail("protocol", "not used with emg_calibration (it sets the trials itself: MVC, isometric, gait)");
-    if (root["fixed_joints"])
-      r.Fail("fixed_joints", "not used with emg_calibration, expected emg_calibration.hip_pose / knee_pose");
-    if (s.human.contractions < 2)
-      r.Fail("human.contractions", "emg_calibration needs at least 2 (flexion and extension per joint)");
-    if (s.human.behaviour != "relaxed")
-      r.Fail("human.behaviour", "emg_calibration sets the behaviour of each trial itself; leave it out");
-  }
+  if (root["fixed_joints"]) ParseFixedJoints(r, root["fixed_joints"], s);
+  if (root["protocol"]) ParseProtocol(r, root["protocol"], s);
+  if (root["hardware"]) ParseHardware(r, root["hardware"], s);
+  if (root["controller"]) ParseController(r, root["controller"], s);
+  if (root["faults"] && !root["faults"].IsNull()) ParseFaults(r, root["faults"], s);
+  if (root["logs"]) ParseLogs(r, root["logs"], s);
+  if (root["checks"] && !root["checks"].IsNull()) ParseChecks(r, root["checks"], s);
+  if (s.emg_calibration) CheckEmgCalibration(r, root, s);
   return s;
 }
 

@@ -11,7 +11,6 @@
 
 #include "core/error.h"
 #include "sim/plant.h"
-#include "runner/hal_runner.h"
 
 namespace exotwin {
 namespace {
@@ -39,7 +38,6 @@ int RunScenarioJob(const Scenario& s, const RunOptions& opt) {
   std::filesystem::remove(opt.out_dir + "/error.txt", ec);
   std::filesystem::remove(opt.out_dir + "/result.json", ec);
   try {
-    if (s.device == Device::kHal3) return RunHalScenario(s, opt).all_passed() ? kJobOk : kJobCheckFailed;
     return RunScenario(s, opt).all_passed() ? kJobOk : kJobCheckFailed;
   } catch (const InputError& e) {
     WriteError(opt.out_dir, e.what());

@@ -55,6 +55,10 @@ std::string ShippedModelPath(const std::string& file) {
   return std::string(EXOTWIN_SOURCE_DIR) + "/mjcf/" + file;
 }
 
+std::string ExowheelMjcfPath(bool with_human) {
+  return ShippedModelPath(with_human ? "leg_exowheel.xml" : "exowheel_exo_only.xml");
+}
+
 Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
   char err[1000] = "";
   m_ = mj_loadXML(mjcf_path.c_str(), nullptr, err, sizeof(err));

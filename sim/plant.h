@@ -19,6 +19,10 @@ namespace exotwin {
 // Path of a model shipped in mjcf/ (e.g. "leg_exowheel.xml").
 std::string ShippedModelPath(const std::string& file);
 
+// The shipped EXOwheel model: leg_exowheel.xml (exoskeleton + human bodies) with a human, else
+// exowheel_exo_only.xml (the exoskeleton alone).
+std::string ExowheelMjcfPath(bool with_human);
+
 class Plant {
  public:
   // Loads an MJCF file with bodies exo_thigh, exo_shank (+ human_thigh, human_shank) and hinges

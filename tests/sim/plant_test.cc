@@ -64,5 +64,13 @@ TEST(PlantDivergence, ExplodingStateIsCaught) {
       << msg;
 }
 
+// The shipped EXOwheel model: with a human the leg + exoskeleton, else the exoskeleton alone.
+TEST(ExowheelMjcfPath, ChoosesTheModelWithHumanBodiesOnlyWithAHuman) {
+  EXPECT_EQ(ExowheelMjcfPath(true), ShippedModelPath("leg_exowheel.xml"));
+  EXPECT_EQ(ExowheelMjcfPath(false), ShippedModelPath("exowheel_exo_only.xml"));
+  EXPECT_TRUE(Plant(ExowheelMjcfPath(true)).has_human_bodies());
+  EXPECT_FALSE(Plant(ExowheelMjcfPath(false)).has_human_bodies());
+}
+
 }  // namespace
 }  // namespace exotwin

@@ -1,0 +1,97 @@
+// The lockstep co-simulation rig: see cosim_rig.h.
+#include "runner/cosim_rig.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace exotwin {
+namespace {
+
+constexpr long kProgressEvery = 2000;  // steps between progress reports
+
+}  // namespace
+
+CosimSchedule ScheduleOf(const Scenario& s, double dt, CosimClock clock) {
+  const double ctrl_dt = 1.0 / s.controller.rate_hz;
+  if (std::abs(ctrl_dt / dt - std::round(ctrl_dt / dt)) > 1e-9 || ctrl_dt < dt - 1e-12)
+    throw InputError(s.source + ": controller.rate_hz: expected the physics rate (1000 Hz) divided by an integer");
+  CosimSchedule c;
+  c.dt = dt;
+  c.steps = std::lround(s.protocol.duration / dt);
+  c.steps_per_tick = static_cast<int>(std::lround(ctrl_dt / dt));
+  c.log_every = std::max(1L, std::lround(1.0 / (s.log_rate_hz * dt)));
+  c.clock = clock;
+  return c;
+}
+
+hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed) {
+  hwsim::VirtualCanBusConfig c;
+  c.bitrate = hw.can_bitrate;
+  c.latency = hw.can_latency;
+  c.jitter = hw.can_jitter;
+  c.drop_probability = hw.can_drop_rate;
+  c.seed = seed;
+  return c;
+}
+
+TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
+                        const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
+                        std::vector<std::string>* files) {
+  const std::string suffix = trials > 1 ? "_trial" + std::to_string(trial + 1) : "";
+  TrialLogs logs;
+  logs.measured = std::make_unique<CsvStreamWriter>(dir + "/measured" + suffix + ".csv", measured_columns, comments);
+  logs.truth = std::make_unique<CsvStreamWriter>(dir + "/truth" + suffix + ".csv", truth_columns, comments);
+  files->push_back("measured" + suffix + ".csv");
+  files->push_back("truth" + suffix + ".csv");
+  return logs;
+}
+
+CosimRig::CosimRig(const hwsim::VirtualCanBusConfig& bus, CandumpWriter* log, double epoch) : bus_(bus) {
+  if (!log) return;
+  bus_.SetTap([log, epoch](const CanFrame& f) {
+    CanFrame g = f;
+    g.t += epoch;
+    log->Write(g);
+  });
+}
+
+void CosimRig::AttachEmg(CanBus* endpoint, const MuscleModel* muscles, SyntheticEmg* electrodes) {
+  emg_node_ = std::make_unique<hwsim::EmgNode>(hwsim::EmgAmplifierSpec{}, endpoint);
+  muscles_ = muscles;
+  electrodes_ = electrodes;
+}
+
+double CosimRig::Run(const CosimSchedule& sc, CosimDevice& device, const std::function<void(double)>& tick,
+                     const CosimProgress& progress) {
+  const double dt = sc.dt;
+  double t = 0.0;
+  device.SampleNodes(t);
+  for (long k = 0; k < sc.steps; ++k) {
+    device.BeginStep(t);
+    const double plant_clock = device.StepPlant(t);
+    device.SampleStepStart(t);
+    if (k % sc.steps_per_tick == 0) {
+      bus_.AdvanceTo(t + 0.5 * dt);
+      tick(t + 0.5 * dt);
+    }
+    bus_.AdvanceTo(t + 0.999 * dt);
+    device.LatchDrivers(t + dt, dt);
+    t = sc.clock == CosimClock::kGrid ? static_cast<double>(k + 1) * dt : plant_clock;
+    device.SampleNodes(t);
+    if (emg_node_) {  // the amplifier samples the electrodes at 1 kHz and sends one frame
+      const MuscleVec v = electrodes_->Sample(muscles_->electrical_activation());
+      std::array<double, hwsim::EmgAmplifier::kChannels> in{};
+      for (int c = 0; c < kNumMuscles; ++c) in[c] = v[c];
+      emg_node_->Sample(t, in);
+    }
+    device.EndStep(t);
+    if (k % sc.log_every == 0) device.LogSample(t);
+    if (progress.bar && k % kProgressEvery == 0) progress.bar->Update(progress.done + static_cast<size_t>(k));
+  }
+  return t;
+}
+
+}  // namespace exotwin

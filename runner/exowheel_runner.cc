@@ -1,0 +1,292 @@
+// The EXOwheel closed-loop runner: see exowheel_runner.h.
+#include "runner/exowheel_runner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "analysis/csv_table.h"
+#include "controller/exo_controller.h"
+#include "dsp/butterworth.h"
+#include "model/leg_dynamics.h"
+#include "render/video_renderer.h"
+#include "runner/cosim_rig.h"
+#include "runner/exowheel_setup.h"
+#include "runner/fault_injection.h"
+#include "runner/progress_bar.h"
+#include "sim/muscles.h"
+#include "sim/plant.h"
+#include "sim/synthetic_emg.h"
+
+namespace exotwin {
+namespace {
+
+// rad -> deg as (rad * 180) / pi, the rounding the tracking metrics' baselines hold bit for bit
+// (rad * kDegPerRad differs in the last bit for about a quarter of the values).
+double Deg(double rad) { return rad * 180.0 / M_PI; }
+
+struct Accum {
+  double sum2 = 0, max = 0;
+  size_t n = 0;
+  void Add(double e) {
+    sum2 += e * e;
+    max = std::max(max, std::abs(e));
+    ++n;
+  }
+  double rms() const { return n ? std::sqrt(sum2 / n) : 0.0; }
+};
+
+// What the metrics of result.json accumulate over the trials.
+struct ExowheelTotals {
+  Accum track[2], torque[2];
+  double fault_time = -1, safe_time = -1, max_torque_after_safe = 0, bus_load_max = 0;
+  double torque_after_fault = 0;  // max |applied torque| from 50 ms after the first fault on
+  int final_state = 0;
+  uint64_t frames_total = 0, frames_dropped = 0, error_frames = 0;
+  size_t samples = 0;
+};
+
+// One trial of the EXOwheel on the rig: plant (shared across trials), joint modules, the subject
+// (muscles, behaviour, surface EMG), faults, logs and the metrics' accumulation.
+class ExowheelTrial : public CosimDevice {
+ public:
+  ExowheelTrial(const Scenario& s, const RunOptions& opt, const LegParams& truth, Plant& plant, int trial,
+                CandumpWriter* can_log, RunResult* result, ExowheelTotals* totals)
+      : s_(s), opt_(opt), plant_(plant), result_(result), totals_(totals),
+        seed_(result->seed * 7919ull + static_cast<uint64_t>(trial)),
+        trajectory_(BuildTrajectory(s, trial)),
+        rig_(BusConfigOf(s.hardware, seed_), can_log, trial * (s.protocol.duration + 1.0)),  // trials follow each other
+        ctrl_ep_(rig_.bus().AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee, msg::kIdEmgSamples})),
+        emg_ep_(rig_.bus().AddNode("emg_amplifier", {0x7FF})),  // sends only
+        hip_(JointModuleSpecOf(s.hardware, 0), rig_.bus().AddNode("hip_module", {msg::kIdJointCommandHip}), seed_ + 1),
+        knee_(JointModuleSpecOf(s.hardware, 1), rig_.bus().AddNode("knee_module", {msg::kIdJointCommandKnee}), seed_ + 2),
+        ctrl_cfg_(ControllerConfig(s, truth)),
+        ctrl_(ctrl_cfg_, trajectory_, ctrl_ep_),
+        human_(truth.human.has_value()),
+        emg_on_(human_ && s.human.emg) {
+    trajectory_->Sample(0.0, &h0_, &k0_);
+    const MuscleParams mp = SubjectMuscles(s, {h0_.q, k0_.q});
+    muscles_ = std::make_unique<MuscleModel>(mp, plant.timestep());
+    behaviour_ = BuildBehaviour(s, mp, trajectory_, seed_ + 3);
+    emg_ = std::make_unique<SyntheticEmg>(ExowheelSyntheticEmgConfig(), seed_ + 4);
+    if (emg_on_) rig_.AttachEmg(emg_ep_, muscles_.get(), emg_.get());
+    for (const FaultSpec& f : s.faults) faults_.push_back({f, false});
+    OpenLogs(truth, trial);
+    plant.Reset({h0_.q, k0_.q}, {h0_.qd, k0_.qd}, 0.0);
+    if (!opt.video_path.empty() && trial == 0) {
+      RenderOptions ro;
+      video_ = std::make_unique<VideoRenderer>(plant.model(), opt.video_path, ro);
+      const double dt = plant.timestep();
+      envelope_.assign(5, dsp::SosFilter(dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, 3.0)));
+    }
+    events_seen_ = result->events.size();
+  }
+
+  // Runs the trial on the rig and adds its bus statistics and final state to the totals.
+  void Run(const CosimSchedule& schedule, const CosimProgress& progress) {
+    const double t_end = rig_.Run(schedule, *this, [this](double t) { ctrl_.Tick(t); }, progress);
+    if (video_) {
+      video_->Finish(t_end);
+      result_->files.push_back(opt_.video_path);
+    }
+    totals_->final_state = std::max(totals_->final_state, static_cast<int>(ctrl_.state()));
+    const hwsim::CanBusStatistics st = rig_.bus().Statistics();
+    totals_->frames_total += st.frames;
+    totals_->frames_dropped += st.drops;
+    totals_->error_frames += st.error_frames;
+    totals_->bus_load_max = std::max(totals_->bus_load_max, st.mean_load_percent);
+  }
+
+  void BeginStep(double t) override {
+    ApplyFaults(faults_, t, modules_, rig_.bus(), ctrl_ep_, s_.hardware, &result_->events);
+    if (totals_->fault_time < 0) {
+      for (const auto& f : faults_)
+        if (f.active) totals_->fault_time = t;
+    }
+  }
+
+  double StepPlant(double t) override {
+    tau_M_ = Eigen::Vector2d::Zero();
+    if (human_) {
+      muscles_->Step(behaviour_->Excitation(t, plant_.q(), plant_.qd()));
+      tau_M_ = muscles_->Torques(plant_.q(), plant_.qd()).total();
+    }
+    // The torques of this step, for the metrics and truth.csv (row t + dt: the state at t + dt and
+    // the actuator and muscle torques held over [t, t + dt], the step that ended there).
+    applied_[0] = tau_[0], applied_[1] = tau_[1];
+    plant_.Step({tau_[0], tau_[1]}, tau_M_);  // the drivers' output at t, held over [t, t + dt]
+    return plant_.time();
+  }
+
+  void LatchDrivers(double t, double dt) override {
+    for (int j = 0; j < 2; ++j) tau_[j] = modules_[j]->Applied(t, dt);
+  }
+
+  void SampleNodes(double t) override {
+    q_ = plant_.q();
+    hip_.Sample(t, q_[0], tau_[0]);  // one instant: q(t) and the torque held from t
+    knee_.Sample(t, q_[1], tau_[1]);
+  }
+
+  void EndStep(double t) override {
+    const auto& tel = ctrl_.telemetry();
+    ExowheelTotals& m = *totals_;
+    const bool after_ramp = t >= s_.protocol.ramp;
+    if (tel.safety.state != controller::SafetyState::kRunning && m.safe_time < 0) m.safe_time = t;
+    for (int j = 0; j < 2; ++j) {
+      if (after_ramp && m.fault_time < 0) m.track[j].Add(Deg(tel.ref[j].q - q_[j]));
+      m.torque[j].Add(applied_[j]);
+      if (m.safe_time >= 0 && t > m.safe_time + 0.05)
+        m.max_torque_after_safe = std::max(m.max_torque_after_safe, std::abs(applied_[j]));
+      // Torque on the faulted joints from 50 ms after the fault on (the damping of a safe state on
+      // the other joint is bounded separately by torque_max_after_safe).
+      bool faulted_joint = false;
+      for (const auto& f : faults_)
+        faulted_joint |= f.active && FaultActsOn(f.spec, j);
+      if (m.fault_time >= 0 && t > m.fault_time + 0.05 && faulted_joint)
+        m.torque_after_fault = std::max(m.torque_after_fault, std::abs(applied_[j]));
+    }
+  }
+
+  void LogSample(double t) override {
+    const auto& tel = ctrl_.telemetry();
+    ++totals_->samples;
+    if (logs_.measured) {
+      const double row[] = {t, tel.est[0].q, tel.est[1].q, tel.tau_sensor[0], tel.tau_sensor[1],
+                            tel.tau_cmd[0], tel.tau_cmd[1], tel.ref[0].q, tel.ref[1].q,
+                            static_cast<double>(tel.safety.state), tel.emg[0], tel.emg[1], tel.emg[2],
+                            tel.emg[3], tel.emg[4]};
+      logs_.measured->Row(row, emg_on_ ? 15 : 10);
+      const Eigen::Vector2d qd = plant_.qd();
+      const double trow[] = {t, q_[0], q_[1], qd[0], qd[1], applied_[0], applied_[1], tau_M_[0], tau_M_[1]};
+      logs_.truth->Row(trow, 9);
+    }
+    if (video_) AddVideoSample(t);
+    if (opt_.on_sample) {
+      const double qa[2] = {q_[0], q_[1]};
+      opt_.on_sample(t, qa, applied_);
+    }
+  }
+
+ private:
+  // measured[_trialN].csv and truth[_trialN].csv (logs.measured_csv).
+  void OpenLogs(const LegParams& truth, int trial) {
+    if (!s_.log_measured_csv) return;
+    std::vector<std::string> measured = {"t",       "q_hip",    "q_knee",  "tau_hip",  "tau_knee",
+                                         "cmd_hip", "cmd_knee", "ref_hip", "ref_knee", "state"};
+    if (emg_on_) measured.insert(measured.end(), {"emg_GMAX", "emg_VM", "emg_RF", "emg_ST", "emg_GAS"});
+    logs_ = OpenTrialLogs(
+        opt_.out_dir, trial, s_.protocol.trials, measured,
+        {"t", "q_hip", "q_knee", "qd_hip", "qd_knee", "tau_R_hip", "tau_R_knee", "tau_M_hip", "tau_M_knee"},
+        {"exotwin run " + s_.name + " trial " + std::to_string(trial + 1) + " seed " + std::to_string(result_->seed),
+         "subject truth: L1 " + std::to_string(truth.L1) + (truth.human ? " with human" : " exo only")},
+        &result_->files);
+  }
+
+  void AddVideoSample(double t) {
+    const auto& tel = ctrl_.telemetry();
+    OverlaySample os;
+    os.t = t;
+    os.q_hip = q_[0];
+    os.q_knee = q_[1];
+    // The twin's estimate: the controller's own model on its estimated state.
+    const Eigen::Vector2d est =
+        -ActuatorTorque(ctrl_cfg_.model, {tel.est[0].q, tel.est[1].q}, {tel.est[0].qd, tel.est[1].qd},
+                        {tel.est[0].qdd, tel.est[1].qdd});
+    for (int j = 0; j < 2; ++j) {
+      os.tau_meas[j] = std::isfinite(tel.tau_sensor[j]) ? tel.tau_sensor[j] : 0.0;
+      os.tau_est[j] = est[j];
+    }
+    if (emg_on_)
+      for (int c = 0; c < 5; ++c) os.emg.push_back(envelope_[c].Step(std::abs(tel.emg[c])));
+    if (result_->events.size() > events_seen_) os.event = result_->events[events_seen_++];
+    video_->AddSample(plant_.data(), os);
+  }
+
+  const Scenario& s_;
+  const RunOptions& opt_;
+  Plant& plant_;
+  RunResult* result_;
+  ExowheelTotals* totals_;
+  const uint64_t seed_;
+  const std::shared_ptr<const controller::LegTrajectory> trajectory_;
+  controller::JointSetpoint h0_, k0_;  // the reference at t = 0: the start pose
+  CosimRig rig_;
+  hwsim::VirtualCanBus::Endpoint* ctrl_ep_;
+  CanBus* emg_ep_;
+  hwsim::JointModule hip_, knee_;
+  hwsim::JointModule* modules_[2] = {&hip_, &knee_};
+  const controller::ExoControllerConfig ctrl_cfg_;
+  controller::ExoController ctrl_;
+  const bool human_, emg_on_;
+  std::unique_ptr<MuscleModel> muscles_;
+  std::unique_ptr<Behaviour> behaviour_;
+  std::unique_ptr<SyntheticEmg> emg_;
+  std::vector<FaultSwitch> faults_;
+  TrialLogs logs_;
+  std::unique_ptr<VideoRenderer> video_;
+  std::vector<dsp::SosFilter> envelope_;
+  size_t events_seen_ = 0;
+  double tau_[2] = {0, 0};      // the drivers' output at t (at t = 0: no command yet)
+  double applied_[2] = {0, 0};  // the drivers' output held over the last step
+  Eigen::Vector2d tau_M_ = Eigen::Vector2d::Zero();  // muscle torque of the last step
+  Eigen::Vector2d q_ = Eigen::Vector2d::Zero();      // plant angles at the last sampling instant
+};
+
+}  // namespace
+
+RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
+  RunResult result;
+  result.scenario = s.name;
+  result.seed = opt.seed ? *opt.seed : s.seed;
+  std::filesystem::create_directories(opt.out_dir);
+
+  const LegParams truth = ResolveSubject(s);
+  Plant plant(ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
+  plant.SetParams(truth);
+  const CosimSchedule schedule = ScheduleOf(s, plant.timestep());
+
+  std::unique_ptr<CandumpWriter> can_log;
+  if (!opt.can_log.empty()) can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
+
+  ExowheelTotals totals;
+  const auto wall0 = std::chrono::steady_clock::now();
+  ProgressBar bar(static_cast<size_t>(s.protocol.trials * schedule.steps), s.name, opt.progress);
+  for (int trial = 0; trial < s.protocol.trials; ++trial) {
+    ExowheelTrial run(s, opt, truth, plant, trial, can_log.get(), &result, &totals);
+    run.Run(schedule, {&bar, static_cast<size_t>(trial * schedule.steps)});
+  }
+  bar.Update(static_cast<size_t>(s.protocol.trials * schedule.steps));
+  bar.Finish();
+
+  auto& m = result.metrics;
+  m["samples"] = static_cast<double>(totals.samples);
+  m["tracking_rms_hip_deg"] = totals.track[0].rms();
+  m["tracking_rms_knee_deg"] = totals.track[1].rms();
+  m["tracking_max_hip_deg"] = totals.track[0].max;
+  m["tracking_max_knee_deg"] = totals.track[1].max;
+  m["torque_max_hip"] = totals.torque[0].max;
+  m["torque_max_knee"] = totals.torque[1].max;
+  m["torque_rms_hip"] = totals.torque[0].rms();
+  m["torque_rms_knee"] = totals.torque[1].rms();
+  m["bus_load_pct"] = totals.bus_load_max;
+  m["frames"] = static_cast<double>(totals.frames_total);
+  m["frames_dropped"] = static_cast<double>(totals.frames_dropped);
+  m["error_frames"] = static_cast<double>(totals.error_frames);
+  const double fault_time = totals.fault_time, safe_time = totals.safe_time;
+  m["fault_time_s"] = fault_time;
+  m["safe_state_time_s"] = safe_time;
+  m["safe_reaction_s"] = (fault_time >= 0 && safe_time >= fault_time) ? safe_time - fault_time : -1;
+  m["torque_max_after_safe"] = totals.max_torque_after_safe;
+  m["torque_max_50ms_after_fault"] = totals.torque_after_fault;
+  m["safe_state_entered"] = safe_time >= 0 ? 1.0 : 0.0;
+  m["final_state"] = totals.final_state;
+  m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+  FinishRun(s, result, opt.out_dir + "/result.json");
+  return result;
+}
+
+}  // namespace exotwin

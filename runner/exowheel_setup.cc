@@ -1,0 +1,166 @@
+// Set-up of an EXOwheel trial from its scenario: see exowheel_setup.h.
+#include "runner/exowheel_setup.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/units.h"
+#include "runner/runner.h"
+#include "sim/anthropometry.h"
+#include "sim/subjects.h"
+
+namespace exotwin {
+namespace {
+
+using controller::FadeInTrajectory;
+using controller::GaitSpec;
+using controller::GaitTrajectory;
+using controller::HarmonicTrajectory;
+using controller::HoldTrajectory;
+using controller::JointTrajectory;
+using controller::JointwiseTrajectory;
+using controller::LegTrajectory;
+
+// The controller's model for the feed-forward: the exoskeleton (known from its own identification)
+// plus, with a subject, the De Leva anthropometric estimate from the subject's weight and lengths:
+// what a rig knows before identifying the user.
+LegParams ControllerModel(const Scenario& s, const LegParams& truth) {
+  LegParams m;
+  m.L1 = truth.L1;
+  m.exo = truth.exo;
+  if (truth.human) {
+    double weight = 68.0, L2 = 0.53;
+    if (const std::optional<Subject> sub = ScenarioSubject(s)) {
+      weight = sub->weight;
+      L2 = sub->L2;
+    }
+    m.human = Table4AnthropometricLumped(AnthropometricModel::kDeLeva, weight, truth.L1, L2);
+    m.passive = PassiveModel::kRiener1999;
+  }
+  return m;
+}
+
+// Mean posture of the gait pattern (Winter, fitted): about 5 deg hip, -25 deg knee (rad).
+const Eigen::Vector2d kGaitMeanPosture(0.09, -0.45);
+
+// The posture the subject's co-contraction stiffens the joints about (MuscleParams::q_rest, rad).
+// Co-contraction raises the joint stiffness about the current equilibrium (Hogan 1984, IEEE TAC
+// 29(8)); the seated-hanging default of sim/muscles (Hayashi's K theta for the HAL knee swing) would
+// make a standing subject's co-contraction pull the knee towards -90 deg: a torque of -K (q - q_rest),
+// about -0.33 S N m in gait (S the co-contracted torque), that no EMG model sees. Isometric trials:
+// the held start pose; exaggerated gait: the pattern's mean posture (as tests/sim/muscles_test.cc).
+Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, const Eigen::Vector2d& start) {
+  if (s.human.behaviour == "exaggerated_gait") return kGaitMeanPosture;
+  if (s.human.behaviour == "isometric_hip" || s.human.behaviour == "isometric_knee") return start;
+  return mp.q_rest;
+}
+
+}  // namespace
+
+std::shared_ptr<const LegTrajectory> BuildTrajectory(const Scenario& s, int trial) {
+  const ProtocolSpec& p = s.protocol;
+  auto held = [&](const char* j, double dflt) {
+    auto it = s.fixed_joints.find(j);
+    return it != s.fixed_joints.end() ? it->second : dflt;
+  };
+  std::shared_ptr<const LegTrajectory> inner;
+  switch (p.trajectory) {
+    case TrajectoryKind::kGait: {
+      GaitSpec g;
+      g.stride_period_s = p.stride_period;
+      // Winter's knee reaches +2 deg (hyperextension) in stance; the exoskeleton stops at 0, so
+      // the pattern is shifted by -3 deg at the knee.
+      g.knee_offset = -3.0 / kDegPerRad;  // the double nearest -3 pi / 180 (-3 * kRadPerDeg is 1 ulp off)
+      inner = std::make_shared<GaitTrajectory>(GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), g));
+      break;
+    }
+    case TrajectoryKind::kExcitation: {
+      const uint64_t seed = p.excitation_seed * 1000003ull + static_cast<uint64_t>(trial);
+      std::shared_ptr<const JointTrajectory> hip, knee;
+      if (p.moving_joint == "hip" || p.moving_joint == "both")
+        hip = std::make_shared<HarmonicTrajectory>(
+            HarmonicTrajectory::Design(controller::ExcitationSpec::PaperHip(), seed));
+      else
+        hip = std::make_shared<HoldTrajectory>(held("hip", M_PI / 2));
+      if (p.moving_joint == "knee" || p.moving_joint == "both")
+        knee = std::make_shared<HarmonicTrajectory>(
+            HarmonicTrajectory::Design(controller::ExcitationSpec::PaperKnee(), seed + 7));
+      else
+        knee = std::make_shared<HoldTrajectory>(held("knee", -M_PI / 2));
+      inner = std::make_shared<JointwiseTrajectory>(hip, knee);
+      break;
+    }
+    case TrajectoryKind::kHold:
+      inner = std::make_shared<JointwiseTrajectory>(std::make_shared<HoldTrajectory>(held("hip", 0.3)),
+                                                    std::make_shared<HoldTrajectory>(held("knee", -0.5)));
+      break;
+  }
+  if (p.ramp > 0) inner = std::make_shared<FadeInTrajectory>(inner, p.ramp);
+  return inner;
+}
+
+controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegParams& truth) {
+  controller::ExoControllerConfig c;
+  c.rate_hz = s.controller.rate_hz;
+  c.hip = {s.controller.kp[0], s.controller.kd[0], s.controller.torque_limit};
+  c.knee = {s.controller.kp[1], s.controller.kd[1], s.controller.torque_limit};
+  c.feedforward = s.controller.feedforward;
+  c.model = ControllerModel(s, truth);
+  c.estimator.sample_rate_hz = s.controller.rate_hz;
+  c.safety = controller::SafetyConfig::Default();
+  for (auto* lim : {&c.safety.hip, &c.safety.knee}) {
+    lim->tau_sensor_max = std::min(115.0, s.hardware.torque_limit);
+    lim->tau_cmd_max = s.controller.torque_limit + 1e-6;
+    lim->qd_max = 8.0;  // rad/s (460 deg/s): gait at 2 km/h peaks near 200 deg/s
+  }
+  return c;
+}
+
+std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams& mp,
+                                          const std::shared_ptr<const LegTrajectory>& trajectory,
+                                          uint64_t seed) {
+  const HumanSpec& h = s.human;
+  if (h.behaviour == "isometric_hip" || h.behaviour == "isometric_knee")
+    return std::make_unique<ContractionProgramme>(IsometricProgrammeOf(h, seed));
+  if (h.behaviour == "exaggerated_gait") {
+    IntendedMotion base = [trajectory](double t, Eigen::Vector2d& q, Eigen::Vector2d& qd, Eigen::Vector2d& qdd) {
+      controller::JointSetpoint a, b;
+      trajectory->Sample(t, &a, &b);
+      q = {a.q, b.q};
+      qd = {a.qd, b.qd};
+      qdd = {a.qdd, b.qdd};
+    };
+    // The exoskeleton imposes the motion (PD 600/400 N m/rad), so the subject's damping term of the
+    // tracking law (TrackingGains::kd, sized to stabilise the FREE limb with 55 ms of loop delay) has
+    // nothing to stabilise; kept, it adds kd (gain - 1) qd of the pattern: a drive in phase with the
+    // velocity that bursts at the knee's 1-3 Hz swing harmonics (measured: knee R^2 of eq. 28 falls
+    // from 0.93 to 0.24 with kd = 15), unlike a person exaggerating a slow 2 km/h gait, whose effort
+    // follows the posture. kd = 0: the exaggeration is an amplitude intent, kp (gain - 1)(q* - mean).
+    TrackingGains gains;
+    gains.kd.setZero();
+    return std::make_unique<ExaggeratedGait>(mp, base, kGaitMeanPosture, h.gain, h.active_from, 0.02, gains,
+                                             h.outward_gate);
+  }
+  return std::make_unique<RelaxedBehaviour>();
+}
+
+hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j) {
+  hwsim::JointModuleSpec ms;
+  ms.joint = static_cast<msg::Joint>(j);
+  ms.torque_sensor.offset = hw.torque_sensor_offset[j];
+  ms.torque_sensor.repeatability_fs = hw.torque_sensor_noise / ms.torque_sensor.range;
+  ms.encoder.bits = hw.encoder_bits;
+  ms.driver.lag = hw.motor_lag;
+  ms.driver.limit = hw.torque_limit;
+  ms.driver.watchdog = hw.watchdog;
+  ms.torque_sensor_skew = hw.torque_sensor_skew;
+  return ms;
+}
+
+MuscleParams SubjectMuscles(const Scenario& s, const Eigen::Vector2d& start) {
+  MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
+  mp.q_rest = CoContractionPosture(s, mp, start);
+  return mp;
+}
+
+}  // namespace exotwin

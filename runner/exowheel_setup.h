@@ -1,0 +1,42 @@
+// Set-up of an EXOwheel trial (runner/exowheel_runner.cc) from its scenario: the controller's
+// reference and configuration, the joint modules' hardware, the subject's muscles and behaviour.
+#pragma once
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "controller/exo_controller.h"
+#include "controller/trajectory.h"
+#include "hwsim/joint_module.h"
+#include "model/lumped_params.h"
+#include "runner/scenario.h"
+#include "sim/muscles.h"
+
+namespace exotwin {
+
+// The reference of trial `trial` (0-based): gait (Winter, knee shifted by -3 deg to the exoskeleton's
+// stop), the identification excitation of the moving joint(s) with the others held at fixed_joints,
+// or a hold; faded in over protocol.ramp s.
+std::shared_ptr<const controller::LegTrajectory> BuildTrajectory(const Scenario& s, int trial);
+
+// The ExoController of the scenario: its gains, rate and limits, and as its feed-forward model the
+// exoskeleton of `truth` plus, with a subject, the De Leva anthropometric estimate (what a rig knows
+// before identifying the user).
+controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegParams& truth);
+
+// The joint module of joint j (0 hip, 1 knee) with the scenario's hardware (sensors, encoder, driver).
+hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j);
+
+// The subject's muscles: ground truth alpha, beta, gamma drawn from human.muscle_seed (Tables 6-7),
+// with co-contraction stiffening the joints about the trial's posture (the held start pose `start`
+// (rad) of isometric trials, the gait's mean posture in exaggerated gait).
+MuscleParams SubjectMuscles(const Scenario& s, const Eigen::Vector2d& start);
+
+// The subject's behaviour in the trial (human.behaviour; relaxed unless the scenario says otherwise),
+// with muscles `mp`; an exaggerated gait amplifies `trajectory`; isometric programmes seeded by `seed`
+// unless human.programme_seed is set.
+std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams& mp,
+                                          const std::shared_ptr<const controller::LegTrajectory>& trajectory,
+                                          uint64_t seed);
+
+}  // namespace exotwin
