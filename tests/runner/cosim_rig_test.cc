@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "protocol/messages.h"
 
 namespace exotwin {
