@@ -23,6 +23,7 @@ void YamlContext::Fail(const std::string& key, const std::string& what) const {
 }
 
 std::string YamlLine(const YAML::Node& n) {
+  if (!n.IsDefined()) return "";  // a missing key: no position
   const YAML::Mark m = n.Mark();
   return m.line >= 0 ? " (line " + std::to_string(m.line + 1) + ")" : "";
 }

@@ -16,7 +16,7 @@ struct YamlContext {
   [[noreturn]] void Fail(const std::string& key, const std::string& what) const;
 };
 
-// " (line N)" for a node with a position (1-based), else "".
+// " (line N)" for a node with a position (1-based), else "" (also for a missing key).
 std::string YamlLine(const YAML::Node& n);
 
 // A finite number in [lo, hi] (`unit`, if any, is named in the message). Fails on a missing or
