@@ -183,7 +183,7 @@ CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const Meas
 
 // Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
 // transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of its time,
-// the twin's torque (eq. 5-7 + P + the model's effects) and the filtered residual.
+// the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual.
 void PrepareRecord(const LegParams& params, const MeasuredData& data, const CutoffChoice& cutoff,
                    double holdout_fraction, Rec* out) {
   Rec& rc = *out;
@@ -212,7 +212,7 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, const Cuto
   const size_t n = kin.t.size();
   const double t_split = kin.t.front() + (1 - holdout_fraction) * (kin.t.back() - kin.t.front());
   rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
-  // The twin: eq. (5)-(7) + P(q) + the model's own effects, which equals predict's MuJoCo inverse
+  // The twin: HJ15 eq. 5-7 + P(q) + the model's own effects, which equals predict's MuJoCo inverse
   // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
   // run (ScoreExtendedTwin) is predict itself.
   for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);

@@ -97,7 +97,7 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
     } else if (e.name == "gravity_error") {
       // The lumped X (or Y) of the segment distal to joint j is off by value: its gravity torque
       // changes by g dX sin(angle) (or g dY cos(angle)) at that joint and every proximal joint
-      // (eq. 7); for the thigh (j = 0) only the hip row changes.
+      // (HJ15 eq. 7); for the thigh (j = 0) only the hip row changes.
       for (size_t i = 0; i < n; ++i) {
         const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
         const double dG = params.g * e.value * (e.axis == "Y" ? std::cos(ang) : std::sin(ang));

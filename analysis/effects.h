@@ -3,11 +3,11 @@
 // Physical models (the same code is the truth in `generate` and the extended twin in `predict`):
 //  - coulomb/viscous friction, inertia_error, joint_stiffness, torque_ripple: the DESIGN formulas
 //    added to tau_R of that joint (MuJoCo frictionloss / damping / armature / stiffness analogues).
-//  - gravity_error: eq. (7) with the distal segment's lumped X (or Y) changed by value.
+//  - gravity_error: HJ15 eq. 7 with the distal segment's lumped X (or Y) changed by value.
 //  - backlash (dead band of total width b): the encoder sits on the motor side; under load the link
 //    rests against one flank, lagging the motor by b/2 in the direction of the transmitted torque:
 //    q_link,j = q_j - (b/2) s(tau_R,j), s(x) = tanh(x / kBacklashTorqueWidth). The link's dynamics
-//    are evaluated at q_link (closed form, eq. 5-7 + P): tau_R += tau(q_link) - tau(q).
+//    are evaluated at q_link (closed form, HJ15 eq. 5-7 + P): tau_R += tau(q_link) - tau(q).
 //  - series_compliance (strap stiffness k): the compliant part (the human limb when the model has
 //    one, else the whole chain behind the transmission) follows the measured exoskeleton angle
 //    through a spring: q_c,j = q_j - tau_C,j(q_c)/k, solved per sample by Newton's method. Quasi-static:
@@ -47,7 +47,7 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
 std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg);
 
 // Torque (N m) the series-compliant part needs: human rigid dynamics + P(q) when params.human,
-// else the whole chain's actuator torque (eq. 5-7).
+// else the whole chain's actuator torque (HJ15 eq. 5-7).
 Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
                                     const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
 

@@ -1,4 +1,4 @@
-// EMG-to-torque calibration (Hwang & Jeon 2015 eq. 23-28): see emg_calibration.h.
+// EMG-to-torque calibration (HJ15 eq. 23-28): see emg_calibration.h.
 #include "analysis/emg_calibration.h"
 
 #include <algorithm>
@@ -61,7 +61,7 @@ AlphaFit FitIsometricAlpha(int joint, const std::vector<MuscleVec>& le, const st
       A(k, c) = ActionSign(MuscleAt(cols[c]), joint) * le[k][cols[c]];
     b[k] = tau[k];
   }
-  const Eigen::VectorXd x = A.colPivHouseholderQr().solve(b);  // eq. (25), unconstrained as the paper
+  const Eigen::VectorXd x = A.colPivHouseholderQr().solve(b);  // HJ15 eq. 25, unconstrained as the paper
   AlphaFit fit;
   for (size_t c = 0; c < cols.size(); ++c) fit.alpha[cols[c]] = x[c];
   std::vector<double> pred(le.size());
@@ -86,7 +86,7 @@ double DynamicTorque(int joint, const MuscleVec& alpha, double beta, double gamm
   double E, F;
   SplitEF(joint, alpha, le, E, F);
   const double d = beta * (q - theta_c) - gamma * qd;
-  return E * (1 + d) - F * (1 - d);  // eq. (26)/(27), no clamp (the paper's linear model)
+  return E * (1 + d) - F * (1 - d);  // HJ15 eq. 26/27, no clamp (the paper's linear model)
 }
 
 BetaGammaFit FitDynamicBetaGamma(int joint, const MuscleVec& alpha, double theta_c,

@@ -77,7 +77,7 @@ void AppendSamples(const MeasuredData& data, bool select_passive, const Identifi
       into->qd[j].push_back(kin.qd[j][i]);
       into->qdd[j].push_back(kin.qdd[j][i]);
     }
-    into->u[0].push_back(-data.tau_hip[i]);  // tau_R = -tau_S, eq. (8)
+    into->u[0].push_back(-data.tau_hip[i]);  // tau_R = -tau_S, HJ15 eq. 8
     into->u[1].push_back(-data.tau_knee[i]);
   }
   if (into->size() == before)
@@ -157,7 +157,7 @@ StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, doub
                      "harmonics over a wide range) of the moving joint");
   e.condition_number = std::sqrt(lmax / lmin);
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);
-  e.phi = d.asDiagonal() * ldlt.solve(d.asDiagonal() * Wtu);  // eq. (21)
+  e.phi = d.asDiagonal() * ldlt.solve(d.asDiagonal() * Wtu);  // HJ15 eq. 21
 
   const double rss = (rows.col(3) - rows.leftCols<3>() * e.phi).squaredNorm();
   e.residual_rms = std::sqrt(rss / static_cast<double>(n));

@@ -1,5 +1,5 @@
-// Off-line least-squares identification of the lumped parameters (eq. 4), the four steps of Hwang &
-// Jeon 2015 sec. 3.2 (eq. 14-21, Appendix A1-A4) with the re-derived signs of model/regressors.cc.
+// Off-line least-squares identification of the lumped parameters (HJ15 eq. 4), the four steps of Hwang &
+// Jeon 2015 sec. 3.2 (HJ15 eq. 14-21, Appendix A1-A4) with the re-derived signs of model/regressors.cc.
 //
 // Configurations (DESIGN.md `identify`): knee swing = the knee moves, the hip is held near 90 deg
 // (steps 1 and 3); hip swing = the hip moves, the knee is held near -90 deg (steps 2 and 4). A file's
@@ -7,16 +7,16 @@
 //
 // Regressor: the held joint is held by a PD controller, so it is near but not exactly at 90 / -90 deg.
 // Instead of the paper's step rows (exact only when the held joint is exactly still) each step uses
-// the moving joint's row of the full regressor, tau_R = Y(q, qd, qdd) theta + P(q) (eq. 3, 8 with
+// the moving joint's row of the full regressor, tau_R = Y(q, qd, qdd) theta + P(q) (HJ15 eq. 3, 8 with
 // tau_M = 0), restricted to the three unknown columns, with every known parameter moved to the left:
 //   step 1 (R2): knee row, unknown [J2 X2 Y2]_R, nothing known (exo alone)
 //   step 2 (R1): hip row,  unknown [J1 X1 Y1]_R, known [J2 X2 Y2]_R from step 1
 //   step 3 (H2): knee row, unknown [J2 X2 Y2]_H, known exo, minus P2 (passive model)
 //   step 4 (H1): hip row,  unknown [J1 X1 Y1]_H, known exo and [J2 X2 Y2]_H from step 3, minus P1
-// This is exact for any state and equals Step1Row..Step4Row (eq. 18, A1-A4) when the held joint is
+// This is exact for any state and equals Step1Row..Step4Row (HJ15 eq. 18, A1-A4) when the held joint is
 // exactly still at 90 / -90 deg (tests/analysis/identification_test.cc).
 //
-// Solver: eq. (21) through the normal equations of the column-scaled regressor W D (D = diag of
+// Solver: HJ15 eq. 21 through the normal equations of the column-scaled regressor W D (D = diag of
 // 1/||column||), LDLT in Eigen. Outputs per step: estimate phi, standard errors sqrt(diag(
 // sigma^2 (W'W)^-1)) with sigma^2 = |r|^2 / (N - 3), plus, for steps 2 and 4, the propagated
 // uncertainty of the step-1/3 values they use (G Sigma G', G = (W'W)^-1 W'A, A the known columns).
@@ -48,8 +48,8 @@ struct IdentificationOptions {
   double held_max_range = 5.0 * kRadPerDeg;     // rad, largest range of the held joint
   double trim_s = 0.1;          // s dropped at both ends of every file (derivative-filter edges)
   double cutoff_hz = 20.0;      // Hz, zero-phase Butterworth of the derivatives (sec. 3.2)
-  PassiveModel passive = PassiveModel::kRiener1999;  // P^ subtracted in steps 3-4 (eq. 16-17)
-  PassiveSelectionOptions selection;                 // eq. (13), human steps only
+  PassiveModel passive = PassiveModel::kRiener1999;  // P^ subtracted in steps 3-4 (HJ15 eq. 16-17)
+  PassiveSelectionOptions selection;                 // HJ15 eq. 13, human steps only
 };
 
 // Range (min, max, mean; rad) of both joints of a file.
@@ -63,7 +63,7 @@ JointRanges ComputeJointRanges(const MeasuredData& data);
 IdConfiguration ClassifyConfiguration(const MeasuredData& data, const IdentificationOptions& opt = {});
 
 // Samples of one configuration ready for the regressor: state (rad, rad/s, rad/s^2) and actuator
-// torque u = tau_R = -tau_S (N m, eq. 8), after derivative estimation, trimming and EMG selection.
+// torque u = tau_R = -tau_S (N m, HJ15 eq. 8), after derivative estimation, trimming and EMG selection.
 struct IdentificationSamples {
   IdConfiguration config = IdConfiguration::kKneeSwing;
   std::vector<std::string> sources;
@@ -73,12 +73,12 @@ struct IdentificationSamples {
 };
 
 // Appends the samples of one file (derivatives by DeriveKinematics with opt.cutoff_hz, trim at both
-// ends; with select_passive, only samples passing eq. 13). Precondition: data is of configuration
+// ends; with select_passive, only samples passing HJ15 eq. 13). Precondition: data is of configuration
 // into->config (use ClassifyConfiguration). Throws InputError if the trim leaves nothing.
 void AppendSamples(const MeasuredData& data, bool select_passive, const IdentificationOptions& opt,
                    IdentificationSamples* into);
 
-// One row u* = w' phi (eq. 18) of step 1..4 from the full regressor at any state (q, qd, qdd) with
+// One row u* = w' phi (HJ15 eq. 18) of step 1..4 from the full regressor at any state (q, qd, qdd) with
 // actuator torque u (N m, the moving joint's tau_R): w = the moving joint's row of FullRegressor at
 // the unknown columns, u* = u - (that row) . known - P_row(q) (P only in steps 3-4, model `passive`).
 // `known` as in SolveStep. Equals Step1Row..Step4Row when the held joint is exactly still at 90 / -90.
@@ -86,9 +86,9 @@ StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, Pass
                        const Eigen::Vector2d& q, const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd,
                        double u);
 
-// Result of one step (eq. 18-21).
+// Result of one step (HJ15 eq. 18-21).
 struct StepEstimate {
-  int step = 0;                                  // 1..4 (eq. 14-17)
+  int step = 0;                                  // 1..4 (HJ15 eq. 14-17)
   std::string segment;                           // "R2", "R1", "H2", "H1"
   Eigen::Vector3d phi = Eigen::Vector3d::Zero();  // [J, X, Y]: kg m^2, kg m, kg m
   Eigen::Vector3d se = Eigen::Vector3d::Zero();   // standard errors, same units

@@ -81,7 +81,7 @@ MeasuredData SimulateTrial(Plant& plant, const LegParams& ff, bool knee_swing, i
     tab.columns[2][i] = q_enc[1];
     for (int j = 0; j < 2; ++j) {
       const double v = std::clamp(-tau[j] + sm.offset + sm.noise_sd * rng.Normal(), -sm.range, sm.range);
-      tab.columns[3 + j][i] = Quantize(v, sm.resolution);  // tau_S = -tau_R, eq. (8)
+      tab.columns[3 + j][i] = Quantize(v, sm.resolution);  // tau_S = -tau_R, HJ15 eq. 8
       tab.columns[5 + j][i] = tau[j];
     }
     if (emg)

@@ -2,7 +2,7 @@
 // MuJoCo plant, for tests, benches and the scenario runner: the moving joint tracks an exciting
 // trajectory, the other is held by PD at 90 deg (hip) or -90 deg (knee); computed-torque feed-forward
 // with a deliberately wrong model + PD at 1 kHz; torque sensor and encoder models; CSV rows in the
-// measured-data schema of DESIGN.md with tau = tau_S = -tau_R (eq. 8). Every draw from the seed.
+// measured-data schema of DESIGN.md with tau = tau_S = -tau_R (HJ15 eq. 8). Every draw from the seed.
 // Actuators saturate at +-150 N m (the MJCF ctrlrange); the held joint's torque beyond that is carried
 // by a support (the seat under the thigh in the knee swing) and is not in its sensor reading.
 #pragma once
@@ -61,7 +61,7 @@ struct ProtocolData {
 // if truth has no realization, SimulationError on divergence. Deterministic for a given seed.
 ProtocolData SimulateProtocol(const LegParams& truth, const ProtocolOptions& opt = {});
 
-// The same combined system (exo + human, which alone sets the dynamics, eq. 3) split so that both
+// The same combined system (exo + human, which alone sets the dynamics, HJ15 eq. 3) split so that both
 // parts have a MuJoCo realization: when the human has none, an inertia dJ1 (kg m^2, the smallest
 // multiple of 0.01 leaving a 0.05 kg m^2 margin) moves from the exo's J1 to the human's. Unchanged
 // when both are realizable. Throws InputError if no dJ1 <= 2 kg m^2 works. Used for S3 of Table 4.

@@ -68,7 +68,7 @@ PassiveSelection SelectPassiveSamples(const MeasuredData& data, const PassiveSel
     }
     sel.thresholds.push_back(Z);
     for (size_t i = 0; i < n; ++i)
-      if (chi[i] >= Z) sel.passive[i] = 0;  // eq. (13): A_ch = 1 when chi >= Z
+      if (chi[i] >= Z) sel.passive[i] = 0;  // HJ15 eq. 13: A_ch = 1 when chi >= Z
   }
   for (char p : sel.passive) sel.kept += p ? 1 : 0;
   return sel;

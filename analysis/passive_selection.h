@@ -1,4 +1,4 @@
-// Selection of passive samples by EMG, eq. (13) of Hwang & Jeon 2015: a sample is passive when every
+// Selection of passive samples by EMG, HJ15 eq. 13 of Hwang & Jeon 2015: a sample is passive when every
 // channel's full-wave rectified, band-passed EMG chi_ch(k) is below its threshold Z_ch = mean + 3 SD
 // of chi_ch while the muscle is relaxed.
 //
@@ -19,8 +19,8 @@ namespace exotwin {
 
 struct PassiveSelectionOptions {
   double reference_s = 2.0;  // s, length of the relaxed reference at the start of each file (> 0)
-  double envelope_s = 0.0;   // s, moving-average window of the rectified EMG (0 = per sample, eq. 13)
-  double n_sd = 3.0;         // Z = mean + n_sd * SD (eq. 13: 3)
+  double envelope_s = 0.0;   // s, moving-average window of the rectified EMG (0 = per sample, HJ15 eq. 13)
+  double n_sd = 3.0;         // Z = mean + n_sd * SD (HJ15 eq. 13: 3)
   // Given thresholds Z_ch (V of the rectified amplifier output) by channel name ("VM" or "emg_VM");
   // key "*" applies to every channel without its own entry. They replace the reference statistics.
   std::map<std::string, double> thresholds;
@@ -33,7 +33,7 @@ struct PassiveSelection {
   size_t kept = 0;                       // number of passive samples
 };
 
-// Applies eq. (13) to one file. Without emg_* columns every sample is passive. Throws InputError
+// Applies HJ15 eq. 13 to one file. Without emg_* columns every sample is passive. Throws InputError
 // (naming data.source) if the reference window holds fewer than 10 samples.
 PassiveSelection SelectPassiveSamples(const MeasuredData& data, const PassiveSelectionOptions& opt = {});
 

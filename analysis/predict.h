@@ -10,7 +10,7 @@ namespace exotwin {
 struct Prediction {
   std::vector<double> t;
   std::vector<double> tau_R[2];  // actuator torque, N m (hip, knee)
-  std::vector<double> tau_S[2];  // predicted sensor reading tau_S = -tau_R (eq. 8) + sensor effects
+  std::vector<double> tau_S[2];  // predicted sensor reading tau_S = -tau_R (HJ15 eq. 8) + sensor effects
 };
 
 // Runs MuJoCo's inverse dynamics of `plant` (whose parameters are set) on every sample, adds the

@@ -1,4 +1,4 @@
-// Lee & Sankai stress metrics, eq. (12)-(18): see stress_metrics.h.
+// Lee & Sankai stress metrics, LS05 eq. 12-18: see stress_metrics.h.
 #include "analysis/stress_metrics.h"
 
 #include <algorithm>
@@ -9,21 +9,21 @@ namespace exotwin {
 
 double IntegratedMyoelectricity(const std::vector<double>& m, double dt) {
   double s = 0;
-  for (double v : m) s += std::abs(v) * dt;  // eq. (15)/(16)
+  for (double v : m) s += std::abs(v) * dt;  // LS05 eq. 15/16
   return s;
 }
 
 double MeanAbsMoment(const std::vector<double>& tau_m, double dt) {
   if (tau_m.empty() || !(dt > 0)) throw std::invalid_argument("MeanAbsMoment: empty record or dt <= 0");
-  return IntegratedMyoelectricity(tau_m, dt) / (tau_m.size() * dt);  // eq. (12)
+  return IntegratedMyoelectricity(tau_m, dt) / (tau_m.size() * dt);  // LS05 eq. 12
 }
 
 std::vector<double> NormalizeByMax(const std::vector<double>& J) {
   if (J.empty()) throw std::invalid_argument("NormalizeByMax: empty");
-  const double mx = *std::max_element(J.begin(), J.end());  // eq. (17)/(18)
+  const double mx = *std::max_element(J.begin(), J.end());  // LS05 eq. 17/18
   if (!(mx > 0)) throw std::invalid_argument("NormalizeByMax: maximum must be > 0");
   std::vector<double> out;
-  for (double v : J) out.push_back(v / mx);  // eq. (13)/(14)
+  for (double v : J) out.push_back(v / mx);  // LS05 eq. 13/14
   return out;
 }
 

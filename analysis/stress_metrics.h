@@ -1,4 +1,4 @@
-// Physical-stress metrics of Lee & Sankai eq. (12)-(18) for sweeps of the virtual impedance.
+// Physical-stress metrics of LS05 eq. 12-18 for sweeps of the virtual impedance.
 // Records are sampled every dt (s); integrals by the rectangle rule (sum |x| dt).
 #pragma once
 #include <cstddef>
@@ -6,13 +6,13 @@
 
 namespace exotwin {
 
-// Eq. (12): mean musculoskeletal moment J_tau = (1/t_f) int_0^tf |tau_m| dt (N m); t_f = n dt.
+// LS05 eq. 12: mean musculoskeletal moment J_tau = (1/t_f) int_0^tf |tau_m| dt (N m); t_f = n dt.
 double MeanAbsMoment(const std::vector<double>& tau_m, double dt);
 
-// Eq. (15)/(16): integrated myoelectricity J = int_0^tf |m| dt (V s).
+// LS05 eq. 15/16: integrated myoelectricity J = int_0^tf |m| dt (V s).
 double IntegratedMyoelectricity(const std::vector<double>& m, double dt);
 
-// Eq. (13)/(14) with (17)/(18): each trial's J divided by the maximum over the trials (0..1].
+// LS05 eq. 13/14 with (17)/(18): each trial's J divided by the maximum over the trials (0..1].
 // Precondition: non-empty, max > 0.
 std::vector<double> NormalizeByMax(const std::vector<double>& J);
 

@@ -82,7 +82,7 @@ std::pair<double, double> GaitTorqueRmse(const MeasuredData& gait, const LegPara
     if (kin.t[i] < t_from || kin.t[i] > t_to) continue;
     const Vec2 tau_R = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
                                       {kin.qdd[0][i], kin.qdd[1][i]});
-    const double e_hip = gait.tau_hip[i] - (-tau_R[0]);  // tau_S = -tau_R, eq. (8)
+    const double e_hip = gait.tau_hip[i] - (-tau_R[0]);  // tau_S = -tau_R, HJ15 eq. 8
     const double e_knee = gait.tau_knee[i] - (-tau_R[1]);
     s2[0] += e_hip * e_hip;
     s2[1] += e_knee * e_knee;

@@ -1,4 +1,4 @@
-// Table 5 of Hwang & Jeon 2015 reproduced by the twin: RMS error (eq. 22) between the measured torque
+// Table 5 of Hwang & Jeon 2015 reproduced by the twin: RMS error (HJ15 eq. 22) between the measured torque
 // of relaxed passive-mode gait and the torque predicted with identified, De Leva and Dempster human
 // parameters (the exoskeleton identified in all three), plus Tables 3-4 (identified against the
 // twin's ground truth), and their side-by-side text next to the paper's numbers.
@@ -25,7 +25,7 @@ struct Table5Entry {
   double gait_samples = 0;        // samples after the ramp used for the RMS errors
 };
 
-// RMS error (eq. 22) of the measured torque-sensor readings against the reading predicted for the
+// RMS error (HJ15 eq. 22) of the measured torque-sensor readings against the reading predicted for the
 // measured kinematics (derivatives: zero-phase Butterworth 20 Hz) with `params`, over t in [t_from,
 // t_to]. Leave ~0.1 s of recording outside the window at the ends: the derivatives of the filter's
 // edges are wrong (a 0.1 s tail of gait otherwise adds ~4 N m to the hip RMS error).

@@ -2,7 +2,7 @@
 // (analysis/identification_data.h, subject S1); the timed part is Identify(): derivative filtering,
 // trimming, EMG selection, regressor rows, least squares, standard errors, condition numbers.
 //   BM_IdentifyExo/200        steps 1-2, 100 s knee swing + 100 s hip swing (200 s in all)
-//   BM_IdentifyHuman/200      steps 3-4, same, with 5 EMG channels (eq. 13) and the passive model
+//   BM_IdentifyHuman/200      steps 3-4, same, with 5 EMG channels (HJ15 eq. 13) and the passive model
 //   BM_IdentifyHuman/400      steps 3-4 on the full protocol: 5 x 40 s per configuration
 //   BM_IdentifyFromCsv/200    as BM_IdentifyHuman/200 plus parsing the CSV files (the CLI path)
 // Run: ./build-ident/bench/identify_bench

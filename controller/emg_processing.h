@@ -1,4 +1,4 @@
-// EMG activity detection of the controllers: the activation threshold of Hwang & Jeon 2015 eq. (13)
+// EMG activity detection of the controllers: the activation threshold of HJ15 eq. 13
 // on the band-passed, rectified EMG chi (V). The signal chains themselves (band-pass, rectification,
 // linear and RMS envelopes, MVC normalization) are dsp/'s: dsp/emg_envelope.h, dsp/mvc.h.
 #pragma once
@@ -6,7 +6,7 @@
 
 namespace exotwin::controller {
 
-// Activation threshold of eq. (13): Z = mean + n_sd SD of chi (band-passed, rectified EMG) recorded
+// Activation threshold of HJ15 eq. 13: Z = mean + n_sd SD of chi (band-passed, rectified EMG) recorded
 // while relaxed; A(k) = 1 if chi(k) > Z.
 struct ActivationThreshold {
   double mean = 0, sd = 0, z = 0;  // V

@@ -38,7 +38,7 @@ double NoiseCorrectedEnvelope(double E, double E0) {
 
 double EstimateMuscleTorque(const HalEmgCoefficients& c, double E_e, double E_f) {
   const double Ee = NoiseCorrectedEnvelope(E_e, c.baseline_e), Ef = NoiseCorrectedEnvelope(E_f, c.baseline_f);
-  return (c.extensor.a * Ee + c.extensor.b) - (c.flexor.a * Ef + c.flexor.b);  // eq. (2)
+  return (c.extensor.a * Ee + c.extensor.b) - (c.flexor.a * Ef + c.flexor.b);  // HKS05 eq. 2
 }
 
 OneLinkPassive IdentifyOneLinkPassive(const std::vector<double>& th, const std::vector<double>& tau,
@@ -60,12 +60,12 @@ OneLinkPassive IdentifyOneLinkPassive(const std::vector<double>& th, const std::
     A(i, 2) = std::sin(f[k]);
     b[i] = tau[k];
   }
-  const Eigen::Vector3d x = A.colPivHouseholderQr().solve(b);  // eq. (14)/(15)
+  const Eigen::Vector3d x = A.colPivHouseholderQr().solve(b);  // HKS05 eq. 14/15
   return {x[0], x[1], x[2]};
 }
 
 double GravityStiffness(double mgl, double th) {
-  return std::abs(th) < 1e-9 ? mgl : mgl * std::sin(th) / th;  // eq. (8)
+  return std::abs(th) < 1e-9 ? mgl : mgl * std::sin(th) / th;  // HKS05 eq. 8
 }
 
 ViscoelasticRls::ViscoelasticRls(const ViscoelasticRlsConfig& cfg) : cfg_(cfg) {
@@ -74,24 +74,24 @@ ViscoelasticRls::ViscoelasticRls(const ViscoelasticRlsConfig& cfg) : cfg_(cfg) {
     throw std::invalid_argument("ViscoelasticRls: need dt > 0, 0 < rho <= 1, p0 > 0, pf > 0, I0 > 0");
   e1_ = 2 * cfg.pf;
   e2_ = cfg.pf * cfg.pf;
-  // X = [e1 - D'/I, e2 - K'/I, T/(2I), 1/I], eq. (11), from the prior (K' at th = 0).
+  // X = [e1 - D'/I, e2 - K'/I, T/(2I), 1/I], HKS05 eq. 11, from the prior (K' at th = 0).
   const double Dp = cfg.D0 + cfg.R, Kp = cfg.K0 + (cfg.gravity_in_input ? 0.0 : cfg.mgl);
   X_ << e1_ - Dp / cfg.I0, e2_ - Kp / cfg.I0, cfg.dt / (2 * cfg.I0), 1 / cfg.I0;
   P_ = cfg.p0 * Eigen::Matrix4d::Identity();
-  // Known inertia: X3, X4 have zero covariance, so P phi has no X3, X4 component and eq. (13) is
-  // the two-parameter RLS on th - X3 phi3 - X4 phi4 (its rows and columns stay zero under eq. 13).
+  // Known inertia: X3, X4 have zero covariance, so P phi has no X3, X4 component and HKS05 eq. 13 is
+  // the two-parameter RLS on th - X3 phi3 - X4 phi4 (its rows and columns stay zero under HKS05 eq. 13).
   if (cfg.known_inertia) P_.block<2, 2>(2, 2).setZero();
 }
 
 void ViscoelasticRls::Step(double th, double u_in) {
   const double u = cfg_.gravity_in_input ? u_in - cfg_.mgl * std::sin(th) : u_in;
-  // Regressor phi(k) = [d th/E, th/E, d u/E, u/E] (eq. 11) from the filter states at k.
+  // Regressor phi(k) = [d th/E, th/E, d u/E, u/E] (HKS05 eq. 11) from the filter states at k.
   const Eigen::Vector4d phi(s2t_, s1t_, s2u_, s1u_);
-  err_ = th - phi.dot(X_);  // eq. (12)
+  err_ = th - phi.dot(X_);  // HKS05 eq. 12
   const Eigen::Vector4d Pphi = P_ * phi;
   const double den = cfg_.rho + phi.dot(Pphi);
-  X_ += Pphi * (err_ / den);                              // eq. (13)
-  P_ = (P_ - Pphi * Pphi.transpose() / den) / cfg_.rho;   // eq. (13), forgetting factor rho
+  X_ += Pphi * (err_ / den);                              // HKS05 eq. 13
+  P_ = (P_ - Pphi * Pphi.transpose() / den) / cfg_.rho;   // HKS05 eq. 13, forgetting factor rho
   // The paper prints P(k+1) = (P - P phi phi' P)/(rho + phi' P phi): a typo for the standard
   // exponentially weighted RLS used here (the printed form does not forget).
   P_ = 0.5 * (P_ + P_.transpose());                        // keep symmetric
@@ -123,11 +123,11 @@ AdaptiveObserver::AdaptiveObserver(double dt, double lambda1, double lambda2)
 
 void AdaptiveObserver::Step(double th, double u, double I, double Dp, double Kp) {
   const double a1 = Dp / I, a0 = Kp / I;
-  const double g1 = l1_ + l2_ - a1;           // eq. (17), re-derived (see header)
+  const double g1 = l1_ + l2_ - a1;           // HKS05 eq. 17, re-derived (see header)
   const double g2 = l1_ * l2_ - a0 - g1 * a1;
-  const double b1 = dt_ / (2 * I), b2 = (1 - Dp * dt_ / (2 * I)) / I;  // eq. (10)
+  const double b1 = dt_ / (2 * I), b2 = (1 - Dp * dt_ / (2 * I)) / I;  // HKS05 eq. 10
   const double e = th - x1_;
-  const double d1 = x2_ + b1 * u + g1 * e;                 // eq. (16)
+  const double d1 = x2_ + b1 * u + g1 * e;                 // HKS05 eq. 16
   const double d2 = -a0 * x1_ - a1 * x2_ + b2 * u + g2 * e;
   x1_ += dt_ * d1;
   x2_ += dt_ * d2;
@@ -142,8 +142,8 @@ HalAssistOutput HalAssistController::Step(double th, double E_e, double E_f, dou
     obs_.Reset(th);
     started_ = true;
   }
-  o.mu_hat = EstimateMuscleTorque(cfg_.emg, E_e, E_f);     // eq. (2)
-  // Eq. (9), sigma = 0; minus the actuator's known Coulomb friction (friction_C, our extension).
+  o.mu_hat = EstimateMuscleTorque(cfg_.emg, E_e, E_f);     // HKS05 eq. 2
+  // HKS05 eq. 9, sigma = 0; minus the actuator's known Coulomb friction (friction_C, our extension).
   const double u = tau_prev_ + o.mu_hat - cfg_.friction_C * std::tanh(thd_prev_ / cfg_.friction_eps);
   rls_.Step(th, u);
   // Safety (our addition): estimates outside a physical range (I beyond 1/4..4 x the identified
@@ -161,10 +161,10 @@ HalAssistOutput HalAssistController::Step(double th, double E_e, double E_f, dou
     obs_.Reset(th);
     o.thd_hat = 0;
   }
-  o.tau_mu = cfg_.alpha_mu * o.mu_hat;                      // eq. (3)
-  o.tau_zeta = cfg_.alpha_zeta * (-o.D * o.thd_hat - o.K * th);  // eq. (5)
+  o.tau_mu = cfg_.alpha_mu * o.mu_hat;                      // HKS05 eq. 3
+  o.tau_zeta = cfg_.alpha_zeta * (-o.D * o.thd_hat - o.K * th);  // HKS05 eq. 5
   o.tau_c = tau_c;
-  o.tau = std::clamp(o.tau_zeta + o.tau_mu + o.tau_c, -cfg_.tau_max, cfg_.tau_max);  // eq. (6)
+  o.tau = std::clamp(o.tau_zeta + o.tau_mu + o.tau_c, -cfg_.tau_max, cfg_.tau_max);  // HKS05 eq. 6
   tau_prev_ = o.tau;
   thd_prev_ = o.thd_hat;
   return o;

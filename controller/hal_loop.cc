@@ -52,7 +52,7 @@ void HalLoop::Tick(double t) {
       if (emg_started_ && e.counter != ((emg_counter_ + 1) & 0x0f)) ++tel_.emg_gaps;
       emg_counter_ = e.counter;
       emg_started_ = true;
-      tel_.E_e = rms_e_.Step(e.volts[cfg_.extensor_channel]);  // eq. (1)
+      tel_.E_e = rms_e_.Step(e.volts[cfg_.extensor_channel]);  // HKS05 eq. 1
       tel_.E_f = rms_f_.Step(e.volts[cfg_.flexor_channel]);
       ++tel_.emg_frames;
     }
@@ -68,7 +68,7 @@ void HalLoop::Tick(double t) {
   if (alive && cfg_.mode != HalMode::kNone) {
     const double tau_c = CompensationTorque(cfg_.impedance, tel_.th, tel_.thd, tel_.thdd);
     if (cfg_.mode == HalMode::kAssist) {
-      out = assist_.Step(tel_.th, tel_.E_e, tel_.E_f, tau_c);  // eq. (6)
+      out = assist_.Step(tel_.th, tel_.E_e, tel_.E_f, tau_c);  // HKS05 eq. 6
     } else {
       out.tau_c = tau_c;
       out.tau = tau_c;

@@ -1,12 +1,12 @@
 // The HAL-3 knee control loop (what runs at 1 kHz on HAL's computer), over a CanBus only:
 // reads HalKneeStatus (0x190: potentiometer angle, strain gauge) and EmgSamples (0x200), computes the
-// RMS envelopes of the extensor and flexor channels (Hayashi eq. 1), and sends HalKneeCommand (0x110)
+// RMS envelopes of the extensor and flexor channels (HKS05 eq. 1), and sends HalKneeCommand (0x110)
 // with one of three laws:
 //   kNone:      zero torque (HAL worn passively, its own impedance uncompensated);
 //   kImpedance: tau = tau_c, the virtual-impedance compensation of Lee & Sankai (virtual_impedance.h);
 //               with B_v = 0, mgl_v = mgl, I_v = I, C_v = 0 it is Hayashi's tau_c, experiment 1;
-//   kAssist:    tau = tau_zeta + tau_mu + tau_c (Hayashi eq. 2-3, 5-6, RLS eq. 8-13, observer
-//               eq. 16-17; controller/hal_assist.h), experiment 2.
+//   kAssist:    tau = tau_zeta + tau_mu + tau_c (HKS05 eq. 2-3, 5-6, RLS HKS05 eq. 8-13, observer
+//               HKS05 eq. 16-17; controller/hal_assist.h), experiment 2.
 // The strain gauge is logged but, as in Hayashi sec. III, never used for control. Real-time path
 // (Tick) allocates nothing and throws nothing; construction throws std::invalid_argument.
 #pragma once
@@ -27,11 +27,11 @@ const char* HalModeName(HalMode m);
 struct HalLoopConfig {
   HalMode mode = HalMode::kImpedance;
   double rate_hz = 1000.0;          // Tick() rate, Hz
-  HalAssistConfig assist;           // eq. (2)-(17): gains, EMG coefficients, RLS, observer
+  HalAssistConfig assist;           // HKS05 eq. 2-17: gains, EMG coefficients, RLS, observer
   VirtualImpedanceConfig impedance; // tau_c: identified exoskeleton (actual) and virtual (target) values
   int extensor_channel = 1;         // EmgSamples channel of the extensor unit (1 = VM)
   int flexor_channel = 3;           // EmgSamples channel of the flexor unit (3 = ST)
-  double rms_window = 0.1;          // s, T of eq. (1)
+  double rms_window = 0.1;          // s, T of HKS05 eq. 1
   double emg_fs = 1000.0;           // Hz, EMG sample rate
   EstimatorConfig velocity;         // causal velocity/acceleration for tau_c (20 Hz low-pass)
   double tau_max = 60.0;            // N m, command limit (HAL-3 actuator)
@@ -43,9 +43,9 @@ struct HalTelemetry {
   double t = 0;
   double th = 0, strain = 0;        // rad, N m: latest potentiometer and strain-gauge readings
   double thd = 0, thdd = 0;         // rad/s, rad/s^2: causal estimates used by tau_c
-  double E_e = 0, E_f = 0;          // V: RMS envelopes (eq. 1) of extensor and flexor
+  double E_e = 0, E_f = 0;          // V: RMS envelopes (HKS05 eq. 1) of extensor and flexor
   double tau_cmd = 0;               // N m, sent
-  HalAssistOutput assist;           // terms of eq. (6) (tau_c also filled in kImpedance)
+  HalAssistOutput assist;           // terms of HKS05 eq. 6 (tau_c also filled in kImpedance)
   bool have_status = false, enabled = false;
   uint32_t status_frames = 0, emg_frames = 0, emg_gaps = 0, send_failures = 0;
 };

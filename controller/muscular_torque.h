@@ -1,4 +1,4 @@
-// Muscular torque estimate of Hwang & Jeon 2015 eq. (9)-(10): tau_M = tau_S - tau_PAS, with
+// Muscular torque estimate of HJ15 eq. 9-10: tau_M = tau_S - tau_PAS, with
 // tau_PAS = -(M qdd + V + G + P) from the IDENTIFIED lumped parameters (model/leg_dynamics.h).
 // Convention (DESIGN.md): hip flexion +, knee flexion -, tau_S = -tau_R the torque-sensor reading.
 // qd, qdd are the caller's: off line, dsp::ZeroPhaseDerivatives (the paper's zero-phase 20 Hz
@@ -10,11 +10,11 @@
 
 namespace exotwin::controller {
 
-// tau_PAS of eq. (10) (N m): minus the torque the relaxed combined system needs at (q, qd, qdd).
+// tau_PAS of HJ15 eq. 10 (N m): minus the torque the relaxed combined system needs at (q, qd, qdd).
 Eigen::Vector2d PassiveTorqueEstimate(const LegParams& identified, const Eigen::Vector2d& q,
                                       const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
 
-// tau_M of eq. (9) (N m) from the sensor reading tau_S (N m) and the kinematics (rad, rad/s, rad/s^2).
+// tau_M of HJ15 eq. 9 (N m) from the sensor reading tau_S (N m) and the kinematics (rad, rad/s, rad/s^2).
 Eigen::Vector2d MuscularTorque(const LegParams& identified, const Eigen::Vector2d& q,
                                const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd,
                                const Eigen::Vector2d& tau_S);

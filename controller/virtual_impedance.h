@@ -5,7 +5,7 @@
 // With tau_c below, the operator feels  I_v thdd + B_v thd + mgl_v sin th + C_v sgn(thd) (+ the
 // remaining I - I_v mismatch of the acceleration estimate). Lee & Sankai's criteria: (i) I_v = 0 and
 // C_v = 0, (ii) mgl_v = mgl (gravity retained), (iii) B_v a little above 1.56 N m/(rad/s).
-// It is also Hayashi's tau_c of eq. (6) with I_v = 0, B_v = 0, mgl_v = mgl, C_v = 0.
+// It is also Hayashi's tau_c of HKS05 eq. 6 with I_v = 0, B_v = 0, mgl_v = mgl, C_v = 0.
 #pragma once
 
 namespace exotwin::controller {
@@ -18,7 +18,7 @@ struct OneLinkImpedance {
 };
 
 struct VirtualImpedanceConfig {
-  OneLinkImpedance actual;   // identified exoskeleton (eq. 15 for I, B, mgl; C separately)
+  OneLinkImpedance actual;   // identified exoskeleton (LS05 eq. 15 for I, B, mgl; C separately)
   OneLinkImpedance target;   // virtual values
   double coulomb_eps = 0.05; // rad/s: sgn(thd) smoothed as tanh(thd / eps) (our choice, avoids chatter)
 };

@@ -1,6 +1,6 @@
 // Velocity and acceleration of a sampled signal: zero-phase low-pass, then central differences.
 // The paper's off-line chain (Hwang & Jeon 2015 sec. 3.2: 2nd-order Butterworth at 20 Hz, zero
-// phase), shared by the analysis (measured data), the HAL passive identification (Hayashi eq. 14-15)
+// phase), shared by the analysis (measured data), the HAL passive identification (HKS05 eq. 14-15)
 // and whoever needs qd, qdd from recorded angles. Uniform sampling only: resampling a non-uniform
 // record is the caller's business.
 #pragma once

@@ -82,7 +82,7 @@ double RmsEnvelope::Step(double x) {
     sum_ = 0;
     for (double v : buf_) sum_ += v;
   }
-  // Before the window is full, average over the samples seen (eq. 1 with t - T < 0 clipped).
+  // Before the window is full, average over the samples seen (HKS05 eq. 1 with t - T < 0 clipped).
   return std::sqrt(std::max(0.0, sum_) / static_cast<double>(count_));
 }
 

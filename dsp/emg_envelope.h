@@ -1,7 +1,7 @@
 // EMG amplitude chains: band-pass, full-wave rectification, linear envelope (Hwang & Jeon 2015
 // sec. 4.3: 4th-order Butterworth 2 Hz low-pass of the rectified signal) in a causal variant for the
 // real-time path and a zero-phase variant for off-line calibration and analysis, and the moving RMS
-// envelope (Hayashi, Kawamoto & Sankai eq. 1). Input: the amplified EMG in V (after the amplifier's
+// envelope (HKS05 eq. 1). Input: the amplified EMG in V (after the amplifier's
 // gain 1000), sampled at fs (1 kHz unless said). Causal classes are allocation-free after
 // construction; the zero-phase functions take whole records.
 #pragma once
@@ -65,7 +65,7 @@ std::vector<double> ZeroPhaseEnvelope(const std::vector<Biquad>& prefilter, cons
 std::vector<double> LinearEnvelopeZeroPhase(const std::vector<double>& amplified, double fs = 1000.0,
                                             double fc = 2.0);
 
-// Moving RMS over the last T seconds (Hayashi eq. 1: E(t) = sqrt(1/T int_{t-T}^t m^2)), causal.
+// Moving RMS over the last T seconds (HKS05 eq. 1: E(t) = sqrt(1/T int_{t-T}^t m^2)), causal.
 // Hayashi gives no T; default 0.1 s (our choice: ripple < 10 % for 20-450 Hz EMG, delay T/2).
 // Running sum of squares with periodic exact recomputation (no drift). Precondition: T*fs >= 1
 // (throws std::invalid_argument otherwise).

@@ -39,7 +39,7 @@ class JointModule {
 
   // Samples the sensors at the instant t (s), with the true link angle q(t) (rad) and the torque the
   // motor applies at t, tau_R(t) (N m; the sensor sits between motor and link, so it reads
-  // tau_S = -tau_R, eq. 8), and sends a JointStatus frame (unless stale). Returns the CanStatus of
+  // tau_S = -tau_R, HJ15 eq. 8), and sends a JointStatus frame (unless stale). Returns the CanStatus of
   // the send. Both arguments must belong to the same instant (DESIGN.md "Sampling instant of a joint
   // node"): with the plant's semi-implicit Euler step, q(t) and the torque held over [t, t + dt]
   // (the driver's output at t, Applied()); the spec's torque_sensor_skew then delays one of them.

@@ -11,10 +11,10 @@ namespace exotwin {
 // n1 = (cos th1, sin th1) is u1 turned by +90 deg. Segment i's centre of mass is a_i u_i + b_i n_i
 // from its proximal joint, with u2, n2 at th12 = th1 + th2 and the knee at L1 u1.
 //   Potential energy: y_c1 = -a1 cos th1 + b1 sin th1, y_c2 = -L1 cos th1 - a2 cos th12 + b2 sin th12
-//   => G = dV/dq gives eq. (7): G1 = g (X1 s1 + Y1 c1 + X2 s12 + Y2 c12), G2 = g (X2 s12 + Y2 c12).
+//   => G = dV/dq gives HJ15 eq. 7: G1 = g (X1 s1 + Y1 c1 + X2 s12 + Y2 c12), G2 = g (X2 s12 + Y2 c12).
 //   Kinetic energy cross term of segment 2: m2 L1 th1d th12d (a2 cos th2 - b2 sin th2)
-//   => eq. (5): M11 = J1 + 2 L1 (X2 c2 - Y2 s2), M12 = J2 + L1 (X2 c2 - Y2 s2), M22 = J2,
-//   and the Christoffel terms of eq. (6).
+//   => HJ15 eq. 5: M11 = J1 + 2 L1 (X2 c2 - Y2 s2), M12 = J2 + L1 (X2 c2 - Y2 s2), M22 = J2,
+//   and the Christoffel terms of HJ15 eq. 6.
 Eigen::Matrix2d MassMatrix(const LumpedParams& p, double L1, double th2) {
   const double h = L1 * (p.X2 * std::cos(th2) - p.Y2 * std::sin(th2));
   Eigen::Matrix2d M;

@@ -1,4 +1,4 @@
-// Lumped inertial parameters of the two-segment sagittal leg model of Hwang & Jeon 2015, eq. (4),
+// Lumped inertial parameters of the two-segment sagittal leg model of Hwang & Jeon 2015, HJ15 eq. 4,
 // and the model-file contents built on them (DESIGN.md "Model parameter file").
 #pragma once
 #include <map>
@@ -8,7 +8,7 @@
 
 namespace exotwin {
 
-// Lumped parameters of one system (exoskeleton R or human H), eq. (4):
+// Lumped parameters of one system (exoskeleton R or human H), HJ15 eq. 4:
 //   J1 = Iz1 + Iz2 + m1 (a1^2 + b1^2) + m2 (a2^2 + b2^2) + m2 L1^2   [kg m^2]
 //   J2 = Iz2 + m2 (a2^2 + b2^2)                                      [kg m^2]
 //   X1 = m1 a1 + m2 L1,  X2 = m2 a2                                   [kg m]
@@ -21,7 +21,7 @@ struct LumpedParams {
   double m1 = 0, m2 = 0;
 };
 
-// Sum of two systems' lumped parameters (the combined human-exoskeleton system, eq. (3)).
+// Sum of two systems' lumped parameters (the combined human-exoskeleton system, HJ15 eq. 3).
 LumpedParams operator+(const LumpedParams& a, const LumpedParams& b);
 
 enum class PassiveModel { kNone, kRiener1999 };
@@ -46,7 +46,7 @@ struct LegParams {
   PassiveModel passive = PassiveModel::kNone;
   std::vector<Effect> effects;
 
-  // Combined lumped parameters (exo + human when present): the HR system of eq. (3).
+  // Combined lumped parameters (exo + human when present): the HR system of HJ15 eq. 3.
   LumpedParams Total() const;
 };
 

@@ -1,5 +1,5 @@
-// Passive elastic joint torque P(q) of eq. (1) and (12), rebuilt from Riener & Edrich 1999
-// (J. Biomech. 32:539-544) because the 2015 print of eq. (12) is garbled (see the .cc file).
+// Passive elastic joint torque P(q) of HJ15 eq. 1 and 12, rebuilt from Riener & Edrich 1999
+// (J. Biomech. 32:539-544) because the 2015 print of HJ15 eq. 12 is garbled (see the .cc file).
 #pragma once
 #include <Eigen/Core>
 
@@ -16,7 +16,7 @@ double RienerHipMoment(double H_deg, double K_deg);
 double RienerKneeMoment(double A_deg, double K_deg, double H_deg);
 
 // P(q) in this project's convention (q in rad, hip flexion positive, knee flexion negative), the term
-// that sits on the left of eq. (1) beside G: P = minus the passive moment along each generalized
+// that sits on the left of HJ15 eq. 1 beside G: P = minus the passive moment along each generalized
 // coordinate. Ankle held at 0 (the lower leg is one rigid segment). N m. kNone gives zero.
 Eigen::Vector2d PassiveElasticTorque(PassiveModel model, const Eigen::Vector2d& q);
 

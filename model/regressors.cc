@@ -4,7 +4,7 @@
 
 namespace exotwin {
 
-// Sign question of eq. (15), (17), (A2), (A4). From eq. (5), M11 = J1 + 2 L1 (X2 cos th2 - Y2 sin th2).
+// Sign question of HJ15 eq. 15, 17, A2, A4. From HJ15 eq. 5, M11 = J1 + 2 L1 (X2 cos th2 - Y2 sin th2).
 // With the knee held at th2 = -90 deg: cos th2 = 0, sin th2 = -1, so M11 = J1 + 2 L1 Y2, not the
 // printed "J1 - 2 L1 Y2". The gravity term, with th12 = th1 - 90 deg (sin th12 = -cos th1,
 // cos th12 = sin th1), is g (X1 sin th1 + Y1 cos th1 - X2 cos th1 + Y2 sin th1) as printed, and the
@@ -12,7 +12,7 @@ namespace exotwin {
 //   step 2: u2 = (J_R1 + 2 L1 Y_R2) y'' + g (X_R1 sin y + Y_R1 cos y - X_R2 cos y + Y_R2 sin y)
 //   step 4: u4 = (J_RH1 + 2 L1 Y_RH2) y'' + g (...RH...) + P1.
 // With the hip held at th1 = 90 deg (sin th12 = cos th2, cos th12 = -sin th2), the knee row is
-//   u1 = J_R2 y'' + g (X_R2 cos y - Y_R2 sin y)           (eq. 14 as printed)
+//   u1 = J_R2 y'' + g (X_R2 cos y - Y_R2 sin y)           (LS05 eq. 14 as printed)
 // so w1 = [y'', g cos y, -g sin y]: (A1) prints "+g sin y", another sign slip. (A3) moves the known
 // exo part with the wrong sign ("+J_R2 y''"); u3* = u3 - P2 - J_R2 y'' - g (X_R2 cos y - Y_R2 sin y).
 // tests/model/regressors_test.cc checks all four rows against MuJoCo and the closed form.

@@ -1,4 +1,4 @@
-// Identification regressors: the dynamics written linearly in the lumped parameters, eq. (18)-(21)
+// Identification regressors: the dynamics written linearly in the lumped parameters, HJ15 eq. 18-21
 // and Appendix A1-A4 of Hwang & Jeon 2015, with the signs re-derived (see regressors.cc).
 #pragma once
 #include <Eigen/Core>
@@ -18,7 +18,7 @@ LumpedParams FromVector(const Vector6& v);
 Matrix26 FullRegressor(double L1, double g, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                        const Eigen::Vector2d& qdd);
 
-// One row of a step regressor: u* = w^T phi (eq. 18).
+// One row of a step regressor: u* = w^T phi (HJ15 eq. 18).
 struct StepRow {
   double u_star = 0;
   Eigen::Vector3d w = Eigen::Vector3d::Zero();

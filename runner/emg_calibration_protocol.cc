@@ -42,7 +42,7 @@ constexpr double kIsometricTorqueBudget = 80.0;
 const char* const kJoint[2] = {"hip", "knee"};
 const char* const kModel[3] = {"identified", "deleva", "dempster"};
 
-// Linear envelopes (eq. 23 chain, V) of the emg_* columns of a record sampled at 1 kHz.
+// Linear envelopes (HJ15 eq. 23 chain, V) of the emg_* columns of a record sampled at 1 kHz.
 std::vector<std::vector<double>> Envelopes(const CsvTable& t, const std::string& source) {
   std::vector<std::vector<double>> env;
   for (int c = 0; c < kNumMuscles; ++c) {
@@ -158,7 +158,7 @@ MuscleVec MvcStage(const Scenario& s, const MuscleParams& mp, const RunOptions& 
   return mvc;
 }
 
-// Stage 2, joint j: isometric trial with the exoskeleton holding the pose, eq. (23)-(25) alpha
+// Stage 2, joint j: isometric trial with the exoskeleton holding the pose, HJ15 eq. 23-25 alpha
 // against tau_S minus its relaxed reading, Table 6 R^2 / NRMS per direction; iso_* and alpha_* metrics.
 IsometricResult IsometricStage(const Scenario& s, int j, const MuscleParams& mp, const MuscleVec& mvc,
                                const RunOptions& opt, RunResult& result, TrialTotals& totals) {
@@ -173,7 +173,7 @@ IsometricResult IsometricStage(const Scenario& s, int j, const MuscleParams& mp,
   sub.human.behaviour = j == 0 ? "isometric_hip" : "isometric_knee";
   sub.human.programme_seed = MixSeed(result.seed ^ (0x69736full + j));
   // Levels scaled down (all blocks alike) so that no contraction asks for more than the torque
-  // budget at either joint (eq. 23-24 at the programme's peaks; biarticular RF / ST load both).
+  // budget at either joint (HJ15 eq. 23-24 at the programme's peaks; biarticular RF / ST load both).
   double peak_torque = 0;
   const ContractionProgramme planned = IsometricProgrammeOf(sub.human, 0);
   for (const ContractionBlock& blk : planned.blocks())
@@ -204,7 +204,7 @@ IsometricResult IsometricStage(const Scenario& s, int j, const MuscleParams& mp,
     le.push_back(Normalized(env, k, mvc));
     tau.push_back(tau_S[k] - offset);
   }
-  iso.fit = FitIsometricAlpha(j, le, tau);  // eq. (25)
+  iso.fit = FitIsometricAlpha(j, le, tau);  // HJ15 eq. 25
   // Table 6 per direction: the contractions of that direction (even blocks act along +q).
   for (int dir = 0; dir < 2; ++dir) {
     std::vector<double> y, yhat;
@@ -252,14 +252,14 @@ void IsometricSummary(const IsometricResult iso[2], RunResult& result) {
 }
 
 // Samples of the fitted window of the gait trial: LE per sample, q (rad), qd (rad/s) per joint, and
-// tau_M of eq. (9) (N m) per parameter set (kModel order) and joint.
+// tau_M of HJ15 eq. 9 (N m) per parameter set (kModel order) and joint.
 struct GaitSamples {
   std::vector<MuscleVec> le;
   std::vector<double> q[2], qd[2], tau_M[3][2];
 };
 
 // Stage 3: the exaggerated gait at 2 km/h through the runner into DIR/gait/; returns the fitted
-// window's samples, tau_M = eq. (9) with the identified, De Leva and Dempster parameter sets.
+// window's samples, tau_M = HJ15 eq. 9 with the identified, De Leva and Dempster parameter sets.
 GaitSamples DynamicTrialStage(const Scenario& s, const Subject& subject, const MuscleVec& mvc,
                               const RunOptions& opt, RunResult& result, TrialTotals& totals) {
   const EmgCalibrationSpec& cal = *s.emg_calibration;
@@ -299,7 +299,7 @@ GaitSamples DynamicTrialStage(const Scenario& s, const Subject& subject, const M
       g.qd[j].push_back(qdk[j]);
     }
     for (int mi = 0; mi < 3; ++mi) {
-      // Eq. (9)-(10): tau_M = tau_S - tau_PAS, tau_PAS = -(the actuator torque the relaxed leg needs).
+      // HJ15 eq. 9-10: tau_M = tau_S - tau_PAS, tau_PAS = -(the actuator torque the relaxed leg needs).
       const Eigen::Vector2d tm =
           controller::MuscularTorque(model[mi], qk, qdk, qddk, Eigen::Vector2d(d.tau_hip[k], d.tau_knee[k]));
       for (int j = 0; j < 2; ++j) g.tau_M[mi][j].push_back(tm[j]);
@@ -308,14 +308,14 @@ GaitSamples DynamicTrialStage(const Scenario& s, const Subject& subject, const M
   return g;
 }
 
-// Stage 4: eq. (28) beta, gamma per parameter set and joint on the gait samples (Table 7), into
+// Stage 4: HJ15 eq. 28 beta, gamma per parameter set and joint on the gait samples (Table 7), into
 // fit[model][joint]; dyn_*, r2_margin_*, tau_M_* metrics.
 void DynamicFitStage(const GaitSamples& g, const IsometricResult iso[2], const MuscleParams& mp,
                      BetaGammaFit fit[3][2], RunResult& result) {
   auto& m = result.metrics;
   const std::vector<MuscleVec>& le = g.le;
   for (int j = 0; j < 2; ++j) {
-    std::vector<double> yhat_identified;  // eq. (27) with the identified set's beta, gamma
+    std::vector<double> yhat_identified;  // HJ15 eq. 27 with the identified set's beta, gamma
     for (int mi = 0; mi < 3; ++mi) {
       fit[mi][j] = FitDynamicBetaGamma(j, iso[j].fit.alpha, mp.theta_c[j], le, g.q[j], g.qd[j], g.tau_M[mi][j]);
       const std::string key = std::string(kModel[mi]) + "_" + kJoint[j];

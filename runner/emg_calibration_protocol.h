@@ -6,11 +6,11 @@
 //      paper's MVCs do not go through the torque sensors), EMG through the amplifier -> mvc/*.csv;
 //      MVC = mean of the trial peaks of the 2 Hz linear envelope;
 //   2. isometric trials per joint, the exoskeleton holding the pose (runner, behaviour
-//      isometric_hip / isometric_knee) -> eq. (25) alpha against tau_S minus its relaxed reading,
+//      isometric_hip / isometric_knee) -> HJ15 eq. 25 alpha against tau_S minus its relaxed reading,
 //      R^2 / NRMS per direction (Table 6);
 //   3. with `dynamic`: exaggerated gait at 2 km/h (runner, behaviour exaggerated_gait), tau_M of
-//      eq. (9) from tau_S and the inverse dynamics of three parameter sets (identified = the
-//      subject's Table 4 parameters, De Leva and Dempster from sim/anthropometry), eq. (28) beta,
+//      HJ15 eq. 9 from tau_S and the inverse dynamics of three parameter sets (identified = the
+//      subject's Table 4 parameters, De Leva and Dempster from sim/anthropometry), HJ15 eq. 28 beta,
 //      gamma per joint and model (Table 7).
 #pragma once
 #include "runner/runner.h"

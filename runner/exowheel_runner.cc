@@ -77,6 +77,7 @@ class ExowheelTrial : public CosimDevice {
     plant.Reset({h0_.q, k0_.q}, {h0_.qd, k0_.qd}, 0.0);
     if (!opt.video_path.empty() && trial == 0) {
       RenderOptions ro;
+      if (emg_on_) ro.emg_names = EmgChannelNames();  // the EMG panel's traces by muscle
       video_ = std::make_unique<VideoRenderer>(plant.model(), opt.video_path, ro);
       const double dt = plant.timestep();
       envelope_.assign(5, dsp::SosFilter(dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, 3.0)));

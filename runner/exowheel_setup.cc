@@ -133,7 +133,7 @@ std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams&
     // The exoskeleton imposes the motion (PD 600/400 N m/rad), so the subject's damping term of the
     // tracking law (TrackingGains::kd, sized to stabilise the FREE limb with 55 ms of loop delay) has
     // nothing to stabilise; kept, it adds kd (gain - 1) qd of the pattern: a drive in phase with the
-    // velocity that bursts at the knee's 1-3 Hz swing harmonics (measured: knee R^2 of eq. 28 falls
+    // velocity that bursts at the knee's 1-3 Hz swing harmonics (measured: knee R^2 of HJ15 eq. 28 falls
     // from 0.93 to 0.24 with kd = 15), unlike a person exaggerating a slow 2 km/h gait, whose effort
     // follows the posture. kd = 0: the exaggeration is an amplitude intent, kp (gain - 1)(q* - mean).
     TrackingGains gains;

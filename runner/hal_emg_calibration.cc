@@ -1,4 +1,4 @@
-// EMG calibration exercise of Hayashi eq. (2): see hal_emg_calibration.h.
+// EMG calibration exercise of HKS05 eq. 2: see hal_emg_calibration.h.
 #include "runner/hal_emg_calibration.h"
 
 #include <array>

@@ -39,7 +39,7 @@ struct Mean {
   double get() const { return n ? sum / n : 0.0; }
 };
 
-// Ground truth the on-line RLS (eq. 8-13) can identify. Eq. (4) lets D(t), K(t) vary, and in the
+// Ground truth the on-line RLS (HKS05 eq. 8-13) can identify. HKS05 eq. 4 lets D(t), K(t) vary, and in the
 // twin they vary within every swing (co-contraction only in swing-down, the contraction's velocity /
 // angle factors with the activation). An estimator of CONSTANT D, K over its memory (forgetting
 // factor rho: weight rho^(k-j), ~dt/(1-rho) = 1 s) converges, with the exact input, to the weighted
@@ -149,8 +149,8 @@ class HalTrial : public CosimDevice {
   void EndStep(double t) override {
     const double th = plant_.th(), thd = plant_.thd();
     const hwsim::EmgNode& emg_node = *rig_->emg_node();
-    // Ground truth of Hayashi eq. (4): muscle torque = mu_c - D thd - K th with the contraction's
-    // angle/velocity factors (eq. 26-27 structure, q_c = hanging) moved into D and K.
+    // Ground truth of HKS05 eq. 4: muscle torque = mu_c - D thd - K th with the contraction's
+    // angle/velocity factors (HJ15 eq. 26-27 structure, q_c = hanging) moved into D and K.
     const MuscleVec& a = muscles_->mechanical_activation();
     double sum_alpha_a = 0, mu_ext = 0;
     mu_c_ = 0;
@@ -216,9 +216,9 @@ class HalTrial : public CosimDevice {
     m["strain_up_Nm"] = strain_up_.get();
     m["strain_down_Nm"] = strain_down_.get();
     m["mu_ext_up_Nm"] = mu_up_.get();
-    m["J_tau_m"] = tau_m_.empty() ? 0.0 : MeanAbsMoment(tau_m_, dt);  // Lee & Sankai eq. (12)
-    m["J_e"] = IntegratedMyoelectricity(m_e_, dt);                    // eq. (16)
-    m["J_f"] = IntegratedMyoelectricity(m_f_, dt);                    // eq. (15)
+    m["J_tau_m"] = tau_m_.empty() ? 0.0 : MeanAbsMoment(tau_m_, dt);  // LS05 eq. 12
+    m["J_e"] = IntegratedMyoelectricity(m_e_, dt);                    // LS05 eq. 16
+    m["J_f"] = IntegratedMyoelectricity(m_f_, dt);                    // LS05 eq. 15
     m["th_max"] = th_max_;
     m["th_min"] = th_min_;
     m["tracking_rms_rad"] = std::sqrt(track2_.get());
@@ -239,8 +239,8 @@ class HalTrial : public CosimDevice {
       m["truth_K_timemean"] = K_true_.get();
       m["rls_D_err_pct"] = 100 * std::abs(D_hat_.get() / D_proj_.get() - 1);
       m["rls_K_err_pct"] = 100 * std::abs(K_hat_.get() / K_proj_.get() - 1);
-      // The same error against the stiffness the RLS actually sees, K' = K + G(th) ~ K + Mgl (eq. 8):
-      // K is ~6 % of K' in the seated swing, so this says how close eq. (13) comes on its own scale.
+      // The same error against the stiffness the RLS actually sees, K' = K + G(th) ~ K + Mgl (HKS05 eq. 8):
+      // K is ~6 % of K' in the seated swing, so this says how close HKS05 eq. 13 comes on its own scale.
       m["rls_K_err_pct_of_Kprime"] = 100 * std::abs(K_hat_.get() - K_proj_.get()) / (K_proj_.get() + pp_.mgl());
       m["rls_I_hat"] = loop_->assist().rls().I();
     }
@@ -322,7 +322,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   if (sweep) {
     std::vector<double> J, Je, Jf;
     for (const auto& r : per_run) J.push_back(r.at("J_tau_m")), Je.push_back(r.at("J_e")), Jf.push_back(r.at("J_f"));
-    const std::vector<double> Jme = NormalizeByMax(Je), Jmf = NormalizeByMax(Jf);  // eq. (13)-(18)
+    const std::vector<double> Jme = NormalizeByMax(Je), Jmf = NormalizeByMax(Jf);  // LS05 eq. 13-18
     const size_t best = ArgMin(J);
     for (size_t i = 0; i < values.size(); ++i) {
       m["J_tau_m@" + Fmt(values[i])] = J[i];
@@ -343,7 +343,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
              {"Lee & Sankai eq. (12)-(18) over the virtual viscous coefficient B_v (N m s/rad)"});
     result.files.push_back("sweep.csv");
     // The curves of Lee & Sankai Fig. 9: each criterion over B_v, scaled to its maximum (J_me, J_mf
-    // are eq. 13-18's own normalisation), with the twin's and the paper's optimum marked.
+    // are LS05 eq. 13-18's own normalisation), with the twin's and the paper's optimum marked.
     LineChart chart;
     chart.title = s.name + ": stress criteria over the virtual viscous coefficient (Lee & Sankai Fig. 9)";
     chart.x_label = "virtual viscous coefficient B_v (N m s/rad)";

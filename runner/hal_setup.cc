@@ -35,7 +35,7 @@ controller::HalLoopConfig HalLoopConfigOf(const Scenario& s, const Hal3PlantPara
   c.extensor_channel = kHalExtChannel;
   c.flexor_channel = kHalFlexChannel;
   c.velocity.sample_rate_hz = s.controller.rate_hz;
-  // tau_c (Lee & Sankai; Hayashi eq. 6): identified exoskeleton (eq. 15; the twin hands over its
+  // tau_c (Lee & Sankai; HKS05 eq. 6): identified exoskeleton (HKS05 eq. 15; the twin hands over its
   // true values: identification itself is tested in tests/controller/hal_assist_test.cc). Inertia
   // is not compensated (I_v = I: a causal acceleration estimate from a potentiometer is too noisy).
   c.impedance.actual = {pp.hal_I(), pp.R, pp.hal_mgl(), pp.C};
@@ -47,12 +47,12 @@ controller::HalLoopConfig HalLoopConfigOf(const Scenario& s, const Hal3PlantPara
   a.emg = emg;
   a.tau_max = c.tau_max;
   a.rls.dt = a.dt;
-  a.rls.R = pp.R;        // eq. (15)
-  a.rls.mgl = pp.mgl();  // eq. (14)
+  a.rls.R = pp.R;        // HKS05 eq. 15
+  a.rls.mgl = pp.mgl();  // HKS05 eq. 14
   a.rls.I0 = pp.I();
   a.rls.gravity_in_input = s.hal.rls_gravity_in_input;
   a.rls.known_inertia = s.hal.rls_known_inertia;
-  if (s.hal.rls_friction_in_input) {  // the identified C of tau_c (eq. 15), smoothed as tau_c smooths it
+  if (s.hal.rls_friction_in_input) {  // the identified C of tau_c (HKS05 eq. 15), smoothed as tau_c smooths it
     a.friction_C = c.impedance.actual.C;
     a.friction_eps = c.impedance.coulomb_eps;
   }

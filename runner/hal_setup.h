@@ -9,7 +9,7 @@
 namespace exotwin {
 
 constexpr int kHalExtChannel = 1, kHalFlexChannel = 3;  // EMG channels of HAL's two sensor units: VM, ST
-constexpr double kHalRmsWindow = 0.1;  // s, T of eq. (1), controller and calibration alike
+constexpr double kHalRmsWindow = 0.1;  // s, T of HKS05 eq. 1, controller and calibration alike
 
 // The plant of a preset or population subject (Hal3ParamsForSubject), HAL defaults without one.
 // Throws InputError for a subject.params file (device hal3 takes no MODEL.yaml).
@@ -21,7 +21,7 @@ Hal3PlantParams Hal3PlantParamsOf(const Scenario& s);
 MuscleParams OperatorMuscles(const Scenario& s);
 
 // The HalLoop of the scenario (hal.mode, rate, torque limit 60 N m at most) on plant `pp`, with the
-// eq. (2) EMG calibration `emg` and the virtual viscosity B_v (N m s/rad) of Lee & Sankai's tau_c.
+// HKS05 eq. 2 EMG calibration `emg` and the virtual viscosity B_v (N m s/rad) of Lee & Sankai's tau_c.
 controller::HalLoopConfig HalLoopConfigOf(const Scenario& s, const Hal3PlantParams& pp,
                                           const controller::HalEmgCoefficients& emg, double B_v);
 

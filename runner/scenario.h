@@ -57,8 +57,8 @@ struct HumanSpec {
 };
 
 // Hwang & Jeon 2015 sec. 4.3 EMG-to-torque calibration run as one scenario (EXOwheel with a
-// subject; scenarios/emg_calibration_protocol.h): MVC trials, isometric trials per joint (eq. 25)
-// and, with `dynamic`, the exaggerated gait (eq. 28) evaluated with three parameter sets.
+// subject; scenarios/emg_calibration_protocol.h): MVC trials, isometric trials per joint (HJ15 eq. 25)
+// and, with `dynamic`, the exaggerated gait (HJ15 eq. 28) evaluated with three parameter sets.
 struct EmgCalibrationSpec {
   bool dynamic = true;                  // run the gait trial and fit beta, gamma (Table 7)
   int mvc_trials = 3;                   // MVC trials per muscle (paper: 3)
@@ -69,7 +69,7 @@ struct EmgCalibrationSpec {
   // result metrics are the means over the subjects (worst case for *max*, *min*, safe_state_entered),
   // plus *_sd and per-subject "subject_S<i>.<metric>".
   int subjects = 1;
-  // Samples of the eq. (28) fit and of Table 7's R^2: "active" = the exaggerated strides only
+  // Samples of the HJ15 eq. 28 fit and of Table 7's R^2: "active" = the exaggerated strides only
   // (human.active_from .. the last stride); "trial" = the whole gait trial after the controller's
   // fade-in, so the relaxed lead-in (Fig. 9: relaxed up to 5 s, tau_M ~ 0 with the identified set)
   // is part of the comparison, as Fig. 9-d shows it.
@@ -80,22 +80,22 @@ struct EmgCalibrationSpec {
 // 0.5 Hz knee swing (targets +1.0 / -0.3 rad) with co-contraction cc_down in swing-down.
 struct HalSpec {
   std::string mode = "impedance";   // none | impedance (tau_c only: Hayashi exp. 1, Lee & Sankai) | assist (exp. 2)
-  double alpha_mu = 1.0;            // Hayashi eq. (3)
-  double alpha_zeta = 0.5;          // Hayashi eq. (5)
+  double alpha_mu = 1.0;            // HKS05 eq. 3
+  double alpha_zeta = 0.5;          // HKS05 eq. 5
   double virtual_viscosity = 0.0;   // B_v of tau_c, N m s/rad (Lee & Sankai; 0 = Hayashi's tau_c)
   std::vector<double> sweep_viscosity;  // non-empty: one run per B_v (replaces protocol.trials)
   double swing_freq = 0.5;          // Hz
   double cc_up = 0.0, cc_down = 0.05;  // co-contraction drive (fraction of MVC) outside / in swing-down
   bool cc_synergy = false;          // TrackingGains::cocontraction_synergy (mix within each group)
-  // Eq. (2) calibration exercise (scenarios/hal_emg_calibration.h): contraction levels per direction
+  // HKS05 eq. 2 calibration exercise (scenarios/hal_emg_calibration.h): contraction levels per direction
   // from 2 % to calibration_hi of MVC, and the relaxed rest (s) that gives the baselines.
   int calibration_levels = 4;
   double calibration_hi = 0.12;
   double calibration_rest = 1.5;
   double settle = 4.0;              // s at the start excluded from the metrics
   bool rls_gravity_in_input = true; // ViscoelasticRlsConfig::gravity_in_input
-  bool rls_known_inertia = false;   // ViscoelasticRlsConfig::known_inertia (I from eq. 14)
-  bool rls_friction_in_input = false;  // HalAssistConfig::friction_C = the actuator's C (eq. 15)
+  bool rls_known_inertia = false;   // ViscoelasticRlsConfig::known_inertia (I from HKS05 eq. 14)
+  bool rls_friction_in_input = false;  // HalAssistConfig::friction_C = the actuator's C (HKS05 eq. 15)
   double operator_delay = 0.0;      // s, neural delay of the operator's feedback (TrackingGains::feedback_delay)
 };
 

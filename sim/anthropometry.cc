@@ -15,8 +15,8 @@
 //   table; Table 1's 45.5 % gives +5.4 %). Dempster needs 0.1040 -> Winter's masses (10.0 % thigh,
 //   6.1 % shank + foot), Table 1's 9.7/4.5/1.4 % give -3 %.
 // * Dempster J_H2 (0.0330 W L2^2) is Winter's "Foot leg" row exactly (6.1 % (0.606^2 + 0.416^2)).
-// * J_H1 is not reachable by any rule consistent with eq. (4): the printed J_H1 scales as W L1^2
-//   alone (one-coefficient fit within 0.8 %, i.e. rounding), although eq. (4) puts J_H2 (~ W L2^2)
+// * J_H1 is not reachable by any rule consistent with HJ15 eq. 4: the printed J_H1 scales as W L1^2
+//   alone (one-coefficient fit within 0.8 %, i.e. rounding), although HJ15 eq. 4 puts J_H2 (~ W L2^2)
 //   inside J_H1. The printed values also sit below thigh + m2 L1^2 + J_H2 for both models.
 // Adopted (Table4RuleBsip), mean relative error over S1..S10 against the printed columns
 // (tests/sim/anthropometry_test.cc recomputes these):
@@ -61,7 +61,7 @@ void CheckInput(double W, double L1, double L2) {
   if (!(std::isfinite(L2) && L2 > 0)) bad("L2", L2, "a finite value > 0 m");
 }
 
-// Eq. (11) for one segment of length L.
+// HJ15 eq. 11 for one segment of length L.
 SegmentBsip Eq11(const SegmentFractions& f, double W, double L) {
   SegmentBsip s;
   s.mass = W * f.M / 100.0;
@@ -71,7 +71,7 @@ SegmentBsip Eq11(const SegmentFractions& f, double W, double L) {
   return s;
 }
 
-// Shank (eq. 11 over L2) plus a point mass m_f at distance L2 from the knee, combined into one
+// Shank (HJ15 eq. 11 over L2) plus a point mass m_f at distance L2 from the knee, combined into one
 // rigid segment: mass, CM and Iz about the combined CM (parallel-axis theorem).
 SegmentBsip ShankPlusFootAtL2(const SegmentBsip& shank, double m_f, double L2) {
   SegmentBsip s;

@@ -1,5 +1,5 @@
 // Body-segment inertial parameters (BSIPs) from anthropometric models (Hwang & Jeon 2015, Table 1 and
-// eq. 11) and their lumped form (eq. 4). The lower leg is shank + foot as one rigid segment
+// HJ15 eq. 11) and their lumped form (HJ15 eq. 4). The lower leg is shank + foot as one rigid segment
 // (assumption 4 of the paper).
 #pragma once
 #include "model/lumped_params.h"
@@ -18,13 +18,13 @@ struct LegBsip {
   double L1 = 0;  // m
 };
 
-// Eq. (4): lumped J (kg m^2), X, Y (kg m) of a two-segment leg; m1, m2 carry the segment masses.
+// HJ15 eq. 4: lumped J (kg m^2), X, Y (kg m) of a two-segment leg; m1, m2 carry the segment masses.
 LumpedParams LumpFromBsip(const LegBsip& bsip);
 
 enum class AnthropometricModel { kDeLeva, kDempster, kClauser };
 const char* AnthropometricModelName(AnthropometricModel m);
 
-// Eq. (11) with Table 1 as printed: m_i = W M_i, a_i = L_i CM_i, Iz_i = m_i (L_i RG_i)^2, b_i = 0.
+// HJ15 eq. 11 with Table 1 as printed: m_i = W M_i, a_i = L_i CM_i, Iz_i = m_i (L_i RG_i)^2, b_i = 0.
 // Lower leg = shank (length L2) + foot as a point mass at the distal end (distance L2 from the knee);
 // the foot's own inertia is ignored (its RG refers to the foot length, which Table 2 does not give).
 // weight_kg > 0, L1, L2 > 0 (m). Throws InputError on bad input and for kClauser (Table 1 gives no

@@ -104,7 +104,7 @@ void Hal3Plant::Step(double tau_motor, double tau_muscle) {
   CheckDivergence("step");
   thdd_ = d_->qacc[dof_];
   tau_applied_ = d_->actuator_force[0];
-  // HAL side of eq. (15) solved for the torque it passes on to the leg (the limiter acts on HAL).
+  // HAL side of HKS05 eq. 15 solved for the torque it passes on to the leg (the limiter acts on HAL).
   tau_int_ = tau_applied_ + d_->qfrc_constraint[dof_] - friction - p_.hal_mgl() * std::sin(th0) -
              p_.hal_I() * thdd_;
 }

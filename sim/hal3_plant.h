@@ -1,7 +1,7 @@
 // The MuJoCo plant of the HAL-3 seated knee (mjcf/hal3_knee.xml, Hayashi et al.; Lee & Sankai):
 // one hinge "knee" carrying HAL's shank frame (body hal_shank, with the actuator) and the operator's
 // lower leg (body human_shank, welded to it: no cuff compliance). HAL's convention: th = 0 hanging,
-// positive = extension. The link obeys Hayashi eq. (4) with sigma = 0:
+// positive = extension. The link obeys HKS05 eq. 4 with sigma = 0:
 //   (I_h + I_hu + J_m) thdd + R thd + C sgn(thd) + (mgl_h + mgl_hu) sin th = tau + mu
 // where the actuator's viscous R and Coulomb C (tanh-smoothed) are applied by this class, J_m is
 // the motor's reflected inertia (MuJoCo armature) and mu is the muscle torque given to Step().

@@ -12,7 +12,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Action signs, rows in Muscle order, columns hip / knee (eq. 23-24 in the EXOwheel convention).
+// Action signs, rows in Muscle order, columns hip / knee (HJ15 eq. 23-24 in the EXOwheel convention).
 constexpr int kSign[kNumMuscles][2] = {
     {-1, 0},   // GMAX: hip extensor
     {0, +1},   // VM:   knee extensor (knee extension = +th2)
@@ -45,12 +45,18 @@ const char* MuscleName(Muscle m) {
   return "?";
 }
 
+std::vector<std::string> EmgChannelNames() {
+  std::vector<std::string> names;
+  for (int c = 0; c < kNumMuscles; ++c) names.push_back(MuscleName(MuscleAt(c)));
+  return names;
+}
+
 int ActionSign(Muscle m, int joint) { return kSign[static_cast<int>(m)][joint]; }
 
 MuscleParams PaperMeanMuscleParams() {
   MuscleParams p;
   const auto G = [](Muscle m) { return static_cast<int>(m); };
-  // alpha: eq. (25) text, x100 (per % MVC -> per fraction of MVC, see muscles.h).
+  // alpha: HJ15 eq. 25 text, x100 (per % MVC -> per fraction of MVC, see muscles.h).
   p.alpha(G(Muscle::kRF), 0) = 188;
   p.alpha(G(Muscle::kGMAX), 0) = 108;
   p.alpha(G(Muscle::kST), 0) = 170;
@@ -234,7 +240,7 @@ MuscleVec VoluntaryTracking::Excitation(double t, const Eigen::Vector2d& q_now,
   motion_(t, qs, qds, qdds);
   const Eigen::Vector2d ff = ff_ ? ff_(t, q, qd) : Eigen::Vector2d(0, 0);
   const double cc = cc_ ? cc_(t, q, qd) : 0.0;
-  // Torque map of the muscles at the active joints (rows), eq. (23)-(24) at q = q_c.
+  // Torque map of the muscles at the active joints (rows), HJ15 eq. 23-24 at q = q_c.
   Eigen::Matrix<double, 2, kNumMuscles> A = Eigen::Matrix<double, 2, kNumMuscles>::Zero();
   MuscleVec target = MuscleVec::Zero();
   std::array<bool, kNumMuscles> used{};

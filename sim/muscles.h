@@ -1,11 +1,11 @@
 // Simulated leg muscles of the twin's human (issue 6): GMAX, VM, RF, ST, GAS with the joint actions of
-// Hwang & Jeon 2015 eq. (23)-(24), first-order activation dynamics, an electromechanical delay, the
-// angle/velocity dependence of eq. (26)-(27) with subject-specific ground truth alpha, beta, gamma,
-// and co-contraction raising the joint viscosity D and stiffness K (Hayashi et al. eq. 4).
+// HJ15 eq. 23-24, first-order activation dynamics, an electromechanical delay, the
+// angle/velocity dependence of HJ15 eq. 26-27 with subject-specific ground truth alpha, beta, gamma,
+// and co-contraction raising the joint viscosity D and stiffness K (HKS05 eq. 4).
 //
 // Convention (DESIGN.md): q = (th1 hip, th2 knee); hip flexion positive, knee flexion NEGATIVE.
 // A knee extensor pulls th2 from negative (flexed) towards 0, i.e. in the POSITIVE direction of th2;
-// a knee flexor acts along -th2. Hence the signs of eq. (23)-(24):
+// a knee flexor acts along -th2. Hence the signs of HJ15 eq. 23-24:
 //   hip:  +RF - GMAX - ST          knee: +VM + RF - ST - GAS
 // HAL (Hayashi, Lee & Sankai) measures its knee angle from the hanging lower leg, extension positive:
 // th_HAL = th2 + pi/2 with the hip at 90 deg; torques have the same sign in both conventions.
@@ -40,8 +40,11 @@ const char* MuscleName(Muscle m);
 // Index -> Muscle (0..4). Precondition: 0 <= i < kNumMuscles.
 inline Muscle MuscleAt(int i) { return static_cast<Muscle>(i); }
 
+// The EMG amplifier's channel names, channel c recording muscle MuscleAt(c) ("GMAX", "VM", ...).
+std::vector<std::string> EmgChannelNames();
+
 // Action sign of muscle m at joint j (0 hip, 1 knee) in the EXOwheel convention: +1 acts along +q_j,
-// -1 along -q_j, 0 does not span the joint (eq. 23-24).
+// -1 along -q_j, 0 does not span the joint (HJ15 eq. 23-24).
 int ActionSign(Muscle m, int joint);
 
 // The random stream of the muscle and EMG models: Marsaglia's polar method (core/rng.h). Seed it with
@@ -57,13 +60,13 @@ struct MuscleParams {
   // alpha(m, j): torque (N m) muscle m produces at joint j at full activation, q = q_c, qd = 0;
   // >= 0; zero where the muscle does not span the joint.
   Eigen::Matrix<double, kNumMuscles, 2> alpha = Eigen::Matrix<double, kNumMuscles, 2>::Zero();
-  Eigen::Vector2d beta{0, 0};     // 1/rad, eq. (26)-(27) (per joint)
-  Eigen::Vector2d gamma{0, 0};    // s/rad, eq. (26)-(27)
-  Eigen::Vector2d theta_c{0.0, -1.5707963267948966};  // calibration angles (eq. 27: 0, -90 deg)
+  Eigen::Vector2d beta{0, 0};     // 1/rad, HJ15 eq. 26-27 (per joint)
+  Eigen::Vector2d gamma{0, 0};    // s/rad, HJ15 eq. 26-27
+  Eigen::Vector2d theta_c{0.0, -1.5707963267948966};  // calibration angles (HJ15 eq. 27: 0, -90 deg)
   double tau_act = 0.015;    // activation time constant, s (Zajac 1989: 10-20 ms)
   double tau_deact = 0.050;  // deactivation time constant, s (Zajac 1989: 40-60 ms)
   double emd = 0.040;        // electromechanical delay EMG -> force, s (Cavanagh & Komi 1979: 30-50 ms)
-  // Co-contraction viscoelasticity (Hayashi eq. 4): per joint j
+  // Co-contraction viscoelasticity (HKS05 eq. 4): per joint j
   //   K_j = K0_j + cK_j * S_j,  D_j = D0_j + cD_j * S_j,  S_j = 2 min(E_j, F_j)  (N m)
   // with E_j, F_j the summed alpha * a of the muscles acting along +q_j and -q_j: the co-contracted
   // (balanced) part of flexor + extensor activity. Our choice: a plain flexor + extensor sum makes
@@ -80,28 +83,28 @@ struct MuscleParams {
   Eigen::Vector2d q_rest{0.0, -1.5707963267948966};  // rad; knee: hanging when seated (HAL th = 0)
 };
 
-// Means of Hwang & Jeon 2015 (eq. 25 text and Table 7, "identified" rows), in this API's units.
+// Means of Hwang & Jeon 2015 (HJ15 eq. 25 text and Table 7, "identified" rows), in this API's units.
 MuscleParams PaperMeanMuscleParams();
 
-// Subject-specific ground truth drawn from the paper's means and SDs (alpha: eq. 25 text; beta,
+// Subject-specific ground truth drawn from the paper's means and SDs (alpha: HJ15 eq. 25 text; beta,
 // gamma: Table 7 identified rows), normal, redrawn while below 20 % of the mean (no sign flips).
 // The same seed gives the same bits. Activation time constants and EMD are drawn +-20 % uniform.
 MuscleParams DrawMuscleParams(uint64_t seed);
 
 // Torques of the muscles at one instant (N m, EXOwheel convention).
 struct MuscleTorques {
-  Eigen::Vector2d contraction{0, 0};    // eq. (26)-(27) structure
+  Eigen::Vector2d contraction{0, 0};    // HJ15 eq. 26-27 structure
   Eigen::Vector2d viscoelastic{0, 0};   // -D qd - K (q - q_rest), co-contraction dependent
   Eigen::Vector2d total() const { return contraction + viscoelastic; }
   Eigen::Vector2d K{0, 0}, D{0, 0};     // current stiffness (N m/rad) and viscosity (N m s/rad)
 };
 
-// Eq. (26)-(27) factor for a muscle of action sign s at one joint:
+// HJ15 eq. 26-27 factor for a muscle of action sign s at one joint:
 //   s = +1: 1 + beta (q - q_c) - gamma qd;   s = -1: 1 - beta (q - q_c) + gamma qd;  clamped >= 0
 // (a muscle cannot push; the paper's linear model has no clamp).
 double ForceFactor(int s, double beta, double gamma, double q, double q_c, double qd);
 
-// Contraction torque at joint j of activations a (0..1), eq. (26)-(27) with alpha, beta, gamma.
+// Contraction torque at joint j of activations a (0..1), HJ15 eq. 26-27 with alpha, beta, gamma.
 Eigen::Vector2d ContractionTorque(const MuscleParams& p, const MuscleVec& a, const Eigen::Vector2d& q,
                                   const Eigen::Vector2d& qd);
 
@@ -211,7 +214,7 @@ MuscleVec SolveUnitBoxQp(const Eigen::Matrix<double, kNumMuscles, kNumMuscles>& 
 
 // Voluntary tracking: desired torque tau_d = I_ff qdd* + kp (q* - q) + kd (qd* - qd) + ff(t, q, qd)
 // per active joint, allocated to the muscles spanning the active joints by the box-constrained least
-// squares min |A u - tau_d|^2 + lambda |u - c|^2, 0 <= u <= 1 (A: signed alpha of eq. 23-24; c the
+// squares min |A u - tau_d|^2 + lambda |u - c|^2, 0 <= u <= 1 (A: signed alpha of HJ15 eq. 23-24; c the
 // co-contraction drive c(t, q, qd)), so biarticular RF/ST are balanced by the monoarticular muscles
 // and the antagonists stay near c. The subject does not know its own beta/gamma nor the
 // electromechanical delay; the feedback corrects them.

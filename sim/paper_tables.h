@@ -16,7 +16,7 @@ struct Table2Row {
   double age, height, weight, bmi, L1, L2;
 };
 
-// Table 3: identified exoskeleton lumped parameters (eq. 4) per subject fitting.
+// Table 3: identified exoskeleton lumped parameters (HJ15 eq. 4) per subject fitting.
 struct Table3Row {
   const char* subject;
   LumpedParams exo;

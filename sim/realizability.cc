@@ -5,7 +5,7 @@
 
 namespace exotwin {
 
-// Derivation (eq. 4). Lower leg: a2 = X2/m2, b2 = Y2/m2, Iz2 = J2 - (X2^2 + Y2^2)/m2 > 0
+// Derivation (HJ15 eq. 4). Lower leg: a2 = X2/m2, b2 = Y2/m2, Iz2 = J2 - (X2^2 + Y2^2)/m2 > 0
 //   <=> m2 > (X2^2 + Y2^2)/J2 (needs J2 > 0).
 // Thigh: m1 a1 = X1 - m2 L1, m1 b1 = Y1,
 //   Iz1 = J1 - J2 - m2 L1^2 - ((X1 - m2 L1)^2 + Y1^2)/m1 > 0

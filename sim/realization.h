@@ -1,4 +1,4 @@
-// A physically consistent set of rigid bodies for lumped parameters (eq. 4): the inverse of the
+// A physically consistent set of rigid bodies for lumped parameters (HJ15 eq. 4): the inverse of the
 // lumping, used to write MODEL.yaml values into the MuJoCo model at run time.
 #pragma once
 #include <string>
@@ -17,13 +17,13 @@ struct SystemRealization {
   SegmentInertial thigh, lower_leg;
 };
 
-// Chooses masses and returns segments whose eq. (4) lumping reproduces p exactly, with every mass and
+// Chooses masses and returns segments whose HJ15 eq. 4 lumping reproduces p exactly, with every mass and
 // Iz > 0. Rule (documented in the .cc): m2 = p.m2 if given, else the middle of its feasible window;
 // m1 = p.m1 if given, else 1.25 x its lower bound. Throws InputError naming `what` (e.g. "human")
 // and the violated condition when no consistent realization exists or a given mass is infeasible.
 SystemRealization RealizeLumped(const LumpedParams& p, double L1, const std::string& what);
 
-// Eq. (4) applied to a realization (the forward lumping), for checks.
+// HJ15 eq. 4 applied to a realization (the forward lumping), for checks.
 LumpedParams LumpRealization(const SystemRealization& r, double L1);
 
 }  // namespace exotwin

@@ -16,8 +16,8 @@ struct Subject {
   double weight = 0;  // kg
   double L1 = 0;      // thigh length, m
   double L2 = 0;      // lower-leg length, m
-  LumpedParams human;  // eq. (4), identified (Table 4) or drawn
-  LumpedParams exo;    // eq. (4), exoskeleton adjusted to this subject (Table 3) or drawn
+  LumpedParams human;  // HJ15 eq. 4, identified (Table 4) or drawn
+  LumpedParams exo;    // HJ15 eq. 4, exoskeleton adjusted to this subject (Table 3) or drawn
 };
 
 // "S1".."S10": Table 2 characteristics, Table 4 identified human parameters (ground truth), Table 3

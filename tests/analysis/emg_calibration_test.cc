@@ -1,6 +1,6 @@
 // End-to-end EMG calibration on the twin (issue 6 item 5): ground-truth muscles (sim/muscles.h) ->
 // synthetic EMG (sim/synthetic_emg.h) -> amplifier (gain 1000; the band-pass is in the envelope
-// chain) -> linear envelope / MVC -> eq. (25) alpha and eq. (28) beta, gamma. Compared with the
+// chain) -> linear envelope / MVC -> HJ15 eq. 25 alpha and HJ15 eq. 28 beta, gamma. Compared with the
 // ground truth and with Tables 6-7 (isometric R^2 0.951-0.976, NRMS 5.03-8.12 %; dynamic R^2 0.935
 // hip / 0.924 knee with identified parameters, 0.884 / 0.877 with De Leva, 0.879 / 0.872 Dempster).
 // In-process (no plant: the exoskeleton imposes a sinusoidal gait, the sensor is truth + noise); the
@@ -198,7 +198,7 @@ struct Knobs {
   const char* name = "twin as shipped";
   bool emd = true;            // electromechanical delay (EMG leads force by ~40 ms)
   bool crosstalk = true;      // VM<->RF, ST<->GAS, GMAX<->ST crosstalk
-  bool cocontraction_kd = true;  // co-contraction K, D terms that eq. (26)-(27) lack
+  bool cocontraction_kd = true;  // co-contraction K, D terms that HJ15 eq. 26-27 lack
   bool sensor_noise = true;   // 0.3 N m torque-sensor noise
   bool baseline = true;       // relaxed EMG baseline (electrode noise)
   double envelope_hz = 2.0;   // linear-envelope cut-off (Hz)
@@ -226,7 +226,7 @@ struct DynamicOutcome {
   double r2[3][2];          // [identified, De Leva, Dempster][hip, knee]
   double beta[3][2], gamma[3][2];
   double rms_tau_m[2];      // RMS of the true muscular torque over the active gait, N m
-  double rms_model_err[3][2];  // RMS of the model's error on tau_M (eq. 9), N m
+  double rms_model_err[3][2];  // RMS of the model's error on tau_M (HJ15 eq. 9), N m
 };
 
 // The whole pipeline (MVC, isometric alpha, exaggerated gait, beta/gamma with 3 models) with knobs.
@@ -286,7 +286,7 @@ DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
     o.rms_tau_m[j] = std::sqrt(s2 / (r.tau.size() - k0));
   }
   std::vector<Eigen::Vector2d> tau_S;
-  for (size_t k = 0; k < r.tau.size(); ++k)  // sensor (eq. 8), the identified model as the plant
+  for (size_t k = 0; k < r.tau.size(); ++k)  // sensor (HJ15 eq. 8), the identified model as the plant
     tau_S.push_back(r.tau[k] - ActuatorTorque(models[0], r.q[k], r.qd[k], kin_acc(k * kDt)) +
                     noise_sd * Eigen::Vector2d(sn.Normal(), sn.Normal()));
   for (int mi = 0; mi < 3; ++mi) {
@@ -295,7 +295,7 @@ DynamicOutcome RunPipeline(const Knobs& kb, uint64_t seed) {
       std::vector<double> q, qd, tau_M;
       double e2 = 0;
       for (size_t k = k0; k < r.tau.size(); ++k) {
-        const Eigen::Vector2d tm = tau_S[k] + ActuatorTorque(models[mi], r.q[k], r.qd[k], kin_acc(k * kDt));  // eq. 9
+        const Eigen::Vector2d tm = tau_S[k] + ActuatorTorque(models[mi], r.q[k], r.qd[k], kin_acc(k * kDt));  // HJ15 eq. 9
         e2 += (tm[j] - r.tau[k][j]) * (tm[j] - r.tau[k][j]);
         le.push_back(r.le[k]);
         q.push_back(r.q[k][j]);
@@ -339,7 +339,7 @@ TEST(EmgCalibration, DynamicBetaGammaAndTheTable7Pattern) {
 }
 
 // The error budget of the twin's dynamic R^2 (Table 7): one EMG-side source switched off at a time,
-// next to the torque error the anthropometric models induce on tau_M (eq. 9) over the same gait.
+// next to the torque error the anthropometric models induce on tau_M (HJ15 eq. 9) over the same gait.
 TEST(EmgCalibration, Table7ErrorBudget) {
   std::vector<Knobs> rows(13);
   rows[1].name = "no electromechanical delay"; rows[1].emd = false;

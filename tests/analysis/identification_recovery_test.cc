@@ -98,8 +98,8 @@ TEST(IdentificationRecovery, FiftyRandomSubjects) {
          RecoverAll(subjects, o), false);
 }
 
-// Muscle activity (tau_M != 0) in bursts with loud EMG: without the selection of eq. (13) the human
-// estimate is biased; per-sample eq. (13) removes most of it; with a 50 ms envelope it is gone.
+// Muscle activity (tau_M != 0) in bursts with loud EMG: without the selection of HJ15 eq. 13 the human
+// estimate is biased; per-sample HJ15 eq. 13 removes most of it; with a 50 ms envelope it is gone.
 TEST(IdentificationRecovery, ActiveBurstsRejectedByEq13) {
   LegParams truth = testing::PaperSubjects()[0].truth;
   ProtocolOptions o;

@@ -1,6 +1,6 @@
 // Core of the four-step identification (analysis/identification.h) on closed-form data: the general
 // rows equal the paper's step rows when the held joint is exactly still, exact recovery when it is
-// not, the solver against a QR, configuration classification, EMG selection (eq. 13), bad input.
+// not, the solver against a QR, configuration classification, EMG selection (HJ15 eq. 13), bad input.
 #include "analysis/identification.h"
 
 #include <gtest/gtest.h>
@@ -66,7 +66,7 @@ void ExpectNear(const LumpedParams& a, const LumpedParams& b, double tol) {
 }
 
 // With the held joint exactly at 90 / -90 deg and still, the general rows are the paper's rows
-// (eq. 14-17, A1-A4 with the re-derived signs, model/regressors.h).
+// (HJ15 eq. 14-17, A1-A4 with the re-derived signs, model/regressors.h).
 TEST(Identification, GeneralRowsEqualPaperStepRowsWhenHeld) {
   const LegParams p = S1();
   const LumpedParams& R = p.exo;
@@ -222,7 +222,7 @@ TEST(Identification, MissingConfigurationIsInputError) {
   }
 }
 
-// Eq. (13): without EMG every sample is passive; with EMG a loud burst is rejected, the relaxed
+// HJ15 eq. 13: without EMG every sample is passive; with EMG a loud burst is rejected, the relaxed
 // reference threshold is mean + 3 SD of the first 2 s; a given threshold replaces it.
 TEST(Identification, PassiveSelectionEq13) {
   CsvTable tab;

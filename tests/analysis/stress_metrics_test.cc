@@ -1,4 +1,4 @@
-// Tests of analysis/stress_metrics.h (Lee & Sankai eq. 12-18) on signals with closed-form integrals.
+// Tests of analysis/stress_metrics.h (LS05 eq. 12-18) on signals with closed-form integrals.
 #include "analysis/stress_metrics.h"
 
 #include <cmath>

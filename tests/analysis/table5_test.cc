@@ -1,4 +1,4 @@
-// analysis/table5.h: the RMS error of eq. (22) against the closed form, the three parameter sets of
+// analysis/table5.h: the RMS error of HJ15 eq. 22 against the closed form, the three parameter sets of
 // Table 5, and the side-by-side text.
 #include "analysis/table5.h"
 

@@ -41,7 +41,7 @@ class IdentifyCli : public ::testing::Test {
     std::system(("mkdir -p " + *dir_ + "/exo " + *dir_ + "/human").c_str());
     WriteProtocolCsv(SimulateProtocol(exo, o), *dir_ + "/exo");
     o.seed = 2;
-    o.emg_rms = 0.05;  // relaxed EMG: eq. (13) runs on the amplifier noise
+    o.emg_rms = 0.05;  // relaxed EMG: HJ15 eq. 13 runs on the amplifier noise
     WriteProtocolCsv(SimulateProtocol(Truth(), o), *dir_ + "/human");
     testing::WriteText(*dir_ + "/human/notes.csv", "a,b\n1,2\n");  // not measured data: skipped
   }

@@ -1,4 +1,4 @@
-// Tests of controller/emg_processing.h: the false-activation rate of the eq. (13) threshold on
+// Tests of controller/emg_processing.h: the false-activation rate of the HJ15 eq. 13 threshold on
 // relaxed Gaussian noise (half-normal theory), on the rectified EMG and on its linear envelope.
 #include "controller/emg_processing.h"
 
@@ -29,7 +29,7 @@ TEST(EmgProcessing, ThresholdFalseActivationRateOnRelaxedNoise) {
   }
   const ActivationThreshold th = FitActivationThreshold(chi);
   // chi = |x| of a Gaussian x is half-normal: mean sigma sqrt(2/pi), SD sigma sqrt(1 - 2/pi), so
-  // Z = 2.606 sigma and P(chi > Z) = 2 (1 - Phi(2.606)) = 0.92 %: eq. (13) applied sample by sample to
+  // Z = 2.606 sigma and P(chi > Z) = 2 (1 - Phi(2.606)) = 0.92 %: HJ15 eq. 13 applied sample by sample to
   // the rectified signal flags ~0.9 % of relaxed samples, not the 0.13 % of a Gaussian 3 SD.
   const double rate = ActiveFraction(th, chi_test);
   std::printf("[emg] eq. 13 false-activation rate on rectified relaxed noise: %.3f %%\n", 100 * rate);

@@ -4,7 +4,7 @@
 //  - start-up: zero torque and enable = false until both modules have reported, then enabled;
 //    one command per joint per tick, the heartbeat at 100 Hz (every 10th tick) and at once on a fault;
 //  - the torque for a known (held) state is tau = tau_ff + Kp (q_ref - q) + Kd (qd_ref - qd)
-//    (Hwang & Jeon 2015 sec. 3.1), tau_ff = M qdd + V + G + P of the controller's model (eq. 5-7);
+//    (Hwang & Jeon 2015 sec. 3.1), tau_ff = M qdd + V + G + P of the controller's model (HJ15 eq. 5-7);
 //  - the safety supervisor (controller/safety_supervisor.h) reacts on the tick a condition appears:
 //    a silent module or a stuck counter -> safe torque off (enable = false, 0 N m) after
 //    max_age_s / max_counter_repeats; an out-of-range or invalid reading -> safe damping; latched.

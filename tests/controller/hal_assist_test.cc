@@ -1,6 +1,6 @@
-// Tests of controller/hal_assist.h against a simulated one-link seated knee (Hayashi eq. 4,
+// Tests of controller/hal_assist.h against a simulated one-link seated knee (HKS05 eq. 4,
 // integrated here with a fine-step RK4, independent of the delta-operator model of the estimator):
-// eq. (2) calibration, eq. (14) passive identification, RLS tracking of a ground-truth D(t), K(t),
+// HKS05 eq. 2 calibration, HKS05 eq. 14 passive identification, RLS tracking of a ground-truth D(t), K(t),
 // the adaptive observer, and the assist reducing the operator's effort (the Fig. 9 pattern).
 #include "controller/hal_assist.h"
 
@@ -41,7 +41,7 @@ double Drive(double t) {
 
 TEST(HalAssist, EmgCalibrationEq2) {
   // The exercise: HAL's reference torque is exact, the envelope noisy (a 100 ms RMS of surface EMG
-  // scatters by ~20 %; here 0.06 V on 0.1-1 V). Eq. (2) as fitted: E regressed on the torque and the
+  // scatters by ~20 %; here 0.06 V on 0.1-1 V). HKS05 eq. 2 as fitted: E regressed on the torque and the
   // line inverted, so the noise in E does not flatten the slope; an ordinary least squares of tau on
   // E is low by var(noise) / var(E) (errors in variables), here 0.0036 / 0.071 = 5 %.
   std::mt19937_64 rng(1);
@@ -69,7 +69,7 @@ TEST(HalAssist, EmgCalibrationEq2) {
   EXPECT_THROW(FitEmgToTorque({0.3, 0.1}, {1.0, 5.0}), std::invalid_argument);   // E falls with tau
 }
 
-// The relaxed noise adds in power to the muscle signal, E = sqrt((A e)^2 + E0^2). An eq. (2) line
+// The relaxed noise adds in power to the muscle signal, E = sqrt((A e)^2 + E0^2). An HKS05 eq. 2 line
 // fitted on 2-12 % MVC with the raw E is ~17 % too steep at the seated swing's levels and ~5 N m low
 // near rest; on the noise-corrected envelope the same fit is exact at every level.
 TEST(HalAssist, NoiseCorrectedEnvelopeMakesEq2LinearAtSwingLevels) {
@@ -93,7 +93,7 @@ TEST(HalAssist, NoiseCorrectedEnvelopeMakesEq2LinearAtSwingLevels) {
   EXPECT_GT(worst_raw, 3.0);   // N m: the paper's raw-envelope line misses the swing's torques
   EXPECT_LT(worst_cor, 1e-6);  // N m
   EXPECT_DOUBLE_EQ(NoiseCorrectedEnvelope(0.05, 0.1), 0.0);  // below the baseline: no activity
-  EXPECT_DOUBLE_EQ(NoiseCorrectedEnvelope(0.3, 0.0), 0.3);   // no baseline: eq. (2) as printed
+  EXPECT_DOUBLE_EQ(NoiseCorrectedEnvelope(0.3, 0.0), 0.3);   // no baseline: HKS05 eq. 2 as printed
 }
 
 TEST(HalAssist, PassiveIdentificationEq14) {
@@ -197,7 +197,7 @@ TEST(HalAssist, AdaptiveObserverEstimatesVelocity) {
 }
 
 // Closed loop: an operator tracks the 0.5 Hz swing (HAL targets +1.0 / -0.3 rad) with a feedback
-// law; its EMG envelopes follow its extensor / flexor torques (eq. 2 with known coefficients). With
+// law; its EMG envelopes follow its extensor / flexor torques (HKS05 eq. 2 with known coefficients). With
 // the assist (alpha_mu = 1, alpha_zeta = 0.5, experiment 2) the operator's own extensor torque in
 // swing-up must drop against experiment 1 (no assist), as Fig. 9-A.
 double SwingUpExtensorEffort(bool assist) {
@@ -243,7 +243,7 @@ double RlsStiffnessErrorInASwing(bool known_inertia, double& I_hat) {
   cfg.known_inertia = known_inertia;
   cfg.R = knee.R;
   cfg.mgl = knee.mgl;
-  cfg.I0 = knee.I;  // eq. (14)'s identified inertia (also the prior of the four-parameter RLS)
+  cfg.I0 = knee.I;  // HKS05 eq. 14's identified inertia (also the prior of the four-parameter RLS)
   ViscoelasticRls rls(cfg);
   const double D = 2.0, K = 6.0;
   std::mt19937_64 rng(11);
@@ -273,7 +273,7 @@ TEST(HalAssist, RlsKnownInertiaSeparatesStiffnessFromInertia) {
 }
 
 // Friction in the input (HalAssistConfig::friction_C): HAL's actuator has Coulomb friction C that
-// eq. (4) lacks. The plant here carries C tanh(thd / eps); the operator drives it through EMG (eq. 2
+// HKS05 eq. 4 lacks. The plant here carries C tanh(thd / eps); the operator drives it through EMG (HKS05 eq. 2
 // with known coefficients, no assist: tau = 0). Without the correction the RLS reads the friction
 // as viscosity, by about its least-squares projection C E|thd| / E[thd^2] (a closed form along the
 // run); with it, D^ is the truth.

@@ -4,7 +4,7 @@
 //  - no status yet: enable = false, 0 N m; one command per tick, counter +1 per tick;
 //  - for a held knee (thd = thdd = 0) the torque is the law of the mode: kNone 0 N m (enabled),
 //    kImpedance tau_c = (mgl - mgl_v) sin th (Lee & Sankai, virtual_impedance.h), kAssist
-//    tau = alpha_mu mu^ + tau_c with mu^ of Hayashi eq. (2)-(3) from the RMS envelopes (eq. 1);
+//    tau = alpha_mu mu^ + tau_c with mu^ of HKS05 eq. 2-3 from the RMS envelopes (HKS05 eq. 1);
 //    clamped at +-tau_max;
 //  - a status older than status_timeout: enable = false, 0 N m on that tick; back when it returns;
 //  - EMG counter gaps are counted; error frames and wrong-length frames are skipped.
@@ -138,8 +138,8 @@ TEST(HalLoopBus, CommandClampedAtTauMax) {
   }
 }
 
-// Eq. (6) with alpha_zeta = 0: tau = alpha_mu [(a_e E_e + b_e) - (a_f E_f + b_f)] + tau_c, where the
-// RMS envelope of a constant EMG level is that level once the window (eq. 1) is full.
+// HKS05 eq. 6 with alpha_zeta = 0: tau = alpha_mu [(a_e E_e + b_e) - (a_f E_f + b_f)] + tau_c, where the
+// RMS envelope of a constant EMG level is that level once the window (HKS05 eq. 1) is full.
 TEST(HalLoopBus, AssistModeTorqueIsTheEmgLawPlusCompensation) {
   Rig rig(HalMode::kAssist);
   rig.cfg.assist.dt = kDt;

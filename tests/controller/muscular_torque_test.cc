@@ -1,4 +1,4 @@
-// Tests of controller/muscular_torque.h: eq. (8)-(10) round trip with a known muscular torque on a
+// Tests of controller/muscular_torque.h: HJ15 eq. 8-10 round trip with a known muscular torque on a
 // smooth gait-like motion, relaxed -> ~0 with off-line derivatives, and the effect of a parameter error.
 #include "controller/muscular_torque.h"
 
@@ -28,7 +28,7 @@ struct Motion {
   std::vector<Eigen::Vector2d> q, qd, qdd, tau_M, tau_S;
 };
 
-// Gait-like motion at 0.8 Hz; tau_S by eq. (8): tau_S = tau_M - (M qdd + V + G + P).
+// Gait-like motion at 0.8 Hz; tau_S by HJ15 eq. 8: tau_S = tau_M - (M qdd + V + G + P).
 Motion Make(const LegParams& truth, bool active, double dt = 1e-3, int n = 6000) {
   Motion m;
   const double w = 2 * M_PI * 0.8;
@@ -60,7 +60,7 @@ TEST(MuscularTorque, ExactKinematicsRecoverTheMuscularTorque) {
               0.0, 1e-12);
 }
 
-// Eq. (9) on kinematics derived as off line (dsp::ZeroPhaseDerivatives, 20 Hz): relaxed -> ~0.
+// HJ15 eq. 9 on kinematics derived as off line (dsp::ZeroPhaseDerivatives, 20 Hz): relaxed -> ~0.
 TEST(MuscularTorque, OfflineDerivativesRelaxedGivesNearZero) {
   const LegParams p = Params();
   const Motion m = Make(p, false);

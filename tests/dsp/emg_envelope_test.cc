@@ -129,7 +129,7 @@ TEST(EmgEnvelope, RmsEnvelopeIsEq1) {
   double y = 0;
   for (int k = 0; k < 5000; ++k) y = rms.Step(0.3 * std::sin(2 * M_PI * 50 * k / kFs));
   EXPECT_NEAR(y, 0.3 / std::sqrt(2.0), 1e-9);  // 5 periods in the window: exact
-  // Against a brute-force eq. (1) on a random signal.
+  // Against a brute-force HKS05 eq. 1 on a random signal.
   Gauss g;
   RmsEnvelope r2(kFs, 0.05);
   std::vector<double> x;

@@ -1,5 +1,5 @@
 // MuJoCo's inverse dynamics of models/leg_exowheel.xml, with lumped parameters written in at run time,
-// against the closed form of eq. (5)-(7) + P: the proof that the twin's physics is the paper's model.
+// against the closed form of HJ15 eq. 5-7 + P: the proof that the twin's physics is the paper's model.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>

@@ -27,7 +27,7 @@ LegParams S1() {
 }
 
 // data/reference_dynamics.csv was computed by an independent closed form whose energy balance was
-// checked; it pins eq. (5)-(7) and the Riener mapping to numbers this code did not produce.
+// checked; it pins HJ15 eq. 5-7 and the Riener mapping to numbers this code did not produce.
 TEST(LegDynamics, MatchesReferenceTable) {
   std::ifstream in(std::string(EXOTWIN_SOURCE_DIR) + "/data/reference_dynamics.csv");
   ASSERT_TRUE(in);

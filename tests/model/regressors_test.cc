@@ -38,7 +38,7 @@ TEST(Regressors, FullRegressorTimesParametersEqualsInverseDynamics) {
   }
 }
 
-// Steps 1-4 of the protocol (eq. 14-17 with the signs re-derived): u* = w' phi where u is the
+// Steps 1-4 of the protocol (HJ15 eq. 14-17 with the signs re-derived): u* = w' phi where u is the
 // torque the closed form gives with the other joint held (hip at 90 deg, or knee at -90 deg).
 TEST(Regressors, StepRowsMatchClosedForm) {
   std::mt19937_64 rng(3);
@@ -83,7 +83,7 @@ TEST(Regressors, StepRowsMatchClosedForm) {
   }
 }
 
-// The printed eq. (15) "J1 - 2 L1 Y2" would fail: with Y2 != 0 and y'' != 0 it misses 4 L1 Y2 y''.
+// The printed HJ15 eq. 15 "J1 - 2 L1 Y2" would fail: with Y2 != 0 and y'' != 0 it misses 4 L1 Y2 y''.
 TEST(Regressors, PrintedSignOfEq15IsWrong) {
   LegParams lp;
   lp.L1 = 0.41;

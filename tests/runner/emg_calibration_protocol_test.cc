@@ -137,7 +137,7 @@ TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
   EXPECT_NEAR(fitted(Muscle::kRF, 0), exp(Muscle::kRF, 0), 0.15 * exp(Muscle::kRF, 0));
   EXPECT_NEAR(fitted(Muscle::kVM, 1) + fitted(Muscle::kRF, 1), exp(Muscle::kVM, 1) + exp(Muscle::kRF, 1),
               0.15 * (exp(Muscle::kVM, 1) + exp(Muscle::kRF, 1)));
-  // Co-active synergists (hip extensors GMAX + ST, knee flexors ST + GAS): eq. (25) splits them poorly
+  // Co-active synergists (hip extensors GMAX + ST, knee flexors ST + GAS): HJ15 eq. 25 splits them poorly
   // (the paper's alpha SDs are 25-50 % of the means), their sum within 15 %, each within a factor 3.
   EXPECT_NEAR(fitted(Muscle::kGMAX, 0) + fitted(Muscle::kST, 0), exp(Muscle::kGMAX, 0) + exp(Muscle::kST, 0),
               0.15 * (exp(Muscle::kGMAX, 0) + exp(Muscle::kST, 0)));
@@ -156,7 +156,7 @@ TEST(EmgCalibrationProtocol, IsometricScenarioRecoversAlphaAndMeetsTable6) {
   EXPECT_DOUBLE_EQ(js["isometric"]["hip"]["alpha_Nm"]["RF"].get<double>(), r.metrics.at("alpha_RF_hip"));
 }
 
-// Table 7 on the twin: eq. (9) from the recorded gait with the identified parameters gives the
+// Table 7 on the twin: HJ15 eq. 9 from the recorded gait with the identified parameters gives the
 // plant's true muscular torque (truth.csv) to well under the sensor/derivative error, the De Leva and
 // Dempster sets move it by several N m (Table 5's size), and the shipped checks pass.
 TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
@@ -202,7 +202,7 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
     if (d.t[k] < s.human.active_from) ++n_rest;
   }
   // Fig. 9: relaxed, the identified set's tau_M is near zero (the passive torque removed), while De
-  // Leva's stays off by its Table 5 error, with no EMG there for eq. (28)'s beta to absorb it.
+  // Leva's stays off by its Table 5 error, with no EMG there for HJ15 eq. 28's beta to absorb it.
   ASSERT_GT(n_rest, 1000u);
   for (int j = 0; j < 2; ++j) {
     std::printf("[table7] relaxed lead-in, %s: tau_M RMS %.2f N m (identified), De Leva shift %.2f N m\n",

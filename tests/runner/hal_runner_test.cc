@@ -1,5 +1,5 @@
 // HAL-3 end to end (scenarios/hal_runner.h): Hayashi's experiment 1 against 2 (Fig. 9), the on-line
-// RLS of D and K against the twin's ground truth, and Lee & Sankai's viscous sweep (Fig. 9, eq. 12).
+// RLS of D and K against the twin's ground truth, and Lee & Sankai's viscous sweep (Fig. 9, LS05 eq. 12).
 #include "tests/temp_dir.h"
 #include "runner/hal_runner.h"
 
@@ -59,7 +59,7 @@ TEST(HalRunner, AssistLowersExtensorEmgInSwingUpAsFig9) {
   PrintPhaseTable();
   const auto& a = Exp(1).metrics;
   const auto& b = Exp(2).metrics;
-  // Compared above the relaxed level (~0.1 V, emg_baseline_ext_V): with the noise-corrected eq. (2)
+  // Compared above the relaxed level (~0.1 V, emg_baseline_ext_V): with the noise-corrected HKS05 eq. 2
   // mu^ no longer over-assists at swing levels (the raw-envelope line was ~1.25x too steep there).
   // Seed 1: the envelope drops 0.143 -> 0.123 V (-14 %; -43 % above the baseline).
   const double E0 = b.at("emg_baseline_ext_V");
@@ -75,7 +75,7 @@ TEST(HalRunner, AssistLowersExtensorEmgInSwingUpAsFig9) {
   EXPECT_LT(b.at("emg_flex_up_V"), 0.15);
 }
 
-// RLS (eq. 8-13) against the identifiable ground truth of eq. (4) in the twin: the rho-weighted
+// RLS (HKS05 eq. 8-13) against the identifiable ground truth of HKS05 eq. 4 in the twin: the rho-weighted
 // least-squares D, K of the operator's true viscoelastic torque (co-contraction D, K + the
 // contraction's angle / velocity factors), means over t > settle (scenarios/hal_runner.cc,
 // ProjectedViscoelasticity).
@@ -88,14 +88,14 @@ TEST(HalRunner, RlsViscosityWithin20PercentStiffnessIsAKnownGap) {
   // constant-parameter window can identify: the identifiable K is well below it (seed 1: ~1.0 vs ~3.1).
   EXPECT_LT(m.at("truth_K_mean"), 0.6 * m.at("truth_K_timemean"));
   // Seed 1: D within 7 %, K within 21 % (was +235 % before the exact muscle allocation and the
-  // errors-in-variables fit of eq. 2, see the known gap's header). K is ~6 % of the gravity stiffness
+  // errors-in-variables fit of HKS05 eq. 2, see the known gap's header). K is ~6 % of the gravity stiffness
   // the RLS also sees, so 1 % of gain error in mu^ is ~17 % of K: over seeds 1-5 K^ errs by 20-140 %.
   // Regression bounds, not the acceptance (scenarios/hal3_rls_tracking.yaml meets the 20 % with a
   // co-contracting operator; known_gaps/hal3_rls_exp2_stiffness.yaml holds experiment 2's own
   // condition): D inside the bound, K inside twice it.
   EXPECT_LT(m.at("rls_D_err_pct"), 20.0);
   EXPECT_LT(m.at("rls_K_err_pct"), 40.0);
-  // On the RLS's own scale, K' = K + Mgl (eq. 8): recomputed from the reported means; seed 1 ~1 %.
+  // On the RLS's own scale, K' = K + Mgl (HKS05 eq. 8): recomputed from the reported means; seed 1 ~1 %.
   const double Kp = m.at("truth_K_mean") + m.at("plant_mgl");
   EXPECT_NEAR(m.at("rls_K_err_pct_of_Kprime"), 100 * std::abs(m.at("rls_K_mean") - m.at("truth_K_mean")) / Kp, 1e-9);
   EXPECT_LT(m.at("rls_K_err_pct_of_Kprime"), 5.0);
@@ -105,7 +105,7 @@ TEST(HalRunner, RlsViscosityWithin20PercentStiffnessIsAKnownGap) {
 // operator who co-contracts (10 % of MVC), with the four extensions of the scenario's header. The
 // same run with the paper's four-parameter RLS (I estimated): K' trades with I w^2 in the 0.5 Hz
 // swing and K^ misses by far more (seed 1: ~60 %), while I^ leaves the truth; with the known
-// inertia I^ is eq. (14)'s exactly.
+// inertia I^ is HKS05 eq. 14's exactly.
 TEST(HalRunner, RlsTracksACoContractingOperatorWithin20Percent) {
   const Scenario s = ReadScenario(Shipped("hal3_rls_tracking.yaml"));
   RunOptions o;
@@ -153,7 +153,7 @@ TEST(HalRunner, RejectsNonHalDevice) {
   EXPECT_THROW(RunHalScenario(s, o), InputError);
 }
 
-// Lee & Sankai Fig. 9 / eq. (12): J_tau_m over the virtual viscous coefficient. See the comment in
+// Lee & Sankai Fig. 9 / LS05 eq. 12: J_tau_m over the virtual viscous coefficient. See the comment in
 // scenarios/hal3_viscous_sweep.yaml for where the twin's trough falls and why.
 TEST(HalRunner, ViscousSweepMusculoskeletalMomentCurve) {
   RunOptions o;

@@ -1,4 +1,4 @@
-// Tests of sim/anthropometry.h: eq. (11) by hand, eq. (4) by hand, and how close the adopted rule
+// Tests of sim/anthropometry.h: HJ15 eq. 11 by hand, HJ15 eq. 4 by hand, and how close the adopted rule
 // lands on Table 4's printed anthropometric columns (read from data/, not from sim/paper_tables).
 #include "sim/anthropometry.h"
 

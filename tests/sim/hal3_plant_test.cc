@@ -1,4 +1,4 @@
-// The HAL-3 one-joint plant: pendulum dynamics of eq. (4)/(15), the strain-gauge torque, divergence.
+// The HAL-3 one-joint plant: pendulum dynamics of HKS05 eq. 4/15, the strain-gauge torque, divergence.
 #include "sim/hal3_plant.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// Tests of sim/muscles.h: joint actions (eq. 23-24) checked against the closed-form leg dynamics,
-// activation dynamics and delay, the eq. (26)-(27) structure, co-contraction stiffness, seeded
+// Tests of sim/muscles.h: joint actions (HJ15 eq. 23-24) checked against the closed-form leg dynamics,
+// activation dynamics and delay, the HJ15 eq. 26-27 structure, co-contraction stiffness, seeded
 // ground-truth draws against the paper's means/SDs, and the behaviours in closed loop.
 #include "sim/muscles.h"
 
@@ -32,7 +32,7 @@ LumpedParams Human() {  // DESIGN.md example human block
   return h;
 }
 
-// Forward dynamics of the closed-form leg (eq. 3 with tau_R = 0): M qdd = tau - V - G.
+// Forward dynamics of the closed-form leg (HJ15 eq. 3 with tau_R = 0): M qdd = tau - V - G.
 Eigen::Vector2d Accel(const LumpedParams& p, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                       const Eigen::Vector2d& tau) {
   const double L1 = 0.41, g = 9.81;
@@ -53,6 +53,13 @@ TEST(Muscles, ActionSignsFollowEq23And24) {
   EXPECT_EQ(ActionSign(Muscle::kGAS, 1), -1);
   EXPECT_EQ(ActionSign(Muscle::kGMAX, 1), 0);
   EXPECT_STREQ(MuscleName(Muscle::kGAS), "GAS");
+}
+
+// The amplifier's channels as the video's EMG panel and the logs label them: HJ15's five muscles
+// (gluteus maximus, vastus medialis, rectus femoris, semitendinosus, gastrocnemius) in channel order.
+TEST(Muscles, EmgChannelNamesAreTheMusclesInChannelOrder) {
+  const std::vector<std::string> expected = {"GMAX", "VM", "RF", "ST", "GAS"};
+  EXPECT_EQ(EmgChannelNames(), expected);
 }
 
 // Independent check of the convention with the physics: seated (hip 90 deg, knee -90 deg, at rest),
@@ -79,7 +86,7 @@ TEST(Muscles, ContractionTorqueHasTheStructureOfEq26And27) {
   a << 0.3, 0.2, 0.4, 0.1, 0.25;
   const Eigen::Vector2d q(0.4, -1.1), qd(1.2, -2.0);
   const Eigen::Vector2d tau = ContractionTorque(p, a, q, qd);
-  // Eq. (26): hip = alpha_RF LE_RF {1 + b(q - qc) - g qd} - (alpha_GMAX LE_GMAX + alpha_ST LE_ST) {1 - ...}.
+  // HJ15 eq. 26: hip = alpha_RF LE_RF {1 + b(q - qc) - g qd} - (alpha_GMAX LE_GMAX + alpha_ST LE_ST) {1 - ...}.
   const double dq1 = q[0] - p.theta_c[0], dq2 = q[1] - p.theta_c[1];
   const double hip = p.alpha(I(Muscle::kRF), 0) * a[I(Muscle::kRF)] *
                          (1 + p.beta[0] * dq1 - p.gamma[0] * qd[0]) -
@@ -153,7 +160,7 @@ TEST(Muscles, DrawsAreSeededAndFollowThePaperStatistics) {
   EXPECT_EQ(a.alpha, b.alpha);
   EXPECT_EQ(a.beta, b.beta);
   EXPECT_NE(a.alpha, c.alpha);
-  // Population statistics over many subjects: means and SDs of eq. (25) text and Table 7.
+  // Population statistics over many subjects: means and SDs of HJ15 eq. 25 text and Table 7.
   const int n = 4000;
   double s = 0, s2 = 0, sb = 0, sg = 0;
   for (int i = 0; i < n; ++i) {
@@ -190,7 +197,7 @@ TEST(Muscles, IsometricAndMvcProgrammes) {
   EXPECT_NEAR(mvc.duration(), 1.0 + 3 * 4.0 + 2 * 2.0, 1e-12);
 }
 
-// One-link seated knee in HAL's convention (Hayashi eq. 4 without D, K):
+// One-link seated knee in HAL's convention (HKS05 eq. 4 without D, K):
 // I thdd + R thd + Mgl sin th = tau_muscle. th_HAL = th2 + pi/2.
 struct OneLinkKnee {
   double I = 0.35, R = 0.3, mgl = 10.0;
@@ -371,7 +378,7 @@ TEST(Muscles, BoxQpFindsTheExactMinimiser) {
 // (the min-norm solution): VM / RF = alpha_VM / alpha_RF for extension, ST / GAS for flexion, as in
 // HAL's calibration exercise (scenarios/hal_emg_calibration.cc). 40 sweeps of coordinate descent,
 // the solver before, left RF at 0.75 of that share in the seated swing: the swing then used another
-// VM / RF mix than the calibration, and eq. (2) read the extensor torque ~7 % high.
+// VM / RF mix than the calibration, and HKS05 eq. 2 read the extensor torque ~7 % high.
 TEST(Muscles, KneeDemandIsSharedBySynergistsInProportionToAlpha) {
   const MuscleParams p = DrawMuscleParams(3);
   TrackingGains g;
@@ -397,7 +404,7 @@ TEST(Muscles, KneeDemandIsSharedBySynergistsInProportionToAlpha) {
 
 // Co-contraction mix (TrackingGains::cocontraction_synergy): with a knee demand AND co-contraction c,
 // the synergy mix keeps every group alpha-proportional (target c alpha / max alpha plus the min-norm
-// correction, also alpha-proportional), the mix eq. (2) was calibrated with; the uniform mix (every
+// correction, also alpha-proportional), the mix HKS05 eq. 2 was calibrated with; the uniform mix (every
 // muscle at c) does not, which is what shifts a one-electrode-per-group mu^ under co-contraction.
 TEST(Muscles, CoContractionSynergyKeepsTheCalibrationMix) {
   const MuscleParams p = DrawMuscleParams(2);

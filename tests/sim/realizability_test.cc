@@ -38,7 +38,7 @@ void ExpectConstructive(const LumpedParams& p, double L1) {
   EXPECT_GT(m1, 0);
   EXPECT_GT(Iz2, 0);
   EXPECT_GT(Iz1, 0);
-  // eq. (4)
+  // HJ15 eq. 4
   EXPECT_NEAR(Iz1 + Iz2 + m1 * (a1 * a1 + b1 * b1) + m2 * (a2 * a2 + b2 * b2) + m2 * L1 * L1, p.J1,
               1e-9);
   EXPECT_NEAR(m1 * a1 + m2 * L1, p.X1, 1e-9);
@@ -109,7 +109,7 @@ TEST(Realizability, RejectsBadNumbersAndLength) {
 }
 
 TEST(Realizability, EveryPhysicalLegIsRealizable) {
-  // Random positive masses and inertias, any offsets: eq. (4) of them must be accepted.
+  // Random positive masses and inertias, any offsets: HJ15 eq. 4 of them must be accepted.
   std::mt19937_64 g(5);
   auto u = [&g](double lo, double hi) { return lo + (hi - lo) * ((g() >> 11) * 0x1.0p-53); };
   for (int i = 0; i < 1000; ++i) {

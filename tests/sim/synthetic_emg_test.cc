@@ -5,7 +5,7 @@
 //   within 20-450 Hz (De Luca 1997, the band of the Bagnoli amplifier used by Hwang & Jeon);
 // - amplitude distribution close to Gaussian at a constant contraction (Clancy & Hogan 1999, IEEE
 //   TBME 46:730, find the PDF between Gaussian and Laplacian, nearer Gaussian at higher levels);
-// - RMS amplitude proportional to activation (the linear EMG-force assumption of eq. 23-24);
+// - RMS amplitude proportional to activation (the linear EMG-force assumption of HJ15 eq. 23-24);
 // - crosstalk, mains, seeding, electromechanical delay.
 #include "sim/synthetic_emg.h"
 
