@@ -265,7 +265,7 @@ std::vector<Case> Cases() {
       {"ScenarioUnknownFault", Kind::kScenario, S + "faults:\n  - {type: meltdown, at: 0.01}\n",
        "s.yaml: faults[0].type", "is not one of"},
       {"ScenarioUnknownPreset", Kind::kScenario, std::string(kScenarioHead) + "subject: {preset: S99}\n" +
-       kScenarioProtocol, "s.yaml: subject.preset: unknown preset 'S99' (line 3)", "expected one of: S1, S2"},
+       kScenarioProtocol, "s.yaml: subject.preset: 'S99' is not one of: S1, S10, S2", "(line 3)"},
       {"ScenarioMissingParamsFile", Kind::kScenario,
        std::string(kScenarioHead) + "subject: {params: /nonexistent/model.yaml}\n" + kScenarioProtocol,
        "/nonexistent/model.yaml", "cannot open model file"},
