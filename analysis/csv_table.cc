@@ -6,9 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <set>
-#include <sstream>
 
 #include "core/error.h"
 #include "core/file_text.h"
@@ -23,19 +22,204 @@ int CsvTable::Find(const std::string& name) const {
 
 namespace {
 
-std::string Trim(const std::string& s) {
-  size_t b = 0, e = s.size();
-  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
-  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
-  return s.substr(b, e - b);
-}
+bool Blank(char c) { return c == ' ' || c == '\t'; }
 
-std::string Where(const std::string& path, int line) { return path + ":" + std::to_string(line) + ": "; }
+// The whole file. Throws InputError for a folder, a file that cannot be read or holds a NUL byte.
+std::string ReadCsvText(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a CSV file");
+  return ReadTextFile(path, "", "a text CSV file");
+}
 
 }  // namespace
 
+CsvReader::CsvReader(const std::string& text, std::string source)
+    : next_(text.data()), end_(text.data() + text.size()), source_(std::move(source)) {
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) next_ += 3;  // UTF-8 byte-order mark
+}
+
+std::string CsvReader::Where() const { return source_ + ":" + std::to_string(line_) + ": "; }
+
+bool CsvReader::NextLine() {
+  while (next_ < end_) {
+    const char* nl = static_cast<const char*>(std::memchr(next_, '\n', end_ - next_));
+    line_begin_ = next_;
+    line_end_ = nl ? nl : end_;
+    next_ = nl ? nl + 1 : end_;
+    ++line_;
+    if (line_end_ > line_begin_ && line_end_[-1] == '\r') --line_end_;  // CRLF
+    while (line_begin_ < line_end_ && Blank(*line_begin_)) ++line_begin_;
+    while (line_end_ > line_begin_ && Blank(line_end_[-1])) --line_end_;
+    if (line_begin_ < line_end_ && *line_begin_ != '#') return true;
+  }
+  return false;
+}
+
+void CsvReader::Split() {
+  fields_.clear();
+  unquoted_.clear();
+  // Unquoted text is no longer than the line, plus a NUL per field: the views never move.
+  unquoted_.reserve(2 * static_cast<size_t>(line_end_ - line_begin_) + 2);
+  const char* s = line_begin_;
+  while (true) {
+    while (s < line_end_ && Blank(*s)) ++s;
+    if (s < line_end_ && *s == '"') {
+      const size_t start = unquoted_.size();
+      for (++s;; ++s) {
+        if (s >= line_end_)
+          throw InputError(Where() + "field " + std::to_string(fields_.size() + 1) +
+                           ": a quoted field is not closed on its line, expected a closing '\"' (a field "
+                           "may not span lines)");
+        if (*s != '"') {
+          unquoted_ += *s;
+        } else if (s + 1 < line_end_ && s[1] == '"') {
+          unquoted_ += '"';
+          ++s;
+        } else {
+          ++s;
+          break;
+        }
+      }
+      fields_.emplace_back(unquoted_.data() + start, unquoted_.size() - start);
+      unquoted_ += '\0';
+      while (s < line_end_ && Blank(*s)) ++s;
+      if (s < line_end_ && *s != ',')
+        throw InputError(Where() + "field " + std::to_string(fields_.size()) +
+                         ": text after the closing quote, expected ',' or the end of the line");
+    } else {
+      const char* b = s;
+      while (s < line_end_ && *s != ',') {
+        if (*s == '"')
+          throw InputError(Where() + "field " + std::to_string(fields_.size() + 1) +
+                           ": a '\"' inside an unquoted field, expected the whole field quoted (\"...\") "
+                           "with inner quotes doubled");
+        ++s;
+      }
+      const char* e = s;
+      while (e > b && Blank(e[-1])) --e;
+      fields_.emplace_back(b, static_cast<size_t>(e - b));
+    }
+    if (s >= line_end_) break;
+    ++s;  // ','
+  }
+}
+
+bool CsvReader::ReadHeader() {
+  if (!NextLine()) return false;
+  if (std::memchr(line_begin_, '\r', static_cast<size_t>(line_end_ - line_begin_)))
+    throw InputError(Where() + "a carriage return inside the header line (old Mac line ends?), expected lines "
+                     "ending with LF or CRLF");
+  Split();
+  if (fields_.size() == 1) {
+    const std::string_view h = fields_[0];
+    const char* sep = h.find(';') != std::string_view::npos ? "';'" : h.find('\t') != h.npos ? "tabs" : nullptr;
+    if (sep)
+      throw InputError(Where() + "the header is separated by " + sep +
+                       ", expected ',' between fields and '.' as the decimal mark (a spreadsheet in a locale "
+                       "with decimal commas writes ';' and '1,5'): export the file again as CSV with ',' "
+                       "as the field separator and '.' as the decimal separator");
+  }
+  trailing_empty_column_ = fields_.size() > 1 && line_end_[-1] == ',';
+  if (trailing_empty_column_) fields_.pop_back();
+  names_.clear();
+  for (std::string_view f : fields_) {
+    if (f.empty()) throw InputError(Where() + "empty column name in the header row");
+    if (std::find(names_.begin(), names_.end(), f) != names_.end())
+      throw InputError(Where() + "duplicated column '" + std::string(f) + "' in the header");
+    names_.emplace_back(f);
+  }
+  return true;
+}
+
+void CsvReader::CheckFieldCount(size_t found, bool last_empty) const {
+  const size_t n = names_.size();
+  if (trailing_empty_column_) {
+    if (found == n + 1 && last_empty) return;
+    if (found == n + 1)
+      throw InputError(Where() + "expected an empty last field (the header ends with ','), found a value");
+    throw InputError(Where() + "expected " + std::to_string(n) + " fields and a trailing ',' (as in the header), found " +
+                     std::to_string(found) + " fields");
+  }
+  if (found == n) return;
+  if (found == n + 1 && last_empty)
+    throw InputError(Where() + "row ends with ',' (an empty last field), expected " + std::to_string(n) +
+                     " fields as in the header");
+  throw InputError(Where() + "expected " + std::to_string(n) + " fields (as in the header), found " +
+                   std::to_string(found));
+}
+
+bool CsvReader::NextRow() {
+  if (!NextLine()) return false;
+  Split();
+  CheckFieldCount(fields_.size(), fields_.back().empty());
+  return true;
+}
+
+namespace {
+
+// Reads a number at the start of [b, e) as strtod does in the "C" locale; returns the end of the
+// number (b if there is none). Precondition: the byte at e cannot continue a number. std::from_chars
+// (correctly rounded, as strtod) reads the common forms; what it leaves (a leading '+', hex, a value
+// beyond the double range) goes to strtod.
+const char* ScanNumber(const char* b, const char* e, double* v) {
+  const auto r = std::from_chars(b, e, *v);
+  if (r.ec == std::errc() && (r.ptr == e || *r.ptr == ',' || Blank(*r.ptr))) return r.ptr;
+  // strtod would skip leading white space: a number starts with a printable character.
+  if (b == e || static_cast<unsigned char>(*b) <= ' ') return b;
+  char* q = nullptr;
+  const double x = std::strtod(b, &q);
+  if (q != b) *v = x;
+  return q;
+}
+
+}  // namespace
+
+bool CsvReader::ParseNumber(std::string_view f, double* v) {
+  const char* e = f.data() + f.size();
+  return !f.empty() && ScanNumber(f.data(), e, v) == e;
+}
+
+void CsvReader::NotANumber(size_t column, std::string_view text) const {
+  throw InputError(Where() + "column '" + names_[column] + "': '" + std::string(text) + "' is not a number");
+}
+
+bool CsvReader::NumbersFromFields(double* values) {
+  Split();
+  CheckFieldCount(fields_.size(), fields_.back().empty());
+  for (size_t i = 0; i < names_.size(); ++i)
+    if (!ParseNumber(fields_[i], &values[i])) NotANumber(i, fields_[i]);
+  return true;
+}
+
+bool CsvReader::NextNumbers(double* values) {
+  if (!NextLine()) return false;
+  const size_t length = static_cast<size_t>(line_end_ - line_begin_);
+  if (std::memchr(line_begin_, '"', length)) return NumbersFromFields(values);
+  // Unquoted: numbers read straight from the line (a field ends at ',', a blank, '\r', '\n' or the text's
+  // NUL, none of which continues a number). Anything unexpected goes to the field-by-field path,
+  // which names the column or the field count.
+  const size_t n = names_.size();
+  const char* s = line_begin_;
+  for (size_t i = 0; i < n; ++i) {
+    while (s < line_end_ && Blank(*s)) ++s;
+    double x = 0;
+    const char* q = ScanNumber(s, line_end_, &x);
+    const char* after = q;
+    while (after < line_end_ && Blank(*after)) ++after;
+    const bool last = i + 1 == n;
+    if (q == s || (after < line_end_ && *after != ',') || (!last && after >= line_end_))
+      return NumbersFromFields(values);
+    values[i] = x;
+    s = after;
+    if (!last) ++s;  // ','
+  }
+  // Line end, or the trailing ',' of a header that ends with one.
+  const bool complete = trailing_empty_column_ ? s + 1 == line_end_ : s == line_end_;
+  return complete ? true : NumbersFromFields(values);
+}
+
 CsvTable ReadCsv(const std::string& path) {
-  std::string content = ReadTextFile(path, "", "a text CSV file");
+  std::string content = ReadCsvText(path);
   if (content.empty()) throw InputError(path + ": file is empty, expected a CSV header row");
 
   CsvTable t;
@@ -46,67 +230,15 @@ CsvTable ReadCsv(const std::string& path) {
                  "(the run was killed while writing it)\n", path.c_str(), t.dropped_cut_line);
     content.resize(cut);
   }
-  bool have_header = false;
-  size_t pos = 0;
-  int line_no = 0;
-  std::vector<double> row;
-  while (pos < content.size()) {
-    size_t end = content.find('\n', pos);
-    if (end == std::string::npos) end = content.size();
-    const std::string line = content.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    const std::string trimmed = Trim(line);
-    if (trimmed.empty() || trimmed[0] == '#') continue;
-    if (!have_header) {
-      std::stringstream ss(trimmed);
-      std::string name;
-      std::set<std::string> seen;
-      while (std::getline(ss, name, ',')) {
-        name = Trim(name);
-        if (name.empty())
-          throw InputError(Where(path, line_no) + "empty column name in the header row");
-        if (!seen.insert(name).second)
-          throw InputError(Where(path, line_no) + "duplicated column '" + name + "' in the header");
-        t.names.push_back(name);
-      }
-      if (trimmed.back() == ',') throw InputError(Where(path, line_no) + "header ends with ','");
-      t.columns.assign(t.names.size(), {});
-      have_header = true;
-      continue;
-    }
-    row.clear();
-    const char* p = trimmed.c_str();
-    const char* const stop = p + trimmed.size();
-    size_t field = 0;
-    while (true) {
-      while (p < stop && (*p == ' ' || *p == '\t')) ++p;
-      char* q = nullptr;
-      errno = 0;
-      const double v = std::strtod(p, &q);
-      const char* after = q;
-      while (after < stop && (*after == ' ' || *after == '\t')) ++after;
-      if (q == p || (after < stop && *after != ',')) {
-        const char* fe = p;
-        while (fe < stop && *fe != ',') ++fe;
-        const std::string col = field < t.names.size() ? t.names[field] : "#" + std::to_string(field + 1);
-        throw InputError(Where(path, line_no) + "column '" + col + "': '" + std::string(p, fe) +
-                         "' is not a number");
-      }
-      row.push_back(v);
-      ++field;
-      p = after;
-      if (p >= stop) break;
-      ++p;  // skip ','
-      if (p >= stop) throw InputError(Where(path, line_no) + "row ends with ','");
-    }
-    if (row.size() != t.names.size())
-      throw InputError(Where(path, line_no) + "expected " + std::to_string(t.names.size()) +
-                       " fields (as in the header), found " + std::to_string(row.size()));
+  CsvReader in(content, path);
+  if (!in.ReadHeader()) throw InputError(path + ": no header row (only comments or blank lines)");
+  t.names = in.names();
+  t.columns.assign(t.names.size(), {});
+  std::vector<double> row(t.names.size());
+  while (in.NextNumbers(row.data())) {
     for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
-    t.line_of_row.push_back(line_no);
+    t.line_of_row.push_back(in.line());
   }
-  if (!have_header) throw InputError(path + ": no header row (only comments or blank lines)");
   return t;
 }
 

@@ -1,14 +1,73 @@
-// Numeric CSV tables: a header row of column names, then one row of numbers per sample. Lines
-// starting with '#' are comments. Used for the measured-data CSV of DESIGN.md and every CSV exotwin
-// writes.
+// CSV files as exotwin reads them (DESIGN.md "Measured-data CSV", "What the CSV reader accepts"): a
+// header row of column names, then one record per line. Every CSV exotwin reads goes through
+// CsvReader: measured data and column maps' inputs (ReadCsv), sweep tables (runner/sweep_table.cc).
 #pragma once
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace exotwin {
 
 // First comment line of every streamed CSV: every complete row of such a file ends with '\n'.
 inline constexpr const char* kStreamMarker = "# exotwin stream: complete rows end with a newline";
+
+// Splits a CSV text into a header and records. The dialect (RFC 4180 without line breaks in fields):
+// - a UTF-8 byte-order mark at the start is skipped; lines end with LF or CRLF;
+// - blank lines and lines whose first non-blank character is '#' are skipped (comments);
+// - fields are separated by ','; spaces and tabs around a field are ignored;
+// - a field may be quoted ("..."): inside, ',' is a character and "" is one '"'; a quoted field ends
+//   on its line; a '"' inside an unquoted field is an error;
+// - the first record is the header: non-empty, distinct names; a header ending with ',' declares an
+//   empty last column: every row must end with ',' too, and the column is dropped;
+// - every row has as many fields as the header;
+// - a number is what strtod reads in the "C" locale over the whole field ("1.5", "-2e-3", "nan",
+//   "inf", "0x1p-3"); a quoted field holding a number is that number.
+// A header separated by ';' or by tabs is rejected with a message naming the separator and the fix.
+// Errors are InputError naming "source:line:".
+class CsvReader {
+ public:
+  // `text` is the whole file and must outlive the reader; `source` names it in messages.
+  CsvReader(const std::string& text, std::string source);
+
+  // Reads the header row. False if the text holds no record (only comments or blank lines).
+  bool ReadHeader();
+  const std::vector<std::string>& names() const { return names_; }
+
+  // Advances to the next row and splits it; false at the end of the text. Then field(i), i <
+  // names().size(), is the text of field i (quotes removed).
+  bool NextRow();
+  std::string_view field(size_t i) const { return fields_[i]; }
+  // Field i of the current row (after NextRow) as a number; false if it is not one.
+  bool Number(size_t i, double* v) const { return ParseNumber(fields_[i], v); }
+
+  // Advances to the next row and parses every field as a number into values[0 .. names().size());
+  // false at the end of the text. Throws InputError naming the column for a field that is not a
+  // number. The fast path of numeric tables: an unquoted row is parsed in place.
+  bool NextNumbers(double* values);
+
+  int line() const { return line_; }  // 1-based line of the current record
+  std::string Where() const;          // "source:line: "
+
+ private:
+  bool NextLine();
+  void Split();
+  void CheckFieldCount(size_t found, bool last_empty) const;
+  bool NumbersFromFields(double* values);  // NextNumbers on the split line
+  [[noreturn]] void NotANumber(size_t column, std::string_view text) const;
+  // True if the whole of `f` is a number (the rule above). Precondition: the byte after `f` cannot
+  // continue a number (the reader's fields are followed by ',', a blank, a line end or a NUL).
+  static bool ParseNumber(std::string_view f, double* v);
+
+  const char* next_;  // start of the next line
+  const char* end_;   // end of the text
+  const char *line_begin_ = nullptr, *line_end_ = nullptr;  // current line, without its line end
+  int line_ = 0;
+  std::string source_;
+  std::vector<std::string> names_;
+  bool trailing_empty_column_ = false;
+  std::vector<std::string_view> fields_;
+  std::string unquoted_;  // quoted fields' text, each followed by a NUL; reserved per line, never reallocated
+};
 
 struct CsvTable {
   std::vector<std::string> names;
@@ -21,11 +80,12 @@ struct CsvTable {
   int Find(const std::string& name) const;
 };
 
-// Parses a CSV file. Throws InputError naming the file and line for: unreadable or empty file, no
-// header, duplicated or empty column names, a row with the wrong number of fields, a field that is
-// not a number. NaN/inf are parsed (callers decide whether they are allowed). In a file that starts
-// with kStreamMarker, an unterminated last line is a row cut by a killed run: it is dropped, with a
-// warning on stderr, and its line number kept in dropped_cut_line.
+// Parses a numeric CSV file with CsvReader. Throws InputError naming the file and line for: a folder,
+// an unreadable, empty or binary (NUL byte) file, no header, duplicated or empty column
+// names, a row with the wrong number of fields, a field that is not a number. NaN/inf are parsed
+// (callers decide whether they are allowed). In a file that starts with kStreamMarker, an
+// unterminated last line is a row cut by a killed run: it is dropped, with a warning on stderr, and
+// its line number kept in dropped_cut_line.
 CsvTable ReadCsv(const std::string& path);
 
 // Writes a table with full double precision (%.17g), header first. `comments` go first as '# ' lines.

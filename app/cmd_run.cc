@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "app/commands.h"
+#include "runner/out_folder_lock.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
 
@@ -36,6 +37,7 @@ CommandRunner RegisterRun(CLI::App& app) {
   return [sub, o, seed]() -> int {
     if (!*sub) return -1;
     const Scenario s = ReadScenario(o->scenario);
+    const OutFolderLock lock(o->out);
     RunOptions opt;
     opt.out_dir = o->out;
     if (*seed) opt.seed = o->seed;
@@ -60,6 +62,7 @@ CommandRunner RegisterRender(CLI::App& app) {
   return [sub, o]() -> int {
     if (!*sub) return -1;
     const Scenario s = ReadScenario(o->scenario);
+    const OutFolderLock lock(o->out);
     RunOptions opt;
     opt.out_dir = o->out;
     opt.video_path = o->video;

@@ -37,21 +37,6 @@ std::string Quote(const std::string& s) {
   return q + "\"";
 }
 
-// Splits one CSV line (RFC 4180 quotes, no embedded newlines).
-std::vector<std::string> SplitLine(const std::string& line) {
-  std::vector<std::string> f(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') f.back() += '"', ++i;
-      else if (c == '"') quoted = false;
-      else f.back() += c;
-    } else if (c == '"') quoted = true;
-    else if (c == ',') f.emplace_back();
-    else f.back() += c;
-  }
-  return f;
 }
 
 }  // namespace
@@ -87,56 +72,39 @@ std::string SweepCsv(const std::vector<SweepRow>& rows) {
 }
 
 std::vector<SweepRow> ParseSweepCsv(const std::string& text, const std::string& source) {
+  CsvReader in(text, source);
+  if (!in.ReadHeader()) throw InputError(source + ": empty, expected a sweep CSV with a header row");
+  const std::vector<std::string>& header = in.names();
+  for (size_t i = 0; i < std::size(kFixed); ++i)
+    if (header.size() <= i || header[i] != kFixed[i])
+      throw InputError(in.Where() + "expected the sweep header starting scenario,subject,subject_seed,status,checks_failed");
   std::vector<SweepRow> rows;
-  std::istringstream in(text);
-  std::string line;
-  std::vector<std::string> header;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    const auto f = SplitLine(line);
-    auto fail = [&](const std::string& what) {
-      throw InputError(source + ":" + std::to_string(lineno) + ": " + what);
-    };
-    if (header.empty()) {
-      header = f;
-      for (size_t i = 0; i < std::size(kFixed); ++i)
-        if (header.size() <= i || header[i] != kFixed[i])
-          fail(std::string("expected the sweep header starting scenario,subject,subject_seed,status,checks_failed"));
-      continue;
-    }
-    if (f.size() != header.size())
-      fail(std::to_string(f.size()) + " fields, expected " + std::to_string(header.size()) + " as in the header");
+  while (in.NextRow()) {
+    auto fail = [&](const std::string& what) { throw InputError(in.Where() + what); };
     SweepRow r;
-    r.scenario = f[0];
+    r.scenario = in.field(0);
     try {
+      const std::string subject(in.field(1)), seed(in.field(2)), checks(in.field(4));
       size_t pos = 0;
-      r.subject = std::stoi(f[1], &pos);
-      if (pos != f[1].size() || r.subject < 0) throw std::invalid_argument("");
-      r.subject_seed = std::stoull(f[2], &pos);
-      if (pos != f[2].size()) throw std::invalid_argument("");
-      r.checks_failed = std::stoi(f[4], &pos);
-      if (pos != f[4].size()) throw std::invalid_argument("");
+      r.subject = std::stoi(subject, &pos);
+      if (pos != subject.size() || r.subject < 0) throw std::invalid_argument("");
+      r.subject_seed = std::stoull(seed, &pos);
+      if (pos != seed.size()) throw std::invalid_argument("");
+      r.checks_failed = std::stoi(checks, &pos);
+      if (pos != checks.size()) throw std::invalid_argument("");
     } catch (const std::exception&) {
       fail("subject, subject_seed and checks_failed: expected non-negative integers");
     }
-    r.status = f[3];
-    for (size_t i = std::size(kFixed); i < f.size(); ++i) {
-      if (f[i].empty()) continue;
+    r.status = in.field(3);
+    for (size_t i = std::size(kFixed); i < header.size(); ++i) {
+      if (in.field(i).empty()) continue;  // no value of this metric in this run
       double v = 0;
-      if (f[i] == "nan") v = std::nan("");
-      else {
-        auto res = std::from_chars(f[i].data(), f[i].data() + f[i].size(), v);
-        if (res.ec != std::errc() || res.ptr != f[i].data() + f[i].size())
-          fail("column " + header[i] + ": '" + f[i] + "', expected a number");
-      }
+      if (!in.Number(i, &v))
+        fail("column " + header[i] + ": '" + std::string(in.field(i)) + "', expected a number");
       r.values[header[i]] = v;
     }
     rows.push_back(std::move(r));
   }
-  if (header.empty()) throw InputError(source + ": empty, expected a sweep CSV with a header row");
   return rows;
 }
 

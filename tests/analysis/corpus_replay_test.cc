@@ -44,6 +44,19 @@ TEST(CorpusReplay, MeasuredCsvParsesOrThrowsInputError) {
   EXPECT_GE(parsed, 3);  // the valid seeds
 }
 
+// The seeds say what they are: valid_* parse (BOM, quotes, CRLF, a trailing comma included),
+// invalid_* are rejected.
+TEST(CorpusReplay, MeasuredCsvSeedsParseAsTheirNamesSay) {
+  for (const auto& f : CorpusFiles("fuzz_csv")) {
+    const std::string name = std::filesystem::path(f).filename().string();
+    if (name.rfind("valid_", 0) == 0) {
+      EXPECT_TRUE(fuzz::MeasuredCsvFile(f)) << name;
+    } else if (name.rfind("invalid_", 0) == 0) {
+      EXPECT_FALSE(fuzz::MeasuredCsvFile(f)) << name;
+    }
+  }
+}
+
 TEST(CorpusReplay, ModelYamlParsesOrThrowsInputError) {
   const auto files = CorpusFiles("fuzz_model_yaml");
   ASSERT_GE(files.size(), 8u);

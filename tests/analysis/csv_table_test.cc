@@ -1,10 +1,15 @@
 // CSV tables: a streamed log cut anywhere by a killed run reads back as its complete rows; the same
 // cut in a file without the stream marker is an error; a hand-written file may omit the last newline.
+// Files as spreadsheets and lab software write them (issue 21): a byte-order mark, CRLF line ends,
+// RFC 4180 quotes and a trailing comma on every line read as the plain file does, to the bit; a
+// semicolon-separated file, a folder, broken quotes get a message naming the place and the fix.
 #include "tests/temp_dir.h"
 #include "analysis/csv_table.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -80,6 +85,163 @@ TEST(ReadCsv, AHandWrittenFileMayOmitTheLastNewline) {
   EXPECT_EQ(t.columns[1][1], 2.0);
   EXPECT_EQ(t.dropped_cut_line, 0);
   std::filesystem::remove(path);
+}
+
+// The message of the InputError `f` throws ("" if none).
+template <class F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string ReadError(const std::string& name, const std::string& text) {
+  const std::string path = TempPath(name);
+  Spit(path, text);
+  return ErrorOf([&] { ReadCsv(path); });
+}
+
+CsvTable ReadText(const std::string& name, const std::string& text) {
+  const std::string path = TempPath(name);
+  Spit(path, text);
+  return ReadCsv(path);
+}
+
+void ExpectSameTable(const CsvTable& a, const CsvTable& b, const std::string& what) {
+  EXPECT_EQ(a.names, b.names) << what;
+  ASSERT_EQ(a.columns.size(), b.columns.size()) << what;
+  for (size_t c = 0; c < a.columns.size(); ++c) {
+    ASSERT_EQ(a.columns[c].size(), b.columns[c].size()) << what;
+    // Bit for bit (NaN included).
+    EXPECT_EQ(0, std::memcmp(a.columns[c].data(), b.columns[c].data(), a.columns[c].size() * sizeof(double)))
+        << what << ", column " << a.names[c];
+  }
+  EXPECT_EQ(a.line_of_row, b.line_of_row) << what;
+}
+
+const char kPlain[] =
+    "# a comment\n"
+    "t,q_hip,tau_knee\n"
+    "0,0.30000000000000004,-20\n"
+    "0.001,1e-300,-5.5\n"
+    "0.002,-0.7,nan\n";
+
+TEST(ReadCsv, SpreadsheetDialectsReadAsThePlainFileToTheBit) {
+  const CsvTable plain = ReadText("plain.csv", kPlain);
+  ASSERT_EQ(plain.rows(), 3u);
+  const std::string bom = "\xEF\xBB\xBF";
+  ExpectSameTable(plain, ReadText("bom.csv", bom + kPlain), "UTF-8 byte-order mark");
+  ExpectSameTable(plain,
+                  ReadText("crlf.csv", "# a comment\r\nt,q_hip,tau_knee\r\n0,0.30000000000000004,-20\r\n"
+                                       "0.001,1e-300,-5.5\r\n0.002,-0.7,nan\r\n"),
+                  "CRLF line ends");
+  ExpectSameTable(plain,
+                  ReadText("quoted.csv", "# a comment\n\"t\",\"q_hip\",\"tau_knee\"\n"
+                                         "\"0\",\"0.30000000000000004\",\"-20\"\n"
+                                         "\"0.001\", \"1e-300\" ,-5.5\n\"0.002\",\"-0.7\",\"nan\"\n"),
+                  "RFC 4180 quotes on names and values, blanks around a quoted field");
+  ExpectSameTable(plain,
+                  ReadText("trailing.csv", "# a comment\nt,q_hip,tau_knee,\n0,0.30000000000000004,-20,\n"
+                                           "0.001,1e-300,-5.5,\n0.002,-0.7,nan,\n"),
+                  "a trailing comma on every line");
+  ExpectSameTable(plain,
+                  ReadText("all.csv", bom + "# a comment\r\n\"t\",\"q_hip\",\"tau_knee\",\r\n"
+                                            "\"0\",\"0.30000000000000004\",\"-20\",\r\n"
+                                            "0.001,1e-300,\"-5.5\",\r\n0.002,-0.7,nan,\r\n"),
+                  "all of them at once");
+}
+
+TEST(ReadCsv, AQuotedNameMayHoldACommaAndADoubledQuote) {
+  const CsvTable t = ReadText("names.csv", "t,\"force, left\",\"say \"\"hi\"\"\",\"\"\"\"\n0,1,2,3\n");
+  ASSERT_EQ(t.names.size(), 4u);
+  EXPECT_EQ(t.names[1], "force, left");
+  EXPECT_EQ(t.names[2], "say \"hi\"");
+  EXPECT_EQ(t.names[3], "\"");
+  EXPECT_EQ(t.Find("force, left"), 1);
+  EXPECT_EQ(t.columns[3][0], 3.0);
+  // A comma inside a quoted value is part of it: "1,5" is not a number (a decimal comma).
+  const std::string e = ReadError("decimal_comma.csv", "t,a\n0,\"1,5\"\n");
+  EXPECT_NE(e.find("decimal_comma.csv:2: column 'a': '1,5' is not a number"), std::string::npos) << e;
+}
+
+TEST(ReadCsv, NumbersAreWhatStrtodReadsInBothPaths) {
+  // The unquoted fast path and the quoted path agree with strtod, to the bit, on every form.
+  const char* forms[] = {"1.5", "-2e-3", "+1", "0x1p-3", "1e999", "-1e999", "1e-400", "4.9e-324",
+                         "2.2250738585072011e-308", "inf", "-Infinity", "0.1", "123456789012345678901234567890"};
+  for (const char* f : forms) {
+    const CsvTable t = ReadText("forms.csv", std::string("a,b\n") + f + ",\"" + f + "\"\n");
+    const double ref = std::strtod(f, nullptr);
+    ASSERT_EQ(t.rows(), 1u) << f;
+    EXPECT_EQ(0, std::memcmp(&t.columns[0][0], &ref, sizeof ref)) << f << " unquoted: " << t.columns[0][0];
+    EXPECT_EQ(0, std::memcmp(&t.columns[1][0], &ref, sizeof ref)) << f << " quoted: " << t.columns[1][0];
+  }
+  for (const char* bad : {"1.5x", "1,5", "0x", "--1", "1 2", "", "e5", "\"\""}) {
+    const std::string e = ReadError("bad_number.csv", std::string("a,b\n1,") + bad + "\n");
+    EXPECT_NE(e.find("bad_number.csv:2: "), std::string::npos) << bad << ": " << e;
+  }
+}
+
+TEST(ReadCsv, TrailingCommaRulesAreTheHeaders) {
+  // The header has none: a row ending with ',' is one field too many.
+  EXPECT_NE(ReadError("t1.csv", "t,a\n0,1\n1,2,\n").find("t1.csv:3: row ends with ','"), std::string::npos);
+  // The header has one: every row must end with ',' and leave the column empty.
+  std::string e = ReadError("t2.csv", "t,a,\n0,1,\n1,2\n");
+  EXPECT_NE(e.find("t2.csv:3: expected 2 fields and a trailing ','"), std::string::npos) << e;
+  e = ReadError("t3.csv", "t,a,\n0,1,\n1,2,7\n");
+  EXPECT_NE(e.find("t3.csv:3: expected an empty last field (the header ends with ',')"), std::string::npos) << e;
+  e = ReadError("t4.csv", "t,a,,\n0,1,,\n");
+  EXPECT_NE(e.find("t4.csv:1: empty column name"), std::string::npos) << e;
+}
+
+TEST(ReadCsv, SemicolonsAndTabsNameTheSeparatorAndTheFix) {
+  std::string e = ReadError("european.csv", "t;q_hip;q_knee\n0;0,3;-0,7\n");
+  EXPECT_NE(e.find("european.csv:1: the header is separated by ';'"), std::string::npos) << e;
+  EXPECT_NE(e.find("'.' as the decimal separator"), std::string::npos) << e;
+  e = ReadError("tabs.csv", "\xEF\xBB\xBFt\tq_hip\n0\t0.3\n");
+  EXPECT_NE(e.find("tabs.csv:1: the header is separated by tabs"), std::string::npos) << e;
+  e = ReadError("mac.csv", "t,a\r0,1\r");
+  EXPECT_NE(e.find("mac.csv:1: a carriage return inside the header line"), std::string::npos) << e;
+}
+
+TEST(ReadCsv, BrokenQuotesNameTheLineAndTheField) {
+  std::string e = ReadError("open.csv", "t,a\n0,1\n1,\"2\n");
+  EXPECT_NE(e.find("open.csv:3: field 2: a quoted field is not closed on its line"), std::string::npos) << e;
+  e = ReadError("inner.csv", "t,a\n0,1\"2\n");
+  EXPECT_NE(e.find("inner.csv:2: field 2: a '\"' inside an unquoted field"), std::string::npos) << e;
+  e = ReadError("after.csv", "t,\"a\"b\n0,1\n");
+  EXPECT_NE(e.find("after.csv:1: field 2: text after the closing quote"), std::string::npos) << e;
+}
+
+TEST(ReadCsv, AFolderNamesThePathAndWhatWasExpected) {
+  const std::string dir = TempPath("a_folder.csv");
+  std::filesystem::create_directories(dir);
+  std::string e = ErrorOf([&] { ReadCsv(dir); });
+  EXPECT_NE(e.find(dir + ": is a folder, expected a CSV file"), std::string::npos) << e;
+  e = ReadError("bom_only.csv", "\xEF\xBB\xBF");
+  EXPECT_NE(e.find("bom_only.csv: no header row"), std::string::npos) << e;
+}
+
+TEST(CsvReader, SplitsTextFieldsByTheSameRules) {
+  const std::string text = "\xEF\xBB\xBF# c\r\nname, \"x, y\" ,n,\r\n\r\n\"a \"\"b\"\"\",,1.5,\r\n";
+  CsvReader in(text, "s.csv");
+  ASSERT_TRUE(in.ReadHeader());
+  EXPECT_EQ(in.names(), (std::vector<std::string>{"name", "x, y", "n"}));
+  ASSERT_TRUE(in.NextRow());
+  EXPECT_EQ(in.line(), 4);
+  EXPECT_EQ(in.field(0), "a \"b\"");
+  EXPECT_EQ(in.field(1), "");
+  double v = 0;
+  EXPECT_FALSE(in.Number(1, &v));
+  ASSERT_TRUE(in.Number(2, &v));
+  EXPECT_EQ(v, 1.5);
+  EXPECT_FALSE(in.NextRow());
+  EXPECT_EQ(in.Where(), "s.csv:4: ");
+  const std::string empty = "# only\n\n";
+  CsvReader none(empty, "e.csv");
+  EXPECT_FALSE(none.ReadHeader());
 }
 
 }  // namespace

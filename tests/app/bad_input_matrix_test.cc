@@ -1,4 +1,4 @@
-// The bad-input matrix of issue 8: one test per case of bad input over MJCF models, MODEL.yaml
+// The bad-input matrix of issues 8 and 21: one test per case of bad input over MJCF models, MODEL.yaml
 // parameter files, measured-data CSV, column maps and scenario YAML (truncated files, wrong types,
 // units out of range, NaN and inf, empty files, huge values, duplicated keys/columns, binary junk).
 // Each goes through the command line (`exotwin predict` for MJCF / parameters / CSV / maps, `exotwin
@@ -211,6 +211,12 @@ std::vector<Case> Cases() {
       {"CsvSampledTooSlowly", Kind::kCsv, "", "d.csv", "expected a sample rate above 40"},
       {"CsvSamplingGap", Kind::kCsv, "", "d.csv: column 't'", "expected roughly uniform sampling"},
       {"CsvMissingFile", Kind::kCsv, "", "nonexistent.csv", "cannot open file", "/nonexistent.csv"},
+      {"CsvMeasuredIsAFolder", Kind::kCsv, "", "/.: is a folder", "expected a CSV file", "/."},
+      {"CsvSemicolonsAndDecimalCommas", Kind::kCsv, "t;q_hip;q_knee;tau_hip;tau_knee\n0;0,3;-0,7;-20;-5\n",
+       "d.csv:1: the header is separated by ';'", "'.' as the decimal separator"},
+      {"CsvUnclosedQuote", Kind::kCsv, CsvWithRow(30, "0.03,\"0.3,-0.7,-20,-5"), "d.csv:32: field 2",
+       "expected a closing '\"'"},
+      {"CsvTrailingCommaMissingOnARow", Kind::kCsv, "", "d.csv:42", "expected 5 fields and a trailing ','"},
       // ---- column maps (predict --measured foreign.csv --map) ----
       {"MapMissingColumn", Kind::kMap, MapReplace("from: pos1", "from: pos_meas1"), "map.yaml: columns.q_hip.from (line 3)",
        "missing required column 'pos_meas1' in"},
@@ -273,6 +279,10 @@ std::vector<Case> Cases() {
       os << "t,q_hip,q_knee,tau_hip,tau_knee\n";
       for (int i = 0; i < 30; ++i) os << i << ",0.3,-0.7,-20,-5\n";
       k.content = os.str();
+    } else if (k.name == "CsvTrailingCommaMissingOnARow") {  // the header and every row but one end with ','
+      std::istringstream in(GoodCsv(200, ",", ","));
+      std::string l;
+      for (int i = -1; std::getline(in, l); ++i) k.content += (i == 40 ? l.substr(0, l.size() - 1) : l) + "\n";
     } else if (k.name == "CsvSamplingGap") {  // 1 kHz, then one sample a day later
       k.content = GoodCsv() + "86400,0.3,-0.7,-20,-5\n";
     }

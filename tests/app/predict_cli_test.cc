@@ -63,6 +63,24 @@ TEST_F(PredictCli, WritesPredictionWithContractColumns) {
   EXPECT_EQ(t.rows(), 200u);
 }
 
+// Issue 21: the same record as a spreadsheet or lab software writes it (byte-order mark, CRLF line
+// ends, RFC 4180 quotes, a trailing comma on every line) predicts the same torques, to the byte.
+TEST_F(PredictCli, SpreadsheetDialectsPredictAsThePlainFile) {
+  const auto plain = Predict(kModel, GoodCsv());
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const std::string expected = testing::ReadText(dir_ + "/pred.csv");
+  std::string dialect = "\xEF\xBB\xBF";  // UTF-8 byte-order mark
+  std::istringstream in(GoodCsv());
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) dialect += "\"" + f + "\",";  // quoted; ends with ','
+    dialect += "\r\n";
+  }
+  const auto r = Predict(kModel, dialect);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(testing::ReadText(dir_ + "/pred.csv"), expected);
+}
+
 TEST_F(PredictCli, MissingColumn) {
   ExpectBadInput(Predict(kModel, "t,q_hip,q_knee,tau_hip\n0,0,0,0\n"), "missing required column 'tau_knee'");
 }

@@ -84,6 +84,28 @@ TEST(SweepTable, CsvRoundTripsBitForBit) {
   EXPECT_THROW(ParseSweepCsv("a,b\n", "z.csv"), InputError);
 }
 
+// A sweep table goes through the CSV reader of every other CSV (analysis/csv_table.h): a byte-order
+// mark, CRLF, quotes and comments read as in a measured-data file; errors name file and line.
+TEST(SweepTable, ReadByTheSharedCsvReader) {
+  const auto rows = ParseSweepCsv(
+      "\xEF\xBB\xBF# edited in a spreadsheet\r\n"
+      "\"scenario\",subject,subject_seed,status,checks_failed,\"m, deg\"\r\n"
+      "\"say \"\"a\"\"\",3,7,ok,0,\"1.5\"\r\n"
+      "b,4,8,ok,1,\r\n",
+      "s.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].scenario, "say \"a\"");
+  EXPECT_EQ(rows[0].values.at("m, deg"), 1.5);
+  EXPECT_EQ(rows[1].values.count("m, deg"), 0u);  // empty cell: no value
+  EXPECT_EQ(rows[1].checks_failed, 1);
+  try {
+    ParseSweepCsv("scenario,subject,subject_seed,status,checks_failed,m\nc,1,2,ok,0,1,2\n", "w.csv");
+    FAIL() << "a row with a field too many must be rejected";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("w.csv:2: expected 6 fields"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SweepTable, SummaryStatistics) {
   SweepManifest m;
   m.scenarios = {"s"};
