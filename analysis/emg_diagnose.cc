@@ -330,6 +330,16 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     ProfileAll(all, &spec);
     d.calibration = all.Fit(spec);
   }
+  // Channels whose fitted alpha contradicts their muscle's action (HJ15 eq. 23-24 signs): crosstalk,
+  // a channel standing for a missing muscle, or collinearity; reported, not constrained.
+  for (const EmgTerm& t : d.calibration.terms) {
+    if (t.kind != TermKind::kAlpha) continue;
+    const int expected = t.proxy ? ActionSign(Muscle::kGMAX, t.joint) : ActionSign(t.muscle, t.joint);
+    if (t.value * expected < 0 && std::abs(t.value) > 2 * t.se)
+      d.notes.push_back(t.Name() + " at the " + kJoint[t.joint] + ": " + Num(t.value) + " +- " + Num(t.se) +
+                        " N m, against the " + MuscleName(t.muscle) +
+                        "'s action there (crosstalk, a missing muscle's activity, or collinearity)");
+  }
   // Plot series of the first recording.
   const EmgRecording& r = *recs[0];
   d.t = r.t;
