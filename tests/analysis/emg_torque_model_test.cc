@@ -155,6 +155,19 @@ TEST(EmgTorqueModel, HiddenActivationNonlinearityIsNamedAndRecovered) {
   EXPECT_TRUE(d.calibration.spec.delay_s.empty());
 }
 
+TEST(EmgTorqueModel, SeveralRecordingsAreLeftOutInTurn) {
+  Truth tr;
+  tr.vm_delay = 0.08;
+  const EmgRecording a = Synthetic(tr, 1), b = Synthetic(tr, 2);
+  const EmgDiagnosis d = DiagnoseEmg({&a, &b});
+  EXPECT_TRUE(d.leave_one_out);
+  ASSERT_TRUE(d.calibration.spec.delay_s.count(Muscle::kVM));
+  EXPECT_NEAR(d.calibration.spec.delay_s.at(Muscle::kVM), 0.08, 0.006);
+  bool scored = false;
+  for (const auto& c : d.scores) scored |= c.added && c.left_out_gain_pct[1] > 50;
+  EXPECT_TRUE(scored) << "the added delay pays on whole recordings left out";
+}
+
 TEST(EmgTorqueModel, ModelFileRoundTrips) {
   Truth tr;
   tr.vm_delay = 0.05;
