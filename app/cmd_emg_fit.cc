@@ -1,0 +1,84 @@
+// exotwin emg-fit (DESIGN.md): calibrates the EMG-driven hip and knee moment model from recordings
+// (OpenSim storage files) and, with --report, writes the discrepancy loop's diagnosis.
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+#include "analysis/csv_table.h"
+#include "analysis/emg_diagnose.h"
+#include "analysis/emg_recording.h"
+#include "analysis/number_text.h"
+#include "app/commands.h"
+#include "model/input_error.h"
+
+namespace exotwin {
+namespace {
+
+CommandRunner RegisterEmgFit(CLI::App& app) {
+  struct Opts {
+    std::vector<std::string> emg, kin, mom;
+    std::string map, out, report;
+    bool linear = false;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand(
+      "emg-fit", "Calibrate the EMG-driven hip and knee moment model (HJ15 eq. 26-27 and the causes the "
+                 "discrepancy loop adds) from OpenSim storage files");
+  sub->add_option("--emg", o->emg, "EMG envelopes (.sto); repeat for several recordings")->required();
+  sub->add_option("--kinematics", o->kin, "inverse-kinematics angles (.sto/.mot), one per --emg")->required();
+  sub->add_option("--moments", o->mom, "inverse-dynamics moments (.sto), one per --emg")->required();
+  sub->add_option("--map", o->map, "muscle map YAML (EMG channel names per twin muscle); default: OpenSim names");
+  sub->add_option("--out", o->out, "calibration output, EMGMODEL.yaml")->required();
+  sub->add_option("--report", o->report, "folder for diagnosis.json and report.html of the discrepancy loop");
+  sub->add_flag("--linear", o->linear, "fit the linear form of HJ15 eq. 26 only (no discrepancy loop)");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    const auto start = std::chrono::steady_clock::now();
+    if (o->kin.size() != o->emg.size() || o->mom.size() != o->emg.size())
+      throw InputError("emg-fit: " + std::to_string(o->emg.size()) + " --emg, " + std::to_string(o->kin.size()) +
+                       " --kinematics and " + std::to_string(o->mom.size()) +
+                       " --moments (expected one of each per recording, in step)");
+    const MuscleMap map = o->map.empty() ? DefaultMuscleMap() : ReadMuscleMap(o->map);
+    std::vector<EmgRecording> recs;
+    for (size_t i = 0; i < o->emg.size(); ++i) recs.push_back(ReadEmgRecording(o->emg[i], o->kin[i], o->mom[i], map));
+    for (const auto& r : recs)
+      for (const auto& n : r.notes) std::fprintf(stderr, "emg-fit: %s: %s\n", r.source.c_str(), n.c_str());
+    std::vector<const EmgRecording*> ptrs;
+    for (const auto& r : recs) ptrs.push_back(&r);
+    EmgDiagnoseOptions opt;
+    if (o->linear) opt.max_steps = 0, opt.robust_candidate = false;
+    const EmgDiagnosis d = DiagnoseEmg(ptrs, opt);
+    std::vector<std::string> header = {"exotwin emg-fit: EMG-driven joint moment model (HJ15 eq. 26-27 + discrepancy loop)"};
+    std::string files;
+    for (size_t i = 0; i < o->emg.size(); ++i)
+      files += (i ? "; " : "") + o->emg[i] + ", " + o->kin[i] + ", " + o->mom[i];
+    header.push_back("recordings: " + files + "; map: " + map.source);
+    for (const auto& s : d.selection) header.push_back(s);
+    header.push_back("fit: the final structure on every sample; held-out figures in 'fit' are of the same structure "
+                     "fitted on the first 70 % of every recording");
+    EmgTorqueModel out = d.calibration;
+    for (int j = 0; j < 2; ++j) out.figures[j] = d.steps.back().model.figures[j];
+    WriteFileAtomic(o->out, EmgModelYaml(out, header));
+    if (!o->report.empty()) WriteEmgDiagnosis(d, o->report);
+    const char* jn[2] = {"hip", "knee"};
+    std::printf("%-44s %8s %8s %8s %8s\n", "step (held-out, within 6 MAD)", "hip R^2", "hip rms", "knee R^2", "knee rms");
+    for (const auto& s : d.steps)
+      std::printf("%-44s %8.3f %8.2f %8.3f %8.2f\n", s.added.substr(0, 44).c_str(), s.model.figures[0].r2_heldout_trim,
+                  s.model.figures[0].rms_heldout_trim, s.model.figures[1].r2_heldout_trim,
+                  s.model.figures[1].rms_heldout_trim);
+    for (int j = 0; j < 2; ++j)
+      std::printf("%s: held-out R^2 %.3f (all samples %.3f), linear form %.3f (all samples %.3f)\n", jn[j],
+                  d.steps.back().model.figures[j].r2_heldout_trim, d.steps.back().model.figures[j].r2_heldout,
+                  d.steps.front().model.figures[j].r2_heldout_trim, d.steps.front().model.figures[j].r2_heldout);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "emg-fit: wrote %s in %s s\n", o->out.c_str(), NumberText(secs, 3).c_str());
+    return 0;
+  };
+}
+
+const CommandRegistration kEmgFit(RegisterEmgFit);
+
+}  // namespace
+}  // namespace exotwin

@@ -1,0 +1,172 @@
+// `exotwin emg-fit` and `exotwin emg-predict` through the command line (DESIGN.md contract): outputs,
+// exit codes, and bad input that must exit 2 naming the file, line or channel.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "analysis/csv_table.h"
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::ReadText;
+using testing::RunExotwin;
+using testing::TempDir;
+using testing::WriteText;
+
+constexpr int kRows = 2000;  // 20 s at 100 Hz
+
+double Env(int c, double t) {
+  const double s = std::sin(2 * M_PI * (0.8 + 0.17 * c) * t + c) + 0.4 * std::sin(2 * M_PI * 0.11 * (c + 1) * t);
+  return 0.02 + 0.25 * std::max(0.0, s) * std::max(0.0, s);
+}
+double Hip(double t) { return 20 * std::sin(2 * M_PI * 0.9 * t) + 5; }        // deg
+double Knee(double t) { return -35 - 25 * std::sin(2 * M_PI * 0.9 * t + 1); }  // deg
+
+// emgFilt.sto as CEINMS writes it (no version line, trailing tab on every line).
+std::string EmgSto(double t0 = 0, const std::string& bad_value = "", int bad_row = -1) {
+  std::ostringstream o;
+  o << "Normalized EMG Linear Envelopes\nnRows=" << kRows << "\nnColumns=6\n\nendheader\n"
+    << "time\t  rect_fem_r\t vas_lat_r\t semimem_r\t med_gas_r\t soleus_r\t\n";
+  for (int i = 0; i < kRows; ++i) {
+    const double t = t0 + 0.01 * i;
+    o << t;
+    for (int c = 0; c < 5; ++c) o << "\t  " << (i == bad_row && c == 1 ? bad_value : std::to_string(Env(c, t)));
+    o << "\t\n";
+  }
+  return o.str();
+}
+
+std::string IkSto(bool in_degrees_line = true) {
+  std::ostringstream o;
+  o << "Coordinates\nversion=1\nnRows=" << kRows << "\nnColumns=3\n" << (in_degrees_line ? "inDegrees=yes\n" : "")
+    << "endheader\ntime\thip_flexion_r\tknee_angle_r\n";
+  for (int i = 0; i < kRows; ++i) o << 0.01 * i << "\t" << Hip(0.01 * i) << "\t" << Knee(0.01 * i) << "\n";
+  return o.str();
+}
+
+std::string IdSto(int drop_value_row = -1) {
+  std::ostringstream o;
+  o << "Inverse Dynamics Generalized Forces\nversion=1\nnRows=" << kRows
+    << "\nnColumns=3\ninDegrees=no\nendheader\ntime\thip_flexion_r_moment\tknee_angle_r_moment\n";
+  for (int i = 0; i < kRows; ++i) {
+    const double t = 0.01 * i;
+    const double hip = 50 * Env(0, t) - 60 * Env(2, t) - 0.2 * Hip(t) + 3 + 0.5 * std::sin(37.0 * i);
+    const double knee = 80 * Env(1, t) + 20 * Env(0, t) - 30 * Env(2, t) - 40 * Env(3, t) + 0.1 * Knee(t) +
+                        0.5 * std::cos(41.0 * i);
+    o << t << "\t" << hip;
+    if (i != drop_value_row) o << "\t" << knee;
+    o << "\n";
+  }
+  return o.str();
+}
+
+class EmgCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = TempDir("emgcli");
+    WriteText(dir_ + "/emg.sto", EmgSto());
+    WriteText(dir_ + "/ik.sto", IkSto());
+    WriteText(dir_ + "/id.sto", IdSto());
+  }
+  std::string Files(const std::string& emg = "emg.sto", const std::string& ik = "ik.sto",
+                    const std::string& id = "id.sto") {
+    return " --emg " + dir_ + "/" + emg + " --kinematics " + dir_ + "/" + ik + " --moments " + dir_ + "/" + id;
+  }
+  testing::RunResult Fit(const std::string& extra = "") {
+    return RunExotwin("emg-fit" + Files() + " --out " + dir_ + "/model.yaml " + extra);
+  }
+  void ExpectBadInput(const testing::RunResult& r, const std::vector<std::string>& pieces) {
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    for (const auto& p : pieces) EXPECT_NE(r.output.find(p), std::string::npos) << "'" << p << "' not in: " << r.output;
+  }
+  std::string dir_;
+};
+
+TEST_F(EmgCli, FitWritesEveryParameterWithUnitAndUncertainty) {
+  const auto r = Fit("--report " + dir_ + "/rep");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string y = ReadText(dir_ + "/model.yaml");
+  for (const char* s : {"term: alpha, channel: rect_fem_r", "term: beta", "term: gamma", "term: offset", "se:",
+                        "unit: \"N m s/rad\"", "missing_channels: [GMAX]"})
+    EXPECT_NE(y.find(s), std::string::npos) << s << " not in:\n" << y;
+  EXPECT_EQ(y.find("soleus_r"), std::string::npos);  // the soleus spans neither hip nor knee
+  EXPECT_NE(r.output.find("soleus_r"), std::string::npos) << "unused channels are reported: " << r.output;
+  EXPECT_NE(r.output.find("GMAX"), std::string::npos) << "the missing gluteus is reported: " << r.output;
+  const std::string j = ReadText(dir_ + "/rep/diagnosis.json");
+  for (const char* s : {"\"effects\"", "\"joints\"", "\"rmse_before\"", "\"gain_pct\"", "\"selection\"", "\"steps\""})
+    EXPECT_NE(j.find(s), std::string::npos) << s;
+  EXPECT_NE(ReadText(dir_ + "/rep/report.html").find("<svg"), std::string::npos);
+}
+
+TEST_F(EmgCli, PredictWritesContractColumnsAndPrintsR2) {
+  ASSERT_EQ(Fit("--linear").exit_code, 0);
+  const auto r = RunExotwin("emg-predict --model " + dir_ + "/model.yaml --emg " + dir_ + "/emg.sto --kinematics " +
+                            dir_ + "/ik.sto --moments " + dir_ + "/id.sto --out " + dir_ + "/pred.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("hip: R^2 0.9"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("knee: R^2 0.9"), std::string::npos) << r.output;
+  const CsvTable t = ReadCsv(dir_ + "/pred.csv");
+  ASSERT_EQ(t.names, (std::vector<std::string>{"t", "tau_hip", "tau_knee"}));
+  EXPECT_EQ(t.rows(), static_cast<size_t>(kRows));
+  // Without moments: the estimate only.
+  const auto r2 = RunExotwin("emg-predict --model " + dir_ + "/model.yaml --emg " + dir_ + "/emg.sto --kinematics " +
+                             dir_ + "/ik.sto --out " + dir_ + "/pred2.csv");
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  EXPECT_EQ(r2.output.find("R^2"), std::string::npos);
+}
+
+TEST_F(EmgCli, MissingEndheader) {
+  std::string s = EmgSto();
+  s.erase(s.find("endheader\n"), 10);
+  WriteText(dir_ + "/bad.sto", s);
+  ExpectBadInput(RunExotwin("emg-fit" + Files("bad.sto") + " --out " + dir_ + "/m.yaml"), {"bad.sto", "endheader"});
+}
+
+TEST_F(EmgCli, RowWithTooFewValues) {
+  WriteText(dir_ + "/bad.sto", IdSto(100));
+  ExpectBadInput(RunExotwin("emg-fit" + Files("emg.sto", "ik.sto", "bad.sto") + " --out " + dir_ + "/m.yaml"),
+                 {"bad.sto", "line 108", "2 values, 3 column names"});
+}
+
+TEST_F(EmgCli, TimeBasesThatDoNotOverlap) {
+  WriteText(dir_ + "/late.sto", EmgSto(100.0));
+  ExpectBadInput(RunExotwin("emg-fit" + Files("late.sto") + " --out " + dir_ + "/m.yaml"), {"late.sto", "time bases"});
+}
+
+TEST_F(EmgCli, MapNamingAMissingChannel) {
+  WriteText(dir_ + "/map.yaml", "muscles:\n  VM: [vas_lat_r, vas_med_r]\n  RF: [rect_fem_r]\n");
+  ExpectBadInput(Fit("--map " + dir_ + "/map.yaml"), {"map.yaml", "vas_med_r"});
+}
+
+TEST_F(EmgCli, NegativeAndNanEnvelopes) {
+  WriteText(dir_ + "/neg.sto", EmgSto(0, "-0.5", 10));
+  ExpectBadInput(RunExotwin("emg-fit" + Files("neg.sto") + " --out " + dir_ + "/m.yaml"),
+                 {"neg.sto", "line 17", "vas_lat_r"});
+  WriteText(dir_ + "/nan.sto", EmgSto(0, "nan", 20));
+  ExpectBadInput(RunExotwin("emg-fit" + Files("nan.sto") + " --out " + dir_ + "/m.yaml"),
+                 {"nan.sto", "line 27", "vas_lat_r"});
+}
+
+TEST_F(EmgCli, AngleUnitNotStated) {
+  WriteText(dir_ + "/ik_nounit.sto", IkSto(false));
+  ExpectBadInput(RunExotwin("emg-fit" + Files("emg.sto", "ik_nounit.sto") + " --out " + dir_ + "/m.yaml"),
+                 {"ik_nounit.sto", "inDegrees"});
+}
+
+TEST_F(EmgCli, RecordingsNotInStep) {
+  ExpectBadInput(RunExotwin("emg-fit" + Files() + " --emg " + dir_ + "/emg.sto --out " + dir_ + "/m.yaml"),
+                 {"--emg", "--kinematics"});
+}
+
+TEST_F(EmgCli, BadModelFile) {
+  WriteText(dir_ + "/bad.yaml", "model: something_else\n");
+  ExpectBadInput(RunExotwin("emg-predict --model " + dir_ + "/bad.yaml --emg " + dir_ + "/emg.sto --kinematics " +
+                            dir_ + "/ik.sto --out " + dir_ + "/p.csv"),
+                 {"bad.yaml", "model"});
+}
+
+}  // namespace
+}  // namespace exotwin
