@@ -6,7 +6,7 @@
 
 #include "analysis/diagnose_select.h"
 #include "analysis/number_text.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

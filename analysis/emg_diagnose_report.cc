@@ -13,7 +13,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/emg_diagnose.h"
 #include "analysis/number_text.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

@@ -6,8 +6,8 @@
 #include "analysis/measured_data.h"
 #include "analysis/number_text.h"
 #include "analysis/opensim_storage.h"
-#include "analysis/yaml_fields.h"
-#include "model/input_error.h"
+#include "core/yaml_fields.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

@@ -9,8 +9,8 @@
 #include "analysis/measured_data.h"
 #include "analysis/number_text.h"
 #include "analysis/statistics.h"
-#include "analysis/yaml_fields.h"
-#include "model/input_error.h"
+#include "core/yaml_fields.h"
+#include "core/error.h"
 #include "model/passive_torque.h"
 
 namespace exotwin {
@@ -135,7 +135,7 @@ std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, co
       case TermKind::kBeta: v[i] = rec.q[j][i]; break;
       case TermKind::kGamma: v[i] = rec.qd[j][i]; break;
       case TermKind::kOffset: v[i] = 1.0; break;
-      case TermKind::kPassive:  // P of eq. (1) is minus the passive moment along the coordinate
+      case TermKind::kPassive:  // P of HJ15 eq. 1 is minus the passive moment along the coordinate
         v[i] = -PassiveElasticTorque(PassiveModel::kRiener1999, Eigen::Vector2d(rec.q[0][i], rec.q[1][i]))[j];
         break;
       default: break;

@@ -1,5 +1,5 @@
 // EMG-driven joint torque of the hip and the knee: the linear form of Hwang & Jeon 2015 (HJ15
-// eq. 26-27, after Olney & Winter 1985) and the extensions the discrepancy loop may add
+// HJ15 eq. 26-27, after Olney & Winter 1985) and the extensions the discrepancy loop may add
 // (analysis/emg_diagnose.h). Per joint j:
 //
 //   tau_j(t) = sum_i (alpha_i + alpha_q,i q_j) a_i(t) + beta q_j + gamma qd_j + offset + s_P M_P,j(q)
@@ -9,7 +9,7 @@
 // (beta, gamma additive, as the README of shared/data/real_human measures it); the extensions:
 //  - d_m: electromechanical delay of the twin muscle m the channel stands for (s; Cavanagh & Komi
 //    1979: 30-100 ms between EMG and force);
-//  - A: activation nonlinearity, Lloyd & Besier 2003 eq. 2 (A-shape factor, -3 < A < 0);
+//  - A: activation nonlinearity, LB03 eq. 2 (Lloyd & Besier 2003) (A-shape factor, -3 < A < 0);
 //  - alpha_q,i: moment arm changing with the joint angle, alpha_i (1 + c_i q) = alpha_i + alpha_q,i q;
 //  - M_P,j: the passive moment of Riener & Edrich 1999 (model/passive_torque.h) along the
 //    coordinate, with a fitted scale s_P (1 = as published);
@@ -88,7 +88,7 @@ struct EmgTorqueModel {
 // The terms of `spec` for the channels of `rec` (coefficients zero).
 std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec);
 
-// Activation a(u) of Lloyd & Besier 2003 eq. 2 with shape factor A (A = 0: u).
+// Activation a(u) of LB03 eq. 2 (Lloyd & Besier 2003) with shape factor A (A = 0: u).
 double ActivationShape(double u, double A);
 
 // The regressor of `term` on every sample of `rec` (N m per unit of the term's coefficient).

@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "analysis/number_text.h"
-#include "analysis/yaml_fields.h"
-#include "model/input_error.h"
+#include "core/yaml_fields.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

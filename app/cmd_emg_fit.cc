@@ -11,7 +11,7 @@
 #include "analysis/emg_recording.h"
 #include "analysis/number_text.h"
 #include "app/commands.h"
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 namespace {

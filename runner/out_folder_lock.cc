@@ -8,7 +8,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
 
 namespace exotwin {
 

@@ -37,8 +37,6 @@ std::string Quote(const std::string& s) {
   return q + "\"";
 }
 
-}
-
 }  // namespace
 
 void SortRows(const SweepManifest& m, std::vector<SweepRow>* rows) {

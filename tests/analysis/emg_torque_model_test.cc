@@ -9,7 +9,8 @@
 #include <cmath>
 
 #include "analysis/emg_diagnose.h"
-#include "model/input_error.h"
+#include "core/error.h"
+#include "core/rng.h"
 #include "sim/muscles.h"
 #include "tests/temp_dir.h"
 
@@ -34,7 +35,7 @@ EmgRecording Synthetic(const Truth& tr, uint64_t seed = 1) {
   const char* ch[] = {"vas_lat_r", "rect_fem_r", "semimem_r", "bifemlh_r", "med_gas_r"};
   const Muscle mu[] = {Muscle::kVM, Muscle::kRF, Muscle::kST, Muscle::kST, Muscle::kGAS};
   const double f[] = {0.93, 1.21, 0.77, 1.07, 1.37}, ph[] = {0.0, 1.3, 2.1, 3.7, 5.0};
-  SeededNormal rng(seed);
+  NormalRng<NormalPolar> rng(seed);
   for (size_t i = 0; i < n; ++i) r.t.push_back(0.01 * static_cast<double>(i));
   for (int c = 0; c < 5; ++c) {
     r.channels.push_back(ch[c]);
@@ -70,10 +71,10 @@ EmgRecording Synthetic(const Truth& tr, uint64_t seed = 1) {
   for (int j = 0; j < 2; ++j) r.tau[j].resize(n);
   for (size_t i = 0; i < n; ++i) {
     r.tau[0][i] = tr.alpha_hip[0] * a[1][i] + tr.alpha_hip[1] * a[2][i] + tr.alpha_hip[2] * a[3][i] +
-                  tr.beta[0] * r.q[0][i] + tr.gamma[0] * r.qd[0][i] + tr.offset[0] + tr.noise * rng();
+                  tr.beta[0] * r.q[0][i] + tr.gamma[0] * r.qd[0][i] + tr.offset[0] + tr.noise * rng.Normal();
     r.tau[1][i] = tr.alpha_knee[0] * a[0][i] + tr.alpha_knee[1] * a[1][i] + tr.alpha_knee[2] * a[2][i] +
                   tr.alpha_knee[3] * a[3][i] + tr.alpha_knee[4] * a[4][i] + tr.beta[1] * r.q[1][i] +
-                  tr.gamma[1] * r.qd[1][i] + tr.offset[1] + tr.noise * rng();
+                  tr.gamma[1] * r.qd[1][i] + tr.offset[1] + tr.noise * rng.Normal();
   }
   return r;
 }
@@ -178,7 +179,8 @@ TEST(EmgTorqueModel, ModelFileRoundTrips) {
   s.passive[0] = true;
   s.moment_arm[1] = true;
   const EmgTorqueModel m = FitEmgModel(s, {&r});
-  const std::string dir = testing::TempDir("emgmodel");
+  const testing::ScopedTempDir dir_tmp("emgmodel");
+  const std::string dir = dir_tmp.path();
   const std::string path = dir + "/m.yaml";
   {
     std::FILE* f = std::fopen(path.c_str(), "w");

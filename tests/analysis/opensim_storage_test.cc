@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "tests/temp_dir.h"
 
 namespace exotwin {
@@ -127,7 +127,8 @@ TEST(OpenSimStorage, AngleUnitMustBeStated) {
 }
 
 TEST(OpenSimStorage, ReadsFilesAndNamesUnreadableOnes) {
-  const std::string dir = testing::TempDir("sto");
+  const testing::ScopedTempDir dir_tmp("sto");
+  const std::string dir = dir_tmp.path();
   std::ofstream(dir + "/a.sto") << "endheader\ntime a\n0 1\n1 2\n";
   EXPECT_EQ(ReadStorage(dir + "/a.sto").rows(), 2u);
   ExpectThrows([&] { ReadStorage(dir + "/missing.sto"); }, {"missing.sto", "cannot open"});

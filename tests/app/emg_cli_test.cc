@@ -2,6 +2,8 @@
 // exit codes, and bad input that must exit 2 naming the file, line or channel.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include <cmath>
 #include <sstream>
 
@@ -13,7 +15,6 @@ namespace {
 
 using testing::ReadText;
 using testing::RunExotwin;
-using testing::TempDir;
 using testing::WriteText;
 
 constexpr int kRows = 2000;  // 20 s at 100 Hz
@@ -66,7 +67,8 @@ std::string IdSto(int drop_value_row = -1) {
 class EmgCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = TempDir("emgcli");
+    tmp_ = std::make_unique<testing::ScopedTempDir>("emgcli");
+    dir_ = tmp_->path();
     WriteText(dir_ + "/emg.sto", EmgSto());
     WriteText(dir_ + "/ik.sto", IkSto());
     WriteText(dir_ + "/id.sto", IdSto());
@@ -82,6 +84,7 @@ class EmgCli : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 2) << r.output;
     for (const auto& p : pieces) EXPECT_NE(r.output.find(p), std::string::npos) << "'" << p << "' not in: " << r.output;
   }
+  std::unique_ptr<testing::ScopedTempDir> tmp_;
   std::string dir_;
 };
 

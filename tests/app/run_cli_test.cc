@@ -27,7 +27,8 @@ std::string Scenario(double duration) {
 }
 
 TEST(RunCli, OutNamingAFileExitsTwoNamingIt) {
-  const std::string dir = testing::TempDir("run_out_file");
+  const testing::ScopedTempDir dir_tmp("run_out_file");
+  const std::string dir = dir_tmp.path();
   WriteText(dir + "/s.yaml", Scenario(0.05));
   WriteText(dir + "/taken", "not a folder\n");
   const auto r = RunExotwin("run " + dir + "/s.yaml --out " + dir + "/taken");
@@ -38,7 +39,8 @@ TEST(RunCli, OutNamingAFileExitsTwoNamingIt) {
 }
 
 TEST(RunCli, SecondRunOnAHeldOutRefusesAndAKilledRunsLockDoesNotBlock) {
-  const std::string dir = testing::TempDir("run_out_lock");
+  const testing::ScopedTempDir dir_tmp("run_out_lock");
+  const std::string dir = dir_tmp.path();
   const std::string out = dir + "/out", lock = out + "/" + kOutFolderLockName;
   WriteText(dir + "/long.yaml", Scenario(3600));
   WriteText(dir + "/short.yaml", Scenario(0.05));

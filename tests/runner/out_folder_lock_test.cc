@@ -13,7 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "model/input_error.h"
+#include "core/error.h"
 #include "tests/temp_dir.h"
 
 namespace exotwin {
@@ -29,7 +29,8 @@ std::string MessageOfLock(const std::string& dir) {
 }
 
 TEST(OutFolderLock, OneHolderAtATimeAndReleasedByDestruction) {
-  const std::string dir = testing::TempDir("out_lock") + "/a/b";  // parents created
+  const testing::ScopedTempDir dir_tmp("out_lock");
+  const std::string dir = dir_tmp.path() + "/a/b";  // parents created
   std::optional<OutFolderLock> first(std::in_place, dir);
   EXPECT_TRUE(std::filesystem::is_directory(dir));
   const std::string e = MessageOfLock(dir);
@@ -40,7 +41,8 @@ TEST(OutFolderLock, OneHolderAtATimeAndReleasedByDestruction) {
 }
 
 TEST(OutFolderLock, ReleasedWhenTheHolderIsKilled) {
-  const std::string dir = testing::TempDir("out_lock_killed");
+  const testing::ScopedTempDir dir_tmp("out_lock_killed");
+  const std::string dir = dir_tmp.path();
   int ready[2];
   ASSERT_EQ(pipe(ready), 0);
   const pid_t child = fork();
@@ -63,7 +65,8 @@ TEST(OutFolderLock, ReleasedWhenTheHolderIsKilled) {
 }
 
 TEST(OutFolderLock, AFileIsNotAFolder) {
-  const std::string file = testing::TempDir("out_lock_file") + "/f";
+  const testing::ScopedTempDir file_tmp("out_lock_file");
+  const std::string file = file_tmp.path() + "/f";
   std::ofstream(file) << "x";
   const std::string e = MessageOfLock(file);
   EXPECT_NE(e.find("--out " + file + ": exists and is not a folder"), std::string::npos) << e;
