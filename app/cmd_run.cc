@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "app/commands.h"
+#include "core/stop_signal.h"
 #include "runner/out_folder_lock.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
@@ -10,7 +11,8 @@
 namespace exotwin {
 namespace {
 
-// Prints the checks as a table; returns 0 when all passed, 1 otherwise.
+// Prints the checks as a table; returns 0 when all passed, 1 otherwise, 128 + N when signal N
+// (SIGINT, SIGTERM) interrupted the run (result.json then says where: DESIGN.md "Interrupted runs").
 int Report(const RunResult& r, const std::string& out_dir) {
   const auto samples = r.metrics.find("samples");
   std::printf("scenario %s (seed %llu): %zu samples, results in %s/result.json\n", r.scenario.c_str(),
@@ -19,6 +21,11 @@ int Report(const RunResult& r, const std::string& out_dir) {
   for (const CheckResult& c : r.checks)
     std::printf("  %-4s %-32s %12.5g %s %-10.5g (%s)\n", c.passed ? "ok" : "FAIL", c.name.c_str(), c.value,
                 c.op.c_str(), c.limit, c.metric.c_str());
+  if (r.interrupted) {
+    std::fprintf(stderr, "exotwin: interrupted by %s at t = %.3f s (trial %d): checks not passed\n",
+                 StopSignalName(r.interrupted->signal), r.interrupted->t, r.interrupted->trial);
+    return 128 + r.interrupted->signal;
+  }
   return r.all_passed() ? 0 : 1;
 }
 
@@ -36,6 +43,7 @@ CommandRunner RegisterRun(CLI::App& app) {
   sub->add_option("--video", o->video, "render an MP4 video of the run");
   return [sub, o, seed]() -> int {
     if (!*sub) return -1;
+    InstallStopSignalHandlers();
     const Scenario s = ReadScenario(o->scenario);
     const OutFolderLock lock(o->out);
     RunOptions opt;
@@ -61,15 +69,16 @@ CommandRunner RegisterRender(CLI::App& app) {
   sub->add_option("--out", o->out, "folder for the run's logs and result.json");
   return [sub, o]() -> int {
     if (!*sub) return -1;
+    InstallStopSignalHandlers();
     const Scenario s = ReadScenario(o->scenario);
     const OutFolderLock lock(o->out);
     RunOptions opt;
     opt.out_dir = o->out;
     opt.video_path = o->video;
     opt.progress = true;
-    Report(RunScenario(s, opt), o->out);
+    const int rc = Report(RunScenario(s, opt), o->out);
     std::printf("wrote %s\n", o->video.c_str());
-    return 0;
+    return rc > 1 ? rc : 0;  // a failed check does not fail the rendering; an interruption does
   };
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/stop_signal.h"
 
 namespace exotwin {
 namespace {
@@ -68,6 +69,8 @@ double CosimRig::Run(const CosimSchedule& sc, CosimDevice& device, const std::fu
                      const CosimProgress& progress) {
   const double dt = sc.dt;
   double t = 0.0;
+  stopped_by_ = 0;
+  steps_run_ = 0;
   device.SampleNodes(t);
   for (long k = 0; k < sc.steps; ++k) {
     device.BeginStep(t);
@@ -90,6 +93,11 @@ double CosimRig::Run(const CosimSchedule& sc, CosimDevice& device, const std::fu
     device.EndStep(t);
     if (k % sc.log_every == 0) device.LogSample(t);
     if (progress.bar && k % kProgressEvery == 0) progress.bar->Update(progress.done + static_cast<size_t>(k));
+    steps_run_ = k + 1;
+    if (const int sig = StopSignal(); sig != 0 && k + 1 < sc.steps) {  // step 8
+      stopped_by_ = sig;
+      break;
+    }
   }
   return t;
 }

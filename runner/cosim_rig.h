@@ -15,6 +15,8 @@
 //   6. t becomes the step's end; device.SampleNodes(t): the nodes sample q(t) and the torque held from t
 //      at one instant; then the EMG node samples the electrodes at t and sends one EmgSamples frame;
 //   7. device.EndStep(t) (metrics), then, on the log instants (k % log_every == 0), device.LogSample(t).
+//   8. a stop request (StopSignal(), core/stop_signal.h: SIGINT / SIGTERM) ends the run here, at the
+//      step's end t, as if the schedule ended there.
 // Before the first step, device.SampleNodes(0) takes the nodes' samples of the start instant (the EMG
 // node's first ADC sample is at dt). The controller sees the plant only through the bus.
 #pragma once
@@ -112,15 +114,23 @@ class CosimRig {
   const hwsim::EmgNode* emg_node() const { return emg_node_.get(); }
 
   // Runs schedule.steps steps from t = 0 (the plant and nodes set up at t = 0) in the order of the
-  // file comment; `tick(t)` is the controller's tick at t (s). Returns the time of the last step's end.
+  // file comment, fewer if a stop request arrives (step 8); `tick(t)` is the controller's tick at t (s).
+  // Returns the time of the last step's end.
   double Run(const CosimSchedule& schedule, CosimDevice& device, const std::function<void(double)>& tick,
              const CosimProgress& progress = {});
+  // The stop signal that ended the last Run() before its schedule's end (2 SIGINT, 15 SIGTERM), 0 when
+  // it ran every step.
+  int stopped_by() const { return stopped_by_; }
+  // The steps the last Run() ran (schedule.steps unless stopped).
+  long steps_run() const { return steps_run_; }
 
  private:
   hwsim::VirtualCanBus bus_;
   std::unique_ptr<hwsim::EmgNode> emg_node_;
   const MuscleModel* muscles_ = nullptr;
   SyntheticEmg* electrodes_ = nullptr;
+  int stopped_by_ = 0;
+  long steps_run_ = 0;
 };
 
 }  // namespace exotwin

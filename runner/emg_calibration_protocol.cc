@@ -95,7 +95,14 @@ double RecordMvc(const MuscleParams& mp, Muscle m, int trials, const Eigen::Vect
   return dsp::MvcOfTrials(env[static_cast<int>(m)], w);
 }
 
+// A stop request (SIGINT / SIGTERM) ended a sub-trial: the protocol stops there (its fits need whole
+// trials); RunEmgCalibrationScenario writes result.json with the sub-trial's interruption.
+struct ProtocolInterrupted {
+  RunInterruption stop;
+};
+
 // Runs a sub-trial through the EXOwheel runner into DIR/<tag>; returns its result (checks dropped).
+// Throws ProtocolInterrupted if a stop request ended it.
 RunResult RunTrial(Scenario sub, const std::string& tag, uint64_t seed, const RunOptions& opt) {
   sub.name += "/" + tag;
   sub.emg_calibration.reset();
@@ -108,7 +115,9 @@ RunResult RunTrial(Scenario sub, const std::string& tag, uint64_t seed, const Ru
   ro.seed = seed;
   ro.progress = opt.progress;
   fs::remove_all(ro.out_dir);
-  return RunScenario(sub, ro);
+  RunResult r = RunScenario(sub, ro);
+  if (r.interrupted) throw ProtocolInterrupted{*r.interrupted};
+  return r;
 }
 
 struct IsometricResult {
@@ -452,42 +461,48 @@ RunResult RunEmgCalibrationScenario(const Scenario& s, const RunOptions& opt) {
   const uint64_t seed = opt.seed ? *opt.seed : s.seed;
   const int n = s.emg_calibration->subjects;
   RunResult result;
-  if (n <= 1) {
-    result = CalibrateOneSubject(s, opt, seed);
-  } else {
-    // The paper's population: Table 4's subjects S1..Sn (anthropometry and identified parameters),
-    // each with its own ground-truth muscles (human.muscle_seed + i - 1) and trial seeds.
-    result.scenario = s.name;
-    result.seed = seed;
-    std::map<std::string, std::vector<double>> per_key;
-    for (int i = 1; i <= n; ++i) {
-      Scenario si = s;
-      si.subject = SubjectSpec{};
-      si.subject.preset = "S" + std::to_string(i);
-      si.subject.passive = s.subject.passive;
-      si.human.muscle_seed = s.human.muscle_seed + static_cast<uint64_t>(i - 1);
-      RunOptions oi = opt;
-      const std::string dir = "subject_S" + std::to_string(i);
-      oi.out_dir = opt.out_dir + "/" + dir;
-      const RunResult ri = CalibrateOneSubject(si, oi, MixSeed(seed ^ (0x73756266ull + i)));
-      for (const std::string& f : ri.files) result.files.push_back(dir + "/" + f);
-      for (const auto& kv : ri.metrics) {
-        per_key[kv.first].push_back(kv.second);
-        result.metrics[dir + "." + kv.first] = kv.second;
+  result.scenario = s.name;
+  result.seed = seed;
+  try {
+    if (n <= 1) {
+      result = CalibrateOneSubject(s, opt, seed);
+    } else {
+      // The paper's population: Table 4's subjects S1..Sn (anthropometry and identified parameters),
+      // each with its own ground-truth muscles (human.muscle_seed + i - 1) and trial seeds.
+      result.scenario = s.name;
+      result.seed = seed;
+      std::map<std::string, std::vector<double>> per_key;
+      for (int i = 1; i <= n; ++i) {
+        Scenario si = s;
+        si.subject = SubjectSpec{};
+        si.subject.preset = "S" + std::to_string(i);
+        si.subject.passive = s.subject.passive;
+        si.human.muscle_seed = s.human.muscle_seed + static_cast<uint64_t>(i - 1);
+        RunOptions oi = opt;
+        const std::string dir = "subject_S" + std::to_string(i);
+        oi.out_dir = opt.out_dir + "/" + dir;
+        const RunResult ri = CalibrateOneSubject(si, oi, MixSeed(seed ^ (0x73756266ull + i)));
+        for (const std::string& f : ri.files) result.files.push_back(dir + "/" + f);
+        for (const auto& kv : ri.metrics) {
+          per_key[kv.first].push_back(kv.second);
+          result.metrics[dir + "." + kv.first] = kv.second;
+        }
       }
-    }
-    for (const auto& kv : per_key) {
-      if (kv.second.size() != static_cast<size_t>(n)) continue;  // present for every subject only
-      result.metrics[kv.first] = Aggregate(kv.first, kv.second);
-      if (kv.first.rfind("iso_r2", 0) == 0 || kv.first.rfind("iso_nrms", 0) == 0 ||
-          kv.first.rfind("dyn_r2", 0) == 0 || kv.first.rfind("r2_margin", 0) == 0) {
-        result.metrics[kv.first + "_sd"] = StdDev(kv.second);
-        if (kv.first.rfind("r2_margin", 0) == 0)
-          result.metrics[kv.first + "_subjects_positive"] = static_cast<double>(
-              std::count_if(kv.second.begin(), kv.second.end(), [](double x) { return x > 0; }));
+      for (const auto& kv : per_key) {
+        if (kv.second.size() != static_cast<size_t>(n)) continue;  // present for every subject only
+        result.metrics[kv.first] = Aggregate(kv.first, kv.second);
+        if (kv.first.rfind("iso_r2", 0) == 0 || kv.first.rfind("iso_nrms", 0) == 0 ||
+            kv.first.rfind("dyn_r2", 0) == 0 || kv.first.rfind("r2_margin", 0) == 0) {
+          result.metrics[kv.first + "_sd"] = StdDev(kv.second);
+          if (kv.first.rfind("r2_margin", 0) == 0)
+            result.metrics[kv.first + "_subjects_positive"] = static_cast<double>(
+                std::count_if(kv.second.begin(), kv.second.end(), [](double x) { return x > 0; }));
+        }
       }
+      result.metrics["subjects"] = n;
     }
-    result.metrics["subjects"] = n;
+  } catch (const ProtocolInterrupted& e) {  // metrics: the subjects completed before the stop
+    result.interrupted = e.stop;
   }
   result.metrics["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   FinishRun(s, result, opt.out_dir + "/result.json");

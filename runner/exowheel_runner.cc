@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "analysis/csv_table.h"
 #include "controller/exo_controller.h"
@@ -85,8 +86,9 @@ class ExowheelTrial : public CosimDevice {
     events_seen_ = result->events.size();
   }
 
-  // Runs the trial on the rig and adds its bus statistics and final state to the totals.
-  void Run(const CosimSchedule& schedule, const CosimProgress& progress) {
+  // Runs the trial on the rig and adds its bus statistics and final state to the totals; returns the
+  // stop request that ended it early (its trial field left to the caller), if any.
+  std::optional<RunInterruption> Run(const CosimSchedule& schedule, const CosimProgress& progress) {
     const double t_end = rig_.Run(schedule, *this, [this](double t) { ctrl_.Tick(t); }, progress);
     if (video_) {
       video_->Finish(t_end);
@@ -98,6 +100,8 @@ class ExowheelTrial : public CosimDevice {
     totals_->frames_dropped += st.drops;
     totals_->error_frames += st.error_frames;
     totals_->bus_load_max = std::max(totals_->bus_load_max, st.mean_load_percent);
+    if (!rig_.stopped_by()) return std::nullopt;
+    return RunInterruption{rig_.stopped_by(), t_end, 0};
   }
 
   void BeginStep(double t) override {
@@ -257,9 +261,12 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   ProgressBar bar(static_cast<size_t>(s.protocol.trials * schedule.steps), s.name, opt.progress);
   for (int trial = 0; trial < s.protocol.trials; ++trial) {
     ExowheelTrial run(s, opt, truth, plant, trial, can_log.get(), &result, &totals);
-    run.Run(schedule, {&bar, static_cast<size_t>(trial * schedule.steps)});
+    if ((result.interrupted = run.Run(schedule, {&bar, static_cast<size_t>(trial * schedule.steps)}))) {
+      result.interrupted->trial = trial + 1;
+      break;  // the trial's logs are closed (flushed) with it
+    }
   }
-  bar.Update(static_cast<size_t>(s.protocol.trials * schedule.steps));
+  if (!result.interrupted) bar.Update(static_cast<size_t>(s.protocol.trials * schedule.steps));
   bar.Finish();
 
   auto& m = result.metrics;

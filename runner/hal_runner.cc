@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "analysis/csv_table.h"
 #include "analysis/stress_metrics.h"
@@ -124,8 +125,10 @@ class HalTrial : public CosimDevice {
   // Runs the trial on the rig (DESIGN.md "Loop timing per 1 ms step"; the HAL knee node's frame torque
   // at t needs the step's acceleration a(t): Hal3Plant::interaction_torque, semi-implicit Euler, so the
   // node samples the instant t after the step, before the tick) and returns the run's metrics.
-  std::map<std::string, double> Run(const CosimProgress& progress) {
-    rig_->Run(schedule_, *this, [this](double t) { loop_->Tick(t); }, progress);
+  // A stop request ending it early is stored in *stop (its trial field left to the caller).
+  std::map<std::string, double> Run(const CosimProgress& progress, std::optional<RunInterruption>* stop) {
+    const double t_end = rig_->Run(schedule_, *this, [this](double t) { loop_->Tick(t); }, progress);
+    if (rig_->stopped_by()) *stop = RunInterruption{rig_->stopped_by(), t_end, 0};
     return Metrics();
   }
 
@@ -205,7 +208,7 @@ class HalTrial : public CosimDevice {
  private:
   std::map<std::string, double> Metrics() const {
     const double dt = dt_;
-    const long n_steps = schedule_.steps, log_every = schedule_.log_every;
+    const long n_steps = rig_->steps_run(), log_every = schedule_.log_every;
     std::map<std::string, double> m;
     m["samples"] = static_cast<double>((n_steps + log_every - 1) / log_every);  // log-rate rows (k % log_every == 0)
     m["emg_ext_up_V"] = ext_up_.get();
@@ -310,8 +313,12 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
     HalTrial trial(s, opt, seed, B_v, i, runs, &result, can_log.get(), i * (s.protocol.duration + 1.0));
     const size_t steps = static_cast<size_t>(trial.schedule().steps);
     if (!bar) bar = std::make_unique<ProgressBar>(runs * steps, s.name, opt.progress);
-    per_run.push_back(trial.Run({bar.get(), done}));
+    per_run.push_back(trial.Run({bar.get(), done}, &result.interrupted));
     done += steps;
+    if (result.interrupted) {
+      result.interrupted->trial = i + 1;
+      break;
+    }
   }
   if (bar) bar->Update(done), bar->Finish();
   // Single run (or trials): the metrics of the last run; a sweep adds per-value metrics.
@@ -319,7 +326,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   double samples = 0;
   for (const auto& r : per_run) samples += r.at("samples");
   m["samples"] = samples;  // all runs (trials or sweep values), as the EXOwheel runner counts trials
-  if (sweep) {
+  if (sweep && !result.interrupted) {  // the criteria compare whole runs: none for an interrupted sweep
     std::vector<double> J, Je, Jf;
     for (const auto& r : per_run) J.push_back(r.at("J_tau_m")), Je.push_back(r.at("J_e")), Jf.push_back(r.at("J_f"));
     const std::vector<double> Jme = NormalizeByMax(Je), Jmf = NormalizeByMax(Jf);  // LS05 eq. 13-18
@@ -359,7 +366,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
     WriteFileAtomic(opt.out_dir + "/sweep.svg", LineChartSvg(chart));
     result.files.push_back("sweep.svg");
   }
-  m["runs"] = runs;
+  m["runs"] = static_cast<double>(per_run.size());  // fewer than planned when interrupted
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   FinishRun(s, result, opt.out_dir + "/result.json");

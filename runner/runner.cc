@@ -10,6 +10,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/model_file.h"
 #include "core/error.h"
+#include "core/stop_signal.h"
 #include "runner/emg_calibration_protocol.h"
 #include "runner/exowheel_runner.h"
 #include "runner/hal_runner.h"
@@ -96,6 +97,10 @@ std::vector<CheckResult> Checks(const Scenario& s, const std::map<std::string, d
 void FinishRun(const Scenario& s, RunResult& result, const std::string& path) {
   std::string unknown;
   result.checks = Checks(s, result.metrics, &unknown);
+  if (result.interrupted) {
+    for (CheckResult& c : result.checks) c.passed = false;
+    unknown.clear();
+  }
   WriteResultJson(result, path);
   if (!unknown.empty()) throw InputError(unknown + " (the run's metrics are in " + path + ")");
 }
@@ -112,6 +117,11 @@ void WriteResultJson(const RunResult& r, const std::string& path) {
   for (const auto& kv : r.metrics) j["metrics"][kv.first] = kv.second;
   j["files"] = r.files;
   j["events"] = r.events;
+  if (r.interrupted)
+    j["interrupted"] = {{"signal", r.interrupted->signal},
+                        {"name", StopSignalName(r.interrupted->signal)},
+                        {"t_s", r.interrupted->t},
+                        {"trial", r.interrupted->trial}};
   WriteFileAtomic(path, j.dump(2) + "\n");
 }
 

@@ -33,6 +33,13 @@ struct CheckResult {
   bool passed = false;
 };
 
+// A run ended early by a stop request (SIGINT / SIGTERM, core/stop_signal.h).
+struct RunInterruption {
+  int signal = 0;   // 2 SIGINT, 15 SIGTERM
+  double t = 0;     // s, simulated time reached in the interrupted trial (its last step's end)
+  int trial = 1;    // the interrupted trial (1-based; HAL sweeps: the value's run)
+};
+
 struct RunResult {
   std::string scenario;
   uint64_t seed = 0;
@@ -40,6 +47,7 @@ struct RunResult {
   std::vector<CheckResult> checks;
   std::vector<std::string> files;  // written files
   std::vector<std::string> events; // fault events "t=... type joint"
+  std::optional<RunInterruption> interrupted;  // set when a stop request ended the run early
   bool all_passed() const;
 };
 
@@ -66,7 +74,9 @@ RunResult RunScenario(const Scenario& s, const RunOptions& opt);
 
 // End of a run: evaluates the checks on result.metrics, writes result.json at `path`, then throws
 // InputError if a check names a metric the run did not produce (that check is written as failed with
-// value null, so the metrics of a long run are kept on disk before the exit code 2).
+// value null, so the metrics of a long run are kept on disk before the exit code 2). An interrupted run
+// (result.interrupted) fails every check (value: the metric over the part that ran) and throws nothing:
+// a check holds for the whole scenario, which did not run.
 void FinishRun(const Scenario& s, RunResult& result, const std::string& path);
 
 // Writes result.json (atomically).

@@ -23,16 +23,9 @@ namespace {
 TEST(AbortKeepsLog, KilledRunLeavesReadableLog) {
   const testing::ScopedTempDir tmp("abort");
   const std::string dir = tmp.path();
-  const std::string bin = testing::ExotwinBin();
   const std::string scenario = std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/gait_2kmh.yaml";
-  const pid_t pid = fork();
+  const pid_t pid = testing::StartExotwin({"run", scenario, "--out", dir});
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    freopen("/dev/null", "w", stdout);
-    freopen("/dev/null", "w", stderr);
-    execl(bin.c_str(), bin.c_str(), "run", scenario.c_str(), "--out", dir.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
   // Wait until some rows are on disk, then kill without warning.
   const std::string log = dir + "/measured.csv";
   for (int i = 0; i < 2000; ++i) {  // up to 20 s (slow under sanitizers)

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -35,6 +36,24 @@ inline RunResult RunExotwin(const std::string& args) {
   const int st = pclose(p);
   r.exit_code = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
   return r;
+}
+
+// Starts `exotwin <args>` in a child process (stdout and stderr to /dev/null) and returns its pid,
+// -1 if fork fails; the caller waits for it (waitpid).
+inline pid_t StartExotwin(std::vector<std::string> args) {
+  const std::string bin = ExotwinBin();
+  args.insert(args.begin(), bin);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execv(bin.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
 }
 
 inline void WriteText(const std::string& path, const std::string& text) {
