@@ -57,7 +57,7 @@ struct HumanSpec {
 };
 
 // Hwang & Jeon 2015 sec. 4.3 EMG-to-torque calibration run as one scenario (EXOwheel with a
-// subject; scenarios/emg_calibration_protocol.h): MVC trials, isometric trials per joint (HJ15 eq. 25)
+// subject; runner/emg_calibration_protocol.h): MVC trials, isometric trials per joint (HJ15 eq. 25)
 // and, with `dynamic`, the exaggerated gait (HJ15 eq. 28) evaluated with three parameter sets.
 struct EmgCalibrationSpec {
   bool dynamic = true;                  // run the gait trial and fit beta, gamma (Table 7)
@@ -76,7 +76,7 @@ struct EmgCalibrationSpec {
   std::string fit_window = "active";
 };
 
-// HAL-3 settings (device: hal3 only; scenarios/hal_runner.h). The operator performs Hayashi's seated
+// HAL-3 settings (device: hal3 only; runner/hal_runner.h). The operator performs Hayashi's seated
 // 0.5 Hz knee swing (targets +1.0 / -0.3 rad) with co-contraction cc_down in swing-down.
 struct HalSpec {
   std::string mode = "impedance";   // none | impedance (tau_c only: Hayashi exp. 1, Lee & Sankai) | assist (exp. 2)
@@ -87,7 +87,7 @@ struct HalSpec {
   double swing_freq = 0.5;          // Hz
   double cc_up = 0.0, cc_down = 0.05;  // co-contraction drive (fraction of MVC) outside / in swing-down
   bool cc_synergy = false;          // TrackingGains::cocontraction_synergy (mix within each group)
-  // HKS05 eq. 2 calibration exercise (scenarios/hal_emg_calibration.h): contraction levels per direction
+  // HKS05 eq. 2 calibration exercise (runner/hal_emg_calibration.h): contraction levels per direction
   // from 2 % to calibration_hi of MVC, and the relaxed rest (s) that gives the baselines.
   int calibration_levels = 4;
   double calibration_hi = 0.12;
