@@ -13,6 +13,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/emg_diagnose.h"
 #include "analysis/number_text.h"
+#include "analysis/svg_chart.h"
 #include "core/error.h"
 
 namespace exotwin {
@@ -20,11 +21,6 @@ namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
 
-std::string Esc(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
-  return o;
-}
 
 std::string Joints(Muscle m) {
   std::string o;
@@ -61,34 +57,6 @@ nlohmann::json Effects(const EmgDiagnosis& d) {
   return a;
 }
 
-// One SVG line chart of several series over x.
-std::string Chart(const std::string& title, const std::vector<double>& x, const std::vector<const std::vector<double>*>& ys,
-                  const std::vector<std::string>& colors, const std::vector<std::string>& labels, size_t a, size_t b) {
-  const double W = 900, H = 260, L = 50, R = 10, T = 22, B = 26;
-  double y0 = 1e300, y1 = -1e300;
-  for (const auto* y : ys)
-    for (size_t i = a; i < b; ++i) y0 = std::min(y0, (*y)[i]), y1 = std::max(y1, (*y)[i]);
-  if (!(y1 > y0)) y1 = y0 + 1;
-  const double x0 = x[a], x1 = x[b - 1] > x0 ? x[b - 1] : x0 + 1;
-  std::ostringstream o;
-  o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
-    << "' style='border:1px solid #ccc;margin:4px'><text x='" << W / 2 << "' y='15' text-anchor='middle' font-size='13'>"
-    << Esc(title) << "</text>";
-  o << "<text x='" << L - 4 << "' y='" << T + 10 << "' font-size='10' text-anchor='end'>" << NumberText(y1, 3)
-    << "</text><text x='" << L - 4 << "' y='" << H - B << "' font-size='10' text-anchor='end'>" << NumberText(y0, 3)
-    << "</text><text x='" << L << "' y='" << H - 8 << "' font-size='10'>" << NumberText(x0, 4) << " s</text><text x='"
-    << W - R << "' y='" << H - 8 << "' font-size='10' text-anchor='end'>" << NumberText(x1, 4) << " s</text>";
-  for (size_t s = 0; s < ys.size(); ++s) {
-    o << "<polyline fill='none' stroke-width='1' stroke='" << colors[s] << "' points='";
-    for (size_t i = a; i < b; ++i)
-      o << NumberText(L + (x[i] - x0) / (x1 - x0) * (W - L - R), 5) << ","
-        << NumberText(T + (1 - ((*ys[s])[i] - y0) / (y1 - y0)) * (H - T - B), 5) << " ";
-    o << "'/><text x='" << L + 8 << "' y='" << T + 14 + 13 * s << "' font-size='11' fill='" << colors[s] << "'>"
-      << Esc(labels[s]) << "</text>";
-  }
-  o << "</svg>\n";
-  return o.str();
-}
 
 }  // namespace
 
@@ -144,14 +112,14 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
        "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
        "td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}</style></head><body>\n"
        "<h1>exotwin EMG model diagnosis</h1><p>Recordings: ";
-  for (size_t i = 0; i < d.sources.size(); ++i) o << (i ? ", " : "") << "<code>" << Esc(d.sources[i]) << "</code>";
+  for (size_t i = 0; i < d.sources.size(); ++i) o << (i ? ", " : "") << "<code>" << HtmlEscape(d.sources[i]) << "</code>";
   o << ". Fit on the first " << NumberText(100 * (1 - d.holdout_fraction)) << " % of every recording, scored on the rest"
     << (d.leave_one_out ? " and on each recording left out in turn" : "") << "; held-out scores over the samples within "
     << NumberText(kSpikeMads) << " scaled MADs of the median moment (contact spikes of inverse dynamics left out "
                                  "for every model alike).</p>";
   if (!d.notes.empty()) {
     o << "<ul>";
-    for (const auto& n : d.notes) o << "<li>" << Esc(n) << "</li>";
+    for (const auto& n : d.notes) o << "<li>" << HtmlEscape(n) << "</li>";
     o << "</ul>";
   }
   o << "<h2>Steps from the linear form to the final model</h2><table><tr><th>step</th><th>added</th><th>why</th>"
@@ -159,7 +127,7 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
        "<th>hip / knee R&sup2; all held-out samples</th></tr>";
   for (size_t i = 0; i < d.steps.size(); ++i) {
     const auto& F = d.steps[i].model.figures;
-    o << "<tr><td>" << i << "</td><td>" << Esc(d.steps[i].added) << "</td><td>" << Esc(d.steps[i].why) << "</td><td>"
+    o << "<tr><td>" << i << "</td><td>" << HtmlEscape(d.steps[i].added) << "</td><td>" << HtmlEscape(d.steps[i].why) << "</td><td>"
       << NumberText(F[0].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[0].rms_heldout_trim, 3) << "</td><td>"
       << NumberText(F[1].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[1].rms_heldout_trim, 3) << "</td><td>"
       << NumberText(F[0].r2_heldout, 3) << " / " << NumberText(F[1].r2_heldout, 3) << "</td></tr>";
@@ -167,10 +135,10 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
   o << "</table><h2>Named causes (fitted on every sample)</h2><table><tr><th>cause</th><th>joint</th><th>value</th>"
        "<th>95 % interval</th></tr>";
   for (const auto& e : Effects(d)) {
-    o << "<tr><td>" << Esc(e["name"].get<std::string>()) << (e.contains("muscle") ? " " + e["muscle"].get<std::string>() : "")
-      << (e.contains("parameter") ? " " + Esc(e["parameter"].get<std::string>()) : "") << "</td><td>"
+    o << "<tr><td>" << HtmlEscape(e["name"].get<std::string>()) << (e.contains("muscle") ? " " + e["muscle"].get<std::string>() : "")
+      << (e.contains("parameter") ? " " + HtmlEscape(e["parameter"].get<std::string>()) : "") << "</td><td>"
       << e["joint"].get<std::string>() << "</td><td>" << NumberText(e["value"].get<double>(), 4) << " "
-      << Esc(e["unit"].get<std::string>()) << "</td><td>";
+      << HtmlEscape(e["unit"].get<std::string>()) << "</td><td>";
     if (e.contains("ci95")) o << NumberText(e["ci95"][0].get<double>(), 4) << " .. " << NumberText(e["ci95"][1].get<double>(), 4);
     o << "</td></tr>";
   }
@@ -181,24 +149,28 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
     o << "</p>";
   }
   o << "<h2>Selection</h2><ol>";
-  for (const auto& s : d.selection) o << "<li>" << Esc(s) << "</li>";
+  for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
   o << "</ol><h2>Candidates</h2><table><tr><th>round</th><th>candidate</th><th>&Delta;BIC</th><th>held-out gain hip</th>"
        "<th>knee</th>"
     << (d.leave_one_out ? "<th>left-out hip</th><th>left-out knee</th>" : "") << "<th>verdict</th></tr>";
   for (const auto& c : d.scores) {
-    o << "<tr><td>" << c.round << "</td><td>" << Esc(c.label) << "</td><td>" << NumberText(c.delta_bic, 4) << "</td><td>"
+    o << "<tr><td>" << c.round << "</td><td>" << HtmlEscape(c.label) << "</td><td>" << NumberText(c.delta_bic, 4) << "</td><td>"
       << NumberText(c.gain_pct[0], 3) << " %</td><td>" << NumberText(c.gain_pct[1], 3) << " %</td>";
     if (d.leave_one_out)
       o << "<td>" << NumberText(c.left_out_gain_pct[0], 3) << " %</td><td>" << NumberText(c.left_out_gain_pct[1], 3) << " %</td>";
-    o << "<td>" << (c.added ? "<b>" : "") << Esc(c.verdict) << (c.added ? "</b>" : "") << "</td></tr>";
+    o << "<td>" << (c.added ? "<b>" : "") << HtmlEscape(c.verdict) << (c.added ? "</b>" : "") << "</td></tr>";
   }
   o << "</table>";
   if (d.t.size() > d.split + 2) {
     const size_t a = d.split, b = std::min(d.t.size(), a + static_cast<size_t>(10.0 / std::max(1e-6, d.t[1] - d.t[0])));
+    const std::vector<double> t(d.t.begin() + a, d.t.begin() + b);
+    auto part = [&](const std::vector<double>& y) { return std::vector<double>(y.begin() + a, y.begin() + b); };
     for (int j = 0; j < 2; ++j)
       o << "<h2>" << kJoint[j] << " (held-out, first 10 s)</h2>"
-        << Chart(std::string(kJoint[j]) + " moment (N m)", d.t, {&d.measured[j], &d.linear[j], &d.final_[j]},
-                 {"#000", "#d62728", "#1f77b4"}, {"inverse dynamics", "linear form", "final model"}, a, b);
+        << SvgChart(std::string(kJoint[j]) + " moment", "t (s)", "N m",
+                    {{t, part(d.measured[j]), "#000", "inverse dynamics"},
+                     {t, part(d.linear[j]), "#d62728", "linear form"},
+                     {t, part(d.final_[j]), "#1f77b4", "final model"}});
   }
   o << "</body></html>\n";
   return o.str();

@@ -7,8 +7,9 @@
 #include <sstream>
 
 #include "analysis/number_text.h"
-#include "core/yaml_fields.h"
 #include "core/error.h"
+#include "core/file_text.h"
+#include "core/units.h"
 
 namespace exotwin {
 namespace {
@@ -69,7 +70,7 @@ std::vector<double> StorageTable::AngleRad(const std::string& name) const {
     throw InputError(source + ": the header does not state the angle unit of '" + name +
                      "' (expected an inDegrees=yes or inDegrees=no line before endheader)");
   if (in_degrees == 1)
-    for (double& x : v) x *= M_PI / 180.0;
+    for (double& x : v) x *= kRadPerDeg;
   return v;
 }
 
@@ -159,7 +160,7 @@ StorageTable ParseStorage(const std::string& text, const std::string& source) {
 
 StorageTable ReadStorage(const std::string& path) {
   // The project's text-file reader (unreadable file, NUL bytes: InputError naming the file).
-  return ParseStorage(ReadYamlText(path, "OpenSim storage"), path);
+  return ParseStorage(ReadTextFile(path, "OpenSim storage", "an OpenSim storage (.sto/.mot) text file"), path);
 }
 
 }  // namespace exotwin
