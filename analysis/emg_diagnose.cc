@@ -178,14 +178,27 @@ bool Admissible(const Cause& c, const EmgTorqueModel& m, std::string* why) {
   return true;
 }
 
-// Refines every searched parameter of `s` in turn (fit rows only).
+// Refines the searched parameters of `s` jointly on the fit rows: coordinate descent over the
+// delays and A, each a grid minimum given the others, repeated until a whole pass moves none
+// (the SSE never rises, and the grid is finite, so it ends; kMaxRefinePasses bounds the cost).
+constexpr int kMaxRefinePasses = 10;
 void Refine(const Loop& loop, EmgModelSpec* s) {
-  for (auto& d : s->delay_s) {
-    double se;
-    loop.Search(s, DelayOf(d.first), kDelayStep, kMaxDelay, kDelayStep, kDelayStep, &se);
-    s->delay_se[d.first] = se;
+  for (int pass = 0; pass < kMaxRefinePasses; ++pass) {
+    bool moved = false;
+    for (auto& d : s->delay_s) {
+      const double before = d.second;
+      double se;
+      loop.Search(s, DelayOf(d.first), kDelayStep, kMaxDelay, kDelayStep, kDelayStep, &se);
+      s->delay_se[d.first] = se;
+      moved |= s->delay_s[d.first] != before;
+    }
+    if (s->a_shape != 0) {
+      const double before = s->a_shape;
+      loop.Search(s, AShapeOf, kMinA, -kAStep, kAStep, 0.1, &s->a_shape_se);
+      moved |= s->a_shape != before;
+    }
+    if (!moved) break;
   }
-  if (s->a_shape != 0) loop.Search(s, AShapeOf, kMinA, -kAStep, kAStep, 0.1, &s->a_shape_se);
 }
 
 void ProfileAll(const Loop& loop, EmgModelSpec* s) {
