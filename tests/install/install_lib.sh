@@ -1,0 +1,36 @@
+# Shared by tests/install/*_test.sh (sourced): checks on an installed tree.
+
+fail() { echo "FAIL: $*"; exit 1; }
+
+# no_source_path ROOT SRC: no program or library under ROOT (bin/, lib/) holds the source path.
+no_source_path() {
+  local root=$1 src=$2 f n=0
+  for f in "$root"/bin/* "$root"/lib/exotwin/*; do
+    [ -f "$f" ] || continue
+    n=$((n + 1))
+    if grep -q -a -F "$src" "$f"; then
+      strings -a "$f" | grep -F "$src" | head -5
+      fail "$f holds the source path $src"
+    fi
+  done
+  [ $n -gt 0 ] || fail "no program under $root/bin"
+  echo "ok: none of the $n programs and libraries under $root holds the source path $src"
+}
+
+# run_shipped ROOT WORK: runs a shipped scenario with ROOT/bin/exotwin from an unrelated working
+# directory (WORK/cwd), the data found next to the program; checks its result.json.
+run_shipped() {
+  local root=$1 work=$2 rc=0
+  mkdir -p "$work/cwd"
+  (cd "$work/cwd" && env -u EXOTWIN_DATA_DIR "$root/bin/exotwin" run \
+     "$root/share/exotwin/scenarios/faults/sensor_stuck.yaml" --out "$work/run" >"$work/run.log" 2>&1) || rc=$?
+  [ $rc -eq 0 ] || { cat "$work/run.log"; fail "exotwin run from $work/cwd: exit $rc, expected 0"; }
+  local r="$work/run/result.json"
+  [ -f "$r" ] || fail "no $r"
+  grep -q '"scenario": "fault_sensor_stuck"' "$r" || fail "$r does not name the scenario"
+  grep -q '"passed": true' "$r" || fail "$r has no passed check"
+  ! grep -q '"passed": false' "$r" || fail "$r has a failed check"
+  [ -f "$work/run/measured.csv" ] || [ -n "$(ls "$work"/run/*.csv 2>/dev/null)" ] || fail "the run wrote no CSV log"
+  [ -z "$(ls -A "$work/cwd")" ] || fail "the run wrote into its working directory: $(ls -A "$work/cwd")"
+  echo "ok: $root/bin/exotwin run (cwd $work/cwd): exit 0, $(grep -c '"passed": true' "$r") checks passed"
+}
