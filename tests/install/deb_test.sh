@@ -42,6 +42,6 @@ bad=$(grep -v -E '^\./(usr/?|usr/(bin|lib|share)(/.*)?)$' "$T/contents" || true)
 echo "ok: dpkg-deb -c: $(grep -c -v '/$' "$T/contents") files under /usr/bin, /usr/lib/exotwin, /usr/share/exotwin"
 
 dpkg-deb -x "$DEB" "$T/root"
-no_source_path "$T/root/usr" "$SRC"
+no_source_path "$T/root/usr" "$SRC" "$(realpath "$BUILD")"
 run_shipped "$T/root/usr" "$T/a"
 echo "ok: .deb test"

@@ -2,19 +2,22 @@
 
 fail() { echo "FAIL: $*"; exit 1; }
 
-# no_source_path ROOT SRC: no program or library under ROOT (bin/, lib/) holds the source path.
+# no_source_path ROOT SRC BUILD: no program or library under ROOT (bin/, lib/) holds the source
+# path or the build path (RPATH included).
 no_source_path() {
-  local root=$1 src=$2 f n=0
+  local root=$1 src=$2 build=$3 f p n=0
   for f in "$root"/bin/* "$root"/lib/exotwin/*; do
     [ -f "$f" ] || continue
     n=$((n + 1))
-    if grep -q -a -F "$src" "$f"; then
-      strings -a "$f" | grep -F "$src" | head -5
-      fail "$f holds the source path $src"
-    fi
+    for p in "$src" "$build"; do
+      if grep -q -a -F "$p" "$f"; then
+        strings -a "$f" | grep -F "$p" | head -5
+        fail "$f holds the path $p"
+      fi
+    done
   done
   [ $n -gt 0 ] || fail "no program under $root/bin"
-  echo "ok: none of the $n programs and libraries under $root holds the source path $src"
+  echo "ok: none of the $n programs and libraries under $root holds the source path $src or the build path $build"
 }
 
 # run_shipped ROOT WORK: runs a shipped scenario with ROOT/bin/exotwin from an unrelated working

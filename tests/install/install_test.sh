@@ -24,7 +24,7 @@ for d in mjcf data scenarios examples; do
 done
 echo "ok: layout bin/, lib/exotwin/, share/exotwin/{mjcf,data,scenarios (+ baselines),examples}"
 
-no_source_path "$P" "$SRC"
+no_source_path "$P" "$SRC" "$(realpath "$BUILD")"
 run_shipped "$P" "$T/a"
 
 # EXOTWIN_DATA_DIR overrides the program's location; a missing data folder is exit 2 naming it.
