@@ -5,7 +5,13 @@ fail() { echo "FAIL: $*"; exit 1; }
 # no_source_path ROOT SRC BUILD: no program or library under ROOT (bin/, lib/) holds the source
 # path or the build path (RPATH included).
 no_source_path() {
-  local root=$1 src=$2 build=$3 f p n=0
+  local root=$1 src=$2 build=$3 f p n=0 type
+  # Debug information and assertions name the source files: the check is for the release builds.
+  type=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt")
+  case "$type" in
+    Release|MinSizeRel) ;;
+    *) echo "skipped: source path check (a $type build names its source files in debug information or assertions)"; return 0 ;;
+  esac
   for f in "$root"/bin/* "$root"/lib/exotwin/*; do
     [ -f "$f" ] || continue
     n=$((n + 1))
