@@ -2,10 +2,11 @@
 # cpack -G DEB on the build tree as it is (nothing rebuilt): the package's metadata (dpkg-deb -I: name,
 # architecture, the Debian dependencies dpkg-shlibdeps found) and contents (dpkg-deb -c), then the
 # package extracted into a temporary root (dpkg-deb -x; nothing is installed into /usr) and a shipped
-# scenario run from there. Args: build dir, source dir.
+# scenario run from there. Args: build dir, source dir, build type.
 set -euo pipefail
 BUILD=$1
 SRC=$2
+BUILD_TYPE=${3:-Release}
 . "$(dirname "$0")/install_lib.sh"
 for tool in cpack dpkg-deb dpkg-shlibdeps; do
   command -v $tool >/dev/null || fail "$tool not found (scripts/setup.sh installs dpkg-dev and cmake)"
@@ -42,6 +43,6 @@ bad=$(grep -v -E '^\./(usr/?|usr/(bin|lib|share)(/.*)?)$' "$T/contents" || true)
 echo "ok: dpkg-deb -c: $(grep -c -v '/$' "$T/contents") files under /usr/bin, /usr/lib/exotwin, /usr/share/exotwin"
 
 dpkg-deb -x "$DEB" "$T/root"
-no_source_path "$T/root/usr" "$SRC" "$(realpath "$BUILD")"
+no_source_path "$T/root/usr" "$SRC" "$(realpath "$BUILD")" "$BUILD_TYPE"
 run_shipped "$T/root/usr" "$T/a"
 echo "ok: .deb test"

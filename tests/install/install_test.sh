@@ -2,10 +2,11 @@
 # cmake --install of the build tree as it is (nothing rebuilt) into a temporary prefix: the layout of
 # cmake/install.cmake, no source path in the installed programs, a shipped scenario run from an
 # unrelated working directory, the data folder overridden by EXOTWIN_DATA_DIR and reported when
-# missing (exit 2), an --out without write access (exit 2 naming it). Args: build dir, source dir.
+# missing (exit 2), an --out without write access (exit 2 naming it). Args: build dir, source dir, build type.
 set -euo pipefail
 BUILD=$1
 SRC=$2
+BUILD_TYPE=${3:-Release}
 . "$(dirname "$0")/install_lib.sh"
 T=$(mktemp -d "${TMPDIR:-/tmp}"/exotwin_install_XXXXXX)
 trap 'rm -rf "$T"' EXIT
@@ -24,7 +25,7 @@ for d in mjcf data scenarios examples; do
 done
 echo "ok: layout bin/, lib/exotwin/, share/exotwin/{mjcf,data,scenarios (+ baselines),examples}"
 
-no_source_path "$P" "$SRC" "$(realpath "$BUILD")"
+no_source_path "$P" "$SRC" "$(realpath "$BUILD")" "$BUILD_TYPE"
 run_shipped "$P" "$T/a"
 
 # EXOTWIN_DATA_DIR overrides the program's location; a missing data folder is exit 2 naming it.
