@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "app/bench_probes.h"
+#include "core/data_dir.h"
 #include "runner/fork_pool.h"
 #include "runner/runner.h"
 #include "runner/scenario_job.h"
@@ -42,7 +43,7 @@ double BestOf(int repeat, const std::function<void()>& f) {
 }
 
 Scenario GaitScenario(double duration) {
-  Scenario s = ReadScenario(std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/gait_2kmh.yaml");
+  Scenario s = ReadScenario(DataPath("scenarios/gait_2kmh.yaml"));
   s.protocol.duration = duration;
   s.protocol.ramp = std::min(s.protocol.ramp, duration / 4);
   s.log_measured_csv = false;
@@ -195,7 +196,7 @@ json BenchDiagnosis(const BenchConfig& c) {
   g.rate = 1000;
   g.effects = 1;
   g.allowed = {"coulomb_friction"};
-  const LegParams base = ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml");
+  const LegParams base = ReadModelFile(DataPath("examples/S1.yaml"));
   const auto t_gen0 = std::chrono::steady_clock::now();
   const GeneratedData data = GenerateMeasured(base, g);
   const double t_gen = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_gen0).count();

@@ -12,6 +12,7 @@
 
 #include "analysis/csv_table.h"
 #include "app/commands.h"
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "runner/fork_pool.h"
 #include "runner/progress_bar.h"
@@ -22,7 +23,7 @@ namespace {
 
 CommandRunner RegisterRegress(CLI::App& app) {
   struct Opts {
-    std::string suite = std::string(EXOTWIN_SOURCE_DIR) + "/scenarios", baselines, out = "out/regress";
+    std::string suite, baselines, out = "out/regress";  // suite: default scenarios/ of the data folder
     bool update = false, all = false;
     int jobs = 0;
   };
@@ -37,6 +38,7 @@ CommandRunner RegisterRegress(CLI::App& app) {
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->jobs < 0) throw InputError("--jobs: expected >= 1 (or 0 for the number of cores), got " + std::to_string(o->jobs));
+    if (o->suite.empty()) o->suite = DataPath("scenarios");
     const std::vector<SuiteEntry> suite = ListSuite(o->suite);
     const std::string baselines = o->baselines.empty() ? o->suite + "/baselines" : o->baselines;
     std::filesystem::create_directories(o->out);

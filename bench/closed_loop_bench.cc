@@ -12,6 +12,7 @@
 #include <mujoco/mujoco.h>
 
 
+#include "core/data_dir.h"
 #include "runner/runner.h"
 #include "sim/muscles.h"
 #include "sim/synthetic_emg.h"
@@ -48,7 +49,7 @@ BENCHMARK(BM_BareMjStep)->Unit(benchmark::kMillisecond);
 enum class Human { kRelaxedWithEmg, kRelaxedNoEmg, kExaggeratedWithEmg };
 
 void ClosedLoop(benchmark::State& state, bool logs, Human human = Human::kRelaxedWithEmg) {
-  Scenario s = ReadScenario(std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/gait_2kmh.yaml");
+  Scenario s = ReadScenario(DataPath("scenarios/gait_2kmh.yaml"));
   s.protocol.duration = kDuration;
   s.log_measured_csv = logs;
   s.human.emg = human != Human::kRelaxedNoEmg;

@@ -7,6 +7,7 @@
 #include "analysis/diagnose.h"
 #include "analysis/generate.h"
 #include "analysis/model_file.h"
+#include "core/data_dir.h"
 
 namespace exotwin {
 namespace {
@@ -20,14 +21,14 @@ const GeneratedData& TenMinutes(const std::string& effect) {
     g.effects = effect.empty() ? 0 : 1;
     if (!effect.empty()) g.allowed = {effect};
     it = cache.emplace(effect, GenerateMeasured(
-        ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml"), g)).first;
+        ReadModelFile(DataPath("examples/S1.yaml")), g)).first;
   }
   return it->second;
 }
 
 void Run(benchmark::State& state, const std::string& effect) {
   const GeneratedData& data = TenMinutes(effect);
-  const LegParams base = ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml");
+  const LegParams base = ReadModelFile(DataPath("examples/S1.yaml"));
   for (auto _ : state) {
     const Diagnosis d = Diagnose(base, data.data);
     benchmark::DoNotOptimize(d.joints[0].rmse_after);

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "core/file_text.h"
 #include "core/rng.h"
@@ -242,7 +243,7 @@ void GaitTrajectory::AnglesFromMarkers(double hip_x, double hip_y, double knee_x
 }
 
 std::string GaitTrajectory::DefaultWinterPath() {
-  return std::string(EXOTWIN_SOURCE_DIR) + "/data/WinterTableA1.txt";
+  return DataPath("data/WinterTableA1.txt");
 }
 
 namespace {

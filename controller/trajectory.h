@@ -172,7 +172,7 @@ class GaitTrajectory : public LegTrajectory {
   // Reads Winter's table (whitespace-separated, two quoted header lines, columns FRAME TIME RIB x y
   // HIP x y KNEE x y FIBULA x y ANKLE x y ..., cm) and fits. Throws InputError naming file and line.
   static GaitTrajectory FromWinterFile(const std::string& path, const GaitSpec& spec = GaitSpec());
-  // The shipped recording, EXOTWIN_SOURCE_DIR "/data/WinterTableA1.txt".
+  // The shipped recording, data/WinterTableA1.txt of the data folder (core/data_dir.h).
   static std::string DefaultWinterPath();
   void Sample(double t, JointSetpoint* hip, JointSetpoint* knee) const override;
   const FourierSeries& hip() const { return hip_; }

@@ -9,6 +9,7 @@
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
 #include "analysis/csv_table.h"
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
@@ -65,7 +66,7 @@ void Log(const Table5Options& opt, const std::string& line) {
 
 }  // namespace
 
-std::string ShippedScenarioDir() { return std::string(EXOTWIN_SOURCE_DIR) + "/scenarios"; }
+std::string ShippedScenarioDir() { return DataPath("scenarios"); }
 
 Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Options& opt) {
   if (opt.trials < 1) throw InputError("table5: --trials: expected at least 1");

@@ -34,7 +34,7 @@ struct Table5SubjectRun {
 // subject.yaml (identified). Throws InputError on bad options, SimulationError on divergence.
 Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Options& opt);
 
-// The shipped scenarios folder (source tree).
+// The shipped scenarios folder: scenarios/ of the data folder (core/data_dir.h).
 std::string ShippedScenarioDir();
 
 }  // namespace exotwin

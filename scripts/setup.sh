@@ -15,6 +15,7 @@ PKGS=(
   can-utils                           # log2asc for the candump round-trip test
   clang libclang-rt-14-dev            # libFuzzer targets in fuzz/ (-DEXOTWIN_FUZZ=ON, -fsanitize=fuzzer)
   parallel                            # GNU parallel: the sweep split-and-merge test (tests/cli)
+  slurm-wlm munge                     # a one-node Slurm for scripts/test_slurm.sh (the sweep job array)
 )
 
 missing=()

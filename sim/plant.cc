@@ -7,6 +7,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "model/passive_torque.h"
 #include "sim/realizability.h"
@@ -52,7 +53,7 @@ std::string FirstBadModelValue(const mjModel* m) {
 }  // namespace
 
 std::string ShippedModelPath(const std::string& file) {
-  return std::string(EXOTWIN_SOURCE_DIR) + "/mjcf/" + file;
+  return DataPath("mjcf/" + file);
 }
 
 std::string ExowheelMjcfPath(bool with_human) {

@@ -16,7 +16,7 @@ struct mjData_;
 
 namespace exotwin {
 
-// Path of a model shipped in mjcf/ (e.g. "leg_exowheel.xml").
+// Path of a model shipped in mjcf/ of the data folder (core/data_dir.h), e.g. "leg_exowheel.xml".
 std::string ShippedModelPath(const std::string& file);
 
 // The shipped EXOwheel model: leg_exowheel.xml (exoskeleton + human bodies) with a human, else
