@@ -1,6 +1,6 @@
 // OpenSim motion files through the command line (issue 18 item 3): a scenario driven by Winter's
 // stride written by the test as a .mot (`protocol: {trajectory: file, path: walk.mot}`), tracked as
-// the Winter-table gait scenario is; `run --sto` writes measured.sto / truth.sto that the reader
+// the Winter-table gait scenario is; `run --sto` (and `render --sto`) writes measured.sto / truth.sto that the reader
 // reads back to the CSVs' values; `predict` and `render-replay` take a .mot as --measured; bad motion
 // files exit 2 naming the file and the line.
 #include <gtest/gtest.h>
@@ -154,6 +154,27 @@ TEST_F(MotionFileCli, PredictAndRenderReplayTakeAMotionFile) {
                  dir_ + "/replay.mp4 --width 160 --height 120 --fps 10");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_GT(std::filesystem::file_size(dir_ + "/replay.mp4"), 1000u);
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+TEST(RenderSto, RenderWritesTheLogsAsStorageFilesOnRequest) {
+  const testing::ScopedTempDir tmp("render_sto");
+  const std::string dir = tmp.path();
+  WriteText(dir + "/s.yaml", "name: hold\ndevice: exowheel\nsubject: {preset: S1}\n"
+                             "protocol: {trajectory: hold, duration: 0.2, ramp: 0}\n");
+  const auto r = RunExotwin("render " + dir + "/s.yaml -o " + dir + "/v.mp4 --out " + dir + "/o --sto");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* base : {"measured", "truth"}) {
+    const CsvTable csv = ReadCsv(dir + "/o/" + base + ".csv");
+    const StorageTable sto = ReadStorage(dir + "/o/" + base + ".sto");
+    EXPECT_EQ(sto.rows(), csv.rows()) << base;
+    EXPECT_EQ(sto.Time(), csv.columns[csv.Find("t")]) << base;
+  }
 }
 
 }  // namespace
