@@ -1,8 +1,8 @@
 // OpenSim motion files through the command line (issue 18 item 3): a scenario driven by Winter's
 // stride written by the test as a .mot (`protocol: {trajectory: file, path: walk.mot}`), tracked as
-// the Winter-table gait scenario is; `run --sto` (and `render --sto`) writes measured.sto / truth.sto that the reader
-// reads back to the CSVs' values; `predict` and `render-replay` take a .mot as --measured; bad motion
-// files exit 2 naming the file and the line.
+// the Winter-table gait scenario is; `run --sto` (and `render --sto`) writes measured.sto /
+// truth.sto that the reader reads back to the CSVs' values; `predict` and `render-replay` take a
+// .mot as --measured; bad motion files exit 2 naming the file and the line.
 #include <gtest/gtest.h>
 
 #include <cstdio>
