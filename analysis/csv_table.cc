@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "analysis/number_rows.h"
 #include "core/error.h"
 #include "core/file_text.h"
 
@@ -262,18 +263,22 @@ void WriteCsv(const std::string& path, const std::vector<std::string>& names,
   for (const auto& c : comments) out += "# " + c + "\n";
   for (size_t i = 0; i < names.size(); ++i) out += (i ? "," : "") + names[i];
   out += "\n";
+  AppendNumberRows(out, columns, ',');
+  WriteFileAtomic(path, out);
+}
+
+void AppendNumberRows(std::string& out, const std::vector<const std::vector<double>*>& columns, char sep) {
   const size_t n = columns.empty() ? 0 : columns[0]->size();
   out.reserve(out.size() + n * columns.size() * 24);
   char buf[32];
   for (size_t r = 0; r < n; ++r) {
     for (size_t c = 0; c < columns.size(); ++c) {
       const int len = std::snprintf(buf, sizeof(buf), "%.17g", (*columns[c])[r]);
-      if (c) out += ',';
+      if (c) out += sep;
       out.append(buf, len);
     }
     out += '\n';
   }
-  WriteFileAtomic(path, out);
 }
 
 }  // namespace exotwin

@@ -5,6 +5,7 @@
 
 #include "analysis/measured_data.h"
 #include "analysis/number_text.h"
+#include "analysis/opensim_kinematics.h"
 #include "analysis/opensim_storage.h"
 #include "core/yaml_fields.h"
 #include "core/error.h"
@@ -127,18 +128,7 @@ EmgRecording ReadEmgRecording(const std::string& emg_path, const std::string& ki
   }
 
   // Kinematics on their own time base, derivatives there.
-  const StorageTable ik = ReadStorage(kinematics_path);
-  MeasuredData md;
-  md.source = kinematics_path;
-  md.t = ik.Time();
-  md.q_hip = ik.AngleRad(hip_coord);
-  md.q_knee = ik.AngleRad(knee_coord);
-  for (const auto* q : {&md.q_hip, &md.q_knee})
-    for (size_t i = 0; i < q->size(); ++i)
-      if (!std::isfinite((*q)[i]) || std::abs((*q)[i]) > kMaxHumanJointAngle)
-        throw InputError(kinematics_path + ": line " + std::to_string(ik.line_of_row[i]) + ": angle " +
-                         NumberText((*q)[i]) + " rad in column '" + (q == &md.q_hip ? hip_coord : knee_coord) +
-                         "' (expected a finite human joint angle)");
+  const MeasuredData md = KinematicsFromStorage(ReadStorage(kinematics_path), {hip_coord, knee_coord});
   const Kinematics kin = DeriveKinematics(md);
 
   StorageTable id;

@@ -6,6 +6,8 @@
 #include <set>
 #include <sstream>
 
+#include "analysis/csv_table.h"
+#include "analysis/number_rows.h"
 #include "analysis/number_text.h"
 #include "core/error.h"
 #include "core/file_text.h"
@@ -48,6 +50,15 @@ bool KeyValue(const std::string& line, std::string* key, std::string* value) {
   return true;
 }
 
+// SIMM-era motion header line "datarows 101" / "datacolumns 3" (key, blank, value; no '='): the
+// counts older tools write. Other lines without '=' are free text.
+bool SimmKeyValue(const std::string& line, std::string* key, std::string* value) {
+  const std::vector<std::string> f = Fields(line);
+  if (f.size() != 2 || (f[0] != "datarows" && f[0] != "datacolumns")) return false;
+  *key = f[0], *value = f[1];
+  return true;
+}
+
 }  // namespace
 
 int StorageTable::Find(const std::string& name) const {
@@ -67,8 +78,10 @@ const std::vector<double>& StorageTable::Column(const std::string& name, const s
 std::vector<double> StorageTable::AngleRad(const std::string& name) const {
   std::vector<double> v = Column(name, "joint angle");
   if (in_degrees < 0)
-    throw InputError(source + ": the header does not state the angle unit of '" + name +
-                     "' (expected an inDegrees=yes or inDegrees=no line before endheader)");
+    throw InputError(source + ": line " + std::to_string(endheader_line > 0 ? endheader_line : names_line) +
+                     ": the header does not state the angle unit of '" + name +
+                     "' (expected an inDegrees=yes or inDegrees=no line before " +
+                     (endheader_line > 0 ? "endheader" : "the column names; this file has no header") + ")");
   if (in_degrees == 1)
     for (double& x : v) x *= kRadPerDeg;
   return v;
@@ -93,7 +106,7 @@ StorageTable ParseStorage(const std::string& text, const std::string& source) {
       const std::string l = Trim(lines[end]);
       if (l == "endheader") break;
       std::string key, value;
-      if (!KeyValue(l, &key, &value)) continue;  // free text
+      if (!KeyValue(l, &key, &value) && !SimmKeyValue(l, &key, &value)) continue;  // free text
       const int line = static_cast<int>(end + 1);
       if (key == "inDegrees") {
         if (value == "yes") t.in_degrees = 1;
@@ -108,6 +121,7 @@ StorageTable ParseStorage(const std::string& text, const std::string& source) {
         (key == "nRows" || key == "datarows" ? n_rows : n_cols) = v;
       }
     }
+    if (end < lines.size()) t.endheader_line = static_cast<int>(end + 1);
     if (end == lines.size())
       Fail(source, static_cast<int>(k + 1),
            "a header without 'endheader' (an OpenSim storage file starts with the column names "
@@ -161,6 +175,43 @@ StorageTable ParseStorage(const std::string& text, const std::string& source) {
 StorageTable ReadStorage(const std::string& path) {
   // The project's text-file reader (unreadable file, NUL bytes: InputError naming the file).
   return ParseStorage(ReadTextFile(path, "OpenSim storage", "an OpenSim storage (.sto/.mot) text file"), path);
+}
+
+void WriteStorage(const std::string& path, const std::string& name, const std::vector<std::string>& names,
+                  const std::vector<const std::vector<double>*>& columns, bool in_degrees,
+                  const std::vector<std::string>& notes) {
+  if (names.size() != columns.size() || columns.empty())
+    throw InputError(path + ": internal: " + std::to_string(names.size()) + " column names for " +
+                     std::to_string(columns.size()) + " columns");
+  bool has_time = false;
+  for (const std::string& n : names) has_time = has_time || n == "time";
+  if (!has_time) throw InputError(path + ": internal: no 'time' column to write");
+  const size_t rows = columns[0]->size();
+  for (size_t c = 0; c < columns.size(); ++c)
+    if (columns[c]->size() != rows)
+      throw InputError(path + ": internal: column '" + names[c] + "' has " + std::to_string(columns[c]->size()) +
+                       " rows, '" + names[0] + "' " + std::to_string(rows));
+  std::string out = name + "\nversion=1\nnRows=" + std::to_string(rows) + "\nnColumns=" +
+                    std::to_string(names.size()) + "\ninDegrees=" + (in_degrees ? "yes" : "no") + "\n";
+  for (const std::string& n : notes) out += n + "\n";
+  out += "endheader\n";
+  for (size_t c = 0; c < names.size(); ++c) out += (c ? "\t" : "") + names[c];
+  out += '\n';
+  AppendNumberRows(out, columns, '\t');
+  WriteFileAtomic(path, out);
+}
+
+void CsvToStorage(const std::string& csv_path, const std::string& sto_path) {
+  const CsvTable csv = ReadCsv(csv_path);
+  if (csv.Find("t") < 0) throw InputError(csv_path + ": no column 't' (time, s) to write as 'time' in " + sto_path);
+  std::vector<std::string> names;
+  std::vector<const std::vector<double>*> cols;
+  for (size_t c = 0; c < csv.names.size(); ++c) {
+    names.push_back(csv.names[c] == "t" ? "time" : csv.names[c]);
+    cols.push_back(&csv.columns[c]);
+  }
+  WriteStorage(sto_path, sto_path.substr(sto_path.find_last_of('/') + 1), names, cols, false,
+               {"exotwin: the content of " + csv_path + " (SI units: s, rad, rad/s, N m, V)"});
 }
 
 }  // namespace exotwin

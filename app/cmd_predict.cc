@@ -7,8 +7,10 @@
 #include "analysis/derivative_cutoff.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
+#include "analysis/opensim_kinematics.h"
 #include "analysis/predict.h"
 #include "app/commands.h"
+#include "core/error.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -22,13 +24,16 @@ namespace {
 
 CommandRunner RegisterPredict(CLI::App& app) {
   struct Opts {
-    std::string params, measured, map, out, mjcf, cutoff = "20";
+    std::string params, measured, map, out, mjcf, cutoff = "20", side = "r";
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
       "predict", "Torque-sensor reading the twin predicts for measured kinematics (t,tau_hip,tau_knee)");
   sub->add_option("--params", o->params, "MODEL.yaml (lumped parameters, passive model, effects)")->required();
-  sub->add_option("--measured", o->measured, "measured-data CSV (t, q_hip, q_knee, ...)")->required();
+  sub->add_option("--measured", o->measured,
+                  "measured-data CSV (t, q_hip, q_knee, ...), or an OpenSim .mot/.sto motion file (kinematics only)")
+      ->required();
+  sub->add_option("--side", o->side, "leg of an OpenSim motion file: r (hip_flexion_r, knee_angle_r) or l");
   sub->add_option("--map", o->map, "column map (YAML) turning a foreign --measured CSV into the schema");
   sub->add_option("--out", o->out, "output CSV of the prediction")->required();
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
@@ -39,7 +44,14 @@ CommandRunner RegisterPredict(CLI::App& app) {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
     MapReport map_report;
-    const MeasuredData data = ReadMeasured(o->measured, o->map, 20, &map_report);
+    const MeasuredData data = ReadMeasuredKinematics(o->measured, o->map, o->side, 20, &map_report);
+    if (!HasTorque(data)) {
+      if (o->cutoff == "auto")
+        throw InputError(o->measured + ": --cutoff auto compares predicted with measured torque; this motion file "
+                         "holds kinematics only (give the cutoff in Hz)");
+      std::fprintf(stderr, "predict: %s holds kinematics only (no torque columns): the prediction is written, "
+                   "with no comparison against a measured torque\n", o->measured.c_str());
+    }
     if (!o->map.empty()) std::fprintf(stderr, "predict: %s", map_report.Summary().c_str());
     if (params.human) CheckHumanJointRange(data);
     Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);

@@ -1,4 +1,5 @@
-// `exotwin render-replay`: a video of measured data. The twin's leg follows the measured angles;
+// `exotwin render-replay`: a video of measured data (a measured-data CSV or an OpenSim motion file).
+// The twin's leg follows the measured angles;
 // overlays show the measured torque against the twin's estimate (from --predicted, else computed
 // with `predict`'s model) and EMG envelopes of any emg_* columns.
 #include <CLI/CLI.hpp>
@@ -11,6 +12,7 @@
 #include "analysis/csv_table.h"
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
+#include "analysis/opensim_kinematics.h"
 #include "analysis/predict.h"
 #include "app/commands.h"
 #include "core/error.h"
@@ -58,7 +60,7 @@ void ReadPredicted(const std::string& path, const MeasuredData& data, std::vecto
 
 CommandRunner RegisterRenderReplay(CLI::App& app) {
   struct Opts {
-    std::string params, measured, out, predicted, mjcf;
+    std::string params, measured, out, predicted, mjcf, side = "r";
     RenderOptions render;
   };
   auto o = std::make_shared<Opts>();
@@ -66,8 +68,11 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
       "render-replay", "MP4 video of measured data: the leg follows q_hip/q_knee, overlays compare the "
                        "measured torque with the twin's estimate");
   sub->add_option("--params", o->params, "MODEL.yaml (lumped parameters, passive model, effects)")->required();
-  sub->add_option("--measured", o->measured, "measured-data CSV (t, q_hip, q_knee, tau_hip, tau_knee, emg_*)")
+  sub->add_option("--measured", o->measured,
+                  "measured-data CSV (t, q_hip, q_knee, tau_hip, tau_knee, emg_*), or an OpenSim .mot/.sto motion "
+                  "file (kinematics only: the torque charts show the twin alone)")
       ->required();
+  sub->add_option("--side", o->side, "leg of an OpenSim motion file: r (hip_flexion_r, knee_angle_r) or l");
   sub->add_option("-o,--out", o->out, "output video (MP4, H.264)")->required();
   sub->add_option("--predicted", o->predicted,
                   "twin's prediction CSV (t,tau_hip,tau_knee, as written by `predict`); computed if absent");
@@ -79,7 +84,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
   return [sub, o]() -> int {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
-    const MeasuredData data = ReadMeasuredCsv(o->measured);
+    const MeasuredData data = ReadMeasuredKinematics(o->measured, "", o->side);
     Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
 
@@ -107,8 +112,8 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
       s.t = data.t[i];
       s.q_hip = data.q_hip[i];
       s.q_knee = data.q_knee[i];
-      s.tau_meas[0] = data.tau_hip[i];
-      s.tau_meas[1] = data.tau_knee[i];
+      s.tau_meas[0] = HasTorque(data) ? data.tau_hip[i] : NAN;  // NaN: not drawn
+      s.tau_meas[1] = HasTorque(data) ? data.tau_knee[i] : NAN;
       s.tau_est[0] = est[0][i];
       s.tau_est[1] = est[1][i];
       for (const auto& e : emg) s.emg.push_back(e[i]);

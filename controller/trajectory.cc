@@ -11,6 +11,7 @@
 #include "core/file_text.h"
 #include "core/rng.h"
 #include "core/units.h"
+#include "dsp/derivatives.h"
 
 namespace exotwin::controller {
 namespace {
@@ -377,6 +378,77 @@ GaitTrajectory GaitTrajectory::FromWinterFile(const std::string& path, const Gai
 void GaitTrajectory::Sample(double t, JointSetpoint* hip, JointSetpoint* knee) const {
   *hip = hip_.Eval(t);
   *knee = knee_.Eval(t);
+}
+
+// ---------------------------------------------------------------- TabulatedTrajectory
+
+TabulatedTrajectory::TabulatedTrajectory(double dt, const std::vector<double>& q_hip,
+                                         const std::vector<double>& q_knee, Extend extend, double cutoff_hz)
+    : dt_(dt), extend_(extend) {
+  if (!(Finite(dt) && dt > 0)) throw InputError("TabulatedTrajectory: dt must be > 0 s");
+  if (q_hip.size() != q_knee.size() || q_hip.size() < 2)
+    throw InputError("TabulatedTrajectory: hip and knee need the same number of samples, at least 2");
+  for (size_t i = 0; i < q_hip.size(); ++i)
+    if (!Finite(q_hip[i]) || !Finite(q_knee[i]))
+      throw InputError("TabulatedTrajectory: sample " + std::to_string(i) + " is not finite");
+  if (!(Finite(cutoff_hz) && cutoff_hz > 0 && cutoff_hz < 0.5 / dt))
+    throw InputError("TabulatedTrajectory: the derivative cutoff " + std::to_string(cutoff_hz) +
+                     " Hz must lie in (0, " + std::to_string(0.5 / dt) + ") Hz, below the samples' Nyquist frequency");
+  const size_t n = q_hip.size();
+  const std::vector<double>* in[2] = {&q_hip, &q_knee};
+  for (int j = 0; j < 2; ++j) {
+    if (extend == Extend::kLoop) {
+      std::vector<double> three;
+      three.reserve(3 * n);
+      for (int c = 0; c < 3; ++c) three.insert(three.end(), in[j]->begin(), in[j]->end());
+      const dsp::Derivatives d = dsp::ZeroPhaseDerivatives(three, dt, cutoff_hz);
+      q_[j].assign(d.filtered.begin() + n, d.filtered.begin() + 2 * n);
+      qd_[j].assign(d.first.begin() + n, d.first.begin() + 2 * n);
+      qdd_[j].assign(d.second.begin() + n, d.second.begin() + 2 * n);
+    } else {
+      dsp::Derivatives d = dsp::ZeroPhaseDerivatives(*in[j], dt, cutoff_hz);
+      q_[j] = std::move(d.filtered);
+      qd_[j] = std::move(d.first);
+      qdd_[j] = std::move(d.second);
+    }
+  }
+}
+
+double TabulatedTrajectory::Duration() const {
+  const double n = static_cast<double>(size());
+  return extend_ == Extend::kLoop ? n * dt_ : (n - 1.0) * dt_;
+}
+
+JointSetpoint TabulatedTrajectory::At(int joint, size_t i, size_t j, double s) const {
+  // Cubic Hermite basis on [0, 1] and its derivative (per unit s).
+  const double s2 = s * s, s3 = s2 * s;
+  const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+  const double q0 = q_[joint][i], q1 = q_[joint][j], v0 = qd_[joint][i], v1 = qd_[joint][j];
+  const double a0 = qdd_[joint][i], a1 = qdd_[joint][j];
+  return {h00 * q0 + h10 * dt_ * v0 + h01 * q1 + h11 * dt_ * v1,
+          h00 * v0 + h10 * dt_ * a0 + h01 * v1 + h11 * dt_ * a1,
+          a0 + s * (a1 - a0)};
+}
+
+void TabulatedTrajectory::Sample(double t, JointSetpoint* hip, JointSetpoint* knee) const {
+  const size_t n = size();
+  if (!(t > 0)) {
+    *hip = {q_[0][0], 0.0, 0.0};
+    *knee = {q_[1][0], 0.0, 0.0};
+    return;
+  }
+  if (extend_ == Extend::kHold && t >= Duration()) {
+    *hip = {q_[0][n - 1], 0.0, 0.0};
+    *knee = {q_[1][n - 1], 0.0, 0.0};
+    return;
+  }
+  double u = t / dt_;
+  if (extend_ == Extend::kLoop) u -= std::floor(u / static_cast<double>(n)) * static_cast<double>(n);
+  const size_t i = std::min(static_cast<size_t>(u), n - 1);
+  const size_t j = i + 1 < n ? i + 1 : 0;  // kHold never reaches i = n - 1 here
+  const double s = std::clamp(u - static_cast<double>(i), 0.0, 1.0);
+  *hip = At(0, i, j, s);
+  *knee = At(1, i, j, s);
 }
 
 }  // namespace exotwin::controller

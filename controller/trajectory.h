@@ -1,6 +1,7 @@
 // Reference trajectories for the joint position controllers: exciting trajectories for identification
 // (sums of harmonics, Hwang & Jeon 2015 sec. 3.3), physiological gait at 2 km/h (sec. 3.4, gait
-// pattern from Winter's marker data), a held joint, and compositions of them.
+// pattern from Winter's marker data), a recorded motion (TabulatedTrajectory), a held joint, and
+// compositions of them.
 //
 // Conventions (DESIGN.md): hip th1 = 0 hanging, flexion positive; knee th2 = 0 straight, flexion
 // negative; rad, rad/s, rad/s^2, s.
@@ -188,6 +189,38 @@ class GaitTrajectory : public LegTrajectory {
  private:
   FourierSeries hip_, knee_;
   double data_period_s_ = 0, rms_hip_ = 0, rms_knee_ = 0;
+};
+
+// A recorded leg motion sampled uniformly (e.g. an OpenSim motion file's stride, read and resampled
+// by the runner: the controller reads no file): sample i at t = i dt. Derivatives for the
+// feed-forward as the project takes them from recorded angles (dsp/derivatives.h
+// ZeroPhaseDerivatives: zero-phase 2nd-order Butterworth at cutoff_hz, central differences); the
+// reference q is the filtered angle. Between samples q and qd are cubic Hermite interpolants of
+// (q, qd) and (qd, qdd), qdd is linear, so q, qd are continuous.
+// Beyond the samples (t >= (n - 1) dt):
+//  - kLoop: the samples repeat with period n dt (the last sample is followed by the first: a file
+//    holding one stride without repeating its first pose at the end); derivatives are taken on the
+//    periodic extension (three copies, the middle one kept), so the seam has no filter transient.
+//  - kHold: the last (filtered) pose, at rest (qd = qdd = 0).
+// t < 0 gives the first pose at rest.
+class TabulatedTrajectory : public LegTrajectory {
+ public:
+  enum class Extend { kLoop, kHold };
+  // dt > 0 s; q_hip, q_knee of equal size >= 2, finite (rad); 0 < cutoff_hz < 1/(2 dt). Throws
+  // InputError otherwise.
+  TabulatedTrajectory(double dt, const std::vector<double>& q_hip, const std::vector<double>& q_knee,
+                      Extend extend, double cutoff_hz);
+  void Sample(double t, JointSetpoint* hip, JointSetpoint* knee) const override;
+  // kLoop: the period n dt; kHold: the span (n - 1) dt covered by the samples. s.
+  double Duration() const;
+  size_t size() const { return q_[0].size(); }
+  double dt() const { return dt_; }
+
+ private:
+  JointSetpoint At(int joint, size_t i, size_t j, double s) const;
+  double dt_;
+  Extend extend_;
+  std::vector<double> q_[2], qd_[2], qdd_[2];  // [0] hip, [1] knee: filtered angle and derivatives
 };
 
 }  // namespace exotwin::controller

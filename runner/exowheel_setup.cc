@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "analysis/number_text.h"
+#include "analysis/opensim_kinematics.h"
+#include "core/error.h"
 #include "core/units.h"
 #include "runner/runner.h"
 #include "sim/anthropometry.h"
@@ -20,6 +23,7 @@ using controller::HoldTrajectory;
 using controller::JointTrajectory;
 using controller::JointwiseTrajectory;
 using controller::LegTrajectory;
+using controller::TabulatedTrajectory;
 
 // The controller's model for the feed-forward: the exoskeleton (known from its own identification)
 // plus, with a subject, the De Leva anthropometric estimate from the subject's weight and lengths:
@@ -53,6 +57,25 @@ Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, 
   if (s.human.behaviour == "exaggerated_gait") return kGaitMeanPosture;
   if (s.human.behaviour == "isometric_hip" || s.human.behaviour == "isometric_knee") return start;
   return mp.q_rest;
+}
+
+// trajectory: file. The OpenSim motion file's hip and knee (analysis/opensim_kinematics.h), its first
+// sample at t = 0; a non-uniform record is interpolated linearly onto a uniform grid at its median
+// step (as analysis/measured_data.h DeriveKinematics does), then handed to the controller as samples.
+std::shared_ptr<const LegTrajectory> RecordedTrajectory(const ProtocolSpec& p) {
+  const MeasuredData m = ReadOpenSimKinematics(p.path, p.side);
+  const double dt = MedianStep(m.t);
+  const double span = m.t.back() - m.t.front();
+  const size_t n = static_cast<size_t>(std::floor(span / dt + 1e-9)) + 1;
+  std::vector<double> grid(n);
+  for (size_t i = 0; i < n; ++i) grid[i] = m.t.front() + static_cast<double>(i) * dt;
+  const std::vector<double> hip = Interpolate(m.t, m.q_hip, grid), knee = Interpolate(m.t, m.q_knee, grid);
+  if (!(p.cutoff < 0.5 / dt))
+    throw InputError(p.path + ": sampled at " + NumberText(1.0 / dt) + " Hz; protocol.cutoff " + NumberText(p.cutoff) +
+                     " Hz must lie below its Nyquist frequency " + NumberText(0.5 / dt) + " Hz");
+  return std::make_shared<TabulatedTrajectory>(
+      dt, hip, knee, p.extend == "hold" ? TabulatedTrajectory::Extend::kHold : TabulatedTrajectory::Extend::kLoop,
+      p.cutoff);
 }
 
 }  // namespace
@@ -93,6 +116,9 @@ std::shared_ptr<const LegTrajectory> BuildTrajectory(const Scenario& s, int tria
     case TrajectoryKind::kHold:
       inner = std::make_shared<JointwiseTrajectory>(std::make_shared<HoldTrajectory>(held("hip", 0.3)),
                                                     std::make_shared<HoldTrajectory>(held("knee", -0.5)));
+      break;
+    case TrajectoryKind::kFile:
+      inner = RecordedTrajectory(p);
       break;
   }
   if (p.ramp > 0) inner = std::make_shared<FadeInTrajectory>(inner, p.ramp);

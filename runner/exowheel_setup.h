@@ -16,7 +16,9 @@ namespace exotwin {
 
 // The reference of trial `trial` (0-based): gait (Winter, knee shifted by -3 deg to the exoskeleton's
 // stop), the identification excitation of the moving joint(s) with the others held at fixed_joints,
-// or a hold; faded in over protocol.ramp s.
+// a hold, or a recorded motion (trajectory: file: the OpenSim motion file at protocol.path, read here
+// and handed to the controller as samples, controller::TabulatedTrajectory); faded in over
+// protocol.ramp s. Throws InputError naming the motion file and line for a bad one.
 std::shared_ptr<const controller::LegTrajectory> BuildTrajectory(const Scenario& s, int trial);
 
 // The ExoController of the scenario: its gains, rate and limits, and as its feed-forward model the

@@ -147,16 +147,37 @@ void ParseFixedJoints(const YamlContext& r, const YAML::Node& n, Scenario& s) {
   }
 }
 
+// protocol: the recorded trajectory's settings (trajectory: file): path (relative to the scenario
+// file's folder), side, extend, cutoff. The file itself is read when the trial is built.
+void ParseProtocolFile(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  ProtocolSpec& p = s.protocol;
+  const bool file = p.trajectory == TrajectoryKind::kFile;
+  for (const char* k : {"path", "side", "extend", "cutoff"})
+    if (n[k] && !file) r.Fail(std::string("protocol.") + k, "only with trajectory: file" + YamlLine(n[k]));
+  if (!file) return;
+  if (!n["path"]) r.Fail("protocol.path", "required with trajectory: file (an OpenSim .mot or .sto motion file)");
+  p.path = YamlString(r, n["path"], "protocol.path");
+  if (p.path.empty()) r.Fail("protocol.path", "empty (expected an OpenSim .mot or .sto motion file)");
+  const size_t slash = s.source.find_last_of('/');
+  if (p.path[0] != '/' && slash != std::string::npos) p.path = s.source.substr(0, slash + 1) + p.path;
+  if (n["side"]) p.side = YamlString(r, n["side"], "protocol.side", {"r", "l"});
+  if (n["extend"]) p.extend = YamlString(r, n["extend"], "protocol.extend", {"loop", "hold"});
+  if (n["cutoff"]) p.cutoff = YamlNumber(r, n["cutoff"], "protocol.cutoff", 0.1, 500);
+}
+
 // protocol: trajectory, duration, trials and the excitation's settings.
 void ParseProtocol(const YamlContext& r, const YAML::Node& n, Scenario& s) {
   YamlCheckKeys(r, n, "protocol", {"trajectory", "duration", "trials", "stride_period", "moving_joint",
-                         "excitation_seed", "ramp"});
+                         "excitation_seed", "ramp", "path", "side", "extend", "cutoff"});
   ProtocolSpec& p = s.protocol;
   if (n["trajectory"]) {
-    const std::string t = YamlString(r, n["trajectory"], "protocol.trajectory", {"gait", "excitation", "hold"});
+    const std::string t =
+        YamlString(r, n["trajectory"], "protocol.trajectory", {"gait", "excitation", "hold", "file"});
     p.trajectory = t == "gait" ? TrajectoryKind::kGait
-                               : (t == "excitation" ? TrajectoryKind::kExcitation : TrajectoryKind::kHold);
+                               : (t == "excitation" ? TrajectoryKind::kExcitation
+                                                    : (t == "hold" ? TrajectoryKind::kHold : TrajectoryKind::kFile));
   }
+  ParseProtocolFile(r, n, s);
   if (n["duration"]) p.duration = YamlNumber(r, n["duration"], "protocol.duration", 0.01, 3600);
   if (n["trials"]) p.trials = static_cast<int>(YamlNumber(r, n["trials"], "protocol.trials", 1, 100));
   if (n["stride_period"]) p.stride_period = YamlNumber(r, n["stride_period"], "protocol.stride_period", 0.5, 10);

@@ -12,7 +12,7 @@
 namespace exotwin {
 
 enum class Device { kExowheel, kExowheelExoOnly, kHal3 };
-enum class TrajectoryKind { kGait, kExcitation, kHold };
+enum class TrajectoryKind { kGait, kExcitation, kHold, kFile };
 
 struct SubjectSpec {
   std::string preset;          // "S1".."S10"
@@ -29,6 +29,11 @@ struct ProtocolSpec {
   std::string moving_joint = "both";  // excitation: hip | knee | both
   uint64_t excitation_seed = 1;
   double ramp = 1.0;            // s: the controller ramps from the start pose to the trajectory
+  // trajectory: file (DESIGN.md "OpenSim motion files"): an OpenSim .mot/.sto, its first sample at t = 0
+  std::string path;             // as resolved: relative paths are relative to the scenario file's folder
+  std::string side = "r";       // r | l: hip_flexion_<side>, knee_angle_<side>
+  std::string extend = "loop";  // loop (the file holds one stride, repeated) | hold (last pose at rest)
+  double cutoff = 20.0;         // Hz, the derivative filter of the recorded angles (HJ15 sec. 3.2)
 };
 
 // One injected fault: `type` as in hwsim (sensor_stuck, sensor_stale, encoder_glitch, frame_drop,

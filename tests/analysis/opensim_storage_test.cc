@@ -6,30 +6,23 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "core/error.h"
+#include "tests/expect_input_error.h"
 #include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
 
-// Expects f() to throw InputError whose message contains every piece.
-template <typename F>
-void ExpectThrows(F f, const std::vector<std::string>& pieces) {
-  try {
-    f();
-    ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    for (const auto& p : pieces) EXPECT_NE(m.find(p), std::string::npos) << "'" << p << "' not in: " << m;
-  }
-}
+using testing::ExpectInputError;
+
 
 // Expects ParseStorage(text) to throw InputError naming the file and every piece.
 void ExpectError(const std::string& text, std::vector<std::string> pieces) {
   pieces.push_back("f.sto: ");
-  ExpectThrows([&] { ParseStorage(text, "f.sto"); }, pieces);
+  ExpectInputError([&] { ParseStorage(text, "f.sto"); }, pieces);
 }
 
 TEST(OpenSimStorage, VersionOneHeaderInDegrees) {
@@ -122,7 +115,7 @@ TEST(OpenSimStorage, EmptyOrTooShort) {
 
 TEST(OpenSimStorage, AngleUnitMustBeStated) {
   const StorageTable t = ParseStorage("endheader\ntime q\n0 1\n1 2\n", "k.sto");
-  ExpectThrows([&] { t.AngleRad("q"); }, {"k.sto", "inDegrees"});
+  ExpectInputError([&] { t.AngleRad("q"); }, {"k.sto", "inDegrees"});
   EXPECT_THROW(t.Column("nope", "angle"), InputError);
 }
 
@@ -131,7 +124,59 @@ TEST(OpenSimStorage, ReadsFilesAndNamesUnreadableOnes) {
   const std::string dir = dir_tmp.path();
   std::ofstream(dir + "/a.sto") << "endheader\ntime a\n0 1\n1 2\n";
   EXPECT_EQ(ReadStorage(dir + "/a.sto").rows(), 2u);
-  ExpectThrows([&] { ReadStorage(dir + "/missing.sto"); }, {"missing.sto", "cannot open"});
+  ExpectInputError([&] { ReadStorage(dir + "/missing.sto"); }, {"missing.sto", "cannot open"});
+}
+
+TEST(OpenSimStorage, SimmCountsWithoutEquals) {
+  const StorageTable t = ParseStorage("name walk.mot\ndatacolumns 2\ndatarows 2\nrange 0 1\ninDegrees=no\n"
+                                      "endheader\ntime q\n0 1\n1 2\n", "s.mot");
+  EXPECT_EQ(t.rows(), 2u);
+  EXPECT_EQ(t.endheader_line, 6);
+  ExpectError("datacolumns 3\nendheader\ntime a\n0 1\n1 1\n", {"line 3", "nColumns=3"});
+  ExpectError("datarows 3\nendheader\ntime a\n0 1\n1 1\n", {"nRows=3", "2 rows"});
+  ExpectError("datarows x\nendheader\ntime a\n0 1\n1 1\n", {"line 1", "non-negative integer"});
+}
+
+TEST(OpenSimStorage, UnstatedAngleUnitNamesTheHeaderLine) {
+  const StorageTable t = ParseStorage("ik\nnRows=2\nendheader\ntime q\n0 1\n1 2\n", "k.sto");
+  ExpectInputError([&] { t.AngleRad("q"); }, {"k.sto: line 3", "inDegrees"});
+}
+
+TEST(OpenSimStorage, WriteStorageRoundTripsThroughTheReader) {
+  const testing::ScopedTempDir tmp("sto_w");
+  const std::string path = tmp.path() + "/out.sto";
+  const std::vector<double> t = {0.0, 0.001, 0.002}, q = {0.1, -1.0 / 3.0, 2e-300}, tau = {-12.5, 1e300, M_PI};
+  WriteStorage(path, "out.sto", {"time", "q_knee", "tau_knee"}, {&t, &q, &tau}, false, {"a free line"});
+  const StorageTable r = ReadStorage(path);
+  EXPECT_EQ(r.in_degrees, 0);
+  EXPECT_EQ(r.endheader_line, 7);  // name, version, nRows, nColumns, inDegrees, note, endheader
+  EXPECT_EQ(r.names, (std::vector<std::string>{"time", "q_knee", "tau_knee"}));
+  EXPECT_EQ(r.Time(), t);  // "%.17g": bit-identical
+  EXPECT_EQ(r.AngleRad("q_knee"), q);
+  EXPECT_EQ(r.Column("tau_knee", ""), tau);
+  std::string text;
+  {
+    std::ifstream in(path);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  EXPECT_EQ(text.substr(0, 42), "out.sto\nversion=1\nnRows=3\nnColumns=3\ninDeg");
+  EXPECT_NE(text.find("endheader\ntime\tq_knee\ttau_knee\n0\t0.10000000000000001\t"), std::string::npos) << text;
+  ExpectInputError([&] { WriteStorage(path, "x", {"t", "q"}, {&t, &q}, false); }, {"no 'time'"});
+  ExpectInputError([&] { WriteStorage(tmp.path() + "/no/such/dir/x.sto", "x", {"time"}, {&t}, false); }, {"x.sto"});
+}
+
+TEST(OpenSimStorage, CsvToStorageKeepsEveryColumnAndValue) {
+  const testing::ScopedTempDir tmp("sto_c");
+  const std::string dir = tmp.path();
+  std::ofstream(dir + "/measured.csv") << "# a comment\nt,q_hip,tau_hip\n0,0.5,1.25\n0.001,0.30000000000000004,-7\n";
+  CsvToStorage(dir + "/measured.csv", dir + "/measured.sto");
+  const StorageTable r = ReadStorage(dir + "/measured.sto");
+  EXPECT_EQ(r.names, (std::vector<std::string>{"time", "q_hip", "tau_hip"}));
+  EXPECT_EQ(r.in_degrees, 0);
+  EXPECT_EQ(r.AngleRad("q_hip"), (std::vector<double>{0.5, 0.30000000000000004}));
+  EXPECT_EQ(r.Column("tau_hip", ""), (std::vector<double>{1.25, -7}));
+  std::ofstream(dir + "/x.csv") << "time_s,q\n0,1\n";
+  ExpectInputError([&] { CsvToStorage(dir + "/x.csv", dir + "/x.sto"); }, {"x.csv", "no column 't'"});
 }
 
 TEST(OpenSimStorage, ReadsTheRealRecording) {

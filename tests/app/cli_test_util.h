@@ -14,6 +14,15 @@
 
 namespace exotwin::testing {
 
+// A MODEL.yaml of the exoskeleton with a subject (Table 3/4 values, Riener passive torque), for the
+// commands that take --params.
+inline constexpr char kSubjectModelYaml[] =
+    "L1: 0.41\n"
+    "exo:   {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
+    "human: {J1: 1.69, J2: 0.37, X1: 4.54, X2: 1.20, Y1: -0.16, Y2: 0.42}\n"
+    "passive: riener1999\n"
+    "effects: []\n";
+
 struct RunResult {
   int exit_code = -1;
   std::string output;  // stdout + stderr

@@ -16,12 +16,7 @@ namespace {
 using testing::RunExotwin;
 using testing::WriteText;
 
-const char kModel[] =
-    "L1: 0.41\n"
-    "exo:   {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
-    "human: {J1: 1.69, J2: 0.37, X1: 4.54, X2: 1.20, Y1: -0.16, Y2: 0.42}\n"
-    "passive: riener1999\n"
-    "effects: []\n";
+constexpr const char* kModel = testing::kSubjectModelYaml;
 
 // 2 s at 1 kHz, with two EMG channels.
 std::string MeasuredCsv() {

@@ -309,3 +309,108 @@ TEST(GaitTrajectory, BadFilesAreInputErrors) {
 
 }  // namespace
 }  // namespace exotwin::controller
+
+// ---------------------------------------------------------------- TabulatedTrajectory
+
+namespace exotwin::controller {
+namespace {
+
+// One period of q(t) = c + a sin(2 pi t / T) + b cos(4 pi t / T), sampled every dt over [0, T).
+struct Periodic {
+  double T = 1.2, dt = 0.01;
+  std::vector<double> hip, knee;
+  Periodic() {
+    for (int i = 0; i < 120; ++i) {
+      hip.push_back(Q(0.1, 0.3, 0.05, i * dt));
+      knee.push_back(Q(-0.6, 0.4, -0.1, i * dt));
+    }
+  }
+  double w() const { return 2 * M_PI / T; }
+  // Bound on |d^n q_knee / dt^n|: 0.4 w^n + 0.1 (2 w)^n.
+  double KneeBound(int n) const { return 0.4 * std::pow(w(), n) + 0.1 * std::pow(2 * w(), n); }
+  double Q(double c, double a, double b, double t) const { return c + a * std::sin(w() * t) + b * std::cos(2 * w() * t); }
+  JointSetpoint Exact(double c, double a, double b, double t) const {
+    return {Q(c, a, b, t), a * w() * std::cos(w() * t) - 2 * b * w() * std::sin(2 * w() * t),
+            -a * w() * w() * std::sin(w() * t) - 4 * b * w() * w() * std::cos(2 * w() * t)};
+  }
+};
+
+TEST(TabulatedTrajectory, LoopedStrideFollowsTheSignalAndItsDerivativesAcrossTheSeam) {
+  const Periodic p;
+  // 20 Hz cutoff on a 0.83 / 1.67 Hz signal: the zero-phase filter's gain there is 1 - 1e-7.
+  const TabulatedTrajectory tr(p.dt, p.hip, p.knee, TabulatedTrajectory::Extend::kLoop, 20.0);
+  EXPECT_DOUBLE_EQ(tr.Duration(), 1.2);
+  double worst[3] = {0, 0, 0};
+  for (int i = 1; i < 4000; ++i) {  // three periods and more, off the sample instants
+    const double t = i * 0.000917;
+    JointSetpoint h, k;
+    tr.Sample(t, &h, &k);
+    const JointSetpoint eh = p.Exact(0.1, 0.3, 0.05, t), ek = p.Exact(-0.6, 0.4, -0.1, t);
+    worst[0] = std::max({worst[0], std::abs(h.q - eh.q), std::abs(k.q - ek.q)});
+    worst[1] = std::max({worst[1], std::abs(h.qd - eh.qd), std::abs(k.qd - ek.qd)});
+    worst[2] = std::max({worst[2], std::abs(h.qdd - eh.qdd), std::abs(k.qdd - ek.qdd)});
+  }
+  // Central differences at dt = 10 ms put qd off by max|q^(3)| dt^2 / 6 at the samples and qdd (the
+  // gradient of the gradient, a step of 2 dt) by max|q^(4)| dt^2 / 3; the linear qdd between samples
+  // adds max|q^(4)| dt^2 / 8, and the zero-phase filter scales a harmonic at f by 1 / (1 + (f / 20 Hz)^4).
+  // The knee's bounds: 2.9e-3 rad/s, 0.070 rad/s^2 (of 55).
+  const double filter = std::pow(2.0 / p.T / 20.0, 4);
+  EXPECT_LT(worst[0], 2e-5);
+  EXPECT_LT(worst[1], p.KneeBound(3) * p.dt * p.dt / 6 + p.KneeBound(1) * filter);
+  EXPECT_LT(worst[2], p.KneeBound(4) * p.dt * p.dt * (1.0 / 3 + 1.0 / 8) + p.KneeBound(2) * filter);
+}
+
+TEST(TabulatedTrajectory, QAndQdAreContinuousAndConsistent) {
+  const Periodic p;
+  const TabulatedTrajectory tr(p.dt, p.hip, p.knee, TabulatedTrajectory::Extend::kLoop, 20.0);
+  // Across sample instants (including the seam at 1.2 s) q and qd are continuous.
+  for (double ts : {0.05, 0.5, 1.19, 1.2, 2.4}) {
+    JointSetpoint a, b, k;
+    tr.Sample(ts - 1e-9, &a, &k);
+    tr.Sample(ts + 1e-9, &b, &k);
+    EXPECT_NEAR(a.q, b.q, 1e-8) << ts;
+    EXPECT_NEAR(a.qd, b.qd, 1e-6) << ts;
+  }
+  // qd against the slope of q, qdd against the slope of qd: they differ by the derivative estimates'
+  // errors e at the samples (bounds above): mid-interval, the slope of the cubic through (q, qd) is
+  // 3/2 (q1 - q0) / dt - (qd0 + qd1) / 4, off by -e/2 where the interpolated qd is off by e.
+  const double h = 1e-5;
+  for (double t = 0.013; t < 2.5; t += 0.0123) {
+    JointSetpoint m, c, pl, k;
+    tr.Sample(t - h, &k, &m);
+    tr.Sample(t, &k, &c);
+    tr.Sample(t + h, &k, &pl);
+    EXPECT_NEAR(c.qd, (pl.q - m.q) / (2 * h), 1.5 * p.KneeBound(3) * p.dt * p.dt / 6) << t;
+    EXPECT_NEAR(c.qdd, (pl.qd - m.qd) / (2 * h), p.KneeBound(4) * p.dt * p.dt * (1.0 / 3 + 1.0 / 8)) << t;
+  }
+}
+
+TEST(TabulatedTrajectory, HoldKeepsTheLastPoseAtRestAndStartsAtRest) {
+  const Periodic p;
+  const TabulatedTrajectory tr(p.dt, p.hip, p.knee, TabulatedTrajectory::Extend::kHold, 20.0);
+  EXPECT_NEAR(tr.Duration(), 1.19, 1e-12);
+  JointSetpoint h, k, h_end, k_end;
+  tr.Sample(1.19 - 1e-12, &h_end, &k_end);
+  tr.Sample(5.0, &h, &k);
+  EXPECT_NEAR(h.q, h_end.q, 1e-9);
+  EXPECT_NEAR(k.q, p.knee.back(), 2e-3);  // filtered, one-sided at the end
+  EXPECT_EQ(h.qd, 0.0);
+  EXPECT_EQ(k.qdd, 0.0);
+  tr.Sample(-1.0, &h, &k);
+  EXPECT_EQ(h.qd, 0.0);
+  EXPECT_NEAR(h.q, p.hip[0], 2e-3);
+}
+
+TEST(TabulatedTrajectory, RejectsBadSamples) {
+  const std::vector<double> two = {0, 1}, one = {0};
+  using E = TabulatedTrajectory::Extend;
+  EXPECT_THROW(TabulatedTrajectory(0.0, two, two, E::kLoop, 1.0), InputError);
+  EXPECT_THROW(TabulatedTrajectory(0.01, one, one, E::kLoop, 1.0), InputError);
+  EXPECT_THROW(TabulatedTrajectory(0.01, two, one, E::kLoop, 1.0), InputError);
+  EXPECT_THROW(TabulatedTrajectory(0.01, {0, NAN}, two, E::kHold, 1.0), InputError);
+  EXPECT_THROW(TabulatedTrajectory(0.01, two, two, E::kHold, 50.0), InputError);  // at Nyquist
+  EXPECT_NO_THROW(TabulatedTrajectory(0.01, two, two, E::kHold, 49.0));
+}
+
+}  // namespace
+}  // namespace exotwin::controller

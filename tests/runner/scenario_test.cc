@@ -89,3 +89,36 @@ TEST(Scenario, ExaggeratedGaitOutwardGate) {
 
 }  // namespace
 }  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+TEST(Scenario, RecordedTrajectoryPathIsRelativeToTheScenarioFile) {
+  const char yaml[] = "name: x\ndevice: exowheel\nsubject: {preset: S1}\n"
+                      "protocol: {trajectory: file, path: motions/walk.mot, side: l, extend: hold, cutoff: 8}\n";
+  const Scenario s = ParseScenarioYaml(yaml, "/data/scen/a.yaml");
+  EXPECT_EQ(s.protocol.trajectory, TrajectoryKind::kFile);
+  EXPECT_EQ(s.protocol.path, "/data/scen/motions/walk.mot");
+  EXPECT_EQ(s.protocol.side, "l");
+  EXPECT_EQ(s.protocol.extend, "hold");
+  EXPECT_DOUBLE_EQ(s.protocol.cutoff, 8.0);
+  EXPECT_EQ(ParseScenarioYaml(yaml, "a.yaml").protocol.path, "motions/walk.mot");  // beside a.yaml in the cwd
+  const Scenario d = ParseScenarioYaml("name: x\ndevice: exowheel\nsubject: {preset: S1}\n"
+                                       "protocol: {trajectory: file, path: /abs/w.sto}\n", "s/a.yaml");
+  EXPECT_EQ(d.protocol.path, "/abs/w.sto");
+  EXPECT_EQ(d.protocol.side, "r");
+  EXPECT_EQ(d.protocol.extend, "loop");
+  EXPECT_DOUBLE_EQ(d.protocol.cutoff, 20.0);
+}
+
+TEST(Scenario, RecordedTrajectoryBadSettings) {
+  const std::string head = "name: x\ndevice: exowheel\nsubject: {preset: S1}\n";
+  ExpectError(head + "protocol: {trajectory: file}\n", "protocol.path: required");
+  ExpectError(head + "protocol: {trajectory: file, path: w.mot, side: x}\n", "protocol.side");
+  ExpectError(head + "protocol: {trajectory: file, path: w.mot, extend: mirror}\n", "protocol.extend");
+  ExpectError(head + "protocol: {trajectory: gait, path: w.mot}\n", "protocol.path: only with trajectory: file");
+  ExpectError(head + "protocol: {trajectory: file, path: w.mot, cutoff: 0}\n", "protocol.cutoff");
+}
+
+}  // namespace
+}  // namespace exotwin
