@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "controller/controller_config.h"  // ControllerSpec: the controller block
 #include "model/lumped_params.h"
 
 namespace exotwin {
@@ -121,9 +122,7 @@ struct HardwareSpec {
                                     // JointModuleSpec / Hal3KneeNodeSpec::torque_sensor_skew
 };
 
-struct ControllerSpec {
-  double rate_hz = 1000;
-  double kp[2] = {600, 400};   // N m/rad
+  // N m/rad
   double kd[2] = {30, 15};     // N m s/rad
   bool feedforward = true;     // inverse-dynamics feed-forward from the controller's own model
   double torque_limit = 100;   // N m, supervisor limit
