@@ -142,7 +142,12 @@ CommandRunner RegisterServe(CLI::App& app) {
                  link->Describe().c_str(), static_cast<unsigned long long>(st.received),
                  static_cast<unsigned long long>(st.sent), static_cast<unsigned long long>(st.foreign),
                  static_cast<unsigned long long>(st.malformed), remote.deterministic() ? "" : "; run NOT deterministic (controller lost)");
-    return Report(r, o->out);
+    const int rc = Report(r, o->out);
+    if (rc == 0 && !remote.deterministic()) {
+      std::fprintf(stderr, "exotwin serve: the controller was lost (result.json events): the run fails\n");
+      return 1;
+    }
+    return rc;
   };
 }
 

@@ -40,6 +40,8 @@ struct CanLink::Impl {
 
 namespace {
 
+constexpr double kSendWait = 0.1;  // s
+
 [[noreturn]] void Fail(const BusAddress& a, const std::string& socket, const std::string& what, int err) {
   throw InputError("--bus " + a.text + ": " + socket + ": " + what + (err ? std::string(": ") + std::strerror(err) : ""));
 }
@@ -159,8 +161,16 @@ CanStatus CanLink::Send(const CanFrame& frame) {
   cf.can_id = frame.id;
   cf.can_dlc = frame.dlc;
   std::memcpy(cf.data, frame.data.data(), frame.dlc);
-  const ssize_t n = ::sendto(impl_->fd, &cf, sizeof cf, MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&impl_->peer),
-                             impl_->peer_len);
+  // A Unix datagram queue holds few datagrams (net.unix.max_dgram_qlen, 10 by default): a full queue
+  // of a live peer is waited for, up to kSendWait s, before the frame is refused (kQueueFull).
+  ssize_t n;
+  const double give_up = MonotonicSeconds() + kSendWait;
+  while ((n = ::sendto(impl_->fd, &cf, sizeof cf, MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&impl_->peer),
+                       impl_->peer_len)) < 0 &&
+         (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) && MonotonicSeconds() < give_up) {
+    const timespec pause{0, 20000};
+    ::nanosleep(&pause, nullptr);
+  }
   if (n == static_cast<ssize_t>(sizeof cf)) {
     ++stats_.sent;
     return CanStatus::kOk;
@@ -214,6 +224,10 @@ CanStatus CanLink::Receive(CanFrame* out) {
     ++stats_.received;
     return CanStatus::kOk;
   }
+}
+
+bool CanLink::PeerAlive() const {
+  return address_.kind != BusKind::kUnix || UnixSocketInUse(address_.PeerName(end_));
 }
 
 bool CanLink::WaitInput(double timeout_s) {

@@ -38,13 +38,16 @@ class CanLink : public CanBus {
   CanLink& operator=(const CanLink&) = delete;
 
   // kOk; kError when the frame is invalid or the peer is absent (peer_absent counted); kQueueFull
-  // when the socket buffer is full.
+  // when the peer's queue stayed full for 0.1 s (the send waits that long for a live peer to read).
   CanStatus Send(const CanFrame& frame) override;
   // kOk with the oldest valid frame from the peer (out->t: CLOCK_MONOTONIC, s); kNoFrame when none
   // is waiting (foreign and malformed datagrams are dropped on the way, and counted).
   CanStatus Receive(CanFrame* out) override;
   // Blocks until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if input waits.
   bool WaitInput(double timeout_s);
+  // False when the peer is known to be gone: a Unix peer whose socket no live process holds (the file
+  // of a killed process stays behind). True otherwise (UDP and SocketCAN cannot tell).
+  bool PeerAlive() const;
   const CanLinkStatistics& statistics() const { return stats_; }
   const BusAddress& address() const { return address_; }
   // "unix:PATH (peer PATH.ctl)" and the like, for logs.

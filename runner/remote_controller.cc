@@ -142,7 +142,10 @@ void RemoteController::Tick(double t) {
     if (done) break;
     const double left = deadline - MonotonicSeconds();
     if (left <= 0) break;
-    link_->WaitInput(std::min(left, 0.1));
+    if (!link_->WaitInput(std::min(left, 0.1)) && !link_->PeerAlive()) {
+      Lost(t, "(its socket is gone: process gone)");
+      return;
+    }
   }
   if (!done && clock_ == ServeClock::kLockstep)
     Lost(t, "(no answer within " + std::to_string(timeout_) + " s of wall clock)");

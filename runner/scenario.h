@@ -122,12 +122,6 @@ struct HardwareSpec {
                                     // JointModuleSpec / Hal3KneeNodeSpec::torque_sensor_skew
 };
 
-  // N m/rad
-  double kd[2] = {30, 15};     // N m s/rad
-  bool feedforward = true;     // inverse-dynamics feed-forward from the controller's own model
-  double torque_limit = 100;   // N m, supervisor limit
-};
-
 struct Scenario {
   std::string name;
   std::string source;  // file path, for messages
