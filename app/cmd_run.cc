@@ -1,15 +1,13 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 
 #include "app/commands.h"
 #include "core/stop_signal.h"
 #include "core/error.h"
 #include "protocol/bus_address.h"
 #include "protocol/can_link.h"
-#include "runner/exowheel_setup.h"
+#include "runner/controller_process.h"
 #include "runner/out_folder_lock.h"
 #include "runner/remote_controller.h"
 #include "runner/runner.h"
@@ -115,17 +113,14 @@ CommandRunner RegisterServe(CLI::App& app) {
     if (o->bus.empty() && o->can.empty()) throw InputError("serve: --bus ADDR or --can IFACE is required");
     InstallStopSignalHandlers();
     const Scenario s = ReadScenario(o->scenario);
-    if (s.device == Device::kHal3 || s.emg_calibration)
+    if (!ServesScenario(s))
       throw InputError(s.source + ": device: serve runs EXOwheel scenarios with plain trials (not hal3, not emg_calibration)");
     const BusAddress address = o->can.empty() ? ParseBusAddress(o->bus) : ParseBusAddress("can:" + o->can, "--can");
     if (address.kind == BusKind::kUdp && !address.loopback())
       std::fprintf(stderr, "exotwin serve: note: UDP on %s, not loopback: torque commands cross the network\n",
                    address.host.c_str());
     const OutFolderLock lock(o->out);
-    std::filesystem::create_directories(o->out);
-    const controller::ControllerFile cf = ControllerFileOf(s, ResolveSubject(s));
-    std::ofstream(o->out + "/controller.yaml")
-        << controller::ControllerFileYaml(cf, "the controller file of " + s.source + " (written by exotwin serve)");
+    WriteControllerFile(s, o->out);
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
     const ServeClock clock = o->clock == "realtime" ? ServeClock::kRealtime : ServeClock::kLockstep;
     RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, o->timeout);

@@ -29,6 +29,9 @@ struct RunOptions {
   std::function<void(double, const double*, const double*)> on_sample;
   // The controller in another process (`exotwin serve`; EXOwheel plain trials only); null: in-process.
   RemoteController* remote = nullptr;
+  // RunScenarioJob (scenario_job.h) only: the exotwin-controller executable to run the scenario's
+  // controller in another process (RunWithControllerProcess, controller_process.h); "" = in-process.
+  std::string controller_process;
 };
 
 struct CheckResult {
