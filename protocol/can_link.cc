@@ -153,7 +153,12 @@ std::string CanLink::Describe() const {
 CanStatus CanLink::Send(const CanFrame& frame) {
   if (!IsValidDataFrame(frame)) return CanStatus::kError;
   if (impl_->can) {
-    const CanStatus st = impl_->can->Send(frame);
+    CanStatus st;
+    const double give_up = MonotonicSeconds() + kSendWait;  // a full interface queue: wait as for a Unix peer
+    while ((st = impl_->can->Send(frame)) == CanStatus::kQueueFull && MonotonicSeconds() < give_up) {
+      const timespec pause{0, 20000};
+      ::nanosleep(&pause, nullptr);
+    }
     st == CanStatus::kOk ? ++stats_.sent : ++stats_.send_failures;
     return st;
   }

@@ -5,14 +5,19 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include <linux/can.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -85,6 +90,18 @@ std::vector<std::vector<double>> CsvRows(const std::string& path) {
 size_t Lines(const std::string& path) {
   const std::string t = ReadText(path);
   return static_cast<size_t>(std::count(t.begin(), t.end(), '\n'));
+}
+
+// The output (stdout + stderr) of a shell command.
+std::string Shell(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  pclose(p);
+  return out;
 }
 
 struct Pair {
@@ -218,6 +235,84 @@ TEST(ServeCli, NoControllerWithinTheTimeoutRunsOnSafely) {
   const nlohmann::json j = Result(dir.path() + "/o");
   EXPECT_EQ(j["metrics"]["link_controller_lost_s"], 0.0);
   EXPECT_EQ(j["metrics"]["torque_max_hip"], 0.0);
+}
+
+// Security (issue 17): a second, unconfigured peer floods the twin's socket with full-torque commands
+// during a lockstep run; nothing it sends reaches the plant (the logs are the in-process run's).
+TEST(ServeCli, FramesOfAnUnconfiguredPeerNeverReachThePlant) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 2.0);
+  ASSERT_EQ(testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run").exit_code, 0);
+  std::atomic<bool> stop{false};
+  std::atomic<int> sent{0};
+  std::thread intruder([&] {
+    const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+    sockaddr_un self{}, to{};
+    self.sun_family = to.sun_family = AF_UNIX;
+    std::snprintf(self.sun_path, sizeof self.sun_path, "%s/intruder", dir.path().c_str());
+    std::snprintf(to.sun_path, sizeof to.sun_path, "%s/bus", dir.path().c_str());
+    ::bind(fd, reinterpret_cast<sockaddr*>(&self), sizeof self);
+    can_frame cf{};
+    cf.can_dlc = 4;
+    cf.data[1] = 0x7F;  // +327 N m, enabled
+    cf.data[3] = 0x01;
+    while (!stop) {
+      for (uint32_t id : {0x100u, 0x101u}) {
+        cf.can_id = id;
+        if (::sendto(fd, &cf, sizeof cf, MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&to), sizeof to) == sizeof cf) ++sent;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+    ::close(fd);
+    ::unlink(self.sun_path);
+  });
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve");
+  stop = true;
+  intruder.join();
+  EXPECT_EQ(p.serve, 0) << p.serve_log;
+  EXPECT_GT(sent.load(), 0);
+  const nlohmann::json r = Result(dir.path() + "/serve");
+  EXPECT_GT(r["metrics"]["link_frames_foreign"].get<double>(), 0.0);
+  EXPECT_TRUE(ReadText(dir.path() + "/run/measured.csv") == ReadText(dir.path() + "/serve/measured.csv"));
+  EXPECT_TRUE(ReadText(dir.path() + "/run/truth.csv") == ReadText(dir.path() + "/serve/truth.csv"));
+}
+
+// The regression gate on the deployable controller: baselines made in-process hold, bit for bit, when
+// the suite runs with exotwin-controller in another process.
+TEST(ServeCli, RegressWithTheControllerProcessMatchesInProcessBaselines) {
+  testing::ScopedTempDir dir("serve");
+  std::filesystem::create_directories(dir.path() + "/suite");
+  GaitScenario(dir.path() + "/suite", 1.5);
+  const std::string base = "regress --jobs 1 --suite " + dir.path() + "/suite --out " + dir.path() + "/";
+  const auto made = testing::RunExotwin(base + "update --update");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const auto r = testing::RunExotwin(base + "cp --controller-process");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 scenarios, 0 failed, 0 metrics moved"), std::string::npos) << r.output;
+  EXPECT_NE(ReadText(dir.path() + "/cp/gait_2kmh/controller.log").find("run over (NMT stop): 1500 ticks"),
+            std::string::npos);
+  const auto bad = testing::RunExotwin(base + "x --controller-process --controller-bin " + dir.path() + "/nothing");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find(dir.path() + "/nothing"), std::string::npos) << bad.output;
+}
+
+// The lockstep pair over a virtual SocketCAN interface, where one can be made (vcan module, root).
+TEST(ServeCli, LockstepOverVcanWhereAvailable) {
+  const std::string iface = "vcanexo" + std::to_string(::getpid() % 1000);
+  const std::string made = Shell("ip link add dev " + iface + " type vcan && ip link set " + iface + " up && echo made");
+  if (made.find("made") == std::string::npos)
+    GTEST_SKIP() << "no vcan interface can be created here (needs the vcan kernel module and root): " << made;
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 1.0), out = dir.path() + "/serve";
+  ASSERT_EQ(testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run").exit_code, 0);
+  const pid_t serve = testing::StartProgram(testing::ExotwinBin(), {"serve", scenario, "--can", iface, "--out", out},
+                                            dir.path() + "/serve.log");
+  ASSERT_TRUE(WaitForFile(out + "/controller.yaml", 30));
+  const pid_t ctl = testing::StartProgram(testing::ControllerBin(), {"--config", out + "/controller.yaml", "--can", iface});
+  EXPECT_EQ(WaitFor(serve, 120), 0) << ReadText(dir.path() + "/serve.log");
+  EXPECT_EQ(WaitFor(ctl, 30), 0);
+  Shell("ip link del " + iface);
+  EXPECT_TRUE(ReadText(dir.path() + "/run/measured.csv") == ReadText(out + "/measured.csv"));
 }
 
 TEST(ServeCli, BadInputExitsTwoNamingTheProblem) {
