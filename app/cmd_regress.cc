@@ -10,10 +10,13 @@
 #include <filesystem>
 #include <optional>
 
+#include <unistd.h>
+
 #include "analysis/csv_table.h"
 #include "app/commands.h"
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "runner/controller_process.h"
 #include "runner/fork_pool.h"
 #include "runner/progress_bar.h"
 #include "runner/regress.h"
@@ -24,7 +27,8 @@ namespace {
 CommandRunner RegisterRegress(CLI::App& app) {
   struct Opts {
     std::string suite, baselines, out = "out/regress";  // suite: default scenarios/ of the data folder
-    bool update = false, all = false;
+    bool update = false, all = false, controller_process = false;
+    std::string controller_bin;
     int jobs = 0;
   };
   auto o = std::make_shared<Opts>();
@@ -35,12 +39,21 @@ CommandRunner RegisterRegress(CLI::App& app) {
   sub->add_option("--out", o->out, "output folder (one sub-folder per scenario, regress.json)");
   sub->add_option("--jobs,-j", o->jobs, "scenarios run in parallel (default: number of cores)");
   sub->add_flag("--all", o->all, "print every metric, not only those that moved");
+  sub->add_flag("--controller-process", o->controller_process,
+                "run the EXOwheel scenarios (plain trials) with exotwin-controller in another process, in lockstep");
+  sub->add_option("--controller-bin", o->controller_bin, "the exotwin-controller executable (default: next to exotwin)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->jobs < 0) throw InputError("--jobs: expected >= 1 (or 0 for the number of cores), got " + std::to_string(o->jobs));
     if (o->suite.empty()) o->suite = DataPath("scenarios");
     const std::vector<SuiteEntry> suite = ListSuite(o->suite);
     const std::string baselines = o->baselines.empty() ? o->suite + "/baselines" : o->baselines;
+    std::string controller_bin;
+    if (o->controller_process) {
+      controller_bin = o->controller_bin.empty() ? DefaultControllerBinary() : o->controller_bin;
+      if (controller_bin.empty() || ::access(controller_bin.c_str(), X_OK) != 0)
+        throw InputError("--controller-bin: '" + controller_bin + "': no exotwin-controller executable there");
+    }
     std::filesystem::create_directories(o->out);
     auto dir_of = [&](size_t i) { return o->out + "/" + suite[i].scenario.name; };
 
@@ -51,6 +64,7 @@ CommandRunner RegisterRegress(CLI::App& app) {
         [&](size_t i) {
           RunOptions opt;
           opt.out_dir = dir_of(i);
+          opt.controller_process = controller_bin;
           return RunScenarioJob(suite[i].scenario, opt);
         },
         [&](size_t, const JobOutcome& r) {

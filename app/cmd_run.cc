@@ -5,7 +5,12 @@
 #include "analysis/opensim_storage.h"
 #include "app/commands.h"
 #include "core/stop_signal.h"
+#include "core/error.h"
+#include "protocol/bus_address.h"
+#include "protocol/can_link.h"
+#include "runner/controller_process.h"
 #include "runner/out_folder_lock.h"
+#include "runner/remote_controller.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
 
@@ -111,7 +116,67 @@ CommandRunner RegisterRender(CLI::App& app) {
   };
 }
 
+// `exotwin serve SCENARIO.yaml --bus ADDR`: the scenario's plant and hardware on a CAN link, the
+// controller in another process (DESIGN.md "The CAN transport between processes"). Writes
+// DIR/controller.yaml (the controller file of the scenario) before it waits for the controller.
+CommandRunner RegisterServe(CLI::App& app) {
+  struct Opts {
+    std::string scenario, out = "out", bus, can, clock = "lockstep", can_log;
+    uint64_t seed = 0;
+    double timeout = 10.0;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand("serve", "Run a scenario's twin for a controller in another process");
+  sub->add_option("scenario", o->scenario, "scenario YAML (EXOwheel)")->required();
+  auto* bus = sub->add_option("--bus", o->bus, "unix:PATH | udp:HOST:PORT | can:IFACE");
+  auto* can = sub->add_option("--can", o->can, "SocketCAN interface (same as --bus can:IFACE)");
+  bus->excludes(can);
+  sub->add_option("--clock", o->clock, "lockstep (default) or realtime")->check(CLI::IsMember({"lockstep", "realtime"}));
+  sub->add_option("--out", o->out, "output folder (result.json, measured.csv, truth.csv, controller.yaml)");
+  auto* seed = sub->add_option("--seed", o->seed, "seed (overrides the scenario's)");
+  sub->add_option("--timeout", o->timeout, "s of wall clock without an answer after which the controller is gone")
+      ->check(CLI::Range(0.01, 3600.0));
+  sub->add_option("--can-log", o->can_log, "candump log of every CAN frame of the twin's bus");
+  return [sub, o, seed]() -> int {
+    if (!*sub) return -1;
+    if (o->bus.empty() && o->can.empty()) throw InputError("serve: --bus ADDR or --can IFACE is required");
+    InstallStopSignalHandlers();
+    const Scenario s = ReadScenario(o->scenario);
+    if (!ServesScenario(s))
+      throw InputError(s.source + ": device: serve runs EXOwheel scenarios with plain trials (not hal3, not emg_calibration)");
+    const BusAddress address = o->can.empty() ? ParseBusAddress(o->bus) : ParseBusAddress("can:" + o->can, "--can");
+    if (address.kind == BusKind::kUdp && !address.loopback())
+      std::fprintf(stderr, "exotwin serve: note: UDP on %s, not loopback: torque commands cross the network\n",
+                   address.host.c_str());
+    const OutFolderLock lock(o->out);
+    WriteControllerFile(s, o->out);
+    std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
+    const ServeClock clock = o->clock == "realtime" ? ServeClock::kRealtime : ServeClock::kLockstep;
+    RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, o->timeout);
+    std::fprintf(stderr, "exotwin serve: %s on %s, %s clock; waiting for the controller (controller file %s/controller.yaml)\n",
+                 s.name.c_str(), link->Describe().c_str(), o->clock.c_str(), o->out.c_str());
+    RunOptions opt;
+    opt.out_dir = o->out;
+    if (*seed) opt.seed = o->seed;
+    opt.can_log = o->can_log;
+    opt.remote = &remote;
+    const RunResult r = RunScenario(s, opt);
+    const CanLinkStatistics& st = link->statistics();
+    std::fprintf(stderr, "exotwin serve: link %s: frames received %llu, sent %llu, dropped foreign %llu, malformed %llu%s\n",
+                 link->Describe().c_str(), static_cast<unsigned long long>(st.received),
+                 static_cast<unsigned long long>(st.sent), static_cast<unsigned long long>(st.foreign),
+                 static_cast<unsigned long long>(st.malformed), remote.deterministic() ? "" : "; run NOT deterministic (controller lost)");
+    const int rc = Report(r, o->out);
+    if (rc == 0 && !remote.deterministic()) {
+      std::fprintf(stderr, "exotwin serve: the controller was lost (result.json events): the run fails\n");
+      return 1;
+    }
+    return rc;
+  };
+}
+
 const CommandRegistration kRun(RegisterRun);
+const CommandRegistration kServe(RegisterServe);
 const CommandRegistration kRender(RegisterRender);
 
 }  // namespace

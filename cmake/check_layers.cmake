@@ -15,7 +15,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
   cmake_minimum_required(VERSION 3.16)  # policies of the project (IN_LIST) in script mode too
 endif()
 
-set(EXOTWIN_LAYERS core model dsp protocol controller sim hwsim analysis render runner app)
+set(EXOTWIN_LAYERS core model dsp protocol controller deploy sim hwsim analysis render runner app)
 set(EXOTWIN_GUARDED_LIBS mujoco opencv2)
 
 # What each layer's sources may include besides the layer itself.
@@ -24,6 +24,7 @@ set(EXOTWIN_ALLOWED_model core)
 set(EXOTWIN_ALLOWED_dsp core)
 set(EXOTWIN_ALLOWED_protocol core)
 set(EXOTWIN_ALLOWED_controller core model dsp protocol)
+set(EXOTWIN_ALLOWED_deploy core model dsp protocol controller)
 set(EXOTWIN_ALLOWED_sim core model dsp mujoco)
 set(EXOTWIN_ALLOWED_hwsim core model dsp protocol)
 set(EXOTWIN_ALLOWED_analysis core model dsp sim mujoco)

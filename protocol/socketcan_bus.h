@@ -29,6 +29,8 @@ class SocketCanBus : public CanBus {
   // True after the controller reported bus-off, until it reports a restart.
   bool bus_off() const { return bus_off_; }
   const std::string& interface() const { return interface_; }
+  // The socket's descriptor (for poll(2); owned by this object).
+  int fd() const { return fd_; }
 
  private:
   SocketCanBus(int fd, std::string interface) : fd_(fd), interface_(std::move(interface)) {}

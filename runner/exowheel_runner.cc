@@ -17,6 +17,7 @@
 #include "runner/exowheel_setup.h"
 #include "runner/fault_injection.h"
 #include "runner/progress_bar.h"
+#include "runner/remote_controller.h"
 #include "sim/muscles.h"
 #include "sim/plant.h"
 #include "sim/synthetic_emg.h"
@@ -55,7 +56,7 @@ class ExowheelTrial : public CosimDevice {
  public:
   ExowheelTrial(const Scenario& s, const RunOptions& opt, const LegParams& truth, Plant& plant, int trial,
                 CandumpWriter* can_log, RunResult* result, ExowheelTotals* totals)
-      : s_(s), opt_(opt), plant_(plant), result_(result), totals_(totals),
+      : s_(s), opt_(opt), plant_(plant), result_(result), totals_(totals), trial_(trial),
         seed_(result->seed * 7919ull + static_cast<uint64_t>(trial)),
         trajectory_(BuildTrajectory(s, trial)),
         rig_(BusConfigOf(s.hardware, seed_), can_log, trial * (s.protocol.duration + 1.0)),  // trials follow each other
@@ -89,12 +90,14 @@ class ExowheelTrial : public CosimDevice {
   // Runs the trial on the rig and adds its bus statistics and final state to the totals; returns the
   // stop request that ended it early (its trial field left to the caller), if any.
   std::optional<RunInterruption> Run(const CosimSchedule& schedule, const CosimProgress& progress) {
-    const double t_end = rig_.Run(schedule, *this, [this](double t) { ctrl_.Tick(t); }, progress);
+    if (opt_.remote) opt_.remote->BeginTrial(trial_, ctrl_ep_, &result_->events);
+    const double t_end = rig_.Run(
+        schedule, *this, [this](double t) { opt_.remote ? opt_.remote->Tick(t) : ctrl_.Tick(t); }, progress);
     if (video_) {
       video_->Finish(t_end);
       result_->files.push_back(opt_.video_path);
     }
-    totals_->final_state = std::max(totals_->final_state, static_cast<int>(ctrl_.state()));
+    totals_->final_state = std::max(totals_->final_state, static_cast<int>(Telemetry().safety.state));
     const hwsim::CanBusStatistics st = rig_.bus().Statistics();
     totals_->frames_total += st.frames;
     totals_->frames_dropped += st.drops;
@@ -136,7 +139,7 @@ class ExowheelTrial : public CosimDevice {
   }
 
   void EndStep(double t) override {
-    const auto& tel = ctrl_.telemetry();
+    const auto& tel = Telemetry();
     ExowheelTotals& m = *totals_;
     const bool after_ramp = t >= s_.protocol.ramp;
     if (tel.safety.state != controller::SafetyState::kRunning && m.safe_time < 0) m.safe_time = t;
@@ -156,7 +159,7 @@ class ExowheelTrial : public CosimDevice {
   }
 
   void LogSample(double t) override {
-    const auto& tel = ctrl_.telemetry();
+    const auto& tel = Telemetry();
     ++totals_->samples;
     if (logs_.measured) {
       const double row[] = {t, tel.est[0].q, tel.est[1].q, tel.tau_sensor[0], tel.tau_sensor[1],
@@ -176,6 +179,11 @@ class ExowheelTrial : public CosimDevice {
   }
 
  private:
+  // What the controller's tick saw and did: the in-process loop's, or the remote controller's telemetry.
+  const controller::ControllerTelemetry& Telemetry() const {
+    return opt_.remote ? opt_.remote->telemetry() : ctrl_.telemetry();
+  }
+
   // measured[_trialN].csv and truth[_trialN].csv (logs.measured_csv).
   void OpenLogs(const LegParams& truth, int trial) {
     if (!s_.log_measured_csv) return;
@@ -191,7 +199,7 @@ class ExowheelTrial : public CosimDevice {
   }
 
   void AddVideoSample(double t) {
-    const auto& tel = ctrl_.telemetry();
+    const auto& tel = Telemetry();
     OverlaySample os;
     os.t = t;
     os.q_hip = q_[0];
@@ -215,6 +223,7 @@ class ExowheelTrial : public CosimDevice {
   Plant& plant_;
   RunResult* result_;
   ExowheelTotals* totals_;
+  const int trial_;
   const uint64_t seed_;
   const std::shared_ptr<const controller::LegTrajectory> trajectory_;
   controller::JointSetpoint h0_, k0_;  // the reference at t = 0: the start pose
@@ -291,6 +300,10 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   m["torque_max_50ms_after_fault"] = totals.torque_after_fault;
   m["safe_state_entered"] = safe_time >= 0 ? 1.0 : 0.0;
   m["final_state"] = totals.final_state;
+  if (opt.remote) {
+    opt.remote->EndRun();
+    opt.remote->AddMetrics(&m);
+  }
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   FinishRun(s, result, opt.out_dir + "/result.json");

@@ -7,7 +7,6 @@
 #include "analysis/number_text.h"
 #include "analysis/opensim_kinematics.h"
 #include "core/error.h"
-#include "core/units.h"
 #include "runner/runner.h"
 #include "sim/anthropometry.h"
 #include "sim/subjects.h"
@@ -15,13 +14,6 @@
 namespace exotwin {
 namespace {
 
-using controller::FadeInTrajectory;
-using controller::GaitSpec;
-using controller::GaitTrajectory;
-using controller::HarmonicTrajectory;
-using controller::HoldTrajectory;
-using controller::JointTrajectory;
-using controller::JointwiseTrajectory;
 using controller::LegTrajectory;
 using controller::TabulatedTrajectory;
 
@@ -61,85 +53,61 @@ Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, 
 
 // trajectory: file. The OpenSim motion file's hip and knee (analysis/opensim_kinematics.h), its first
 // sample at t = 0; a non-uniform record is interpolated linearly onto a uniform grid at its median
-// step (as analysis/measured_data.h DeriveKinematics does), then handed to the controller as samples.
-std::shared_ptr<const LegTrajectory> RecordedTrajectory(const ProtocolSpec& p) {
+// step (as analysis/measured_data.h DeriveKinematics does), then handed to the controller as samples
+// (controller::ReferenceKind::kSamples, played by TabulatedTrajectory).
+void RecordedSamples(const ProtocolSpec& p, controller::ReferenceSpec* r) {
   const MeasuredData m = ReadOpenSimKinematics(p.path, p.side);
   const double dt = MedianStep(m.t);
   const double span = m.t.back() - m.t.front();
   const size_t n = static_cast<size_t>(std::floor(span / dt + 1e-9)) + 1;
   std::vector<double> grid(n);
   for (size_t i = 0; i < n; ++i) grid[i] = m.t.front() + static_cast<double>(i) * dt;
-  const std::vector<double> hip = Interpolate(m.t, m.q_hip, grid), knee = Interpolate(m.t, m.q_knee, grid);
   if (!(p.cutoff < 0.5 / dt))
     throw InputError(p.path + ": sampled at " + NumberText(1.0 / dt) + " Hz; protocol.cutoff " + NumberText(p.cutoff) +
                      " Hz must lie below its Nyquist frequency " + NumberText(0.5 / dt) + " Hz");
-  return std::make_shared<TabulatedTrajectory>(
-      dt, hip, knee, p.extend == "hold" ? TabulatedTrajectory::Extend::kHold : TabulatedTrajectory::Extend::kLoop,
-      p.cutoff);
+  r->kind = controller::ReferenceKind::kSamples;
+  r->sample_dt = dt;
+  r->sample_hip = Interpolate(m.t, m.q_hip, grid);
+  r->sample_knee = Interpolate(m.t, m.q_knee, grid);
+  r->sample_loop = p.extend != "hold";
+  r->sample_cutoff = p.cutoff;
 }
 
 }  // namespace
 
-std::shared_ptr<const LegTrajectory> BuildTrajectory(const Scenario& s, int trial) {
+controller::ReferenceSpec ReferenceOf(const Scenario& s) {
   const ProtocolSpec& p = s.protocol;
-  auto held = [&](const char* j, double dflt) {
-    auto it = s.fixed_joints.find(j);
-    return it != s.fixed_joints.end() ? it->second : dflt;
-  };
-  std::shared_ptr<const LegTrajectory> inner;
-  switch (p.trajectory) {
-    case TrajectoryKind::kGait: {
-      GaitSpec g;
-      g.stride_period_s = p.stride_period;
-      // Winter's knee reaches +2 deg (hyperextension) in stance; the exoskeleton stops at 0, so
-      // the pattern is shifted by -3 deg at the knee.
-      g.knee_offset = -3.0 / kDegPerRad;  // the double nearest -3 pi / 180 (-3 * kRadPerDeg is 1 ulp off)
-      inner = std::make_shared<GaitTrajectory>(GaitTrajectory::FromWinterFile(GaitTrajectory::DefaultWinterPath(), g));
-      break;
-    }
-    case TrajectoryKind::kExcitation: {
-      const uint64_t seed = p.excitation_seed * 1000003ull + static_cast<uint64_t>(trial);
-      std::shared_ptr<const JointTrajectory> hip, knee;
-      if (p.moving_joint == "hip" || p.moving_joint == "both")
-        hip = std::make_shared<HarmonicTrajectory>(
-            HarmonicTrajectory::Design(controller::ExcitationSpec::PaperHip(), seed));
-      else
-        hip = std::make_shared<HoldTrajectory>(held("hip", M_PI / 2));
-      if (p.moving_joint == "knee" || p.moving_joint == "both")
-        knee = std::make_shared<HarmonicTrajectory>(
-            HarmonicTrajectory::Design(controller::ExcitationSpec::PaperKnee(), seed + 7));
-      else
-        knee = std::make_shared<HoldTrajectory>(held("knee", -M_PI / 2));
-      inner = std::make_shared<JointwiseTrajectory>(hip, knee);
-      break;
-    }
-    case TrajectoryKind::kHold:
-      inner = std::make_shared<JointwiseTrajectory>(std::make_shared<HoldTrajectory>(held("hip", 0.3)),
-                                                    std::make_shared<HoldTrajectory>(held("knee", -0.5)));
-      break;
-    case TrajectoryKind::kFile:
-      inner = RecordedTrajectory(p);
-      break;
-  }
-  if (p.ramp > 0) inner = std::make_shared<FadeInTrajectory>(inner, p.ramp);
-  return inner;
+  controller::ReferenceSpec r;
+  r.kind = p.trajectory == TrajectoryKind::kGait         ? controller::ReferenceKind::kGait
+           : p.trajectory == TrajectoryKind::kExcitation ? controller::ReferenceKind::kExcitation
+                                                         : controller::ReferenceKind::kHold;
+  r.stride_period = p.stride_period;
+  r.moving_joint = p.moving_joint;
+  r.excitation_seed = p.excitation_seed;
+  r.ramp = p.ramp;
+  if (auto it = s.fixed_joints.find("hip"); it != s.fixed_joints.end()) r.hold_hip = it->second;
+  if (auto it = s.fixed_joints.find("knee"); it != s.fixed_joints.end()) r.hold_knee = it->second;
+  if (p.trajectory == TrajectoryKind::kFile) RecordedSamples(p, &r);
+  return r;
+}
+
+std::shared_ptr<const LegTrajectory> BuildTrajectory(const Scenario& s, int trial) {
+  return controller::BuildReference(ReferenceOf(s), trial);
+}
+
+controller::ControllerFile ControllerFileOf(const Scenario& s, const LegParams& truth) {
+  controller::ControllerFile f;
+  f.source = s.source;
+  f.controller = s.controller;
+  f.driver_limit = s.hardware.torque_limit;
+  f.model = ControllerModel(s, truth);
+  f.reference = ReferenceOf(s);
+  f.trials = s.protocol.trials;
+  return f;
 }
 
 controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegParams& truth) {
-  controller::ExoControllerConfig c;
-  c.rate_hz = s.controller.rate_hz;
-  c.hip = {s.controller.kp[0], s.controller.kd[0], s.controller.torque_limit};
-  c.knee = {s.controller.kp[1], s.controller.kd[1], s.controller.torque_limit};
-  c.feedforward = s.controller.feedforward;
-  c.model = ControllerModel(s, truth);
-  c.estimator.sample_rate_hz = s.controller.rate_hz;
-  c.safety = controller::SafetyConfig::Default();
-  for (auto* lim : {&c.safety.hip, &c.safety.knee}) {
-    lim->tau_sensor_max = std::min(115.0, s.hardware.torque_limit);
-    lim->tau_cmd_max = s.controller.torque_limit + 1e-6;
-    lim->qd_max = 8.0;  // rad/s (460 deg/s): gait at 2 km/h peaks near 200 deg/s
-  }
-  return c;
+  return controller::ExoConfigOf(ControllerFileOf(s, truth));
 }
 
 std::unique_ptr<Behaviour> BuildBehaviour(const Scenario& s, const MuscleParams& mp,

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "controller/controller_config.h"
 #include "controller/exo_controller.h"
 #include "controller/trajectory.h"
 #include "hwsim/joint_module.h"
@@ -14,17 +15,24 @@
 
 namespace exotwin {
 
-// The reference of trial `trial` (0-based): gait (Winter, knee shifted by -3 deg to the exoskeleton's
-// stop), the identification excitation of the moving joint(s) with the others held at fixed_joints,
-// a hold, or a recorded motion (trajectory: file: the OpenSim motion file at protocol.path, read here
-// and handed to the controller as samples, controller::TabulatedTrajectory); faded in over
-// protocol.ramp s. Throws InputError naming the motion file and line for a bad one.
+// The reference of the scenario's protocol and fixed_joints (what the controller file says): gait
+// (Winter, knee shifted by -3 deg to the exoskeleton's stop), the identification excitation, a hold,
+// or a recorded motion (trajectory: file: the OpenSim motion file at protocol.path, read here and
+// handed to the controller as samples). Throws InputError naming the motion file and line for a bad one.
+controller::ReferenceSpec ReferenceOf(const Scenario& s);
+
+// The reference of trial `trial` (0-based): controller::BuildReference of ReferenceOf(s), faded in
+// over protocol.ramp s.
 std::shared_ptr<const controller::LegTrajectory> BuildTrajectory(const Scenario& s, int trial);
 
 // The ExoController of the scenario: its gains, rate and limits, and as its feed-forward model the
 // exoskeleton of `truth` plus, with a subject, the De Leva anthropometric estimate (what a rig knows
 // before identifying the user).
 controller::ExoControllerConfig ControllerConfig(const Scenario& s, const LegParams& truth);
+
+// The controller file of the scenario (ControllerConfig is ExoConfigOf of it): what the deployable
+// controller needs to run the scenario's trials (`exotwin serve` writes it as OUT/controller.yaml).
+controller::ControllerFile ControllerFileOf(const Scenario& s, const LegParams& truth);
 
 // The joint module of joint j (0 hip, 1 knee) with the scenario's hardware (sensors, encoder, driver).
 hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j);

@@ -17,6 +17,8 @@
 
 namespace exotwin {
 
+class RemoteController;  // runner/remote_controller.h
+
 struct RunOptions {
   std::string out_dir = "out";
   std::optional<uint64_t> seed;  // overrides the scenario's seed
@@ -25,6 +27,11 @@ struct RunOptions {
   std::string video_path;        // MP4 of the first trial (side view + overlays); "" = none
   // Called once per logged sample with (t, q_true[2], tau_applied[2]) (e.g. a video renderer).
   std::function<void(double, const double*, const double*)> on_sample;
+  // The controller in another process (`exotwin serve`; EXOwheel plain trials only); null: in-process.
+  RemoteController* remote = nullptr;
+  // RunScenarioJob (scenario_job.h) only: the exotwin-controller executable to run the scenario's
+  // controller in another process (RunWithControllerProcess, controller_process.h); "" = in-process.
+  std::string controller_process;
 };
 
 struct CheckResult {

@@ -214,15 +214,9 @@ void ParseHardware(const YamlContext& r, const YAML::Node& n, Scenario& s) {
   }
 }
 
-// controller: rate, PD gains, feed-forward, supervisor torque limit.
+// controller: rate, PD gains, feed-forward, supervisor torque limit (the controller's own parser).
 void ParseController(const YamlContext& r, const YAML::Node& n, Scenario& s) {
-  YamlCheckKeys(r, n, "controller", {"rate_hz", "kp", "kd", "feedforward", "torque_limit"});
-  ControllerSpec& c = s.controller;
-  if (n["rate_hz"]) c.rate_hz = YamlNumber(r, n["rate_hz"], "controller.rate_hz", 100, 10000);
-  if (n["kp"]) YamlNumberPair(r, n["kp"], "controller.kp", c.kp, 0, 1e5);
-  if (n["kd"]) YamlNumberPair(r, n["kd"], "controller.kd", c.kd, 0, 1e4);
-  if (n["feedforward"]) c.feedforward = YamlBool(r, n["feedforward"], "controller.feedforward");
-  if (n["torque_limit"]) c.torque_limit = YamlNumber(r, n["torque_limit"], "controller.torque_limit", 1, 500);
+  ParseControllerSpec(r, n, &s.controller);
 }
 
 // faults: a list of FaultSpec (null = none).

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "controller/controller_config.h"  // ControllerSpec: the controller block
 #include "model/lumped_params.h"
 
 namespace exotwin {
@@ -124,14 +125,6 @@ struct HardwareSpec {
   double watchdog = 0.02;           // s without a command -> driver cuts torque
   int torque_sensor_skew = 0;       // samples, torque sensor older than the angle sensor (< 0: younger);
                                     // JointModuleSpec / Hal3KneeNodeSpec::torque_sensor_skew
-};
-
-struct ControllerSpec {
-  double rate_hz = 1000;
-  double kp[2] = {600, 400};   // N m/rad
-  double kd[2] = {30, 15};     // N m s/rad
-  bool feedforward = true;     // inverse-dynamics feed-forward from the controller's own model
-  double torque_limit = 100;   // N m, supervisor limit
 };
 
 struct Scenario {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "runner/controller_process.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -30,7 +31,9 @@ std::string ReadText(const std::string& path) {
 
 }  // namespace
 
-bool IsDeterministicMetric(const std::string& name) { return name != "wall_time_s"; }
+bool IsDeterministicMetric(const std::string& name) {
+  return name != "wall_time_s" && name.rfind("link_", 0) != 0;  // link_*: the controller link's, not the scenario's
+}
 
 int RunScenarioJob(const Scenario& s, const RunOptions& opt) {
   std::error_code ec;
@@ -38,7 +41,10 @@ int RunScenarioJob(const Scenario& s, const RunOptions& opt) {
   std::filesystem::remove(opt.out_dir + "/error.txt", ec);
   std::filesystem::remove(opt.out_dir + "/result.json", ec);
   try {
-    return RunScenario(s, opt).all_passed() ? kJobOk : kJobCheckFailed;
+    const bool remote = !opt.controller_process.empty() && ServesScenario(s);
+    return (remote ? RunWithControllerProcess(s, opt, opt.controller_process) : RunScenario(s, opt)).all_passed()
+               ? kJobOk
+               : kJobCheckFailed;
   } catch (const InputError& e) {
     WriteError(opt.out_dir, e.what());
     return kJobInputError;

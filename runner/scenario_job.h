@@ -14,7 +14,8 @@ namespace exotwin {
 // Exit codes of a scenario job (the child's exit code).
 enum JobExit : int { kJobOk = 0, kJobCheckFailed = 1, kJobInputError = 2, kJobDiverged = 3 };
 
-// Runs `s` into opt.out_dir (created) with RunScenario; returns a JobExit. On InputError / SimulationError /
+// Runs `s` into opt.out_dir (created) with RunScenario (with opt.controller_process and an EXOwheel
+// scenario of plain trials: RunWithControllerProcess); returns a JobExit. On InputError / SimulationError /
 // another exception, writes the message to out_dir/error.txt instead of throwing. Meant for the child.
 int RunScenarioJob(const Scenario& s, const RunOptions& opt);
 
@@ -30,7 +31,8 @@ struct JobRun {
 // Reads dir/result.json (or dir/error.txt) of a job with outcome `o`.
 JobRun ReadJobRun(const std::string& dir, const JobOutcome& o);
 
-// True for metrics that are bit-reproducible from the scenario and seed (all but wall_time_s).
+// True for metrics that are bit-reproducible from the scenario and seed (all but wall_time_s and the
+// controller link's link_* figures).
 bool IsDeterministicMetric(const std::string& name);
 
 }  // namespace exotwin

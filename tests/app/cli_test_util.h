@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <sys/wait.h>
@@ -47,22 +48,32 @@ inline RunResult RunExotwin(const std::string& args) {
   return r;
 }
 
-// Starts `exotwin <args>` in a child process (stdout and stderr to /dev/null) and returns its pid,
-// -1 if fork fails; the caller waits for it (waitpid).
-inline pid_t StartExotwin(std::vector<std::string> args) {
-  const std::string bin = ExotwinBin();
+// Starts `bin <args>` in a child process (stdout and stderr to `log`) and returns its pid, -1 if fork
+// fails; the caller waits for it (waitpid).
+inline pid_t StartProgram(const std::string& bin, std::vector<std::string> args, const std::string& log = "/dev/null") {
   args.insert(args.begin(), bin);
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
-    freopen("/dev/null", "w", stdout);
-    freopen("/dev/null", "w", stderr);
+    freopen(log.c_str(), "w", stdout);
+    dup2(fileno(stdout), fileno(stderr));
     execv(bin.c_str(), argv.data());
     _exit(127);
   }
   return pid;
+}
+
+// Starts `exotwin <args>` in a child process (stdout and stderr to /dev/null): StartProgram.
+inline pid_t StartExotwin(std::vector<std::string> args) { return StartProgram(ExotwinBin(), std::move(args)); }
+
+// The deployable controller next to the exotwin executable (build/deploy/exotwin-controller).
+inline std::string ControllerBin() {
+  const std::string exotwin = ExotwinBin();
+  const size_t slash = exotwin.rfind('/');
+  const std::string build = exotwin.substr(0, exotwin.rfind('/', slash - 1));
+  return build + "/deploy/exotwin-controller";
 }
 
 inline void WriteText(const std::string& path, const std::string& text) {

@@ -1,0 +1,64 @@
+// exotwin-controller --config FILE.yaml (--bus ADDR | --can IFACE): the deployable controller
+// (DESIGN.md "Command line"). Exit 0 at the end of the run (NMT stop) or after SIGINT / SIGTERM (zero
+// torque commanded first); 2 on bad input (the file, key or address named on stderr).
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include "controller/controller_config.h"
+#include "core/error.h"
+#include "core/stop_signal.h"
+#include "deploy/controller_node.h"
+#include "protocol/bus_address.h"
+#include "protocol/can_link.h"
+
+namespace {
+
+constexpr const char* kUsage = "usage: exotwin-controller --config FILE.yaml (--bus ADDR | --can IFACE)\n"
+                               "  ADDR: unix:PATH | udp:HOST:PORT | can:IFACE";
+
+int Usage(const std::string& why) {
+  std::cerr << "exotwin-controller: " << why << "\n" << kUsage << std::endl;
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace exotwin;
+  std::string config, bus, what = "--bus";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::cout << kUsage << std::endl;
+      return 0;
+    }
+    if ((a == "--config" || a == "--bus" || a == "--can") && i + 1 >= argc) return Usage(a + ": expected a value");
+    if (a == "--config") config = argv[++i];
+    else if (a == "--bus" || a == "--can") {
+      if (!bus.empty()) return Usage("give one of --bus, --can");
+      what = a;
+      bus = a == "--can" ? std::string("can:") + argv[++i] : argv[++i];
+    } else return Usage("unknown argument '" + a + "'");
+  }
+  if (config.empty()) return Usage("--config FILE.yaml is required");
+  if (bus.empty()) return Usage("--bus ADDR or --can IFACE is required");
+  try {
+    const controller::ControllerFile cfg = controller::ReadControllerFile(config);
+    const BusAddress address = ParseBusAddress(bus, what);
+    if (address.kind == BusKind::kUdp && !address.loopback())
+      std::cerr << "exotwin-controller: note: UDP on " << address.host
+                << ", not loopback: torque commands cross the network" << std::endl;
+    controller::ExoConfigOf(cfg);  // the supervisor's checks of the limits, before the bus is opened
+    std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kController);
+    InstallStopSignalHandlers();
+    ControllerNode node(cfg, link.get(), std::cerr);
+    return node.Run();
+  } catch (const InputError& e) {
+    std::cerr << "exotwin-controller: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "exotwin-controller: error: " << e.what() << std::endl;
+    return 2;
+  }
+}

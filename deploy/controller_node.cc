@@ -1,0 +1,134 @@
+#include "deploy/controller_node.h"
+
+#include <cstdio>
+#include <string>
+
+#include "core/stop_signal.h"
+#include "protocol/link_frames.h"
+#include "protocol/messages.h"
+
+namespace exotwin {
+namespace {
+
+const char* StateName(int s) {
+  return s == 0 ? "running" : (s == 1 ? "safe_damping" : "safe_torque_off");
+}
+
+std::string Hex(uint32_t v) {
+  char b[16];
+  std::snprintf(b, sizeof b, "0x%04x", v);
+  return b;
+}
+
+}  // namespace
+
+CanStatus ControllerNode::TickBus::Receive(CanFrame* out) {
+  if (pending.empty()) return CanStatus::kNoFrame;
+  *out = pending.front();
+  pending.pop_front();
+  return CanStatus::kOk;
+}
+
+ControllerNode::ControllerNode(const controller::ControllerFile& cfg, CanLink* link, std::ostream& log)
+    : cfg_(cfg), exo_cfg_(controller::ExoConfigOf(cfg)), link_(link), log_(log), bus_(link) {}
+
+int ControllerNode::Run() {
+  log_ << "exotwin-controller: " << cfg_.source << ": rate " << cfg_.controller.rate_hz << " Hz, kp ["
+       << cfg_.controller.kp[0] << ", " << cfg_.controller.kp[1] << "], kd [" << cfg_.controller.kd[0] << ", "
+       << cfg_.controller.kd[1] << "], torque limit " << cfg_.controller.torque_limit << " N m, feed-forward "
+       << (cfg_.controller.feedforward ? "on" : "off") << "; bus " << link_->Describe() << "; waiting for NMT start"
+       << std::endl;
+  CanFrame f;
+  while (!done_) {
+    if (const int sig = StopSignal()) {
+      ZeroTorque();
+      log_ << "exotwin-controller: " << StopSignalName(sig) << ": zero torque commanded, drives disabled" << std::endl;
+      Summary("stopped");
+      return 0;
+    }
+    link_->WaitInput(0.1);
+    while (!done_ && link_->Receive(&f) == CanStatus::kOk) Handle(f);
+  }
+  Summary("run over (NMT stop)");
+  return 0;
+}
+
+void ControllerNode::Handle(const CanFrame& f) {
+  double v = 0;
+  switch (f.id) {
+    case link::kIdNmt:
+      if (f.dlc >= 1 && f.data[0] == link::kNmtStart) {
+        trial_ = f.dlc >= 3 ? f.data[2] : 0;
+        ctrl_ = std::make_unique<controller::ExoController>(exo_cfg_, controller::BuildReference(cfg_.reference, trial_),
+                                                             &bus_);
+        bus_.pending.clear();
+        have_stamp_ = false;
+        state_ = 0;
+        faults_ = 0;
+        log_ << "exotwin-controller: trial " << trial_ + 1 << ": control loop started" << std::endl;
+        link_->Send(link::ReadyFrame(trial_));
+      } else if (f.dlc >= 1 && f.data[0] == link::kNmtStop) {
+        done_ = true;
+      }
+      return;
+    case link::kIdRxStamp:
+      have_stamp_ = link::FrameDouble(f, &stamp_);
+      return;
+    case link::kIdSync:
+      if (link::FrameDouble(f, &v)) Tick(v);
+      return;
+    default:
+      if (link::IsLinkFrameId(f.id)) return;  // another node's link frame: not for the control loop
+      if (!ctrl_) return;
+      CanFrame g = f;
+      g.t = have_stamp_ ? stamp_ : last_sync_;  // the receive time on the twin's (simulated) clock
+      have_stamp_ = false;
+      bus_.pending.push_back(g);
+  }
+}
+
+void ControllerNode::Tick(double t) {
+  last_sync_ = t;
+  if (!ctrl_) {
+    if (syncs_ignored_++ == 0) log_ << "exotwin-controller: SYNC before NMT start: ignored" << std::endl;
+    return;
+  }
+  ctrl_->Tick(t);
+  ++ticks_;
+  const controller::ControllerTelemetry& tel = ctrl_->telemetry();
+  const double values[link::kTelCount] = {tel.est[0].q,  tel.est[1].q,  tel.tau_sensor[0],
+                                          tel.tau_sensor[1], tel.tau_cmd[0], tel.tau_cmd[1],
+                                          tel.ref[0].q,  tel.ref[1].q,  static_cast<double>(tel.safety.state),
+                                          tel.emg[0],    tel.emg[1],    tel.emg[2],
+                                          tel.emg[3],    tel.emg[4]};
+  for (int i = 0; i < link::kTelCount; ++i)
+    link_->Send(link::DoubleFrame(static_cast<uint16_t>(link::kIdTelemetryBase + i), values[i]));
+  link_->Send(link::DoubleFrame(link::kIdCycleDone, t));
+  const int state = static_cast<int>(tel.safety.state);
+  if (state != state_ || tel.safety.fault_mask != faults_) {
+    log_ << "exotwin-controller: t " << t << " s: safety " << StateName(state_) << " -> " << StateName(state)
+         << ", faults " << Hex(tel.safety.fault_mask) << " (first " << static_cast<int>(tel.safety.first_fault) << ")"
+         << std::endl;
+    state_ = state;
+    faults_ = tel.safety.fault_mask;
+  }
+}
+
+void ControllerNode::ZeroTorque() {
+  for (int j = 0; j < 2; ++j) {
+    msg::JointCommand c;
+    c.joint = static_cast<msg::Joint>(j);
+    c.torque = 0.0;
+    c.enable = false;
+    link_->Send(msg::Encode(c));
+  }
+}
+
+void ControllerNode::Summary(const char* why) {
+  const CanLinkStatistics& s = link_->statistics();
+  log_ << "exotwin-controller: " << why << ": " << ticks_ << " ticks, frames received " << s.received << ", sent "
+       << s.sent << ", send failures " << s.send_failures + s.peer_absent << ", dropped: foreign " << s.foreign
+       << ", malformed " << s.malformed << std::endl;
+}
+
+}  // namespace exotwin

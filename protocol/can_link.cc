@@ -1,0 +1,246 @@
+#include "protocol/can_link.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <linux/can.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+
+#include "core/error.h"
+#include "protocol/socketcan_bus.h"
+
+namespace exotwin {
+
+double MonotonicSeconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+struct CanLink::Impl {
+  int fd = -1;
+  std::unique_ptr<SocketCanBus> can;  // kSocketCan
+  std::string local_path;             // kUnix: unlinked on close
+  sockaddr_storage peer{};
+  socklen_t peer_len = 0;
+  ~Impl() {
+    if (fd >= 0) ::close(fd);
+    if (!local_path.empty()) ::unlink(local_path.c_str());
+  }
+};
+
+namespace {
+
+constexpr double kSendWait = 0.1;  // s
+
+[[noreturn]] void Fail(const BusAddress& a, const std::string& socket, const std::string& what, int err) {
+  throw InputError("--bus " + a.text + ": " + socket + ": " + what + (err ? std::string(": ") + std::strerror(err) : ""));
+}
+
+sockaddr_un UnixAddress(const std::string& path) {
+  sockaddr_un u{};
+  u.sun_family = AF_UNIX;
+  std::strncpy(u.sun_path, path.c_str(), sizeof u.sun_path - 1);
+  return u;
+}
+
+sockaddr_in InetAddress(const std::string& host_port) {
+  const size_t c = host_port.rfind(':');
+  sockaddr_in in{};
+  in.sin_family = AF_INET;
+  in.sin_port = htons(static_cast<uint16_t>(std::stoi(host_port.substr(c + 1))));
+  ::inet_pton(AF_INET, host_port.substr(0, c).c_str(), &in.sin_addr);
+  return in;
+}
+
+// True when a live process has a datagram socket bound at `path` (a connect succeeds).
+bool UnixSocketInUse(const std::string& path) {
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return false;
+  const sockaddr_un u = UnixAddress(path);
+  const bool live = ::connect(fd, reinterpret_cast<const sockaddr*>(&u), sizeof u) == 0;
+  ::close(fd);
+  return live;
+}
+
+void BindUnix(const BusAddress& a, const std::string& path, CanLink::Impl* impl) {
+  struct stat st{};
+  if (::lstat(path.c_str(), &st) == 0) {
+    if (!S_ISSOCK(st.st_mode)) Fail(a, path, "exists and is not a socket", 0);
+    if (UnixSocketInUse(path)) Fail(a, path, "in use by another process", 0);
+    ::unlink(path.c_str());  // stale: left by a process that died
+  }
+  impl->fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (impl->fd < 0) Fail(a, path, "cannot create a Unix datagram socket", errno);
+  const sockaddr_un u = UnixAddress(path);
+  const mode_t old = ::umask(0177);  // the socket file is created mode 0600
+  const int rc = ::bind(impl->fd, reinterpret_cast<const sockaddr*>(&u), sizeof u);
+  const int err = errno;
+  ::umask(old);
+  if (rc != 0) Fail(a, path, "cannot bind", err);
+  impl->local_path = path;
+  ::chmod(path.c_str(), 0600);
+}
+
+void BindUdp(const BusAddress& a, const std::string& local, CanLink::Impl* impl) {
+  impl->fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (impl->fd < 0) Fail(a, local, "cannot create a UDP socket", errno);
+  const sockaddr_in in = InetAddress(local);
+  if (::bind(impl->fd, reinterpret_cast<const sockaddr*>(&in), sizeof in) != 0)
+    Fail(a, local, errno == EADDRINUSE ? "port in use" : "cannot bind", errno);
+}
+
+bool SamePeer(const sockaddr_storage& from, socklen_t from_len, const CanLink::Impl& impl) {
+  if (from.ss_family != impl.peer.ss_family) return false;
+  if (from.ss_family == AF_UNIX) {
+    const auto& a = reinterpret_cast<const sockaddr_un&>(from);
+    const auto& b = reinterpret_cast<const sockaddr_un&>(impl.peer);
+    const size_t off = offsetof(sockaddr_un, sun_path);
+    if (from_len <= off) return false;  // unnamed sender
+    return std::strncmp(a.sun_path, b.sun_path, sizeof a.sun_path) == 0;
+  }
+  const auto& a = reinterpret_cast<const sockaddr_in&>(from);
+  const auto& b = reinterpret_cast<const sockaddr_in&>(impl.peer);
+  return a.sin_port == b.sin_port && a.sin_addr.s_addr == b.sin_addr.s_addr;
+}
+
+}  // namespace
+
+CanLink::CanLink(BusAddress address, LinkEnd end, std::unique_ptr<Impl> impl)
+    : address_(std::move(address)), end_(end), impl_(std::move(impl)) {}
+
+CanLink::~CanLink() = default;
+
+std::unique_ptr<CanLink> CanLink::Open(const BusAddress& a, LinkEnd end) {
+  auto impl = std::make_unique<Impl>();
+  switch (a.kind) {
+    case BusKind::kSocketCan:
+      impl->can = SocketCanBus::Open(a.interface);
+      break;
+    case BusKind::kUnix: {
+      BindUnix(a, a.LocalName(end), impl.get());
+      const sockaddr_un u = UnixAddress(a.PeerName(end));
+      std::memcpy(&impl->peer, &u, sizeof u);
+      impl->peer_len = sizeof u;
+      break;
+    }
+    case BusKind::kUdp: {
+      BindUdp(a, a.LocalName(end), impl.get());
+      const sockaddr_in in = InetAddress(a.PeerName(end));
+      std::memcpy(&impl->peer, &in, sizeof in);
+      impl->peer_len = sizeof in;
+      break;
+    }
+  }
+  return std::unique_ptr<CanLink>(new CanLink(a, end, std::move(impl)));
+}
+
+std::string CanLink::Describe() const {
+  if (address_.kind == BusKind::kSocketCan) return "can:" + address_.interface;
+  const std::string scheme = address_.kind == BusKind::kUnix ? "unix:" : "udp:";
+  return scheme + address_.LocalName(end_) + " (peer " + address_.PeerName(end_) + ")";
+}
+
+CanStatus CanLink::Send(const CanFrame& frame) {
+  if (!IsValidDataFrame(frame)) return CanStatus::kError;
+  if (impl_->can) {
+    CanStatus st;
+    const double give_up = MonotonicSeconds() + kSendWait;  // a full interface queue: wait as for a Unix peer
+    while ((st = impl_->can->Send(frame)) == CanStatus::kQueueFull && MonotonicSeconds() < give_up) {
+      const timespec pause{0, 20000};
+      ::nanosleep(&pause, nullptr);
+    }
+    st == CanStatus::kOk ? ++stats_.sent : ++stats_.send_failures;
+    return st;
+  }
+  can_frame cf{};
+  cf.can_id = frame.id;
+  cf.can_dlc = frame.dlc;
+  std::memcpy(cf.data, frame.data.data(), frame.dlc);
+  // A Unix datagram queue holds few datagrams (net.unix.max_dgram_qlen, 10 by default): a full queue
+  // of a live peer is waited for, up to kSendWait s, before the frame is refused (kQueueFull).
+  ssize_t n;
+  const double give_up = MonotonicSeconds() + kSendWait;
+  while ((n = ::sendto(impl_->fd, &cf, sizeof cf, MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&impl_->peer),
+                       impl_->peer_len)) < 0 &&
+         (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) && MonotonicSeconds() < give_up) {
+    const timespec pause{0, 20000};
+    ::nanosleep(&pause, nullptr);
+  }
+  if (n == static_cast<ssize_t>(sizeof cf)) {
+    ++stats_.sent;
+    return CanStatus::kOk;
+  }
+  if (n < 0 && (errno == ECONNREFUSED || errno == ENOENT)) {
+    ++stats_.peer_absent;
+    return CanStatus::kError;
+  }
+  ++stats_.send_failures;
+  if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS)) return CanStatus::kQueueFull;
+  return CanStatus::kError;
+}
+
+CanStatus CanLink::Receive(CanFrame* out) {
+  if (impl_->can) {
+    CanStatus st;
+    while ((st = impl_->can->Receive(out)) == CanStatus::kError) ++stats_.malformed;  // error frames
+    if (st == CanStatus::kOk) ++stats_.received;
+    return st;
+  }
+  for (;;) {
+    unsigned char buf[sizeof(can_frame) + 1];  // one byte more: a longer datagram is seen as such
+    sockaddr_storage from{};
+    socklen_t from_len = sizeof from;
+    const ssize_t n = ::recvfrom(impl_->fd, buf, sizeof buf, MSG_TRUNC, reinterpret_cast<sockaddr*>(&from), &from_len);
+    if (n < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK) return CanStatus::kNoFrame;
+      if (errno == ECONNREFUSED || errno == EINTR) continue;  // UDP: a refused earlier send
+      ++stats_.malformed;
+      return CanStatus::kNoFrame;
+    }
+    if (!SamePeer(from, from_len, *impl_)) {
+      ++stats_.foreign;
+      continue;
+    }
+    can_frame cf{};
+    if (n != static_cast<ssize_t>(sizeof cf)) {
+      ++stats_.malformed;
+      continue;
+    }
+    std::memcpy(&cf, buf, sizeof cf);
+    if ((cf.can_id & ~CAN_SFF_MASK) != 0 || cf.can_dlc > 8) {  // EFF / RTR / ERR flags or a long DLC
+      ++stats_.malformed;
+      continue;
+    }
+    *out = CanFrame{};
+    out->id = static_cast<uint16_t>(cf.can_id);
+    out->dlc = cf.can_dlc;
+    std::memcpy(out->data.data(), cf.data, cf.can_dlc);
+    out->t = MonotonicSeconds();
+    ++stats_.received;
+    return CanStatus::kOk;
+  }
+}
+
+bool CanLink::PeerAlive() const {
+  return address_.kind != BusKind::kUnix || UnixSocketInUse(address_.PeerName(end_));
+}
+
+bool CanLink::WaitInput(double timeout_s) {
+  pollfd p{};
+  p.fd = impl_->can ? impl_->can->fd() : impl_->fd;
+  p.events = POLLIN;
+  const int ms = timeout_s <= 0 ? 0 : static_cast<int>(std::ceil(timeout_s * 1e3));
+  return ::poll(&p, 1, ms) > 0 && (p.revents & POLLIN);
+}
+
+}  // namespace exotwin

@@ -1,0 +1,131 @@
+#include "runner/controller_process.h"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include "core/error.h"
+#include "protocol/can_link.h"
+#include "runner/exowheel_setup.h"
+#include "runner/remote_controller.h"
+
+namespace exotwin {
+namespace fs = std::filesystem;
+
+bool ServesScenario(const Scenario& s) { return s.device != Device::kHal3 && !s.emg_calibration; }
+
+std::string WriteControllerFile(const Scenario& s, const std::string& dir) {
+  fs::create_directories(dir);
+  const std::string path = dir + "/controller.yaml";
+  std::ofstream out(path);
+  out << controller::ControllerFileYaml(ControllerFileOf(s, ResolveSubject(s)),
+                                        "the controller file of " + s.source + " (written by exotwin serve)");
+  if (!out) throw InputError(path + ": cannot write the controller file");
+  return path;
+}
+
+std::string DefaultControllerBinary() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return "";
+  for (const fs::path& p : {self.parent_path() / "exotwin-controller",
+                            self.parent_path().parent_path() / "deploy" / "exotwin-controller"})
+    if (fs::exists(p, ec)) return p.string();
+  return "";
+}
+
+namespace {
+
+// A private folder for the link's sockets (short enough for sockaddr_un), removed with them.
+class LinkDir {
+ public:
+  LinkDir() {
+    std::string tmpl = (fs::temp_directory_path() / "exotwin_link_XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw InputError(tmpl + ": cannot create the link's folder");
+    path_ = tmpl;
+  }
+  ~LinkDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+pid_t StartController(const std::string& bin, const std::string& config, const std::string& bus,
+                      const std::string& log) {
+  std::vector<std::string> args = {bin, "--config", config, "--bus", bus};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (std::FILE* f = std::freopen(log.c_str(), "w", stderr)) ::dup2(::fileno(f), STDOUT_FILENO);
+    ::execv(bin.c_str(), argv.data());
+    std::fprintf(stderr, "cannot start %s\n", bin.c_str());
+    ::_exit(127);
+  }
+  if (pid < 0) throw InputError(bin + ": cannot start the controller process");
+  return pid;
+}
+
+// Waits up to `seconds` for the controller to exit, then kills it.
+void Reap(pid_t pid, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int st = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    if (::waitpid(pid, &st, WNOHANG) == pid) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &st, 0);
+}
+
+}  // namespace
+
+RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,
+                                   double timeout_s) {
+  if (!ServesScenario(s))
+    throw InputError(s.source + ": device: a controller process runs EXOwheel scenarios with plain trials "
+                                "(not hal3, not emg_calibration)");
+  if (controller_bin.empty() || ::access(controller_bin.c_str(), X_OK) != 0)
+    throw InputError("exotwin-controller: '" + controller_bin + "' is not an executable");
+  const std::string config = WriteControllerFile(s, opt.out_dir);
+  const LinkDir dir;
+  const BusAddress address = ParseBusAddress("unix:" + dir.path() + "/bus");
+  std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
+  const pid_t pid = StartController(controller_bin, config, address.text, opt.out_dir + "/controller.log");
+  RemoteController remote(link.get(), ServeClock::kLockstep, 1.0 / s.controller.rate_hz, timeout_s);
+  opt.remote = &remote;
+  RunResult r;
+  try {
+    r = RunScenario(s, opt);
+  } catch (...) {
+    ::kill(pid, SIGTERM);
+    Reap(pid, 5.0);
+    throw;
+  }
+  Reap(pid, 5.0);
+  if (!remote.deterministic()) {  // result.json already written: record the failure in it too
+    CheckResult c;
+    c.name = c.metric = "controller_link";
+    c.op = ">=";
+    c.value = 0;
+    c.limit = 1;
+    r.checks.push_back(c);
+    WriteResultJson(r, opt.out_dir + "/result.json");
+  }
+  return r;
+}
+
+}  // namespace exotwin

@@ -1,0 +1,64 @@
+// The controller seat of the co-simulation rig taken by a controller in another process (`exotwin
+// serve`, DESIGN.md "The CAN transport between processes"): at each controller tick the rig's
+// controller endpoint hands its received frames to the link (each after a receive-stamp frame), sends
+// SYNC with the tick's time, and puts the controller's answer (commands, heartbeat) on the virtual bus
+// at the tick's time, as the in-process controller's sends; the controller's telemetry stands in for
+// the in-process telemetry (measured.csv, metrics).
+//   lockstep: the tick waits for the controller's cycle-done frame, so the run is the in-process run,
+//     bit for bit; when the controller is gone (its socket refuses the SYNC, or no cycle-done within
+//     timeout_s of wall clock) the run goes on without it (no more commands: the joint modules'
+//     watchdogs cut the torque), an event is recorded and the run is marked non-deterministic;
+//   realtime: ticks paced at the controller rate on the wall clock; the tick waits for the cycle-done
+//     frame up to half a period, answers arriving later are late (applied at the next tick), cycles
+//     without an answer before the next SYNC are missed; the tick-start jitter is recorded.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "controller/exo_controller.h"
+#include "protocol/can_bus.h"
+#include "protocol/can_link.h"
+
+namespace exotwin {
+
+enum class ServeClock { kLockstep, kRealtime };
+
+class RemoteController {
+ public:
+  // link outlives this; period_s: the controller period (s); timeout_s: wall-clock time without an
+  // answer after which the controller is gone (also the wait for its ready frame at a trial's start).
+  RemoteController(CanLink* link, ServeClock clock, double period_s, double timeout_s);
+  // Starts trial `trial` (0-based) with the rig's controller endpoint `ep`: NMT start, then waits for
+  // the controller's ready frame (re-sent every 100 ms). `events` gets the link's events ("t=... ...").
+  void BeginTrial(int trial, CanBus* ep, std::vector<std::string>* events);
+  // The controller tick at t (s).
+  void Tick(double t);
+  // Ends the run: NMT stop.
+  void EndRun();
+  const controller::ControllerTelemetry& telemetry() const { return tel_; }
+  // The link's figures for result.json's metrics (link_*).
+  void AddMetrics(std::map<std::string, double>* m) const;
+  bool deterministic() const { return deterministic_; }
+
+ private:
+  void Lost(double t, const std::string& why);
+  void Take(const CanFrame& f, double t, bool* done);
+  CanLink* link_;
+  ServeClock clock_;
+  double period_, timeout_;
+  CanBus* ep_ = nullptr;
+  std::vector<std::string>* events_ = nullptr;
+  controller::ControllerTelemetry tel_;
+  bool present_ = false, deterministic_ = true;
+  double lost_at_ = -1;
+  double wall0_ = 0;
+  long ticks_ = 0;
+  double awaited_ = 0;  // t of the cycle whose done frame is awaited (realtime)
+  bool awaiting_ = false;
+  uint64_t unexpected_ = 0, late_ = 0, missed_ = 0, bus_refused_ = 0;
+  std::vector<double> jitter_;  // s, tick start minus its schedule (realtime)
+};
+
+}  // namespace exotwin

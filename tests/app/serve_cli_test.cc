@@ -1,0 +1,337 @@
+// `exotwin serve` with `exotwin-controller` in another process (issue 17; DESIGN.md "The CAN transport
+// between processes"): lockstep gives the in-process run byte for byte; a killed controller leaves the
+// twin running with the joint modules' watchdogs cutting the torque; real time runs to the end and
+// reports its timing; start-up in either order and a restarted twin; bad input exits 2.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <linux/can.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::ReadText;
+using testing::WriteText;
+
+// The shipped gait scenario shortened to `duration` s.
+std::string GaitScenario(const std::string& dir, double duration, const std::string& name = "gait.yaml") {
+  std::string text = ReadText(std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/gait_2kmh.yaml");
+  const size_t at = text.find("duration: 60");
+  text.replace(at, 12, "duration: " + std::to_string(duration));
+  WriteText(dir + "/" + name, text);
+  return dir + "/" + name;
+}
+
+// Waits for `pid` up to `seconds`; its exit code (128 + N when killed by signal N), -1 on time-out (the
+// process is then killed).
+int WaitFor(pid_t pid, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int st = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    if (::waitpid(pid, &st, WNOHANG) == pid) return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &st, 0);
+  return -1;
+}
+
+bool WaitForFile(const std::string& path, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (std::filesystem::exists(path)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+nlohmann::json Result(const std::string& dir) { return nlohmann::json::parse(ReadText(dir + "/result.json")); }
+
+// The columns of a CSV's data rows (comments and header skipped).
+std::vector<std::vector<double>> CsvRows(const std::string& path) {
+  std::istringstream in(ReadText(path));
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {
+      header = false;
+      continue;
+    }
+    std::vector<double> r;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) r.push_back(std::strtod(f.c_str(), nullptr));  // stod throws on subnormals
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// Newlines in a file being written (a progress measure: comments and header count too).
+size_t Lines(const std::string& path) {
+  const std::string t = ReadText(path);
+  return static_cast<size_t>(std::count(t.begin(), t.end(), '\n'));
+}
+
+// The output (stdout + stderr) of a shell command.
+std::string Shell(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  pclose(p);
+  return out;
+}
+
+struct Pair {
+  int serve = -1, controller = -1;
+  std::string serve_log, controller_log;
+};
+
+// serve SCENARIO --bus unix:DIR/bus --out OUT (+ extra), then the controller on OUT/controller.yaml.
+Pair ServeWithController(const std::string& dir, const std::string& scenario, const std::string& out,
+                         std::vector<std::string> extra = {}, double seconds = 120) {
+  std::vector<std::string> args = {"serve", scenario, "--bus", "unix:" + dir + "/bus", "--out", out};
+  args.insert(args.end(), extra.begin(), extra.end());
+  Pair p;
+  const pid_t serve = testing::StartProgram(testing::ExotwinBin(), args, dir + "/serve.log");
+  EXPECT_TRUE(WaitForFile(out + "/controller.yaml", 30));
+  const pid_t ctl = testing::StartProgram(
+      testing::ControllerBin(), {"--config", out + "/controller.yaml", "--bus", "unix:" + dir + "/bus"}, dir + "/ctl.log");
+  p.serve = WaitFor(serve, seconds);
+  p.controller = WaitFor(ctl, 30);
+  p.serve_log = ReadText(dir + "/serve.log");
+  p.controller_log = ReadText(dir + "/ctl.log");
+  return p;
+}
+
+TEST(ServeCli, LockstepWritesTheSameMeasuredCsvAsRun) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 4.0);
+  const auto run = testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve");
+  ASSERT_EQ(p.serve, 0) << p.serve_log;
+  EXPECT_EQ(p.controller, 0) << p.controller_log;
+  const std::string a = ReadText(dir.path() + "/run/measured.csv"), b = ReadText(dir.path() + "/serve/measured.csv");
+  ASSERT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "measured.csv differs between run and serve";
+  EXPECT_TRUE(ReadText(dir.path() + "/run/truth.csv") == ReadText(dir.path() + "/serve/truth.csv"));
+  const nlohmann::json r = Result(dir.path() + "/serve");
+  EXPECT_EQ(r["metrics"]["link_deterministic"], 1.0);
+  EXPECT_EQ(r["metrics"]["link_frames_foreign"], 0.0);
+  EXPECT_EQ(r["metrics"]["tracking_rms_hip_deg"], Result(dir.path() + "/run")["metrics"]["tracking_rms_hip_deg"]);
+  EXPECT_NE(p.controller_log.find("run over (NMT stop): 4000 ticks"), std::string::npos) << p.controller_log;
+}
+
+TEST(ServeCli, ControllerKilledMidGaitWatchdogCutsTheTorque) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 6.0), out = dir.path() + "/serve";
+  const pid_t serve = testing::StartProgram(testing::ExotwinBin(),
+                                            {"serve", scenario, "--bus", "unix:" + dir.path() + "/bus", "--out", out},
+                                            dir.path() + "/serve.log");
+  ASSERT_TRUE(WaitForFile(out + "/controller.yaml", 30));
+  const pid_t ctl = testing::StartProgram(testing::ControllerBin(),
+                                          {"--config", out + "/controller.yaml", "--bus", "unix:" + dir.path() + "/bus"});
+  // Mid-gait: once the twin has logged past 2.5 s (simulated) the controller is killed.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < end && Lines(out + "/measured.csv") < 2500)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ::kill(ctl, SIGKILL);
+  EXPECT_EQ(WaitFor(ctl, 10), 128 + SIGKILL);
+  const int rc = WaitFor(serve, 60);
+  EXPECT_EQ(rc, 1) << ReadText(dir.path() + "/serve.log");  // a run that lost its controller fails
+  const nlohmann::json r = Result(out);
+  EXPECT_EQ(r["metrics"]["link_deterministic"], 0.0);
+  const double t_lost = r["metrics"]["link_controller_lost_s"];
+  EXPECT_GT(t_lost, 2.0);
+  EXPECT_LT(t_lost, 5.9);
+  bool event = false;
+  for (const auto& e : r["events"]) event |= e.get<std::string>().find("controller_lost") != std::string::npos;
+  EXPECT_TRUE(event) << r["events"];
+  // Every log whole; from 50 ms after the loss on (watchdog 20 ms), no actuator torque (truth.csv tau_R_hip, tau_R_knee).
+  const auto truth = CsvRows(out + "/truth.csv"), measured = CsvRows(out + "/measured.csv");
+  ASSERT_EQ(truth.size(), 6000u);
+  ASSERT_EQ(measured.size(), 6000u);
+  double before = 0, after = 0;
+  for (const auto& row : truth) {
+    ASSERT_EQ(row.size(), 9u);
+    if (row[0] < t_lost) before = std::max(before, std::abs(row[5]) + std::abs(row[6]));
+    if (row[0] > t_lost + 0.05) after = std::max(after, std::abs(row[5]) + std::abs(row[6]));
+  }
+  EXPECT_GT(before, 1.0);  // the controller was holding the leg
+  EXPECT_LT(after, 1e-9);  // the driver's current loop (first order, hardware.motor_lag) decays to nothing
+}
+
+TEST(ServeCli, RealtimeTenSecondsRunsToTheEndAndReportsJitter) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 10.0);
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve", {"--clock", "realtime"});
+  EXPECT_TRUE(p.serve == 0 || p.serve == 1) << p.serve_log;  // timing decides tracking on a loaded machine
+  EXPECT_EQ(p.controller, 0) << p.controller_log;
+  const nlohmann::json r = Result(dir.path() + "/serve");
+  EXPECT_EQ(r["metrics"]["samples"], 10000.0);
+  for (const char* k : {"link_jitter_p50_us", "link_jitter_p99_us", "link_jitter_max_us", "link_late_cycles",
+                        "link_missed_cycles"})
+    EXPECT_TRUE(r["metrics"].contains(k)) << k;
+}
+
+TEST(ServeCli, ControllerStartedBeforeTheTwinAndTwinRestartedUnderIt) {
+  testing::ScopedTempDir dir("serve");
+  const std::string bus = "unix:" + dir.path() + "/bus";
+  const std::string scenario = GaitScenario(dir.path(), 1.0), longer = GaitScenario(dir.path(), 600, "long.yaml");
+  // A controller file from a first lockstep pair.
+  const Pair first = ServeWithController(dir.path(), scenario, dir.path() + "/first");
+  ASSERT_EQ(first.serve, 0) << first.serve_log;
+  // The controller first, then a twin that dies (SIGKILL) mid-run, then a new twin: the controller
+  // starts a fresh loop for it and the second run is the in-process run.
+  const pid_t ctl = testing::StartProgram(testing::ControllerBin(),
+                                          {"--config", dir.path() + "/first/controller.yaml", "--bus", bus},
+                                          dir.path() + "/ctl.log");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const pid_t dead = testing::StartProgram(testing::ExotwinBin(), {"serve", longer, "--bus", bus, "--out", dir.path() + "/dead"});
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < end && Lines(dir.path() + "/dead/measured.csv") < 300)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ::kill(dead, SIGKILL);
+  EXPECT_EQ(WaitFor(dead, 10), 128 + SIGKILL);
+  const auto again = testing::RunExotwin("serve " + scenario + " --bus " + bus + " --out " + dir.path() + "/again");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(WaitFor(ctl, 30), 0);
+  const std::string log = ReadText(dir.path() + "/ctl.log");
+  EXPECT_NE(log.find("trial 1: control loop started"), log.rfind("trial 1: control loop started")) << log;
+  EXPECT_TRUE(ReadText(dir.path() + "/first/measured.csv") == ReadText(dir.path() + "/again/measured.csv"));
+  EXPECT_EQ(Result(dir.path() + "/again")["metrics"]["link_deterministic"], 1.0);
+}
+
+TEST(ServeCli, NoControllerWithinTheTimeoutRunsOnSafely) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 0.5);
+  const auto r = testing::RunExotwin("serve " + scenario + " --bus unix:" + dir.path() + "/bus --timeout 0.3 --out " +
+                                     dir.path() + "/o");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("NOT deterministic"), std::string::npos) << r.output;
+  const nlohmann::json j = Result(dir.path() + "/o");
+  EXPECT_EQ(j["metrics"]["link_controller_lost_s"], 0.0);
+  EXPECT_EQ(j["metrics"]["torque_max_hip"], 0.0);
+}
+
+// Security (issue 17): a second, unconfigured peer floods the twin's socket with full-torque commands
+// during a lockstep run; nothing it sends reaches the plant (the logs are the in-process run's).
+TEST(ServeCli, FramesOfAnUnconfiguredPeerNeverReachThePlant) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 2.0);
+  ASSERT_EQ(testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run").exit_code, 0);
+  std::atomic<bool> stop{false};
+  std::atomic<int> sent{0};
+  std::thread intruder([&] {
+    const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+    sockaddr_un self{}, to{};
+    self.sun_family = to.sun_family = AF_UNIX;
+    std::snprintf(self.sun_path, sizeof self.sun_path, "%s/intruder", dir.path().c_str());
+    std::snprintf(to.sun_path, sizeof to.sun_path, "%s/bus", dir.path().c_str());
+    ::bind(fd, reinterpret_cast<sockaddr*>(&self), sizeof self);
+    can_frame cf{};
+    cf.can_dlc = 4;
+    cf.data[1] = 0x7F;  // +327 N m, enabled
+    cf.data[3] = 0x01;
+    while (!stop) {
+      for (uint32_t id : {0x100u, 0x101u}) {
+        cf.can_id = id;
+        if (::sendto(fd, &cf, sizeof cf, MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&to), sizeof to) == sizeof cf) ++sent;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+    ::close(fd);
+    ::unlink(self.sun_path);
+  });
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve");
+  stop = true;
+  intruder.join();
+  EXPECT_EQ(p.serve, 0) << p.serve_log;
+  EXPECT_GT(sent.load(), 0);
+  const nlohmann::json r = Result(dir.path() + "/serve");
+  EXPECT_GT(r["metrics"]["link_frames_foreign"].get<double>(), 0.0);
+  EXPECT_TRUE(ReadText(dir.path() + "/run/measured.csv") == ReadText(dir.path() + "/serve/measured.csv"));
+  EXPECT_TRUE(ReadText(dir.path() + "/run/truth.csv") == ReadText(dir.path() + "/serve/truth.csv"));
+}
+
+// The regression gate on the deployable controller: baselines made in-process hold, bit for bit, when
+// the suite runs with exotwin-controller in another process.
+TEST(ServeCli, RegressWithTheControllerProcessMatchesInProcessBaselines) {
+  testing::ScopedTempDir dir("serve");
+  std::filesystem::create_directories(dir.path() + "/suite");
+  GaitScenario(dir.path() + "/suite", 1.5);
+  const std::string base = "regress --jobs 1 --suite " + dir.path() + "/suite --out " + dir.path() + "/";
+  const auto made = testing::RunExotwin(base + "update --update");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const auto r = testing::RunExotwin(base + "cp --controller-process");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 scenarios, 0 failed, 0 metrics moved"), std::string::npos) << r.output;
+  EXPECT_NE(ReadText(dir.path() + "/cp/gait_2kmh/controller.log").find("run over (NMT stop): 1500 ticks"),
+            std::string::npos);
+  const auto bad = testing::RunExotwin(base + "x --controller-process --controller-bin " + dir.path() + "/nothing");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find(dir.path() + "/nothing"), std::string::npos) << bad.output;
+}
+
+// The lockstep pair over a virtual SocketCAN interface, where one can be made (vcan module, root).
+TEST(ServeCli, LockstepOverVcanWhereAvailable) {
+  const std::string iface = "vcanexo" + std::to_string(::getpid() % 1000);
+  const std::string made = Shell("ip link add dev " + iface + " type vcan && ip link set " + iface + " up && echo made");
+  if (made.find("made") == std::string::npos)
+    GTEST_SKIP() << "no vcan interface can be created here (needs the vcan kernel module and root): " << made;
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 1.0), out = dir.path() + "/serve";
+  ASSERT_EQ(testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run").exit_code, 0);
+  const pid_t serve = testing::StartProgram(testing::ExotwinBin(), {"serve", scenario, "--can", iface, "--out", out},
+                                            dir.path() + "/serve.log");
+  ASSERT_TRUE(WaitForFile(out + "/controller.yaml", 30));
+  const pid_t ctl = testing::StartProgram(testing::ControllerBin(), {"--config", out + "/controller.yaml", "--can", iface});
+  EXPECT_EQ(WaitFor(serve, 120), 0) << ReadText(dir.path() + "/serve.log");
+  EXPECT_EQ(WaitFor(ctl, 30), 0);
+  Shell("ip link del " + iface);
+  EXPECT_TRUE(ReadText(dir.path() + "/run/measured.csv") == ReadText(out + "/measured.csv"));
+}
+
+TEST(ServeCli, BadInputExitsTwoNamingTheProblem) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 0.5);
+  const std::string base = "serve " + scenario + " --out " + dir.path() + "/o ";
+  auto r = testing::RunExotwin(base + "--bus unix:" + dir.path() + "/no/such/dir/bus");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(dir.path() + "/no/such/dir/bus"), std::string::npos) << r.output;
+  r = testing::RunExotwin(base + "--bus tcp:1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("'tcp:1'"), std::string::npos) << r.output;
+  r = testing::RunExotwin(base);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = testing::RunExotwin("serve " + std::string(EXOTWIN_SOURCE_DIR) + "/scenarios/hal3_exp1_no_assist.yaml --bus unix:" +
+                          dir.path() + "/bus --out " + dir.path() + "/h");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("hal3"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace exotwin

@@ -1,0 +1,184 @@
+#include "protocol/can_link.h"
+
+#include <arpa/inet.h>
+#include <linux/can.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "protocol/link_frames.h"
+#include "tests/temp_dir.h"
+
+namespace exotwin {
+namespace {
+
+CanFrame Frame(uint16_t id, uint8_t b0) {
+  CanFrame f;
+  f.id = id;
+  f.dlc = 2;
+  f.data[0] = b0;
+  f.data[1] = 0x5A;
+  return f;
+}
+
+// Waits up to 1 s for a frame on `link`.
+CanStatus ReceiveWait(CanLink& link, CanFrame* out) {
+  for (int i = 0; i < 100; ++i) {
+    const CanStatus st = link.Receive(out);
+    if (st != CanStatus::kNoFrame) return st;
+    link.WaitInput(0.01);
+  }
+  return CanStatus::kNoFrame;
+}
+
+// A raw Unix datagram socket bound at `path` sending `bytes` to `to`.
+void SendRawUnix(const std::string& path, const std::string& to, const void* bytes, size_t n) {
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un a{}, b{};
+  a.sun_family = b.sun_family = AF_UNIX;
+  std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+  std::strncpy(b.sun_path, to.c_str(), sizeof b.sun_path - 1);
+  if (!path.empty()) {
+    ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  }
+  ASSERT_EQ(::sendto(fd, bytes, n, 0, reinterpret_cast<sockaddr*>(&b), sizeof b), static_cast<ssize_t>(n));
+  ::close(fd);
+  if (!path.empty()) ::unlink(path.c_str());
+}
+
+TEST(CanLink, UnixFramesBothWaysSocketsOwnerOnly) {
+  testing::ScopedTempDir dir("canlink");
+  const BusAddress a = ParseBusAddress("unix:" + dir.path() + "/bus");
+  auto twin = CanLink::Open(a, LinkEnd::kTwin);
+  auto ctl = CanLink::Open(a, LinkEnd::kController);
+  for (const std::string& p : {dir.path() + "/bus", dir.path() + "/bus.ctl"}) {
+    struct stat st{};
+    ASSERT_EQ(::stat(p.c_str(), &st), 0) << p;
+    EXPECT_EQ(st.st_mode & 0777, 0600u) << p;
+  }
+  ASSERT_EQ(twin->Send(Frame(0x180, 1)), CanStatus::kOk);
+  ASSERT_EQ(twin->Send(link::DoubleFrame(link::kIdSync, 0.0125)), CanStatus::kOk);
+  CanFrame f;
+  ASSERT_EQ(ReceiveWait(*ctl, &f), CanStatus::kOk);
+  EXPECT_TRUE(SamePayload(f, Frame(0x180, 1)));
+  ASSERT_EQ(ReceiveWait(*ctl, &f), CanStatus::kOk);
+  double t = 0;
+  ASSERT_TRUE(link::FrameDouble(f, &t));
+  EXPECT_EQ(t, 0.0125);
+  ASSERT_EQ(ctl->Send(Frame(0x100, 7)), CanStatus::kOk);
+  ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk);
+  EXPECT_TRUE(SamePayload(f, Frame(0x100, 7)));
+  EXPECT_EQ(twin->Receive(&f), CanStatus::kNoFrame);
+}
+
+TEST(CanLink, UnconfiguredPeerAndMalformedDatagramsAreDroppedAndCounted) {
+  testing::ScopedTempDir dir("canlink");
+  const BusAddress a = ParseBusAddress("unix:" + dir.path() + "/bus");
+  auto twin = CanLink::Open(a, LinkEnd::kTwin);
+  can_frame cf{};
+  cf.can_id = 0x100;
+  cf.can_dlc = 4;
+  SendRawUnix(dir.path() + "/intruder", dir.path() + "/bus", &cf, sizeof cf);  // a second peer
+  SendRawUnix("", dir.path() + "/bus", &cf, sizeof cf);                         // unnamed sender
+  {
+    auto ctl = CanLink::Open(a, LinkEnd::kController);
+    ctl.reset();  // frees the controller's path for raw senders below
+  }
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", &cf, 15);  // wrong length, from the peer
+  can_frame eff = cf;
+  eff.can_id = 0x100 | CAN_EFF_FLAG;
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", &eff, sizeof eff);  // not an 11-bit frame
+  can_frame dlc = cf;
+  dlc.can_dlc = 9;
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", &dlc, sizeof dlc);
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", &cf, sizeof cf);  // the one good frame
+  CanFrame f;
+  ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk);
+  EXPECT_EQ(f.id, 0x100);
+  EXPECT_EQ(f.dlc, 4);
+  EXPECT_EQ(twin->Receive(&f), CanStatus::kNoFrame);
+  EXPECT_EQ(twin->statistics().foreign, 2u);
+  EXPECT_EQ(twin->statistics().malformed, 3u);
+  EXPECT_EQ(twin->statistics().received, 1u);
+}
+
+TEST(CanLink, PeerAbsentIsAStatusNotACrash) {
+  testing::ScopedTempDir dir("canlink");
+  auto twin = CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/bus"), LinkEnd::kTwin);
+  EXPECT_EQ(twin->Send(Frame(0x80, 0)), CanStatus::kError);
+  EXPECT_EQ(twin->statistics().peer_absent, 1u);
+  EXPECT_FALSE(twin->WaitInput(0.01));
+}
+
+TEST(CanLink, BadPlacesExitWithTheAddressNamed) {
+  testing::ScopedTempDir dir("canlink");
+  try {
+    CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/no/such/dir/bus"), LinkEnd::kTwin);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/no/such/dir/bus"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir.path() + "/file") << "x";
+  EXPECT_THROW(CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/file"), LinkEnd::kTwin), InputError);
+  auto live = CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/bus"), LinkEnd::kTwin);
+  try {
+    CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/bus"), LinkEnd::kTwin);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(CanLink::Open(ParseBusAddress("can:nosuchcan9"), LinkEnd::kTwin), InputError);
+}
+
+TEST(CanLink, UdpOnLoopbackAndPortInUse) {
+  // Port 0 is not allowed in ADDR: find a free pair by trying a few.
+  std::unique_ptr<CanLink> twin, ctl;
+  BusAddress a;
+  for (int port = 47000; port < 47400 && !ctl; port += 2) {
+    a = ParseBusAddress("udp:127.0.0.1:" + std::to_string(port));
+    try {
+      twin = CanLink::Open(a, LinkEnd::kTwin);
+      ctl = CanLink::Open(a, LinkEnd::kController);
+    } catch (const InputError&) {
+      twin.reset();
+    }
+  }
+  ASSERT_TRUE(ctl);
+  ASSERT_EQ(ctl->Send(Frame(0x101, 3)), CanStatus::kOk);
+  CanFrame f;
+  ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk);
+  EXPECT_TRUE(SamePayload(f, Frame(0x101, 3)));
+  try {
+    CanLink::Open(a, LinkEnd::kTwin);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("port in use"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(a.text), std::string::npos) << e.what();
+  }
+  // A sender on another port is foreign.
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(a.port);
+  ::inet_pton(AF_INET, "127.0.0.1", &to.sin_addr);
+  can_frame cf{};
+  cf.can_id = 0x100;
+  cf.can_dlc = 2;
+  ASSERT_EQ(::sendto(fd, &cf, sizeof cf, 0, reinterpret_cast<sockaddr*>(&to), sizeof to), 16);
+  ::close(fd);
+  twin->WaitInput(0.5);
+  EXPECT_EQ(twin->Receive(&f), CanStatus::kNoFrame);
+  EXPECT_EQ(twin->statistics().foreign, 1u);
+}
+
+}  // namespace
+}  // namespace exotwin
