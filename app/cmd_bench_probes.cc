@@ -18,7 +18,7 @@
 #include "sim/plant.h"
 #include "sim/subjects.h"
 
-#include "render/video_renderer.h"
+#include "render/render_plugin.h"
 #include "analysis/identification.h"
 #include "analysis/identification_data.h"
 #include "analysis/diagnose.h"
@@ -121,7 +121,7 @@ json BenchRender(const BenchConfig& c) {
     long frames = 0;
     const std::string path = c.scratch + "/bench.mp4";
     const double t = BestOf(c.quick ? 1 : std::min(c.repeat, 2), [&] {
-      VideoRenderer v(plant.model(), path, opt);
+      const std::unique_ptr<VideoSink> v = OpenVideo(plant.model(), path, opt);
       for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) {
         OverlaySample s;
         s.t = i * 1e-3;
@@ -131,10 +131,10 @@ json BenchRender(const BenchConfig& c) {
         s.tau_est[0] = s.tau_meas[0] + 1, s.tau_est[1] = s.tau_meas[1] - 0.5;
         s.emg = {0.1 + 0.05 * std::sin(s.t), 0.2, 0.05};
         if (i == 500) s.event = "knee torque sensor: stuck reading";
-        v.AddSample(s);
+        v->AddSample(s);
       }
-      v.Finish(seconds);
-      frames = v.frames();
+      v->Finish(seconds);
+      frames = v->frames();
     });
     return std::make_pair(t, frames);
   };
