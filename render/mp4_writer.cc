@@ -70,8 +70,16 @@ void Mp4Writer::Write(const cv::Mat& frame) {
   if (frame.size() != size_ || frame.type() != CV_8UC3)
     throw std::invalid_argument("render: frame size/type does not match the video");
   std::unique_lock<std::mutex> lock(mu_);
-  cv_.wait(lock, [this] { return queue_.size() < 4; });
-  queue_.push_back(frame.clone());
+  cv_.wait(lock, [this] { return queue_.size() < kMaxQueued; });
+  cv::Mat copy;
+  if (!free_.empty()) {
+    copy = std::move(free_.back());
+    free_.pop_back();
+  }
+  lock.unlock();
+  frame.copyTo(copy);  // into a recycled buffer: no 3 MB allocation (and page faults) per frame
+  lock.lock();
+  queue_.push_back(std::move(copy));
   ++frames_;
   lock.unlock();
   cv_.notify_all();
@@ -89,6 +97,8 @@ void Mp4Writer::Run() {
     }
     cv_.notify_all();
     writer_.write(f);
+    std::lock_guard<std::mutex> lock(mu_);
+    free_.push_back(std::move(f));
   }
 }
 

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
@@ -23,7 +24,8 @@ class Mp4Writer {
   Mp4Writer(const Mp4Writer&) = delete;
   Mp4Writer& operator=(const Mp4Writer&) = delete;
 
-  // Queues a copy of a BGR CV_8UC3 frame of the writer's size; blocks while 4 frames are queued.
+  // Queues a copy of a BGR CV_8UC3 frame of the writer's size; blocks while kMaxQueued frames are
+  // queued. The copies go to buffers the encoder has finished with (at most kMaxQueued + 2 exist).
   void Write(const cv::Mat& frame);
   // Flushes the queue, closes the file and renames it to PATH. Idempotent.
   void Close();
@@ -33,6 +35,7 @@ class Mp4Writer {
   const std::string& path() const { return path_; }
 
  private:
+  static constexpr size_t kMaxQueued = 4;
   void Run();
 
   std::string path_, tmp_path_, codec_;
@@ -41,7 +44,8 @@ class Mp4Writer {
   std::thread worker_;
   std::mutex mu_;
   std::condition_variable cv_;
-  std::deque<cv::Mat> queue_;
+  std::deque<cv::Mat> queue_;  // frames waiting for the encoder
+  std::vector<cv::Mat> free_;   // buffers the encoder is done with, reused by Write
   bool stop_ = false, closed_ = false;
   long frames_ = 0;
 };
