@@ -1,6 +1,7 @@
 // The rendering stack is loaded only by the commands that render (render/render_plugin.h): the
 // dynamic loader's own record (LD_DEBUG=files, every object mapped, also by dlopen) shows no
-// libOSMesa and no libopencv for `--help` and a `run` without video, and shows both for `render`.
+// libOSMesa and no libopencv for `--help` and a `run` without video, and shows them (and FFmpeg's
+// libavcodec) for `render`.
 // A copy of the executable without the plugin runs every other command and exits 2 on a render,
 // naming the files looked for; with the plugin in <prefix>/lib/exotwin/ it renders.
 #include <gtest/gtest.h>
@@ -62,7 +63,8 @@ TEST_F(RenderPluginCli, RenderMapsThePluginOsMesaAndOpenCv) {
   EXPECT_TRUE(fs::exists(dir_ + "/v.mp4"));
   EXPECT_TRUE(Maps(r.output, kRenderPluginFile));
   EXPECT_TRUE(Maps(r.output, "libOSMesa"));
-  EXPECT_TRUE(Maps(r.output, "libopencv_videoio"));
+  EXPECT_TRUE(Maps(r.output, "libopencv_imgproc"));
+  EXPECT_TRUE(Maps(r.output, "libavcodec"));
 }
 
 TEST_F(RenderPluginCli, WithoutThePluginOnlyRenderingFailsNamingTheFiles) {
