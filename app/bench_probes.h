@@ -17,8 +17,14 @@ struct BenchConfig {
 // number of steps (10 s = 10000 steps; quick: 2 s).
 nlohmann::ordered_json BenchClosedLoop(const BenchConfig& c);
 
+// Start-up: wall time of `exotwin --help` (this executable, /proc/self/exe) against /bin/true, each
+// spawned and waited for (best of 10 x repeat; quick: 5); ratio first. Goal: --help < 0.03 s.
+nlohmann::ordered_json BenchStartup(const BenchConfig& c);
+
 // Render + H.264 encode at 1280x720 with overlays (3 s of video; quick: 1 s) vs no overlays and vs
-// real time (30 fps); {"status": "unavailable", ...} without the renderer.
+// real time (30 fps), ratio (x real time) first; cpu_ms_per_frame (all threads: llvmpipe, encoder,
+// caller) bounds the fps of idle cores, fps <= cores * 1000 / cpu_ms_per_frame, so the row reads on
+// a shared machine too; {"status": "unavailable", ...} without the renderer (plugin missing).
 nlohmann::ordered_json BenchRender(const BenchConfig& c);
 
 // Identification (steps 3-4, S1, 80 s of 1 kHz data; quick: 40 s): data seconds per wall second.

@@ -1,7 +1,8 @@
 // `exotwin bench [--out FILE.json] [--repeat R] [--quick] [--only NAME,...]`: speed of the twin, as
-// JSON (stdout, and FILE.json): closed loop vs bare mj_step, render + encode fps, identification and
-// diagnosis throughput, sweep speed-up on 2 worker processes; each with the ratio against its
-// baseline measured in the same run (app/bench_probes.h). Exit 0, 2 on bad options.
+// JSON (stdout, and FILE.json): start-up (--help vs /bin/true), closed loop vs bare mj_step, render
+// + encode fps, identification and diagnosis throughput, sweep speed-up on 2 worker processes; each
+// with the ratio against its baseline measured in the same run (app/bench_probes.h). Exit 0, 2 on
+// bad options.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -26,15 +27,15 @@ CommandRunner RegisterBench(CLI::App& app) {
     bool quick = false;
   };
   auto o = std::make_shared<Opts>();
-  CLI::App* sub = app.add_subcommand("bench", "Benchmark the twin (closed loop, render, identification, diagnosis, sweep)");
+  CLI::App* sub = app.add_subcommand("bench", "Benchmark the twin (start-up, closed loop, render, identification, diagnosis, sweep)");
   sub->add_option("--out", o->out, "write the JSON here too");
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
-  sub->add_option("--only", o->only, "comma-separated subset: closed_loop,render,identification,diagnosis,sweep");
+  sub->add_option("--only", o->only, "comma-separated subset: startup,closed_loop,render,identification,diagnosis,sweep");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
-    const std::vector<std::string> all = {"closed_loop", "render", "identification", "diagnosis", "sweep"};
+    const std::vector<std::string> all = {"startup", "closed_loop", "render", "identification", "diagnosis", "sweep"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -44,7 +45,7 @@ CommandRunner RegisterBench(CLI::App& app) {
         const std::string name = o->only.substr(start, end - start);
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
-                           "', expected a comma-separated subset of closed_loop,render,identification,diagnosis,sweep");
+                           "', expected a comma-separated subset of startup,closed_loop,render,identification,diagnosis,sweep");
         selected.push_back(name);
         start = end + 1;
       }
@@ -64,6 +65,7 @@ CommandRunner RegisterBench(CLI::App& app) {
     j["repeat"] = o->repeat;
     for (const std::string& name : selected) {
       std::fprintf(stderr, "bench: %s...\n", name.c_str());
+      if (name == "startup") j[name] = BenchStartup(c);
       if (name == "closed_loop") j[name] = BenchClosedLoop(c);
       if (name == "render") j[name] = BenchRender(c);
       if (name == "identification") j[name] = BenchIdentification(c);

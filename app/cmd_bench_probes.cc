@@ -1,7 +1,11 @@
 // The probes of `exotwin bench` (app/bench_probes.h). Optional layers are detected at compile time:
 // a probe whose library is not in the build reports {"status": "unavailable"}.
+#include <fcntl.h>
 #include <mujoco/mujoco.h>
+#include <spawn.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -9,6 +13,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <thread>
 
 #include "app/bench_probes.h"
 #include "core/data_dir.h"
@@ -19,7 +24,7 @@
 #include "sim/plant.h"
 #include "sim/subjects.h"
 
-#include "render/video_renderer.h"
+#include "render/render_plugin.h"
 #include "analysis/identification.h"
 #include "analysis/identification_data.h"
 #include "analysis/diagnose.h"
@@ -62,6 +67,23 @@ double SelfCpuSeconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// Spawns argv[0] with argv (stdout and stderr to /dev/null) and waits for it; false if it cannot run
+// or exits non-zero.
+bool SpawnAndWait(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  int st = 0;
+  return rc == 0 && waitpid(pid, &st, 0) == pid && WIFEXITED(st) && WEXITSTATUS(st) == 0;
 }
 
 json Unavailable(const std::string& why) { return json{{"status", "unavailable"}, {"reason", why}}; }
@@ -112,6 +134,22 @@ json BenchClosedLoop(const BenchConfig& c) {
               {"ratio_voluntary_human_to_bare", closed_voluntary / bare}};
 }
 
+json BenchStartup(const BenchConfig& c) {
+  const std::string self = ExecutablePath();
+  if (self.empty()) return Unavailable("/proc/self/exe unreadable");
+  const int n = c.quick ? 5 : 10 * std::max(1, c.repeat);
+  bool ok = true;
+  const double help = BestOf(n, [&] { ok &= SpawnAndWait({self, "--help"}); });
+  const double base = BestOf(n, [&] { ok &= SpawnAndWait({"/bin/true"}); });
+  if (!ok) return Unavailable("exotwin --help or /bin/true did not run");
+  return json{{"ratio_help_to_true", help / base},
+              {"status", "ok"},
+              {"help_s", help},
+              {"true_s", base},
+              {"target_help_s", 0.03},
+              {"runs", n}};
+}
+
 json BenchRender(const BenchConfig& c) {
   const double seconds = c.quick ? 1.0 : 3.0;
   Plant plant(ShippedModelPath("leg_exowheel.xml"));
@@ -121,8 +159,10 @@ json BenchRender(const BenchConfig& c) {
     opt.emg_names = {"VM", "RF", "ST"};
     long frames = 0;
     const std::string path = c.scratch + "/bench.mp4";
+    const double cpu0 = SelfCpuSeconds();
+    int runs = 0;
     const double t = BestOf(c.quick ? 1 : std::min(c.repeat, 2), [&] {
-      VideoRenderer v(plant.model(), path, opt);
+      const std::unique_ptr<VideoSink> v = OpenVideo(plant.model(), path, opt);
       for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) {
         OverlaySample s;
         s.t = i * 1e-3;
@@ -132,18 +172,21 @@ json BenchRender(const BenchConfig& c) {
         s.tau_est[0] = s.tau_meas[0] + 1, s.tau_est[1] = s.tau_meas[1] - 0.5;
         s.emg = {0.1 + 0.05 * std::sin(s.t), 0.2, 0.05};
         if (i == 500) s.event = "knee torque sensor: stuck reading";
-        v.AddSample(s);
+        v->AddSample(s);
       }
-      v.Finish(seconds);
-      frames = v.frames();
+      v->Finish(seconds);
+      frames = v->frames();
+      ++runs;
     });
-    return std::make_pair(t, frames);
+    return std::make_tuple(t, frames, 1e3 * (SelfCpuSeconds() - cpu0) / (runs * frames));
   };
   try {
-    const auto [t_ov, frames] = video(true);
-    const auto [t_plain, frames_plain] = video(false);
+    const auto [t_ov, frames, cpu_ms] = video(true);
+    const auto [t_plain, frames_plain, cpu_ms_plain] = video(false);
     const double fps = frames / t_ov, fps_plain = frames_plain / t_plain;
-    return json{{"status", "ok"},
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    return json{{"x_realtime_with_overlays", fps / 30.0},
+                {"status", "ok"},
                 {"width", 1280},
                 {"height", 720},
                 {"frames", frames},
@@ -152,8 +195,11 @@ json BenchRender(const BenchConfig& c) {
                 {"no_overlays_s", t_plain},
                 {"fps_with_overlays", fps},
                 {"fps_without_overlays", fps_plain},
-                {"x_realtime_with_overlays", fps / 30.0},
-                {"ratio_overlays_to_plain", t_ov / t_plain}};
+                {"ratio_overlays_to_plain", t_ov / t_plain},
+                {"target_fps_with_overlays", 60.0},
+                {"cpu_ms_per_frame_with_overlays", cpu_ms},
+                {"cpu_ms_per_frame_without_overlays", cpu_ms_plain},
+                {"fps_bound_idle_cores_with_overlays", cores * 1e3 / cpu_ms}};
   } catch (const std::exception& e) {
     return Unavailable(std::string("renderer failed: ") + e.what());
   }

@@ -17,7 +17,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "dsp/butterworth.h"
-#include "render/video_renderer.h"
+#include "render/render_plugin.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -106,7 +106,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
       }
 
     const auto wall0 = std::chrono::steady_clock::now();
-    VideoRenderer video(plant.model(), o->out, o->render);
+    const std::unique_ptr<VideoSink> video = OpenVideo(plant.model(), o->out, o->render);
     for (size_t i = 0; i < data.size(); ++i) {
       OverlaySample s;
       s.t = data.t[i];
@@ -117,14 +117,14 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
       s.tau_est[0] = est[0][i];
       s.tau_est[1] = est[1][i];
       for (const auto& e : emg) s.emg.push_back(e[i]);
-      video.AddSample(s);
+      video->AddSample(s);
     }
-    video.Finish(data.t.back() + dt);
+    video->Finish(data.t.back() + dt);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     const double duration = data.t.back() + dt - data.t.front();
     std::fprintf(stderr, "render-replay: wrote %s: %ld frames (%.2f s at %g fps, %dx%d, %s) in %.2f s wall, "
-                 "%.2fx real time\n", o->out.c_str(), video.frames(), duration, o->render.fps,
-                 o->render.width, o->render.height, video.codec().c_str(), wall, duration / wall);
+                 "%.2fx real time\n", o->out.c_str(), video->frames(), duration, o->render.fps,
+                 o->render.width, o->render.height, video->codec().c_str(), wall, duration / wall);
     return 0;
   };
 }

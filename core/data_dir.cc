@@ -10,6 +10,12 @@ namespace exotwin {
 
 namespace fs = std::filesystem;
 
+std::string ExecutablePath() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string() : exe.string();
+}
+
 std::string DataDir() {
   const char* env = std::getenv("EXOTWIN_DATA_DIR");
   std::string dir, source;
@@ -18,11 +24,9 @@ std::string DataDir() {
     while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
     source = "the environment variable EXOTWIN_DATA_DIR";
   } else {
-    std::error_code ec;
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (ec)
-      throw InputError("exotwin data folder: cannot read /proc/self/exe (" + ec.message() +
-                       ") to find <bin>/../share/exotwin; set EXOTWIN_DATA_DIR to the folder holding mjcf/, "
+    const fs::path exe = ExecutablePath();
+    if (exe.empty())
+      throw InputError("exotwin data folder: cannot read /proc/self/exe to find <bin>/../share/exotwin; set EXOTWIN_DATA_DIR to the folder holding mjcf/, "
                        "data/, scenarios/");
     dir = (exe.parent_path().parent_path() / "share" / "exotwin").string();
     source = "the executable " + exe.string() + " (<bin>/../share/exotwin)";

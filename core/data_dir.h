@@ -15,6 +15,10 @@ namespace exotwin {
 // (EXOTWIN_DATA_DIR or the executable's path), and how to set it.
 std::string DataDir();
 
+// The running executable's path (/proc/self/exe, resolved); empty when it cannot be read. The one
+// place programs locate themselves: the data folder, the rendering plugin, exotwin-controller.
+std::string ExecutablePath();
+
 // DataDir() + "/" + rel (rel: a path relative to the data folder, e.g. "mjcf/leg_exowheel.xml").
 // The file itself is not checked: its reader names it when it is missing.
 std::string DataPath(const std::string& rel);

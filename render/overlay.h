@@ -7,19 +7,10 @@
 
 #include <opencv2/core.hpp>
 
+#include "render/overlay_sample.h"
 #include "render/render_options.h"
 
 namespace exotwin {
-
-// What the overlays show at one instant (SI units; NaN in tau_est = no estimate).
-struct OverlaySample {
-  double t = 0;                     // s
-  double q_hip = 0, q_knee = 0;     // rad
-  double tau_meas[2] = {0, 0};      // measured torque (sensor), N m; [0] hip, [1] knee
-  double tau_est[2] = {0, 0};       // the twin's estimate, N m
-  std::vector<double> emg;          // EMG envelopes, V (optional; labels in RenderOptions::emg_names)
-  std::string event;                // non-empty: a fault event raised at t
-};
 
 // The recent past the strip charts need (decimated to about one point per chart pixel).
 class OverlayHistory {

@@ -1,5 +1,7 @@
 #include "render/scene_renderer.h"
 
+#include <GL/gl.h>
+#include <GL/glext.h>
 #include <dlfcn.h>
 #include <mujoco/mujoco.h>
 
@@ -69,7 +71,13 @@ SceneRenderer::SceneRenderer(const mjModel_* m, const RenderOptions& opt) : opt_
   gl_->scn.flags[mjRND_REFLECTION] = 0;
   gl_->scn.flags[mjRND_SKYBOX] = 0;
   FrameCamera();
-  rgb_.create(opt.height, opt.width, CV_8UC3);
+  // Read-back rows top-down (GL_MESA_pack_invert), so no flip pass; without it, flipped after.
+  while (glGetError() != GL_NO_ERROR) {
+  }
+  glPixelStorei(GL_PACK_INVERT_MESA, GL_TRUE);
+  top_down_ = glGetError() == GL_NO_ERROR;
+  if (gl_->con.offSamples > 0) rgb_.create(opt.height, opt.width, CV_8UC3);
+  else bgra_.create(opt.height, opt.width, CV_8UC4);
   bgr_.create(opt.height, opt.width, CV_8UC3);
 }
 
@@ -128,12 +136,19 @@ const cv::Mat& SceneRenderer::Render(const double* qpos) {
   const mjrRect viewport = {0, 0, opt_.width, opt_.height};
   mjr_setBuffer(mjFB_OFFSCREEN, &gl_->con);
   mjr_render(viewport, &gl_->scn, &gl_->con);
-  mjr_readPixels(rgb_.data, nullptr, viewport, &gl_->con);
+  // OpenCV wants top-down BGR. Single-sampled, the off-screen framebuffer mjr_setBuffer bound is
+  // read in llvmpipe's own layout, BGRA (a copy; RGB costs a per-pixel repack), then the alpha is
+  // dropped; multisampled, mjr_readPixels resolves it first and returns RGB.
+  if (gl_->con.offSamples == 0) {
+    glReadPixels(0, 0, opt_.width, opt_.height, GL_BGRA, GL_UNSIGNED_BYTE, bgra_.data);
+    cv::cvtColor(bgra_, bgr_, cv::COLOR_BGRA2BGR);
+  } else {
+    mjr_readPixels(rgb_.data, nullptr, viewport, &gl_->con);
+    cv::cvtColor(rgb_, bgr_, cv::COLOR_RGB2BGR);
+  }
+  if (!top_down_) cv::flip(bgr_, bgr_, 0);  // OpenGL rows are bottom-up
   const mjvGLCamera avg = mjv_averageCamera(gl_->scn.camera, gl_->scn.camera + 1);
   view_ = MakeCameraView(avg, opt_.width, opt_.height);
-  // OpenGL rows are bottom-up and RGB; OpenCV wants top-down BGR.
-  cv::flip(rgb_, bgr_, 0);
-  cv::cvtColor(bgr_, bgr_, cv::COLOR_RGB2BGR);
   return bgr_;
 }
 

@@ -44,7 +44,8 @@ class SceneRenderer {
   std::unique_ptr<OsMesaContext> osmesa_;
   std::unique_ptr<Gl> gl_;
   CameraView view_{};
-  cv::Mat rgb_, bgr_;
+  cv::Mat rgb_, bgra_, bgr_;  // read-back (RGB multisampled, BGRA otherwise) and the BGR frame
+  bool top_down_ = false;     // GL_MESA_pack_invert accepted: read-back rows come top-down
 };
 
 }  // namespace exotwin

@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "core/data_dir.h"
+
 #include "core/error.h"
 #include "protocol/can_link.h"
 #include "runner/exowheel_setup.h"
@@ -34,8 +36,8 @@ std::string WriteControllerFile(const Scenario& s, const std::string& dir) {
 
 std::string DefaultControllerBinary() {
   std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return "";
+  const fs::path self = ExecutablePath();
+  if (self.empty()) return "";
   for (const fs::path& p : {self.parent_path() / "exotwin-controller",
                             self.parent_path().parent_path() / "deploy" / "exotwin-controller"})
     if (fs::exists(p, ec)) return p.string();

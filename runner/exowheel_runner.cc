@@ -12,7 +12,7 @@
 #include "controller/exo_controller.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
-#include "render/video_renderer.h"
+#include "render/render_plugin.h"
 #include "runner/cosim_rig.h"
 #include "runner/exowheel_setup.h"
 #include "runner/fault_injection.h"
@@ -80,7 +80,7 @@ class ExowheelTrial : public CosimDevice {
     if (!opt.video_path.empty() && trial == 0) {
       RenderOptions ro;
       if (emg_on_) ro.emg_names = EmgChannelNames();  // the EMG panel's traces by muscle
-      video_ = std::make_unique<VideoRenderer>(plant.model(), opt.video_path, ro);
+      video_ = OpenVideo(plant.model(), opt.video_path, ro);
       const double dt = plant.timestep();
       envelope_.assign(5, dsp::SosFilter(dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / dt, 3.0)));
     }
@@ -240,7 +240,7 @@ class ExowheelTrial : public CosimDevice {
   std::unique_ptr<SyntheticEmg> emg_;
   std::vector<FaultSwitch> faults_;
   TrialLogs logs_;
-  std::unique_ptr<VideoRenderer> video_;
+  std::unique_ptr<VideoSink> video_;
   std::vector<dsp::SosFilter> envelope_;
   size_t events_seen_ = 0;
   double tau_[2] = {0, 0};      // the drivers' output at t (at t = 0: no command yet)

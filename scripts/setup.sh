@@ -9,7 +9,8 @@ PKGS=(
   libmujoco-dev libqhull-dev          # physics (find_package(mujoco) needs qhull's CMake config)
   libeigen3-dev                       # linear algebra
   libosmesa6-dev                      # off-screen OpenGL for render/
-  libopencv-dev                       # video encoding (render/)
+  libopencv-dev                       # overlays (render/); videoio decodes the videos in tests
+  libavcodec-dev libavformat-dev libswscale-dev  # MP4 encoding (render/mp4_writer.cc), x264 inside
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   can-utils                           # log2asc for the candump round-trip test

@@ -1,5 +1,6 @@
 // `exotwin bench`: JSON with each probe's timing and its ratio against the in-run baseline.
-// Quick sizes, closed loop and sweep only (render, identification and diagnosis have their own benches).
+// Quick sizes, start-up, closed loop and sweep only (render, identification and diagnosis have their
+// own benches). No timing is asserted: the machines are shared.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -14,16 +15,20 @@ namespace {
 TEST(BenchCli, QuickJsonHasRatios) {
   const testing::ScopedTempDir tmp("bench");
   const std::string dir = tmp.path();
-  const RunResult r = RunExotwin("bench --quick --repeat 1 --only closed_loop,sweep --out " + dir + "/b.json");
+  const RunResult r = RunExotwin("bench --quick --repeat 1 --only startup,closed_loop,sweep --out " + dir + "/b.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream f(dir + "/b.json");
-  const nlohmann::json j = nlohmann::json::parse(f);
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(f);  // key order as written
   EXPECT_EQ(j["closed_loop"]["status"], "ok");
   EXPECT_GT(j["closed_loop"]["ratio_closed_loop_to_bare"].get<double>(), 1.0);
   EXPECT_EQ(j["closed_loop"]["steps"], 2000);
   EXPECT_GT(j["closed_loop"]["ratio_voluntary_human_to_bare"].get<double>(), 1.0);
   EXPECT_TRUE(j["closed_loop"]["emg_cost_us_per_step"].is_number());
   EXPECT_GT(j["sweep"]["speedup_2_jobs"].get<double>(), 0.0);
+  EXPECT_EQ(j["startup"]["status"], "ok");
+  EXPECT_EQ(j["startup"].begin().key(), "ratio_help_to_true");  // ratio first
+  EXPECT_GT(j["startup"]["help_s"].get<double>(), 0.0);
+  EXPECT_GT(j["startup"]["true_s"].get<double>(), 0.0);
   EXPECT_FALSE(j.contains("render"));
 }
 
