@@ -125,67 +125,53 @@ constexpr std::array<std::array<uint8_t, 256>, kStuffStates> MakeStuffTable() {
 }
 constexpr std::array<std::array<uint8_t, 256>, kStuffStates> kStuffTable = MakeStuffTable();
 
-// MSB-first bit string in bytes (at most 98 bits: a frame's stuff region).
-struct BitString {
-  uint8_t bytes[16] = {};
-  int bits = 0;
-  uint64_t acc = 0;  // bits not yet stored in bytes: the low (bits % 8) bits
-  // Appends the k (<= 32) low bits of v, most significant first.
-  void Put(uint32_t v, int k) {
-    acc = (acc << k) | v;
-    int pending = bits % 8 + k;
-    bits += k;
-    uint8_t* out = bytes + (bits - pending) / 8;
-    while (pending >= 8) {
-      pending -= 8;
-      *out++ = static_cast<uint8_t>(acc >> pending);
-    }
-    if (pending > 0) *out = static_cast<uint8_t>(acc << (8 - pending));
-  }
-  bool Bit(int i) const { return ((bytes[i / 8] >> (7 - i % 8)) & 1) != 0; }
-};
-
-// CRC-15/CAN of the first n bits of s: whole bytes through kCrc15Table, the rest bit by bit.
-uint16_t Crc15Of(const BitString& s, int n) {
-  uint16_t crc = 0;
-  const int whole = n / 8;
-  for (int i = 0; i < whole; ++i) {
-    const uint16_t x = static_cast<uint16_t>(crc ^ (s.bytes[i] << 7));
-    crc = static_cast<uint16_t>(((x & 0x7F) << 8) ^ kCrc15Table[x >> 7]);
-  }
-  for (int i = 8 * whole; i < n; ++i) crc = Crc15Step(crc, s.Bit(i));
-  return crc;
-}
-
-// Stuff bits of the first n bits of s: whole bytes through kStuffTable, the rest bit by bit.
-int StuffBitsOf(const BitString& s, int n) {
-  uint8_t state = StuffState(false, 0);
-  int stuff = 0;
-  const int whole = n / 8;
-  for (int i = 0; i < whole; ++i) {
-    const uint8_t e = kStuffTable[state][s.bytes[i]];
-    stuff += e >> 4;
-    state = e & 0x0F;
-  }
-  for (int i = 8 * whole; i < n; ++i) state = StuffStep(state, s.Bit(i), &stuff);
-  return stuff;
+// A byte (MSB first) through the CRC register.
+inline uint16_t Crc15Byte(uint16_t crc, uint32_t byte) {
+  const uint32_t x = crc ^ (byte << 7);
+  return static_cast<uint16_t>(((x & 0x7F) << 8) ^ kCrc15Table[x >> 7]);
 }
 
 }  // namespace
 
-// Same bit stream as CanStuffRegion + CanStuffBitCount, without allocation and a byte at a time (CRC and
-// stuffing by tables): this runs for every frame of the virtual bus (5 per millisecond).
-// tests/protocol/can_bits_test.cc checks it against the bit-serial reference on random frames.
+// Same bit stream as CanStuffRegion + CanStuffBitCount, without allocation and mostly a byte at a time
+// (CRC and stuffing by tables): this runs for every frame of the virtual bus (5 per millisecond).
+// tests/protocol/can_bits_test.cc checks it against the bit-serial reference for every ID and DLC.
 int CanFrameBits(const CanFrame& frame) {
-  const int dlc = std::min<int>(frame.dlc, 8);
-  BitString s;
-  s.Put(0, 1);                  // SOF
-  s.Put(frame.id & 0x7FF, 11);  // identifier
-  s.Put(0, 3);                  // RTR, IDE, r0
-  s.Put(frame.dlc & 0xF, 4);    // DLC as sent
-  for (int i = 0; i < dlc; ++i) s.Put(frame.data[i], 8);
-  s.Put(Crc15Of(s, s.bits), 15);  // CRC over SOF..data
-  return s.bits + StuffBitsOf(s, s.bits) + kCanTrailerBits + kCanIfsBits;
+  const int n = std::min<int>(frame.dlc, 8);
+  const uint32_t id = frame.id & 0x7FFu, dlc = frame.dlc & 0xFu;
+  // CRC over SOF..data (19 + 8n bits): SOF and ID bits 10, 9 one at a time, then whole bytes: ID bits
+  // 8..0 + RTR, IDE, r0 (dominant) + DLC (16 bits), then the data.
+  uint16_t crc = Crc15Step(0, false);
+  crc = Crc15Step(crc, ((id >> 10) & 1u) != 0);
+  crc = Crc15Step(crc, ((id >> 9) & 1u) != 0);
+  const uint32_t head16 = ((id & 0x1FFu) << 7) | dlc;
+  crc = Crc15Byte(crc, head16 >> 8);
+  crc = Crc15Byte(crc, head16 & 0xFFu);
+  for (int i = 0; i < n; ++i) crc = Crc15Byte(crc, frame.data[i]);
+  // Stuffing over SOF..CRC (34 + 8n bits): SOF and ID bit 10 one at a time, then the remaining
+  // 32 + 8n bits (ID 9..0, RTR, IDE, r0, DLC, data, CRC) in whole bytes from a bit accumulator.
+  int stuff = 0;
+  uint8_t state = StuffStep(StuffState(false, 0), false, &stuff);
+  state = StuffStep(state, ((id >> 10) & 1u) != 0, &stuff);
+  uint64_t acc = ((id & 0x3FFu) << 7) | dlc;  // 17 bits pending
+  int pending = 17;
+  auto drain = [&]() {
+    while (pending >= 8) {
+      pending -= 8;
+      const uint8_t e = kStuffTable[state][(acc >> pending) & 0xFFu];
+      stuff += e >> 4;
+      state = e & 0x0F;
+    }
+  };
+  for (int i = 0; i < n; ++i) {
+    acc = (acc << 8) | frame.data[i];
+    pending += 8;
+    drain();
+  }
+  acc = (acc << 15) | crc;
+  pending += 15;
+  drain();
+  return 34 + 8 * n + stuff + kCanTrailerBits + kCanIfsBits;
 }
 
 int CanFrameBitsWorstCase(int dlc) {
