@@ -283,6 +283,7 @@ json BenchDiagnosis(const BenchConfig& c) {
 json BenchSweep(const BenchConfig& c) {
   const int subjects = c.quick ? 2 : 8;
   const Scenario base = GaitScenario(c.quick ? 2.0 : 20.0);
+  KeepScenarioModel(base);  // as `exotwin sweep`: loaded once, the workers inherit it
   auto run = [&](int workers) {
     const auto outcomes = RunForked(subjects, workers, [&](size_t i) {
       RunOptions o;
