@@ -61,7 +61,7 @@ nlohmann::ordered_json BenchIdentification(const BenchConfig& c);
 nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 
 // Sweep speed-up (rows: speed-up, the parent's share): the same runs (gait 20 s x 8 subjects; quick: 2 s x 2) with 1 and 2 worker
-// processes; ratio = t(1) / t(2) (target >= 1.8 on 2 idle cores); cores_used = children's CPU
+// processes; ratio = t(1) / t(2) (target >= 1.85 on 2 idle cores); cores_used = children's CPU
 // time / wall time (about 2 with 2 jobs on an idle machine: below it, other load took the cores);
 // serial_fraction = the parent's CPU share, amdahl_speedup_2_idle_cores the bound it implies.
 nlohmann::ordered_json BenchSweep(const BenchConfig& c);
