@@ -306,14 +306,19 @@ CsvStreamWriter::~CsvStreamWriter() {
 }
 
 void CsvStreamWriter::Row(const double* values, size_t n) {
-  char buf[32];
+  // Shortest text that reads back to the same double (std::to_chars, no locale, no printf cost),
+  // written in place at the buffer's end: at most 24 characters + the separator per column.
+  constexpr size_t kMaxField = 25;
+  const size_t start = buffer_.size();
+  buffer_.resize(start + columns_ * kMaxField + 1);
+  char* p = buffer_.data() + start;
+  char* const end = buffer_.data() + buffer_.size();
   for (size_t c = 0; c < columns_; ++c) {
-    // Shortest text that reads back to the same double (std::to_chars, no locale, no printf cost).
-    const auto res = std::to_chars(buf, buf + sizeof(buf), c < n ? values[c] : 0.0);
-    if (c) buffer_ += ',';
-    buffer_.append(buf, res.ptr);
+    if (c) *p++ = ',';
+    p = std::to_chars(p, end, c < n ? values[c] : 0.0).ptr;
   }
-  buffer_ += '\n';
+  *p++ = '\n';
+  buffer_.resize(static_cast<size_t>(p - buffer_.data()));
   ++rows_;
   if (++pending_ >= flush_rows_) Flush();
 }

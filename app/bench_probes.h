@@ -3,9 +3,38 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
+#include <cstdio>
 #include <string>
+#include <vector>
 
 namespace exotwin {
+
+// One row of the table `exotwin bench` prints (issue 16's table): a piece of work and its figure
+// against a baseline measured in the same run, ratio first. Every probe returns its rows in its
+// JSON object under "rows" (BenchRowsJson); the command gathers them into one table.
+struct BenchRow {
+  std::string work;      // what was timed, e.g. "exotwin run gait_2kmh (60 s, both CSV logs)"
+  double ratio = 0;      // the figure the goal is about (a time ratio, a speed-up, a share)
+  std::string unit;      // how ratio reads: "x" (times the baseline) or "%"
+  std::string baseline;  // the in-run baseline the ratio is against, e.g. "bare mj_step loop"
+  std::string goal;      // e.g. "<= 2.5x" ("" = none)
+  std::string detail;    // the raw figures, e.g. "0.66 s vs 0.09 s"
+};
+nlohmann::ordered_json BenchRowsJson(const std::vector<BenchRow>& rows);
+std::vector<BenchRow> BenchRowsFromJson(const nlohmann::ordered_json& probe);
+
+// The machine the figures were measured on: cores (nproc) and load averages (1, 5, 15 min).
+struct BenchMachine {
+  unsigned cores = 0;
+  double load[3] = {0, 0, 0};
+};
+BenchMachine MeasureMachine();
+nlohmann::ordered_json MachineJson(const BenchMachine& m);
+
+// The table: a header with the machine's load at the start and at the end, then one line per row
+// (ratio, goal, work, baseline, detail), as Markdown.
+void PrintBenchTable(std::FILE* out, const std::vector<BenchRow>& rows, const BenchMachine& start,
+                     const BenchMachine& end);
 
 struct BenchConfig {
   int repeat = 3;             // repetitions per timing (the minimum is kept)
@@ -14,12 +43,16 @@ struct BenchConfig {
 };
 
 // Closed loop (gait, plant + CAN + sensors + controller, no logs) vs bare mj_step, same model and
-// number of steps (10 s = 10000 steps; quick: 2 s).
+// number of steps (10 s = 10000 steps; quick: 2 s). Rows: with EMG, without EMG.
 nlohmann::ordered_json BenchClosedLoop(const BenchConfig& c);
 
 // Start-up: wall time of `exotwin --help` (this executable, /proc/self/exe) against /bin/true, each
 // spawned and waited for (best of 10 x repeat; quick: 5); ratio first. Goal: --help < 0.03 s.
 nlohmann::ordered_json BenchStartup(const BenchConfig& c);
+
+// `exotwin run scenarios/gait_2kmh.yaml` (60 s, both CSV logs) as a separate process, start-up
+// included, vs a bare mj_step loop of the same model and number of steps in this process.
+nlohmann::ordered_json BenchRunCommand(const BenchConfig& c);
 
 // Render + H.264 encode at 1280x720 with overlays (3 s of video; quick: 1 s) vs no overlays and vs
 // real time (30 fps), ratio (x real time) first; cpu_ms_per_frame (all threads: llvmpipe, encoder,
@@ -33,8 +66,8 @@ nlohmann::ordered_json BenchIdentification(const BenchConfig& c);
 // Diagnosis of 60 s of 1 kHz data with one hidden effect (quick: 20 s): data seconds per wall second.
 nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 
-// Sweep speed-up: the same runs (gait 20 s x 8 subjects; quick: 2 s x 2) with 1 and 2 worker
-// processes; ratio = t(1) / t(2) (target >= 1.8 on 2 idle cores); cores_used = children's CPU
+// Sweep speed-up (rows: speed-up, the parent's share): the same runs (gait 20 s x 8 subjects; quick: 2 s x 2) with 1 and 2 worker
+// processes; ratio = t(1) / t(2) (target >= 1.85 on 2 idle cores); cores_used = children's CPU
 // time / wall time (about 2 with 2 jobs on an idle machine: below it, other load took the cores);
 // serial_fraction = the parent's CPU share, amdahl_speedup_2_idle_cores the bound it implies.
 nlohmann::ordered_json BenchSweep(const BenchConfig& c);

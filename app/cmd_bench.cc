@@ -2,7 +2,8 @@
 // JSON (stdout, and FILE.json): start-up (--help vs /bin/true), closed loop vs bare mj_step, render
 // + encode fps, identification and diagnosis throughput, sweep speed-up on 2 worker processes; each
 // with the ratio against its baseline measured in the same run (app/bench_probes.h). Exit 0, 2 on
-// bad options.
+// bad options. The rows of all probes also go to stderr as one Markdown
+// table, ratio first, under the machine's cores and load.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -31,11 +32,11 @@ CommandRunner RegisterBench(CLI::App& app) {
   sub->add_option("--out", o->out, "write the JSON here too");
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
-  sub->add_option("--only", o->only, "comma-separated subset: startup,closed_loop,render,identification,diagnosis,sweep");
+  sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
-    const std::vector<std::string> all = {"startup", "closed_loop", "render", "identification", "diagnosis", "sweep"};
+    const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -45,7 +46,7 @@ CommandRunner RegisterBench(CLI::App& app) {
         const std::string name = o->only.substr(start, end - start);
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
-                           "', expected a comma-separated subset of startup,closed_loop,render,identification,diagnosis,sweep");
+                           "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep");
         selected.push_back(name);
         start = end + 1;
       }
@@ -58,21 +59,26 @@ CommandRunner RegisterBench(CLI::App& app) {
     c.scratch = tmpl;
 
     nlohmann::ordered_json j;
-    double load[3] = {0, 0, 0};
-    getloadavg(load, 3);
-    j["machine"] = {{"cores", std::thread::hardware_concurrency()}, {"load_avg_1min", load[0]}};
+    const BenchMachine start = MeasureMachine();
+    j["machine"] = MachineJson(start);
     j["quick"] = o->quick;
     j["repeat"] = o->repeat;
+    std::vector<BenchRow> rows;
     for (const std::string& name : selected) {
       std::fprintf(stderr, "bench: %s...\n", name.c_str());
       if (name == "startup") j[name] = BenchStartup(c);
+      if (name == "run") j[name] = BenchRunCommand(c);
       if (name == "closed_loop") j[name] = BenchClosedLoop(c);
       if (name == "render") j[name] = BenchRender(c);
       if (name == "identification") j[name] = BenchIdentification(c);
       if (name == "diagnosis") j[name] = BenchDiagnosis(c);
       if (name == "sweep") j[name] = BenchSweep(c);
+      for (const BenchRow& r : BenchRowsFromJson(j[name])) rows.push_back(r);
     }
+    const BenchMachine end = MeasureMachine();
+    j["machine_at_end"] = MachineJson(end);
     std::filesystem::remove_all(c.scratch);
+    PrintBenchTable(stderr, rows, start, end);
     const std::string text = j.dump(2) + "\n";
     std::fputs(text.c_str(), stdout);
     if (!o->out.empty()) WriteFileAtomic(o->out, text);

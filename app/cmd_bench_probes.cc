@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <stdexcept>
 #include <thread>
 
 #include "app/bench_probes.h"
@@ -88,16 +89,14 @@ bool SpawnAndWait(const std::vector<std::string>& args) {
 
 json Unavailable(const std::string& why) { return json{{"status", "unavailable"}, {"reason", why}}; }
 
-}  // namespace
-
-json BenchClosedLoop(const BenchConfig& c) {
-  const double duration = c.quick ? 2.0 : 10.0;
+// Best wall time (s) of `repeat` bare mj_step loops of n steps on the plant's model (S1's masses), from
+// the same start and with constant torques: the floor, MuJoCo alone.
+double BareMjStepSeconds(int repeat, long n) {
   Plant plant(ShippedModelPath("leg_exowheel.xml"));
   plant.SetParams(SubjectLegParams(PresetSubject("S1")));
   mjModel* m = const_cast<mjModel*>(plant.model());
   mjData* d = plant.data();
-  const long n = std::lround(duration / m->opt.timestep);
-  const double bare = BestOf(c.repeat, [&] {
+  return BestOf(repeat, [&] {
     mj_resetData(m, d);
     d->qpos[0] = 0.3;
     d->qpos[1] = -0.5;
@@ -107,6 +106,45 @@ json BenchClosedLoop(const BenchConfig& c) {
       mj_step(m, d);
     }
   });
+}
+
+std::string Seconds(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g s", s);
+  return b;
+}
+
+// Runs this executable with `args` (output discarded) and waits; throws unless it exits 0.
+void RunSelf(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  static char self[] = "exotwin";
+  argv.push_back(self);
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("bench: fork failed");
+  if (pid == 0) {
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) {
+      dup2(null, 1);
+      dup2(null, 2);
+    }
+    execv("/proc/self/exe", argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw std::runtime_error("bench: exotwin " + args.front() + " failed");
+}
+
+}  // namespace
+
+json BenchClosedLoop(const BenchConfig& c) {
+  const double duration = c.quick ? 2.0 : 10.0;
+  const long n = std::lround(duration / 1e-3);
+  const double bare = BareMjStepSeconds(c.repeat, n);
   const Scenario s = GaitScenario(duration);
   RunOptions o;
   o.out_dir = c.scratch + "/closed_loop";
@@ -131,7 +169,28 @@ json BenchClosedLoop(const BenchConfig& c) {
               {"closed_loop_voluntary_human_s", closed_voluntary},
               {"emg_cost_us_per_step", 1e6 * (closed - closed_no_emg) / n},
               {"voluntary_human_cost_us_per_step", 1e6 * (closed_voluntary - closed) / n},
-              {"ratio_voluntary_human_to_bare", closed_voluntary / bare}};
+              {"ratio_voluntary_human_to_bare", closed_voluntary / bare},
+              {"rows", BenchRowsJson({{"closed loop without logs, EMG (exotwin bench)", closed / bare, "x",
+                                       "bare mj_step loop", "<= 1.5x", Seconds(closed) + " vs " + Seconds(bare)},
+                                      {"closed loop without logs, no EMG", closed_no_emg / bare, "x",
+                                       "bare mj_step loop", "<= 1.5x",
+                                       Seconds(closed_no_emg) + " vs " + Seconds(bare)}})}};
+}
+
+json BenchRunCommand(const BenchConfig& c) {
+  const std::string file = DataPath("scenarios/gait_2kmh.yaml");
+  const Scenario s = ReadScenario(file);
+  const long n = std::lround(s.protocol.duration / 1e-3);
+  const double bare = BareMjStepSeconds(c.repeat, n);
+  const double run = BestOf(c.repeat, [&] { RunSelf({"run", file, "--out", c.scratch + "/run"}); });
+  return json{{"status", "ok"},
+              {"steps", n},
+              {"bare_mj_step_s", bare},
+              {"run_s", run},
+              {"ratio_run_to_bare", run / bare},
+              {"rows", BenchRowsJson({{"exotwin run gait_2kmh.yaml (60 s, both CSV logs, start-up included)",
+                                       run / bare, "x", "bare mj_step loop, same model and steps", "<= 2.5x",
+                                       Seconds(run) + " vs " + Seconds(bare)}})}};
 }
 
 json BenchStartup(const BenchConfig& c) {
@@ -147,7 +206,9 @@ json BenchStartup(const BenchConfig& c) {
               {"help_s", help},
               {"true_s", base},
               {"target_help_s", 0.03},
-              {"runs", n}};
+              {"runs", n},
+              {"rows", BenchRowsJson({{"start-up: exotwin --help", help / base, "x", "/bin/true, spawned the same way",
+                                       "< 0.03 s", Seconds(help) + " vs " + Seconds(base)}})}};
 }
 
 json BenchRender(const BenchConfig& c) {
@@ -199,7 +260,11 @@ json BenchRender(const BenchConfig& c) {
                 {"target_fps_with_overlays", 60.0},
                 {"cpu_ms_per_frame_with_overlays", cpu_ms},
                 {"cpu_ms_per_frame_without_overlays", cpu_ms_plain},
-                {"fps_bound_idle_cores_with_overlays", cores * 1e3 / cpu_ms}};
+                {"fps_bound_idle_cores_with_overlays", cores * 1e3 / cpu_ms},
+                {"rows", BenchRowsJson({{"render 1280x720 with overlays + H.264", fps / 30.0, "x",
+                                         "real time (30 fps video)", ">= 2x",
+                                         std::to_string(static_cast<int>(std::lround(fps))) + " fps, " +
+                                             std::to_string(static_cast<int>(std::lround(cpu_ms))) + " CPU ms/frame"}})}};
   } catch (const std::exception& e) {
     return Unavailable(std::string("renderer failed: ") + e.what());
   }
@@ -232,7 +297,9 @@ json BenchIdentification(const BenchConfig& c) {
               {"samples_per_s", samples / t},
               {"x_realtime", data_s / t},
               {"simulate_data_s", t_sim},
-              {"ratio_identify_to_simulation", t / t_sim}};
+              {"ratio_identify_to_simulation", t / t_sim},
+              {"rows", BenchRowsJson({{"identify steps 3-4", t / t_sim, "x", "simulating its data", "",
+                                       Seconds(t) + " vs " + Seconds(t_sim)}})}};
 }
 
 json BenchDiagnosis(const BenchConfig& c) {
@@ -255,12 +322,15 @@ json BenchDiagnosis(const BenchConfig& c) {
               {"samples_per_s", data.data.size() / t},
               {"x_realtime", g.duration / t},
               {"generate_data_s", t_gen},
-              {"ratio_diagnose_to_generation", t / t_gen}};
+              {"ratio_diagnose_to_generation", t / t_gen},
+              {"rows", BenchRowsJson({{"diagnose " + std::to_string(static_cast<int>(g.duration)) + " s of 1 kHz data",
+                                       t / t_gen, "x", "generating the data", "", Seconds(t) + " vs " + Seconds(t_gen)}})}};
 }
 
 json BenchSweep(const BenchConfig& c) {
   const int subjects = c.quick ? 2 : 8;
   const Scenario base = GaitScenario(c.quick ? 2.0 : 20.0);
+  KeepScenarioModel(base);  // as `exotwin sweep`: loaded once, the workers inherit it
   auto run = [&](int workers) {
     const auto outcomes = RunForked(subjects, workers, [&](size_t i) {
       RunOptions o;
@@ -297,11 +367,18 @@ json BenchSweep(const BenchConfig& c) {
               {"jobs1_s", t1},
               {"jobs2_s", t2},
               {"speedup_2_jobs", t1 / t2},
-              {"target_speedup", 1.8},
+              {"target_speedup", 1.85},
               {"cores_used_jobs1", cpu1 / t1},
               {"cores_used_jobs2", cpu2 / t2},
               {"serial_fraction", serial},
-              {"amdahl_speedup_2_idle_cores", 1.0 / (serial + (1.0 - serial) / 2.0)}};
+              {"amdahl_speedup_2_idle_cores", 1.0 / (serial + (1.0 - serial) / 2.0)},
+              {"rows", BenchRowsJson({{"sweep " + std::to_string(subjects) + " subjects, --jobs 2", t1 / t2, "x",
+                                       "the same sweep with --jobs 1", ">= 1.85x",
+                                       Seconds(t2) + " vs " + Seconds(t1) + ", cores used " +
+                                           std::to_string(cpu2 / t2).substr(0, 4)},
+                                      {"sweep: the parent's share of the CPU time", 100.0 * serial, "%",
+                                       "parent + workers, --jobs 1", "< 2 %",
+                                       Seconds(parent1) + " of " + Seconds(parent1 + cpu1)}})}};
 }
 
 }  // namespace exotwin

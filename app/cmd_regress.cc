@@ -57,6 +57,7 @@ CommandRunner RegisterRegress(CLI::App& app) {
     std::filesystem::create_directories(o->out);
     auto dir_of = [&](size_t i) { return o->out + "/" + suite[i].scenario.name; };
 
+    for (const SuiteEntry& e : suite) KeepScenarioModel(e.scenario);  // loaded once: the workers inherit it
     ProgressBar bar(suite.size(), "regress");
     size_t done = 0, failed = 0;
     const auto outcomes = RunForked(

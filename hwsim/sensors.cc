@@ -51,7 +51,8 @@ SampleSkew::SampleSkew(int samples) : samples_(samples) {
 
 double SampleSkew::Push(double v) {
   if (samples_ == 0) return v;
-  if (line_.empty()) line_.assign(static_cast<size_t>(samples_), v);
+  if (line_.empty())
+    for (int i = 0; i < samples_; ++i) line_.push_back(v);
   line_.push_back(v);
   const double out = line_.front();
   line_.pop_front();

@@ -2,8 +2,8 @@
 // Pure device physics (no bus): the joint-module node packs their readings into frames.
 #pragma once
 #include <cstdint>
-#include <deque>
 
+#include "core/ring_queue.h"
 #include "core/rng.h"
 
 namespace exotwin::hwsim {
@@ -75,7 +75,7 @@ class SampleSkew {
 
  private:
   int samples_;
-  std::deque<double> line_;
+  RingQueue<double> line_;
 };
 
 // Motor driver: torque command -> applied torque through a first-order current-loop lag, saturation

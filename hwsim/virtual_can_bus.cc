@@ -14,9 +14,15 @@ constexpr int kRecoveryBits = 128 * 11;  // bus-off recovery: 128 occurrences of
 
 // ---- Endpoint ----
 
-bool VirtualCanBus::Endpoint::Accepts(uint16_t id) const {
-  return accept_.empty() || std::find(accept_.begin(), accept_.end(), id) != accept_.end();
+VirtualCanBus::Endpoint::Endpoint(VirtualCanBus* bus, std::string name, const std::vector<uint16_t>& accept,
+                                  size_t index)
+    : bus_(bus), name_(std::move(name)), index_(index) {
+  if (accept.empty()) accept_.set();
+  for (uint16_t id : accept)
+    if (id <= kCanMaxId) accept_.set(id);
 }
+
+bool VirtualCanBus::Endpoint::Accepts(uint16_t id) const { return id <= kCanMaxId && accept_.test(id); }
 
 void VirtualCanBus::Endpoint::UpdateState() {
   if (state_ == CanNodeState::kBusOff) return;
@@ -65,7 +71,7 @@ CanStatus VirtualCanBus::Endpoint::Receive(CanFrame* out) {
 VirtualCanBus::VirtualCanBus(const VirtualCanBusConfig& config) : config_(config), rng_(config.seed) {}
 
 VirtualCanBus::Endpoint* VirtualCanBus::AddNode(std::string name, std::vector<uint16_t> accept_ids) {
-  nodes_.push_back(std::unique_ptr<Endpoint>(new Endpoint(this, std::move(name), std::move(accept_ids), nodes_.size())));
+  nodes_.push_back(std::unique_ptr<Endpoint>(new Endpoint(this, std::move(name), accept_ids, nodes_.size())));
   return nodes_.back().get();
 }
 
@@ -186,7 +192,8 @@ CanBusStatistics VirtualCanBus::Statistics() const {
   if (!busy_.empty() && busy_.back().end > now_) s.busy_time -= busy_.back().end - std::max(busy_.back().start, now_);
   const double w0 = std::max(0.0, now_ - config_.load_window);
   double busy = 0;
-  for (const Interval& iv : busy_) busy += std::max(0.0, std::min(iv.end, now_) - std::max(iv.start, w0));
+  for (size_t i = 0; i < busy_.size(); ++i)
+    busy += std::max(0.0, std::min(busy_[i].end, now_) - std::max(busy_[i].start, w0));
   const double window = now_ - w0;
   s.load_percent = window > 0 ? 100.0 * busy / window : 0.0;
   s.mean_load_percent = now_ > 0 ? 100.0 * s.busy_time / now_ : 0.0;

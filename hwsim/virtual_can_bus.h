@@ -16,13 +16,14 @@
 // All randomness comes from one seeded generator drawn in a fixed order: the same seed and the same
 // calls give identical frames and time stamps.
 #pragma once
+#include <bitset>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/ring_queue.h"
 #include "core/rng.h"
 #include "protocol/can_bus.h"
 
@@ -86,18 +87,17 @@ class VirtualCanBus {
       CanFrame frame;
       double ready;  // s, time it was queued
     };
-    Endpoint(VirtualCanBus* bus, std::string name, std::vector<uint16_t> accept, size_t index)
-        : bus_(bus), name_(std::move(name)), accept_(std::move(accept)), index_(index) {}
+    Endpoint(VirtualCanBus* bus, std::string name, const std::vector<uint16_t>& accept, size_t index);
     bool Accepts(uint16_t id) const;
     void EnterBusOff(double t);
     void UpdateState();
 
     VirtualCanBus* bus_;
     std::string name_;
-    std::vector<uint16_t> accept_;
+    std::bitset<kCanMaxId + 1> accept_;  // the IDs it receives (all set: every ID)
     size_t index_;
-    std::deque<Pending> tx_;
-    std::deque<CanFrame> rx_;  // t = delivery time, non-decreasing
+    RingQueue<Pending> tx_;
+    RingQueue<CanFrame> rx_;  // t = delivery time, non-decreasing
     int tec_ = 0, rec_ = 0;
     CanNodeState state_ = CanNodeState::kErrorActive;
     double recover_at_ = 0;
@@ -137,7 +137,7 @@ class VirtualCanBus {
   struct Interval {
     double start, end;
   };
-  std::deque<Interval> busy_;  // recent busy intervals (for the windowed load)
+  RingQueue<Interval> busy_;  // recent busy intervals (for the windowed load)
   std::function<void(const CanFrame&)> tap_;
 };
 

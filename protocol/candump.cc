@@ -22,30 +22,44 @@ int HexDigit(char c) {
 
 }  // namespace
 
-std::string FormatCandumpLine(const CanFrame& f, const std::string& interface, int64_t epoch_s) {
+namespace {
+
+// Room for a line: time stamp "(-9223372036854.775808) ", the interface and " 20000080#" + 16 hex digits.
+size_t LineCapacity(const std::string& interface) { return interface.size() + 72; }
+
+// Writes the line of f followed by '\n' into out (LineCapacity(interface) chars); returns its
+// length. No allocation: the writer calls it for every frame of a run.
+size_t FormatLine(const CanFrame& f, const std::string& interface, int64_t epoch_s, char* out) {
   static const char* kHex = "0123456789ABCDEF";
   const int64_t us = epoch_s * 1000000 + std::llround(f.t * 1e6);
   const int64_t sec = us >= 0 ? us / 1000000 : -((-us + 999999) / 1000000);
   const int64_t frac = us - sec * 1000000;
-  char head[64];
-  std::snprintf(head, sizeof head, "(%lld.%06lld) ", static_cast<long long>(sec), static_cast<long long>(frac));
-  std::string line = head + interface + " ";
-  char id[16];
+  const size_t cap = LineCapacity(interface);
+  size_t n = static_cast<size_t>(std::snprintf(out, cap, "(%lld.%06lld) %s ", static_cast<long long>(sec),
+                                               static_cast<long long>(frac), interface.c_str()));
   if (f.error) {
-    std::snprintf(id, sizeof id, "%08X#", kErrorFrameId);
-    return line + id + "0000000000000000";
+    n += static_cast<size_t>(std::snprintf(out + n, cap - n, "%08X#0000000000000000\n", kErrorFrameId));
+    return n;
   }
-  std::snprintf(id, sizeof id, "%03X#", static_cast<unsigned>(f.id & 0x7FF));
-  line += id;
+  n += static_cast<size_t>(std::snprintf(out + n, cap - n, "%03X#", static_cast<unsigned>(f.id & 0x7FF)));
   for (int i = 0; i < f.dlc && i < 8; ++i) {
-    line += kHex[f.data[i] >> 4];
-    line += kHex[f.data[i] & 0xF];
+    out[n++] = kHex[f.data[i] >> 4];
+    out[n++] = kHex[f.data[i] & 0xF];
   }
+  out[n++] = '\n';
+  return n;
+}
+
+}  // namespace
+
+std::string FormatCandumpLine(const CanFrame& f, const std::string& interface, int64_t epoch_s) {
+  std::string line(LineCapacity(interface), '\0');
+  line.resize(FormatLine(f, interface, epoch_s, line.data()) - 1);  // without the newline
   return line;
 }
 
 CandumpWriter::CandumpWriter(const std::string& path, std::string interface, int64_t epoch_s)
-    : path_(path), interface_(std::move(interface)), epoch_s_(epoch_s) {
+    : path_(path), interface_(std::move(interface)), epoch_s_(epoch_s), line_(LineCapacity(interface_), '\0') {
   file_ = std::fopen(path.c_str(), "w");
   if (!file_) throw InputError(path + ": cannot create CAN log: " + std::strerror(errno));
 }
@@ -55,8 +69,8 @@ CandumpWriter::~CandumpWriter() {
 }
 
 void CandumpWriter::Write(const CanFrame& f) {
-  const std::string line = FormatCandumpLine(f, interface_, epoch_s_) + "\n";
-  if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0)
+  const size_t n = FormatLine(f, interface_, epoch_s_, line_.data());
+  if (std::fwrite(line_.data(), 1, n, file_) != n || std::fflush(file_) != 0)
     throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
   ++lines_;
 }

@@ -29,6 +29,7 @@ class CandumpWriter {
  private:
   std::string path_, interface_;
   int64_t epoch_s_;
+  std::string line_;  // the line being written (sized once: Write does not allocate)
   std::FILE* file_ = nullptr;
   int64_t lines_ = 0;
 };

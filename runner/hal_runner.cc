@@ -118,6 +118,8 @@ class HalTrial : public CosimDevice {
     plant_.Reset(0.35, 0.65 * w, 0.0);
     // Same memory as the RLS: its rho is per control tick, the sums here run per physics step.
     projected_ = std::make_unique<ProjectedViscoelasticity>(std::pow(loop_cfg_.assist.rls.rho, dt_ / ctrl_dt_));
+    // The metric series hold one value per step after the settling time: sized once, not per step.
+    for (std::vector<double>* v : {&tau_m_, &m_e_, &m_f_}) v->reserve(static_cast<size_t>(schedule_.steps));
   }
 
   const CosimSchedule& schedule() const { return schedule_; }

@@ -14,7 +14,9 @@
 #include "runner/emg_calibration_protocol.h"
 #include "runner/exowheel_runner.h"
 #include "runner/hal_runner.h"
+#include "sim/mjcf_cache.h"
 #include "sim/muscles.h"
+#include "sim/plant.h"
 #include "sim/subjects.h"
 
 namespace exotwin {
@@ -54,6 +56,11 @@ LegParams ResolveSubject(const Scenario& s) {
     p.passive = s.subject.passive;
   }
   return p;
+}
+
+void KeepScenarioModel(const Scenario& s) {
+  KeepMjcfModel(s.device == Device::kHal3 ? ShippedModelPath("hal3_knee.xml")
+                                          : ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
 }
 
 RunResult RunScenario(const Scenario& s, const RunOptions& opt) {

@@ -79,6 +79,10 @@ ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed)
 // written so far stay on disk).
 RunResult RunScenario(const Scenario& s, const RunOptions& opt);
 
+// Keeps (sim/mjcf_cache.h) the MuJoCo model the scenario's runner loads, so that runs forked after
+// this call (sweep and regression workers) copy it instead of loading the MJCF file again.
+void KeepScenarioModel(const Scenario& s);
+
 // End of a run: evaluates the checks on result.metrics, writes result.json at `path`, then throws
 // InputError if a check names a metric the run did not produce (that check is written as failed with
 // value null, so the metrics of a long run are kept on disk before the exit code 2). An interrupted run

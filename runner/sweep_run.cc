@@ -47,6 +47,7 @@ SweepOutcome RunSweep(const SweepOptions& opt) {
   m.seed = opt.seed;
   if (opt.sharded) m.shard = opt.shard;
 
+  for (const Scenario& s : scenarios) KeepScenarioModel(s);  // loaded once: the workers inherit it
   const std::vector<SweepJob> jobs = PlanSweep(scenarios.size(), opt.subjects, opt.shard);
   auto dir_of = [&](const SweepJob& j) {
     return opt.out_dir + "/runs/" + scenarios[j.scenario].name + "/subject_" + std::to_string(j.subject);

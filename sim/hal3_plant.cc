@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sim/mjcf_cache.h"
 #include "sim/subjects.h"
 
 namespace exotwin {
@@ -23,7 +24,7 @@ Hal3PlantParams Hal3ParamsForSubject(const Subject& s) {
 
 Hal3Plant::Hal3Plant(const std::string& mjcf_path) : path_(mjcf_path) {
   char err[1000] = "";
-  m_ = mj_loadXML(mjcf_path.c_str(), nullptr, err, sizeof(err));
+  m_ = LoadMjcfModel(mjcf_path, err, sizeof(err));
   if (!m_) throw InputError(mjcf_path + ": cannot load MJCF model: " + err);
   d_ = mj_makeData(m_);
   const int knee = mj_name2id(m_, mjOBJ_JOINT, "knee");

@@ -18,7 +18,6 @@
 // (N m) = 100 x the paper's value. That reading is ours; the paper does not state the unit.
 #pragma once
 #include <array>
-#include <deque>
 #include <cstdint>
 #include <vector>
 #include <functional>
@@ -26,6 +25,7 @@
 
 #include <Eigen/Core>
 
+#include "core/ring_queue.h"
 #include "core/rng.h"
 #include "core/units.h"
 
@@ -243,7 +243,7 @@ class VoluntaryTracking : public Behaviour {
     double t;
     Eigen::Vector2d q, qd;
   };
-  std::deque<Sensed> sensed_;  // history over the last feedback_delay s (delayed feedback)
+  RingQueue<Sensed> sensed_;  // history over the last feedback_delay s (delayed feedback)
 };
 
 // The exaggerated gait's intended motion from the pattern's (q, qd, qdd) = (q_b, qd_b, qdd_b),

@@ -9,6 +9,7 @@
 
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "sim/mjcf_cache.h"
 #include "model/passive_torque.h"
 #include "sim/realizability.h"
 
@@ -62,7 +63,7 @@ std::string ExowheelMjcfPath(bool with_human) {
 
 Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
   char err[1000] = "";
-  m_ = mj_loadXML(mjcf_path.c_str(), nullptr, err, sizeof(err));
+  m_ = LoadMjcfModel(mjcf_path, err, sizeof(err));
   if (!m_) throw InputError(mjcf_path + ": cannot load MJCF model: " + err);
   const std::string bad_value = FirstBadModelValue(m_);
   if (!bad_value.empty()) {

@@ -30,6 +30,14 @@ TEST(BenchCli, QuickJsonHasRatios) {
   EXPECT_GT(j["startup"]["help_s"].get<double>(), 0.0);
   EXPECT_GT(j["startup"]["true_s"].get<double>(), 0.0);
   EXPECT_FALSE(j.contains("render"));
+  // The table (stderr): one row per figure, ratio first, under the machine's cores and load.
+  EXPECT_EQ(j["closed_loop"]["rows"].size(), 2u);
+  EXPECT_EQ(j["sweep"]["rows"][0]["goal"], ">= 1.85x");
+  EXPECT_TRUE(j["machine"]["load_avg_15min"].is_number());
+  EXPECT_GT(j["machine"]["cores"].get<int>(), 0);
+  EXPECT_NE(r.output.find("| ratio | goal | work | against | figures |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("closed loop without logs, EMG"), std::string::npos);
+  EXPECT_NE(r.output.find("machine: "), std::string::npos);
 }
 
 TEST(BenchCli, UnknownProbeExits2) {
