@@ -39,7 +39,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
     MapReport map_report;
-    const MeasuredData data = ReadMeasured(o->measured, o->map, 20, &map_report);
+    MeasuredData data = ReadMeasured(o->measured, o->map, 20, &map_report);
     if (!o->map.empty()) std::fprintf(stderr, "predict: %s", map_report.Summary().c_str());
     if (params.human) CheckHumanJointRange(data);
     Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
@@ -47,7 +47,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
     std::string why;
     const double cutoff = ResolveCutoffOption(o->cutoff, "--cutoff", {&data}, params.L1, params.g, &why);
     if (o->cutoff == "auto") std::fprintf(stderr, "predict: derivative cutoff %s\n", why.c_str());
-    const Kinematics kin = DeriveKinematics(data, cutoff);
+    const Kinematics kin = DeriveKinematics(std::move(data), cutoff);  // data's memory released
     if (kin.resampled)
       std::fprintf(stderr,
                    "predict: %s is sampled non-uniformly; derivatives computed on a uniform grid at "
