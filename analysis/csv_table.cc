@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <string_view>
 
 #include "analysis/number_rows.h"
 #include "core/error.h"
@@ -25,18 +27,25 @@ namespace {
 
 bool Blank(char c) { return c == ' ' || c == '\t'; }
 
-// The whole file. Throws InputError for a folder, a file that cannot be read or holds a NUL byte.
-std::string ReadCsvText(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a CSV file");
-  return ReadTextFile(path, "", "a text CSV file");
-}
-
 }  // namespace
 
+void AppendNumber(std::string* out, double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  out->append(buf, r.ptr);
+}
+
 CsvReader::CsvReader(const std::string& text, std::string source)
-    : next_(text.data()), end_(text.data() + text.size()), source_(std::move(source)) {
-  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) next_ += 3;  // UTF-8 byte-order mark
+    : CsvReader(text.data(), text.data() + text.size(), std::move(source)) {}
+
+CsvReader::CsvReader(const char* begin, const char* end, std::string source)
+    : next_(begin), end_(end), source_(std::move(source)) {
+  if (end - begin >= 3 && std::memcmp(begin, "\xEF\xBB\xBF", 3) == 0) next_ += 3;  // UTF-8 byte-order mark
+}
+
+void CsvReader::Continue(const char* begin, const char* end) {
+  next_ = begin;
+  end_ = end;
 }
 
 std::string CsvReader::Where() const { return source_ + ":" + std::to_string(line_) + ": "; }
@@ -220,26 +229,90 @@ bool CsvReader::NextNumbers(double* values) {
 }
 
 CsvTable ReadCsv(const std::string& path) {
-  std::string content = ReadCsvText(path);
-  if (content.empty()) throw InputError(path + ": file is empty, expected a CSV header row");
-
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a CSV file");
+  TextFileChunks in(path, "", "a text CSV file");
+  // The file in chunks of whole lines (a line longer than a chunk grows the buffer); one byte more
+  // for the NUL after an unterminated last line.
+  std::vector<char> buf((size_t{1} << 22) + 1);
+  size_t have = 0;      // bytes in buf
+  size_t parsed = 0;    // bytes of the file handed to the reader
+  int lines_done = 0;   // lines of the file before buf
+  bool first = true, streamed = false, reserved = false;
+  std::optional<CsvReader> reader;
   CsvTable t;
-  if (content.rfind(kStreamMarker, 0) == 0 && content.back() != '\n') {
-    const size_t cut = content.rfind('\n') + 1;  // npos + 1 == 0: the marker line itself was cut
-    t.dropped_cut_line = static_cast<int>(std::count(content.begin(), content.begin() + cut, '\n')) + 1;
+  std::vector<double> row;
+  // Whole lines [b, e) into t (the header first).
+  auto parse = [&](const char* b, const char* e) {
+    if (!reader) reader.emplace(b, e, path);
+    else reader->Continue(b, e);
+    if (t.names.empty()) {
+      if (!reader->ReadHeader()) return;
+      t.names = reader->names();
+      t.columns.assign(t.names.size(), {});
+      row.resize(t.names.size());
+    }
+    while (reader->NextNumbers(row.data())) {
+      for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
+      t.line_of_row.push_back(reader->line());
+    }
+    parsed += static_cast<size_t>(e - b);
+    if (!reserved && in.size() > parsed && t.rows() > 0) {
+      // Rows expected from the bytes per row so far (capacity never touched costs no memory).
+      const double rows = static_cast<double>(t.rows()) * static_cast<double>(in.size()) / static_cast<double>(parsed);
+      const size_t n = static_cast<size_t>(1.05 * rows) + 64;
+      for (auto& c : t.columns) c.reserve(n);
+      t.line_of_row.reserve(n);
+      reserved = true;
+    }
+  };
+  auto warn_cut = [&](int line) {
+    t.dropped_cut_line = line;
     std::fprintf(stderr, "warning: %s:%d: last line has no newline in a streamed exotwin log: dropped "
-                 "(the run was killed while writing it)\n", path.c_str(), t.dropped_cut_line);
-    content.resize(cut);
+                 "(the run was killed while writing it)\n", path.c_str(), line);
+  };
+  // A parse error: what reading the whole file first said before it comes first (a NUL byte
+  // anywhere in the file, then the warning for a cut last line).
+  auto guarded_parse = [&](const char* b, const char* e) {
+    try {
+      parse(b, e);
+    } catch (const InputError&) {
+      bool ends_with_newline = have > 0 && buf[have - 1] == '\n';
+      const size_t rest = in.DrainCountingNewlines(&ends_with_newline);
+      if (streamed && !ends_with_newline)
+        warn_cut(lines_done + static_cast<int>(std::count(buf.data(), buf.data() + have, '\n') + rest) + 1);
+      throw;
+    }
+  };
+  for (bool eof = false; !eof;) {
+    if (have + 1 == buf.size()) buf.resize(2 * buf.size() - 1);
+    const size_t want = buf.size() - 1 - have;
+    const size_t got = in.Read(buf.data() + have, want);
+    eof = got < want;
+    have += got;
+    buf[have] = '\0';
+    if (first) {
+      if (have == 0) throw InputError(path + ": file is empty, expected a CSV header row");
+      streamed = std::string_view(buf.data(), have).rfind(kStreamMarker, 0) == 0;
+      first = false;
+    }
+    const char* b = buf.data();
+    const char* nl = static_cast<const char*>(memrchr(b, '\n', have));
+    if (nl) {
+      const size_t whole = static_cast<size_t>(nl + 1 - b);
+      guarded_parse(b, nl + 1);
+      lines_done = reader->line();
+      std::memmove(buf.data(), b + whole, have - whole);
+      have -= whole;
+      buf[have] = '\0';
+    }
+    if (eof && have > 0) {
+      // An unterminated last line: a row cut by a killed run in a streamed file, else a row.
+      if (streamed) warn_cut(lines_done + 1);
+      else guarded_parse(buf.data(), buf.data() + have);
+    }
   }
-  CsvReader in(content, path);
-  if (!in.ReadHeader()) throw InputError(path + ": no header row (only comments or blank lines)");
-  t.names = in.names();
-  t.columns.assign(t.names.size(), {});
-  std::vector<double> row(t.names.size());
-  while (in.NextNumbers(row.data())) {
-    for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
-    t.line_of_row.push_back(in.line());
-  }
+  if (t.names.empty()) throw InputError(path + ": no header row (only comments or blank lines)");
   return t;
 }
 
@@ -259,23 +332,44 @@ void WriteFileAtomic(const std::string& path, const std::string& text) {
 void WriteCsv(const std::string& path, const std::vector<std::string>& names,
               const std::vector<const std::vector<double>*>& columns,
               const std::vector<std::string>& comments) {
+  // Streamed to the temporary file in blocks of about 1 MiB (the text of a long record is never
+  // held whole), then renamed as WriteFileAtomic does.
+  const std::string tmp = path + ".tmp";
+  std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
+  if (!file) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
   std::string out;
   for (const auto& c : comments) out += "# " + c + "\n";
   for (size_t i = 0; i < names.size(); ++i) out += (i ? "," : "") + names[i];
   out += "\n";
-  AppendNumberRows(out, columns, ',');
-  WriteFileAtomic(path, out);
+  constexpr size_t kBlock = size_t{1} << 20;
+  out.reserve(kBlock + 1024);
+  const size_t n = columns.empty() ? 0 : columns[0]->size();
+  for (size_t r = 0; r < n; ++r) {
+    for (size_t c = 0; c < columns.size(); ++c) {
+      if (c) out += ',';
+      AppendNumber(&out, (*columns[c])[r]);
+    }
+    out += '\n';
+    if (out.size() >= kBlock) {
+      file.write(out.data(), static_cast<std::streamsize>(out.size()));
+      out.clear();
+    }
+  }
+  file.write(out.data(), static_cast<std::streamsize>(out.size()));
+  file.flush();
+  if (!file) throw InputError(path + ": write failed (" + std::strerror(errno) + ")");
+  file.close();
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw InputError(path + ": cannot rename temporary file (" + std::strerror(errno) + ")");
 }
 
 void AppendNumberRows(std::string& out, const std::vector<const std::vector<double>*>& columns, char sep) {
   const size_t n = columns.empty() ? 0 : columns[0]->size();
   out.reserve(out.size() + n * columns.size() * 24);
-  char buf[32];
   for (size_t r = 0; r < n; ++r) {
     for (size_t c = 0; c < columns.size(); ++c) {
-      const int len = std::snprintf(buf, sizeof(buf), "%.17g", (*columns[c])[r]);
       if (c) out += sep;
-      out.append(buf, len);
+      AppendNumber(&out, (*columns[c])[r]);
     }
     out += '\n';
   }

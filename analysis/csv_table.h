@@ -28,6 +28,13 @@ class CsvReader {
  public:
   // `text` is the whole file and must outlive the reader; `source` names it in messages.
   CsvReader(const std::string& text, std::string source);
+  // The text [begin, end): whole lines of a file read in chunks (see Continue). Precondition: the
+  // byte at `end` is readable and cannot continue a number ('\n', '\r' or a NUL).
+  CsvReader(const char* begin, const char* end, std::string source);
+
+  // Goes on with the next whole lines [begin, end) of the same file (header, line numbers and
+  // dialect kept; the previous text may be gone). Precondition as for the constructor.
+  void Continue(const char* begin, const char* end);
 
   // Reads the header row. False if the text holds no record (only comments or blank lines).
   bool ReadHeader();
@@ -88,7 +95,12 @@ struct CsvTable {
 // its line number kept in dropped_cut_line.
 CsvTable ReadCsv(const std::string& path);
 
-// Writes a table with full double precision (%.17g), header first. `comments` go first as '# ' lines.
+// Appends the shortest text of v that reads back to the same double (std::to_chars: no locale, no
+// printf cost; "1e-05" where %.17g writes "1.0000000000000001e-05").
+void AppendNumber(std::string* out, double v);
+
+// Writes a table with full double precision (AppendNumber: every number reads back to the same
+// double as %.17g's text), header first. `comments` go first as '# ' lines.
 // Written to a temporary file and renamed, so a reader never sees a partial file.
 void WriteCsv(const std::string& path, const std::vector<std::string>& names,
               const std::vector<const std::vector<double>*>& columns,

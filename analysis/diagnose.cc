@@ -655,7 +655,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   });
   D.extended.effects.resize(params.effects.size());
   for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  D.kin = recs[0].kin;
+  D.kin = std::move(recs[0].kin);  // recs are done with: the plot series take the first record's kinematics
   D.split = recs[0].split;
   Lap("extended twin");
 

@@ -168,47 +168,92 @@ std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::v
   return Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(t, x, s.grid)), t);
 }
 
-Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
-  Kinematics k;
-  k.t = data.t;
-  k.q[0] = data.q_hip;
-  k.q[1] = data.q_knee;
-  for (size_t c = 0; c < data.table.names.size(); ++c)
-    if (data.table.names[c].rfind("emg_", 0) == 0 && data.table.names[c].size() > 4)
-      k.emg[data.table.names[c].substr(4)] = data.table.columns[c];
-  const char* names[2] = {"hip", "knee"};
+namespace {
+
+// DeriveKinematics on k (t, q and emg already set from the record; qd_* / qdd_* columns given or
+// null; `source` names the record in messages).
+void Derive(const std::vector<double>* measured[2][2], const std::string& source, double cutoff_hz,
+            Kinematics* out) {
+  Kinematics& k = *out;
   bool all_measured = true;
   for (int j = 0; j < 2; ++j) {
-    const auto* qd = data.Column(std::string("qd_") + names[j]);
-    const auto* qdd = data.Column(std::string("qdd_") + names[j]);
-    if (qd && qdd) {
-      k.qd[j] = *qd;
-      k.qdd[j] = *qdd;
+    if (measured[j][0] && measured[j][1]) {
+      k.qd[j] = *measured[j][0];
+      k.qdd[j] = *measured[j][1];
     } else {
       all_measured = false;
     }
   }
   if (all_measured) {
     k.derivative_source = "measured columns";
-    return k;
+    return;
   }
-  const SampleGrid s = MakeGrid(data.t, data.source, cutoff_hz);
+  const SampleGrid s = MakeGrid(k.t, source, cutoff_hz);
   k.resampled = !s.uniform;
   for (int j = 0; j < 2; ++j) {
-    const auto* qd = data.Column(std::string("qd_") + names[j]);
-    const auto* qdd = data.Column(std::string("qdd_") + names[j]);
-    const std::vector<double> qg = s.uniform ? k.q[j] : Interpolate(data.t, k.q[j], s.grid);
-    dsp::Derivatives der = dsp::ZeroPhaseDerivatives(qg, s.dt, cutoff_hz);
-    std::vector<double> v = std::move(der.first);
-    std::vector<double> a = std::move(der.second);
-    if (!s.uniform) {
-      v = Interpolate(s.grid, v, data.t);
-      a = Interpolate(s.grid, a, data.t);
+    const auto* qd = measured[j][0];
+    const auto* qdd = measured[j][1];
+    std::vector<double> v, a;
+    {
+      dsp::Derivatives der =
+          dsp::ZeroPhaseDerivatives(s.uniform ? k.q[j] : Interpolate(k.t, k.q[j], s.grid), s.dt, cutoff_hz);
+      v = std::move(der.first);
+      a = std::move(der.second);
     }
-    k.qd[j] = qd ? *qd : v;
-    k.qdd[j] = qdd ? *qdd : a;
+    if (!s.uniform) {
+      v = Interpolate(s.grid, v, k.t);
+      a = Interpolate(s.grid, a, k.t);
+    }
+    if (qd) k.qd[j] = *qd;
+    else k.qd[j] = std::move(v);
+    if (qdd) k.qdd[j] = *qdd;
+    else k.qdd[j] = std::move(a);
   }
   k.derivative_source = "butterworth " + NumberText(cutoff_hz) + " Hz";
+}
+
+bool IsEmgChannel(const std::string& name) { return name.rfind("emg_", 0) == 0 && name.size() > 4; }
+
+}  // namespace
+
+Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
+  Kinematics k;
+  k.t = data.t;
+  k.q[0] = data.q_hip;
+  k.q[1] = data.q_knee;
+  for (size_t c = 0; c < data.table.names.size(); ++c)
+    if (IsEmgChannel(data.table.names[c])) k.emg[data.table.names[c].substr(4)] = data.table.columns[c];
+  const char* names[2] = {"hip", "knee"};
+  const std::vector<double>* measured[2][2];
+  for (int j = 0; j < 2; ++j) {
+    measured[j][0] = data.Column(std::string("qd_") + names[j]);
+    measured[j][1] = data.Column(std::string("qdd_") + names[j]);
+  }
+  Derive(measured, data.source, cutoff_hz, &k);
+  return k;
+}
+
+Kinematics DeriveKinematics(MeasuredData&& data, double cutoff_hz) {
+  Kinematics k;
+  k.t = std::move(data.t);
+  k.q[0] = std::move(data.q_hip);
+  k.q[1] = std::move(data.q_knee);
+  CsvTable& tab = data.table;
+  const char* names[2] = {"hip", "knee"};
+  std::vector<double> columns[2][2];  // qd_*, qdd_* when recorded
+  const std::vector<double>* measured[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};
+  for (int j = 0; j < 2; ++j)
+    for (int d = 0; d < 2; ++d) {
+      const int c = tab.Find(std::string(d == 0 ? "qd_" : "qdd_") + names[j]);
+      if (c < 0) continue;
+      columns[j][d] = std::move(tab.columns[c]);
+      measured[j][d] = &columns[j][d];
+    }
+  for (size_t c = 0; c < tab.names.size(); ++c)
+    if (IsEmgChannel(tab.names[c])) k.emg[tab.names[c].substr(4)] = std::move(tab.columns[c]);
+  const std::string source = std::move(data.source);
+  data = MeasuredData();
+  Derive(measured, source, cutoff_hz, &k);
   return k;
 }
 

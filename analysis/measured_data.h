@@ -61,6 +61,10 @@ struct Kinematics {
 // 1 %) is handled by resampling the angles onto a uniform grid at the median step (linear
 // interpolation), differentiating there, and interpolating back onto the measured times.
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz = 20.0);
+// The same, taking the record's columns instead of copying them (t, q_*, emg_*; the other columns
+// are released before the derivatives are computed): for a caller done with `data` (predict of a
+// long record). `data` is left empty.
+Kinematics DeriveKinematics(MeasuredData&& data, double cutoff_hz = 20.0);
 
 // x (one value per time of t) filtered exactly as DeriveKinematics filters the angles: the
 // zero-phase 2nd-order Butterworth low-pass at cutoff_hz, on a uniform grid at the median step when

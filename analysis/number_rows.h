@@ -6,7 +6,7 @@
 namespace exotwin {
 
 // Appends one line per row of `columns` (every column as long as the first) to `out`: the values
-// "%.17g" (doubles round-trip exactly), separated by `sep`, each line ended by '\n'.
+// as AppendNumber (analysis/csv_table.h: the shortest text that reads back to the same double), separated by `sep`, each line ended by '\n'.
 void AppendNumberRows(std::string& out, const std::vector<const std::vector<double>*>& columns, char sep);
 
 }  // namespace exotwin

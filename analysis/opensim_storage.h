@@ -47,7 +47,7 @@ StorageTable ReadStorage(const std::string& path);
 // Writes an OpenSim version-1 storage file that OpenSim (Storage, TimeSeriesTable) and ReadStorage
 // open: the line `name`, `version=1`, `nRows=`, `nColumns=`, `inDegrees=yes|no` (`in_degrees`: the
 // unit of the angle columns), `notes` as free text lines, `endheader`; then the column names and one
-// row per sample, tab-separated, values "%.17g" (doubles round-trip exactly). `names` must contain
+// row per sample, tab-separated, values as AppendNumber writes them (doubles round-trip exactly). `names` must contain
 // `time` (s, strictly increasing); every column as long as the first. Written atomically (temporary
 // file, rename). Throws InputError when the file cannot be written or the columns disagree.
 void WriteStorage(const std::string& path, const std::string& name, const std::vector<std::string>& names,

@@ -73,3 +73,13 @@ nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 nlohmann::ordered_json BenchSweep(const BenchConfig& c);
 
 }  // namespace exotwin
+
+namespace exotwin {
+
+// predict / diagnose of a generated 1 kHz record (600 s, ~75 MB of CSV; quick: 20 s) run as child
+// processes, against reading the same file once with strtod per field: ratio (wall time) first,
+// then the times, the child's peak memory (ru_maxrss) and that of `exotwin --help` (start-up alone).
+nlohmann::ordered_json BenchPredictLong(const BenchConfig& c);
+nlohmann::ordered_json BenchDiagnoseLong(const BenchConfig& c);
+
+}  // namespace exotwin

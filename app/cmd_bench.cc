@@ -32,11 +32,13 @@ CommandRunner RegisterBench(CLI::App& app) {
   sub->add_option("--out", o->out, "write the JSON here too");
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
-  sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep");
+  sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep,"
+                  "predict_long,diagnose_long");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
-    const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep"};
+    const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep",
+                                          "predict_long", "diagnose_long"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -46,7 +48,8 @@ CommandRunner RegisterBench(CLI::App& app) {
         const std::string name = o->only.substr(start, end - start);
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
-                           "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep");
+                           "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep,"
+                           "predict_long,diagnose_long");
         selected.push_back(name);
         start = end + 1;
       }
@@ -73,6 +76,8 @@ CommandRunner RegisterBench(CLI::App& app) {
       if (name == "identification") j[name] = BenchIdentification(c);
       if (name == "diagnosis") j[name] = BenchDiagnosis(c);
       if (name == "sweep") j[name] = BenchSweep(c);
+      if (name == "predict_long") j[name] = BenchPredictLong(c);
+      if (name == "diagnose_long") j[name] = BenchDiagnoseLong(c);
       for (const BenchRow& r : BenchRowsFromJson(j[name])) rows.push_back(r);
     }
     const BenchMachine end = MeasureMachine();

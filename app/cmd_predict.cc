@@ -44,7 +44,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
     MapReport map_report;
-    const MeasuredData data = ReadMeasuredKinematics(o->measured, o->map, o->side, 20, &map_report);
+    MeasuredData data = ReadMeasuredKinematics(o->measured, o->map, o->side, 20, &map_report);
     if (!HasTorque(data)) {
       if (o->cutoff == "auto")
         throw InputError(o->measured + ": --cutoff auto compares predicted with measured torque; this motion file "
@@ -59,7 +59,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
     std::string why;
     const double cutoff = ResolveCutoffOption(o->cutoff, "--cutoff", {&data}, params.L1, params.g, &why);
     if (o->cutoff == "auto") std::fprintf(stderr, "predict: derivative cutoff %s\n", why.c_str());
-    const Kinematics kin = DeriveKinematics(data, cutoff);
+    const Kinematics kin = DeriveKinematics(std::move(data), cutoff);  // data's memory released
     if (kin.resampled)
       std::fprintf(stderr,
                    "predict: %s is sampled non-uniformly; derivatives computed on a uniform grid at "

@@ -246,3 +246,94 @@ TEST(CsvReader, SplitsTextFieldsByTheSameRules) {
 
 }  // namespace
 }  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// A file of several read chunks (4 MiB each) reads as the whole text does, row for row and line for
+// line, with a comment line longer than a chunk in the middle (the buffer grows for it).
+TEST(ReadCsv, ChunkedReadingEqualsTheWholeText) {
+  std::string text = "# long record\nt,a,b\n";
+  for (int i = 0; i < 150000; ++i) {
+    if (i == 70000) text += "# " + std::string(5 << 20, 'x') + "\n\n";
+    text += std::to_string(i) + "," + std::to_string(std::sin(i) * 1e-3) + ", " + std::to_string(i % 7 - 3.5) + "\n";
+  }
+  text += "150000,1.5,2";  // no last newline: a row of a hand-written file
+  const std::string path = TempPath("chunks.csv");
+  Spit(path, text);
+  const CsvTable t = ReadCsv(path);
+  CsvReader in(text, "whole");
+  ASSERT_TRUE(in.ReadHeader());
+  ASSERT_EQ(t.names, in.names());
+  double row[3];
+  size_t r = 0;
+  for (; in.NextNumbers(row); ++r) {
+    ASSERT_LT(r, t.rows());
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(std::memcmp(&t.columns[c][r], &row[c], sizeof(double)), 0) << r;
+    ASSERT_EQ(t.line_of_row[r], in.line()) << r;
+  }
+  EXPECT_EQ(r, t.rows());
+  EXPECT_EQ(t.rows(), 150001u);
+  EXPECT_EQ(t.dropped_cut_line, 0);
+}
+
+// A streamed log cut in a later chunk: every complete row kept, the cut line named.
+TEST(ReadCsv, ACutAfterSeveralChunksNamesTheLine) {
+  std::string text = std::string(kStreamMarker) + "\nt,x\n";
+  for (int i = 0; i < 400000; ++i) text += std::to_string(i) + ",0.125\n";
+  const std::string path = TempPath("cut_chunks.csv");
+  Spit(path, text + "400000,0.1");
+  ::testing::internal::CaptureStderr();
+  const CsvTable t = ReadCsv(path);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(t.rows(), 400000u);
+  EXPECT_EQ(t.dropped_cut_line, 400003);
+  EXPECT_NE(err.find(path + ":400003: last line has no newline"), std::string::npos) << err;
+}
+
+// What the whole-file reading said first still comes first: a NUL byte late in the file before a bad
+// field early in it; a cut last line's warning before the error.
+TEST(ReadCsv, ANulByteAnywhereComesBeforeAParseError) {
+  std::string text = "t,x\n1,oops\n";
+  for (int i = 0; i < 1500000; ++i) text += "2,3\n";  // 6 MB: the NUL is in a later chunk
+  const std::string path = TempPath("late_nul.csv");
+  Spit(path, text + std::string(1, '\0') + "\n");
+  try {
+    ReadCsv(path);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": binary data (NUL byte), expected a text CSV file");
+  }
+  Spit(path, std::string(kStreamMarker) + "\n" + text + "4,");
+  ::testing::internal::CaptureStderr();
+  try {
+    ReadCsv(path);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ":3: column 'x': 'oops' is not a number"), std::string::npos)
+        << e.what();
+  }
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find(path + ":1500004: last line has no newline"), std::string::npos) << err;
+}
+
+// WriteCsv's shortest text reads back to the same double, for every kind of double.
+TEST(WriteCsv, EveryNumberReadsBackToTheSameDouble) {
+  std::vector<double> x = {0.0, -0.0, 1.0, 0.1, 1e-5, 1.0 / 3, -2.5e300, 4.9e-324, 2.2250738585072014e-308,
+                           123456789012345678.0, 0.001, 1e22, 9007199254740993.0, -1e-7};
+  for (int i = 0; i < 20000; ++i) x.push_back(std::ldexp(std::sin(i * 12.9898) * 43758.5453, i % 200 - 100));
+  const std::string path = TempPath("roundtrip.csv");
+  WriteCsv(path, {"x"}, {&x}, {"numbers"});
+  const CsvTable t = ReadCsv(path);
+  ASSERT_EQ(t.rows(), x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    EXPECT_EQ(std::memcmp(&t.columns[0][i], &x[i], sizeof(double)), 0) << i << " " << x[i];
+    char b[40];
+    std::snprintf(b, sizeof(b), "%.17g", x[i]);  // the text WriteCsv wrote before: the same double
+    EXPECT_EQ(std::strtod(b, nullptr), t.columns[0][i]) << b;
+  }
+  EXPECT_NE(Slurp(path).find("\n1e-05\n"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace exotwin

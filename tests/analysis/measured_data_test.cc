@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 
@@ -51,6 +53,51 @@ TEST(MeasuredAngles, HumanJointRangeIsASeparateCheck) {
     EXPECT_NE(m.find("leg.csv:14: column 'q_knee': angle -7.5 rad is beyond a human joint's range, "
                      "expected |q| <= 6.28"), std::string::npos) << m;
   }
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// A 2 s record at 1 kHz with EMG, optionally non-uniform and with a measured qd_knee column.
+MeasuredData Record(bool uniform, bool qd_column) {
+  CsvTable t;
+  t.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "emg_VM"};
+  if (qd_column) t.names.push_back("qd_knee");
+  t.columns.assign(t.names.size(), {});
+  for (int i = 0; i < 2000; ++i) {
+    const double ti = 1e-3 * i + (uniform ? 0.0 : 3e-4 * (i % 3));
+    const double v[7] = {ti, 0.3 * std::sin(3 * ti), -0.6 + 0.4 * std::cos(5 * ti), 1.0, 2.0, 0.01 * std::sin(90 * ti),
+                         -2.0 * std::sin(5 * ti)};
+    for (size_t c = 0; c < t.names.size(); ++c) t.columns[c].push_back(v[c]);
+    t.line_of_row.push_back(i + 2);
+  }
+  return MeasuredFromTable(t, "record.csv");
+}
+
+// DeriveKinematics taking the record's columns gives what the copying one gives, to the bit.
+TEST(DeriveKinematics, TakingTheColumnsEqualsCopyingThem) {
+  for (bool uniform : {true, false})
+    for (bool qd_column : {false, true}) {
+      SCOPED_TRACE(std::to_string(uniform) + std::to_string(qd_column));
+      const MeasuredData d = Record(uniform, qd_column);
+      const Kinematics a = DeriveKinematics(d, 15.0);
+      MeasuredData taken = d;
+      const Kinematics b = DeriveKinematics(std::move(taken), 15.0);
+      EXPECT_EQ(taken.size(), 0u);
+      EXPECT_TRUE(taken.table.columns.empty());
+      EXPECT_EQ(a.t, b.t);
+      for (int j = 0; j < 2; ++j) {
+        EXPECT_EQ(a.q[j], b.q[j]);
+        EXPECT_EQ(a.qd[j], b.qd[j]);
+        EXPECT_EQ(a.qdd[j], b.qdd[j]);
+      }
+      EXPECT_EQ(a.emg, b.emg);
+      EXPECT_EQ(a.resampled, b.resampled);
+      EXPECT_EQ(a.derivative_source, b.derivative_source);
+    }
 }
 
 }  // namespace

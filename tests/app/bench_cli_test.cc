@@ -40,6 +40,27 @@ TEST(BenchCli, QuickJsonHasRatios) {
   EXPECT_NE(r.output.find("machine: "), std::string::npos);
 }
 
+// The long-record rows: ratio against the strtod read of the same file first, the child's peak memory
+// and the start-up's (no timed assertion: the machines are shared).
+TEST(BenchCli, QuickLongRecordRows) {
+  const testing::ScopedTempDir tmp("bench_long");
+  const std::string dir = tmp.path();
+  const RunResult r =
+      RunExotwin("bench --quick --repeat 1 --only predict_long,diagnose_long --out " + dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream f(dir + "/b.json");
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(f);  // in the file's key order
+  for (const char* row : {"predict_long", "diagnose_long"}) {
+    SCOPED_TRACE(row);
+    ASSERT_EQ(j[row]["status"], "ok");
+    EXPECT_EQ(j[row].begin().key(), "ratio_to_strtod_read");
+    EXPECT_GT(j[row]["ratio_to_strtod_read"].get<double>(), 0.0);
+    EXPECT_EQ(j[row]["samples"], 20001);  // 20 s at 1 kHz, both ends
+    EXPECT_GT(j[row]["peak_rss_mb"].get<double>(), 0.0);
+    EXPECT_GT(j[row]["start_up_peak_rss_mb"].get<double>(), 0.0);
+  }
+}
+
 TEST(BenchCli, UnknownProbeExits2) {
   const RunResult r = RunExotwin("bench --only warp_drive");
   EXPECT_EQ(r.exit_code, 2) << r.output;

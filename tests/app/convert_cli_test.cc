@@ -43,7 +43,7 @@ TEST(ConvertCli, OutputRereadsAsWhatTheMapGives) {
   const MeasuredData converted = ReadMeasuredCsv(dir + "/data.csv");
   const MeasuredData mapped = ApplyColumnMap(ReadColumnMap(kMap), ReadCsv(in), in);
   EXPECT_EQ(converted.table.names, mapped.table.names);
-  EXPECT_EQ(converted.table.columns, mapped.table.columns);  // bit for bit (%.17g)
+  EXPECT_EQ(converted.table.columns, mapped.table.columns);  // bit for bit (shortest round-trip text)
   const std::string text = testing::ReadText(dir + "/data.csv");
   EXPECT_NE(text.find("# source: " + in), std::string::npos);
   EXPECT_NE(text.find("# map: " + kMap), std::string::npos);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <string>
 
@@ -43,6 +44,32 @@ TEST(FileText, MissingFileDirectoryAndNulAreInputErrorsNamingThePath) {
   std::ofstream(dir + "/nul.yaml", std::ios::binary) << std::string("a: 1\n\0b: 2\n", 11);
   EXPECT_EQ(MessageOf(dir + "/nul.yaml", "model", "a YAML text file"),
             dir + "/nul.yaml: binary data (NUL byte), expected a YAML text file");
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// TextFileChunks: chunks concatenate to the file; the rest drained with its newlines counted.
+TEST(TextFileChunks, ChunksAndDrainCoverTheFile) {
+  const testing::ScopedTempDir tmp("chunks");
+  const std::string path = tmp.path() + "/c.txt";
+  std::string text;
+  for (int i = 0; i < 5000; ++i) text += "line " + std::to_string(i) + "\n";
+  std::ofstream(path, std::ios::binary) << text << "tail";
+  TextFileChunks in(path, "", "a text file");
+  EXPECT_EQ(in.size(), text.size() + 4);
+  char buf[1000];
+  ASSERT_EQ(in.Read(buf, sizeof(buf)), sizeof(buf));
+  EXPECT_EQ(std::string(buf, sizeof(buf)), text.substr(0, sizeof(buf)));
+  bool ends_with_newline = true;
+  const size_t rest = in.DrainCountingNewlines(&ends_with_newline);
+  EXPECT_EQ(rest, 5000u - static_cast<size_t>(std::count(buf, buf + sizeof(buf), '\n')));
+  EXPECT_FALSE(ends_with_newline);
+  EXPECT_EQ(in.Read(buf, sizeof(buf)), 0u);
+  EXPECT_THROW(TextFileChunks(tmp.path(), "", "a text file"), InputError);
 }
 
 }  // namespace

@@ -1,0 +1,161 @@
+// The long-record rows of `exotwin bench` (app/bench_probes.h): `predict` and `diagnose` of a
+// generated 1 kHz record (600 s; quick: 20 s), each run as a child process of this executable, against
+// reading the same file once with strtod per field (the floor of any CSV reader) in the same run.
+// Peak memory is the child's ru_maxrss (wait4), next to that of `exotwin --help` (start-up alone).
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "analysis/generate.h"
+#include "analysis/model_file.h"
+#include "app/bench_probes.h"
+#include "core/data_dir.h"
+#include "core/file_text.h"
+
+namespace exotwin {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+// Seconds to read `path` whole and parse every comma-separated field of its data lines with strtod.
+double StrtodReadSeconds(const std::string& path, size_t* fields) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string text = ReadTextFile(path, "", "a text CSV file");
+  size_t n = 0;
+  double sum = 0;
+  const char* p = text.c_str();
+  while (*p) {
+    const char* nl = std::strchr(p, '\n');
+    if (!nl) nl = p + std::strlen(p);
+    if (*p != '#' && !(*p >= 'a' && *p <= 'z')) {  // not a comment nor the header
+      for (const char* q = p; q < nl;) {
+        char* e = nullptr;
+        sum += std::strtod(q, &e);
+        ++n;
+        if (e == q || *e != ',') break;
+        q = e + 1;
+      }
+    }
+    p = *nl ? nl + 1 : nl;
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  *fields = n + (sum == 0.123456789 ? 1 : 0);  // keeps the sum alive
+  return s;
+}
+
+struct ChildRun {
+  double wall_s = 0, cpu_s = 0;
+  double max_rss_mb = 0;
+};
+
+// Runs this executable with `args` (stdout and stderr to /dev/null); throws if it does not exit 0.
+ChildRun RunSelf(std::vector<std::string> args) {
+  args.insert(args.begin(), "exotwin");
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("bench: fork failed");
+  if (pid == 0) {
+    if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr)) _exit(127);
+    execv("/proc/self/exe", argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  if (wait4(pid, &status, 0, &ru) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw std::runtime_error("bench: `exotwin " + args[1] + "` failed on the long record");
+  ChildRun r;
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.cpu_s = ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  r.max_rss_mb = ru.ru_maxrss / 1024.0;
+  return r;
+}
+
+// Best wall time of `repeat` runs (its CPU time), the largest peak memory.
+ChildRun BestRun(int repeat, const std::vector<std::string>& args) {
+  ChildRun best;
+  best.wall_s = std::numeric_limits<double>::infinity();
+  double rss = 0;
+  for (int i = 0; i < std::max(1, repeat); ++i) {
+    const ChildRun r = RunSelf(args);
+    rss = std::max(rss, r.max_rss_mb);
+    if (r.wall_s < best.wall_s) best = r;
+  }
+  best.max_rss_mb = rss;
+  return best;
+}
+
+struct LongRecord {
+  std::string csv, params;
+  double data_s = 0;
+  size_t samples = 0, bytes = 0, fields = 0;
+  double strtod_s = 0;      // best strtod read of the file
+  double start_up_mb = 0;   // peak memory of `exotwin --help`
+};
+
+// The record (generated once per scratch folder: S1 with a hidden Coulomb friction, 10 columns),
+// the strtod floor and the start-up memory.
+const LongRecord& TheLongRecord(const BenchConfig& c) {
+  static LongRecord r;
+  if (!r.csv.empty() && std::filesystem::exists(r.csv)) return r;
+  GenerateOptions g;
+  g.seed = 2024;
+  g.duration = c.quick ? 20 : 600;
+  g.rate = 1000;
+  g.effects = 1;
+  g.allowed = {"coulomb_friction"};
+  r.params = DataPath("examples/S1.yaml");
+  const GeneratedData data = GenerateMeasured(ReadModelFile(r.params), g);
+  r.csv = c.scratch + "/long_record.csv";
+  WriteGeneratedCsv(data, r.csv, g.seed);
+  r.data_s = g.duration;
+  r.samples = data.data.size();
+  r.bytes = std::filesystem::file_size(r.csv);
+  r.strtod_s = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < std::max(1, c.repeat); ++i) r.strtod_s = std::min(r.strtod_s, StrtodReadSeconds(r.csv, &r.fields));
+  r.start_up_mb = RunSelf({"--help"}).max_rss_mb;
+  return r;
+}
+
+json LongRecordRow(const BenchConfig& c, const std::string& command, int repeat) {
+  const LongRecord& r = TheLongRecord(c);
+  const std::string out = c.scratch + "/long_" + command + (command == "predict" ? ".csv" : "");
+  const ChildRun run = BestRun(repeat, {command, "--params", r.params, "--measured", r.csv, "--out", out});
+  return json{{"ratio_to_strtod_read", run.wall_s / r.strtod_s},
+              {"status", "ok"},
+              {"data_s", r.data_s},
+              {"samples", r.samples},
+              {"file_mb", r.bytes / 1e6},
+              {"strtod_read_s", r.strtod_s},
+              {command + "_s", run.wall_s},
+              {command + "_cpu_s", run.cpu_s},
+              {"peak_rss_mb", run.max_rss_mb},
+              {"start_up_peak_rss_mb", r.start_up_mb},
+              {"data_peak_rss_mb", run.max_rss_mb - r.start_up_mb},
+              {"rows", BenchRowsJson({{"`" + command + "` on " + std::to_string(static_cast<int>(r.data_s)) +
+                                           " s of 1 kHz data (" + std::to_string(static_cast<int>(r.bytes / 1e6)) + " MB)",
+                                       run.wall_s / r.strtod_s, "x", "reading the file once with strtod per field",
+                                       command == "predict" ? "<= 2.5x, <= 150 MB" : "<= 3x, <= 150 MB",
+                                       std::to_string(static_cast<int>(std::lround(run.max_rss_mb))) + " MB peak"}})}};
+}
+
+}  // namespace
+
+json BenchPredictLong(const BenchConfig& c) { return LongRecordRow(c, "predict", c.repeat); }
+
+json BenchDiagnoseLong(const BenchConfig& c) { return LongRecordRow(c, "diagnose", std::min(c.repeat, 2)); }
+
+}  // namespace exotwin
