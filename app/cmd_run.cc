@@ -6,6 +6,7 @@
 #include "app/commands.h"
 #include "core/stop_signal.h"
 #include "core/error.h"
+#include "core/file_text.h"
 #include "protocol/bus_address.h"
 #include "protocol/can_link.h"
 #include "runner/controller_process.h"
@@ -149,10 +150,11 @@ CommandRunner RegisterServe(CLI::App& app) {
       std::fprintf(stderr, "exotwin serve: note: UDP on %s, not loopback: torque commands cross the network\n",
                    address.host.c_str());
     const OutFolderLock lock(o->out);
-    WriteControllerFile(s, o->out);
+    const std::string controller_file = WriteControllerFile(s, o->out);
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
     const ServeClock clock = o->clock == "realtime" ? ServeClock::kRealtime : ServeClock::kLockstep;
     RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, o->timeout);
+    remote.SetConfiguration(ReadTextFile(controller_file, "controller file", "the file serve just wrote"));
     std::fprintf(stderr, "exotwin serve: %s on %s, %s clock; waiting for the controller (controller file %s/controller.yaml)\n",
                  s.name.c_str(), link->Describe().c_str(), o->clock.c_str(), o->out.c_str());
     RunOptions opt;

@@ -8,6 +8,7 @@
 #include "controller/controller_config.h"
 #include "core/error.h"
 #include "core/stop_signal.h"
+#include "core/yaml_fields.h"
 #include "deploy/controller_node.h"
 #include "protocol/bus_address.h"
 #include "protocol/can_link.h"
@@ -44,14 +45,28 @@ int main(int argc, char** argv) {
   if (config.empty()) return Usage("--config FILE.yaml is required");
   if (bus.empty()) return Usage("--bus ADDR or --can IFACE is required");
   try {
-    const controller::ControllerFile cfg = controller::ReadControllerFile(config);
+    // A scenario (it names a device): its controller part here, the rest from the twin (ControllerNode).
+    const std::string text = ReadYamlText(config, "controller or scenario");
+    const YAML::Node root = ParseYaml(text, config);
+    const bool scenario = root && root.IsMap() && root["device"];
+    ControllerSpec scenario_controller;
+    controller::ControllerFile cfg;
+    if (scenario) {
+      if (root["controller"]) ParseControllerSpec(YamlContext{config}, root["controller"], &scenario_controller);
+    } else {
+      cfg = controller::ParseControllerFile(text, config);
+    }
     const BusAddress address = ParseBusAddress(bus, what);
     if (address.kind == BusKind::kUdp && !address.loopback())
       std::cerr << "exotwin-controller: note: UDP on " << address.host
                 << ", not loopback: torque commands cross the network" << std::endl;
-    controller::ExoConfigOf(cfg);  // the supervisor's checks of the limits, before the bus is opened
+    if (!scenario) controller::ExoConfigOf(cfg);  // the supervisor's checks of the limits, before the bus is opened
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kController);
     InstallStopSignalHandlers();
+    if (scenario) {
+      ControllerNode node(scenario_controller, config, link.get(), std::cerr);
+      return node.Run();
+    }
     ControllerNode node(cfg, link.get(), std::cerr);
     return node.Run();
   } catch (const InputError& e) {

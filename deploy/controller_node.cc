@@ -30,14 +30,75 @@ CanStatus ControllerNode::TickBus::Receive(CanFrame* out) {
 }
 
 ControllerNode::ControllerNode(const controller::ControllerFile& cfg, CanLink* link, std::ostream& log)
-    : cfg_(cfg), exo_cfg_(controller::ExoConfigOf(cfg)), link_(link), log_(log), bus_(link) {}
+    : link_(link), log_(log), bus_(link) {
+  Configure(cfg);
+}
+
+ControllerNode::ControllerNode(const ControllerSpec& scenario_controller, std::string scenario_source, CanLink* link,
+                               std::ostream& log)
+    : link_(link), log_(log), bus_(link) {
+  scenario_controller_ = scenario_controller;
+  cfg_.source = std::move(scenario_source);
+}
+
+void ControllerNode::Configure(const controller::ControllerFile& cfg) {
+  cfg_ = cfg;
+  exo_cfg_ = controller::ExoConfigOf(cfg_);
+  configured_ = true;
+}
+
+// The controller file downloaded from the twin (scenario mode): complete, and with the scenario's
+// controller part; else logged and the run ends with exit 2.
+void ControllerNode::TakeConfiguration(const CanFrame& end) {
+  uint32_t length = 0, hash = 0;
+  std::string text;
+  text.swap(config_text_);
+  if (!link::ConfigEnd(end, &length, &hash) || length != text.size() || hash != link::ConfigHash(text)) {
+    log_ << "exotwin-controller: controller file from the twin incomplete (" << text.size() << " of " << length
+         << " bytes): asking again" << std::endl;
+    return;  // the next NMT start asks again
+  }
+  const std::string source = "the twin's controller file for " + cfg_.source;
+  controller::ControllerFile f;
+  try {
+    f = controller::ParseControllerFile(text, source);
+  } catch (const std::exception& e) {
+    log_ << "exotwin-controller: " << e.what() << std::endl;
+    exit_code_ = 2, done_ = true;
+    return;
+  }
+  const ControllerSpec& a = f.controller;
+  const ControllerSpec& b = scenario_controller_;
+  if (a.rate_hz != b.rate_hz || a.kp[0] != b.kp[0] || a.kp[1] != b.kp[1] || a.kd[0] != b.kd[0] || a.kd[1] != b.kd[1] ||
+      a.feedforward != b.feedforward || a.torque_limit != b.torque_limit) {
+    log_ << "exotwin-controller: " << cfg_.source << ": controller: the twin serves another controller (rate "
+         << a.rate_hz << " Hz, kp [" << a.kp[0] << ", " << a.kp[1] << "], kd [" << a.kd[0] << ", " << a.kd[1]
+         << "], torque limit " << a.torque_limit << " N m): is the twin serving this scenario?" << std::endl;
+    exit_code_ = 2, done_ = true;
+    return;
+  }
+  f.source = source;
+  try {
+    Configure(f);
+  } catch (const std::exception& e) {
+    log_ << "exotwin-controller: " << e.what() << std::endl;
+    exit_code_ = 2, done_ = true;
+    return;
+  }
+  log_ << "exotwin-controller: " << source << " received (" << length << " bytes): feed-forward model and reference"
+       << std::endl;
+}
 
 int ControllerNode::Run() {
-  log_ << "exotwin-controller: " << cfg_.source << ": rate " << cfg_.controller.rate_hz << " Hz, kp ["
-       << cfg_.controller.kp[0] << ", " << cfg_.controller.kp[1] << "], kd [" << cfg_.controller.kd[0] << ", "
-       << cfg_.controller.kd[1] << "], torque limit " << cfg_.controller.torque_limit << " N m, feed-forward "
-       << (cfg_.controller.feedforward ? "on" : "off") << "; bus " << link_->Describe() << "; waiting for NMT start"
-       << std::endl;
+  if (configured_)
+    log_ << "exotwin-controller: " << cfg_.source << ": rate " << cfg_.controller.rate_hz << " Hz, kp ["
+         << cfg_.controller.kp[0] << ", " << cfg_.controller.kp[1] << "], kd [" << cfg_.controller.kd[0] << ", "
+         << cfg_.controller.kd[1] << "], torque limit " << cfg_.controller.torque_limit << " N m, feed-forward "
+         << (cfg_.controller.feedforward ? "on" : "off") << "; bus " << link_->Describe() << "; waiting for NMT start"
+         << std::endl;
+  else
+    log_ << "exotwin-controller: " << cfg_.source << ": a scenario: its controller part, the feed-forward model "
+         << "and reference from the twin; bus " << link_->Describe() << "; waiting for NMT start" << std::endl;
   CanFrame f;
   while (!done_) {
     if (const int sig = StopSignal()) {
@@ -49,8 +110,8 @@ int ControllerNode::Run() {
     link_->WaitInput(0.1);
     while (!done_ && link_->Receive(&f) == CanStatus::kOk) Handle(f);
   }
-  Summary("run over (NMT stop)");
-  return 0;
+  Summary(exit_code_ ? "configuration refused" : "run over (NMT stop)");
+  return exit_code_;
 }
 
 void ControllerNode::Handle(const CanFrame& f) {
@@ -59,6 +120,13 @@ void ControllerNode::Handle(const CanFrame& f) {
     case link::kIdNmt:
       if (f.dlc >= 1 && f.data[0] == link::kNmtStart) {
         trial_ = f.dlc >= 3 ? f.data[2] : 0;
+        if (!configured_) {  // scenario mode: the twin's controller file first
+          CanFrame r = link::ReadyFrame(trial_);
+          r.id = link::kIdConfigRequest;
+          config_text_.clear();
+          link_->Send(r);
+          return;
+        }
         ctrl_ = std::make_unique<controller::ExoController>(exo_cfg_, controller::BuildReference(cfg_.reference, trial_),
                                                              &bus_);
         bus_.pending.clear();
@@ -70,6 +138,13 @@ void ControllerNode::Handle(const CanFrame& f) {
       } else if (f.dlc >= 1 && f.data[0] == link::kNmtStop) {
         done_ = true;
       }
+      return;
+    case link::kIdConfigData:
+      if (!configured_ && config_text_.size() < (size_t{1} << 26))
+        config_text_.append(reinterpret_cast<const char*>(f.data.data()), f.dlc);
+      return;
+    case link::kIdConfigEnd:
+      if (!configured_) TakeConfiguration(f);
       return;
     case link::kIdRxStamp:
       have_stamp_ = link::FrameDouble(f, &stamp_);

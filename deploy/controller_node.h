@@ -19,8 +19,15 @@ class ControllerNode {
  public:
   // cfg and link outlive the node; log gets one line per event (start, trial, safety state, end).
   ControllerNode(const controller::ControllerFile& cfg, CanLink* link, std::ostream& log);
-  // Runs until an NMT stop (returns 0) or a stop signal (StopSignal(), core/stop_signal.h: commands
-  // zero torque with the drives disabled, then returns 0).
+  // Started on a scenario file: the controller part `scenario_controller` (its gains and limits) is
+  // the scenario's, the feed-forward model and the reference are the twin's (computed from the
+  // subject in sim/): the node asks for the controller file on the first NMT start
+  // (link::kIdConfigRequest) and runs it once its controller part equals `scenario_controller`.
+  ControllerNode(const ControllerSpec& scenario_controller, std::string scenario_source, CanLink* link,
+                 std::ostream& log);
+  // Runs until an NMT stop (returns 0), a stop signal (StopSignal(), core/stop_signal.h: commands
+  // zero torque with the drives disabled, then returns 0), or a downloaded controller file that does
+  // not fit the scenario (returns 2, the difference logged).
   int Run();
 
  private:
@@ -40,8 +47,15 @@ class ControllerNode {
   void ZeroTorque();
   void Summary(const char* why);
 
-  const controller::ControllerFile& cfg_;
-  const controller::ExoControllerConfig exo_cfg_;
+  void Configure(const controller::ControllerFile& cfg);
+  void TakeConfiguration(const CanFrame& end);
+
+  controller::ControllerFile cfg_;
+  controller::ExoControllerConfig exo_cfg_;
+  bool configured_ = false;
+  ControllerSpec scenario_controller_;  // scenario mode: what the downloaded file must say
+  std::string config_text_;             // scenario mode: the download so far
+  int exit_code_ = 0;
   CanLink* link_;
   std::ostream& log_;
   TickBus bus_;

@@ -8,12 +8,20 @@
 //   0x701 boot-up / ready: controller -> twin, answer to an NMT start; data[0] 0x05, data[1] the trial.
 //   0x780 + i telemetry: controller -> twin after each tick, i = TelemetryIndex (the value logged).
 //   0x7F0 cycle done: controller -> twin, last frame of a tick; data: the SYNC's t echoed.
+//   0x702 configuration request: controller -> twin, answer to an NMT start by a controller started on a
+//         scenario file (its feed-forward model and reference are the twin's): data[1] the trial.
+//   0x7E0 configuration data: twin -> controller, the controller file's text (DESIGN.md "Controller
+//         file"), DLC 1..8 bytes per frame, in order; 0x7E1 configuration end: data[0..3] the text's
+//         length, data[4..7] its FNV-1a 32-bit hash (little-endian): a gap or reordering is detected.
 //   0x7F1 receive stamp (lockstep): twin -> controller, just before a forwarded frame; data: the
 //         simulated time at which the virtual bus delivered it (the controller's receive time stamp).
 // None of these is put on the twin's virtual CAN bus: the twin handles them at the link.
 #pragma once
 #include <cstdint>
+#include <algorithm>
 #include <cstring>
+#include <string>
+#include <vector>
 
 #include "protocol/can_frame.h"
 
@@ -24,6 +32,9 @@ constexpr uint16_t kIdSync = 0x080;
 constexpr uint16_t kIdReady = 0x701;
 constexpr uint16_t kIdTelemetryBase = 0x780;
 constexpr int kTelemetryValues = 16;
+constexpr uint16_t kIdConfigRequest = 0x702;
+constexpr uint16_t kIdConfigData = 0x7E0;
+constexpr uint16_t kIdConfigEnd = 0x7E1;
 constexpr uint16_t kIdCycleDone = 0x7F0;
 constexpr uint16_t kIdRxStamp = 0x7F1;
 constexpr uint8_t kNmtStart = 0x01;
@@ -78,7 +89,42 @@ inline CanFrame ReadyFrame(int trial) {
 // True for the link's own identifiers (never forwarded to the virtual bus).
 inline bool IsLinkFrameId(uint16_t id) {
   return id == kIdNmt || id == kIdSync || id == kIdReady || id == kIdCycleDone || id == kIdRxStamp ||
+         id == kIdConfigRequest || id == kIdConfigData || id == kIdConfigEnd ||
          (id >= kIdTelemetryBase && id < kIdTelemetryBase + kTelemetryValues);
+}
+
+// FNV-1a, 32 bits, of a configuration text (the check of its download).
+inline uint32_t ConfigHash(const std::string& text) {
+  uint32_t h = 2166136261u;
+  for (unsigned char c : text) h = (h ^ c) * 16777619u;
+  return h;
+}
+
+// The frames that carry `text` to the controller: data frames of 8 bytes (the last 1..8), then the end.
+inline std::vector<CanFrame> ConfigFrames(const std::string& text) {
+  std::vector<CanFrame> out;
+  for (size_t i = 0; i < text.size(); i += 8) {
+    CanFrame f;
+    f.id = kIdConfigData;
+    f.dlc = static_cast<uint8_t>(std::min<size_t>(8, text.size() - i));
+    std::memcpy(f.data.data(), text.data() + i, f.dlc);
+    out.push_back(f);
+  }
+  CanFrame e;
+  e.id = kIdConfigEnd;
+  e.dlc = 8;
+  const uint32_t n = static_cast<uint32_t>(text.size()), h = ConfigHash(text);
+  for (int i = 0; i < 4; ++i) e.data[i] = static_cast<uint8_t>(n >> (8 * i)), e.data[4 + i] = static_cast<uint8_t>(h >> (8 * i));
+  out.push_back(e);
+  return out;
+}
+
+// Length and hash of a configuration end frame (false when not DLC 8).
+inline bool ConfigEnd(const CanFrame& f, uint32_t* length, uint32_t* hash) {
+  if (f.dlc != 8) return false;
+  *length = *hash = 0;
+  for (int i = 0; i < 4; ++i) *length |= uint32_t{f.data[i]} << (8 * i), *hash |= uint32_t{f.data[4 + i]} << (8 * i);
+  return true;
 }
 
 }  // namespace exotwin::link

@@ -52,8 +52,13 @@ void RemoteController::BeginTrial(int trial, CanBus* ep, std::vector<std::string
       last_nmt = MonotonicSeconds();
     }
     link_->WaitInput(0.02);
-    while (link_->Receive(&f) == CanStatus::kOk)
+    while (link_->Receive(&f) == CanStatus::kOk) {
       if (f.id == link::kIdReady && f.dlc >= 2 && f.data[1] == static_cast<uint8_t>(trial)) present_ = true;
+      if (f.id == link::kIdConfigRequest && !configuration_.empty()) {
+        for (const CanFrame& c : link::ConfigFrames(configuration_)) link_->Send(c);
+        last_nmt = -1;  // the next NMT start right after the configuration
+      }
+    }
   }
   if (!present_) Lost(0.0, "controller did not answer the NMT start of trial " + std::to_string(trial + 1) +
                              " within " + std::to_string(timeout_) + " s");

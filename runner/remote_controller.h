@@ -30,6 +30,9 @@ class RemoteController {
   // link outlives this; period_s: the controller period (s); timeout_s: wall-clock time without an
   // answer after which the controller is gone (also the wait for its ready frame at a trial's start).
   RemoteController(CanLink* link, ServeClock clock, double period_s, double timeout_s);
+  // The controller file's text sent to a controller that asks for it (one started on the scenario
+  // file: link::kIdConfigRequest) before it answers the NMT start.
+  void SetConfiguration(std::string text) { configuration_ = std::move(text); }
   // Starts trial `trial` (0-based) with the rig's controller endpoint `ep`: NMT start, then waits for
   // the controller's ready frame (re-sent every 100 ms). `events` gets the link's events ("t=... ...").
   void BeginTrial(int trial, CanBus* ep, std::vector<std::string>* events);
@@ -59,6 +62,7 @@ class RemoteController {
   bool awaiting_ = false;
   uint64_t unexpected_ = 0, late_ = 0, missed_ = 0, bus_refused_ = 0;
   std::vector<double> jitter_;  // s, tick start minus its schedule (realtime)
+  std::string configuration_;
 };
 
 }  // namespace exotwin

@@ -110,15 +110,17 @@ struct Pair {
 };
 
 // serve SCENARIO --bus unix:DIR/bus --out OUT (+ extra), then the controller on OUT/controller.yaml.
+// config: the controller's --config (default: the controller file serve writes).
 Pair ServeWithController(const std::string& dir, const std::string& scenario, const std::string& out,
-                         std::vector<std::string> extra = {}, double seconds = 120) {
+                         std::vector<std::string> extra = {}, double seconds = 120, std::string config = "") {
   std::vector<std::string> args = {"serve", scenario, "--bus", "unix:" + dir + "/bus", "--out", out};
   args.insert(args.end(), extra.begin(), extra.end());
   Pair p;
   const pid_t serve = testing::StartProgram(testing::ExotwinBin(), args, dir + "/serve.log");
   EXPECT_TRUE(WaitForFile(out + "/controller.yaml", 30));
   const pid_t ctl = testing::StartProgram(
-      testing::ControllerBin(), {"--config", out + "/controller.yaml", "--bus", "unix:" + dir + "/bus"}, dir + "/ctl.log");
+      testing::ControllerBin(), {"--config", config.empty() ? out + "/controller.yaml" : config, "--bus", "unix:" + dir + "/bus"},
+      dir + "/ctl.log");
   p.serve = WaitFor(serve, seconds);
   p.controller = WaitFor(ctl, 30);
   p.serve_log = ReadText(dir + "/serve.log");
@@ -143,6 +145,38 @@ TEST(ServeCli, LockstepWritesTheSameMeasuredCsvAsRun) {
   EXPECT_EQ(r["metrics"]["link_frames_foreign"], 0.0);
   EXPECT_EQ(r["metrics"]["tracking_rms_hip_deg"], Result(dir.path() + "/run")["metrics"]["tracking_rms_hip_deg"]);
   EXPECT_NE(p.controller_log.find("run over (NMT stop): 4000 ticks"), std::string::npos) << p.controller_log;
+}
+
+// DESIGN.md: `exotwin-controller --config SCENARIO.yaml`: the scenario's controller part, the
+// feed-forward model and reference downloaded from the twin (link::kIdConfigRequest): the same bytes.
+TEST(ServeCli, ControllerStartedOnTheScenarioFileWritesTheSameMeasuredCsvAsRun) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 3.0);
+  const auto run = testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve", {}, 120, scenario);
+  ASSERT_EQ(p.serve, 0) << p.serve_log;
+  EXPECT_EQ(p.controller, 0) << p.controller_log;
+  EXPECT_NE(p.controller_log.find("controller file for " + scenario + " received"), std::string::npos) << p.controller_log;
+  const std::string a = ReadText(dir.path() + "/run/measured.csv"), b = ReadText(dir.path() + "/serve/measured.csv");
+  ASSERT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "measured.csv differs between run and serve with the scenario as the controller's config";
+}
+
+// A scenario whose controller part differs from the served one: the controller refuses it (exit 2).
+TEST(ServeCli, ControllerOnAnotherScenarioRefusesTheTwinsFile) {
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 1.0);
+  std::string other = ReadText(scenario);
+  const size_t at = other.find("kp: [600, 400]");
+  ASSERT_NE(at, std::string::npos);
+  other.replace(at, 14, "kp: [123, 45]");
+  testing::WriteText(dir.path() + "/other.yaml", other);
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve", {"--timeout", "2"}, 120,
+                                     dir.path() + "/other.yaml");
+  EXPECT_EQ(p.controller, 2) << p.controller_log;
+  EXPECT_NE(p.controller_log.find("the twin serves another controller"), std::string::npos) << p.controller_log;
+  EXPECT_EQ(p.serve, 1) << p.serve_log;  // no controller answered: the run fails, logs kept
 }
 
 TEST(ServeCli, ControllerKilledMidGaitWatchdogCutsTheTorque) {
