@@ -20,10 +20,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// What a worker sends back after each job: the job's index and its exit code.
+// What a worker sends back after each job: the job's index, its exit code, and whether the worker
+// takes another job (0 after an exception: it exits, and no job may be handed to it).
 struct Report {
   uint64_t index;
   int64_t code;
+  uint64_t alive;
 };
 
 struct Worker {
@@ -70,7 +72,7 @@ bool WriteAll(int fd, const void* p, size_t n) {
     }
     std::fflush(stdout);
     std::fflush(stderr);
-    const Report r{index, code & 0xff};
+    const Report r{index, code & 0xff, healthy ? 1u : 0u};
     if (!WriteAll(out, &r, sizeof r) || !healthy) _exit(healthy ? 0 : 70);
   }
   _exit(0);
@@ -184,6 +186,7 @@ std::vector<JobOutcome> RunForked(size_t n, int workers, const std::function<int
           o.wall_s = std::chrono::duration<double>(Clock::now() - pool[w].started).count();
           pool[w].job = -1;
           finish(static_cast<size_t>(r.index), o);
+          if (!r.alive) retire(w);  // it exits after this report: reaped before it is handed a job
         } else {
           retire(w);  // ended (crash, exit() in a job, or after an exception): reaped
         }

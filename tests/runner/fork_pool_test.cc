@@ -51,6 +51,20 @@ TEST(RunForked, ACrashOrAnExceptionEndsOnlyItsJob) {
   }
 }
 
+// A worker that reported an exception exits: the next job goes to a fresh worker, never to it (one
+// worker makes the hand-over immediate: the job after the exception would otherwise end with 70).
+TEST(RunForked, NoJobIsHandedToAWorkerThatExitsAfterAnException) {
+  const auto out = RunForked(4, 1, [](size_t i) -> int {
+    if (i == 0) throw std::runtime_error("boom");
+    return 0;
+  });
+  EXPECT_EQ(out[0].exit_code, 70);
+  for (size_t i = 1; i < out.size(); ++i) {
+    EXPECT_EQ(out[i].exit_code, 0) << i;
+    EXPECT_EQ(out[i].signal, 0) << i;
+  }
+}
+
 TEST(RunForked, JobsShareLongLivedWorkers) {  // the parent forks `workers` processes, not one per job
   const testing::ScopedTempDir tmp("fork_pool");
   const std::string dir = tmp.path();
