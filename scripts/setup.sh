@@ -17,6 +17,7 @@ PKGS=(
   clang libclang-rt-14-dev            # libFuzzer targets in fuzz/ (-DEXOTWIN_FUZZ=ON, -fsanitize=fuzzer)
   parallel                            # GNU parallel: the sweep split-and-merge test (tests/cli)
   slurm-wlm munge                     # a one-node Slurm for scripts/test_slurm.sh (the sweep job array)
+  file dpkg-dev                       # cpack -G DEB: dpkg-shlibdeps computes the dependencies, `file` finds the ELF files
 )
 
 missing=()
