@@ -2,13 +2,18 @@
 #include "sim/mjcf_cache.h"
 
 #include <map>
+#include <memory>
 
 namespace exotwin {
 namespace {
 
-// The kept models of this process by path (never freed: they live as long as the process).
-std::map<std::string, mjModel*>& Kept() {
-  static std::map<std::string, mjModel*> kept;
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+
+// The kept models of this process by path (freed at exit).
+std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>>& Kept() {
+  static std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>> kept;
   return kept;
 }
 
@@ -18,7 +23,7 @@ mjModel* LoadMjcfModel(const std::string& path, char* err, int err_size) {
   const auto it = Kept().find(path);
   if (it != Kept().end()) {
     if (err_size > 0) err[0] = '\0';
-    return mj_copyModel(nullptr, it->second);
+    return mj_copyModel(nullptr, it->second.get());
   }
   return mj_loadXML(path.c_str(), nullptr, err, err_size);
 }
@@ -31,7 +36,7 @@ bool KeepMjcfModel(const std::string& path) {
     if (m) mj_deleteModel(m);
     return false;
   }
-  Kept()[path] = m;
+  Kept()[path].reset(m);
   return true;
 }
 
