@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "analysis/generate.h"
+
 namespace exotwin {
 
 // One row of the table `exotwin bench` prints (issue 16's table): a piece of work and its figure
@@ -43,6 +45,10 @@ struct BenchConfig {
 };
 
 // Closed loop (gait, plant + CAN + sensors + controller, no logs) vs bare mj_step, same model and
+// The generated record of the diagnosis and long-record probes: S1 at 1 kHz for `duration_s` with one
+// hidden Coulomb friction, seed 2024.
+GenerateOptions BenchFrictionRecord(double duration_s);
+
 // number of steps (10 s = 10000 steps; quick: 2 s). Rows: with EMG, without EMG.
 nlohmann::ordered_json BenchClosedLoop(const BenchConfig& c);
 

@@ -111,12 +111,7 @@ struct LongRecord {
 const LongRecord& TheLongRecord(const BenchConfig& c) {
   static LongRecord r;
   if (!r.csv.empty() && std::filesystem::exists(r.csv)) return r;
-  GenerateOptions g;
-  g.seed = 2024;
-  g.duration = c.quick ? 20 : 600;
-  g.rate = 1000;
-  g.effects = 1;
-  g.allowed = {"coulomb_friction"};
+  const GenerateOptions g = BenchFrictionRecord(c.quick ? 20 : 600);
   r.params = DataPath("examples/S1.yaml");
   const GeneratedData data = GenerateMeasured(ReadModelFile(r.params), g);
   r.csv = c.scratch + "/long_record.csv";

@@ -302,13 +302,18 @@ json BenchIdentification(const BenchConfig& c) {
                                        Seconds(t) + " vs " + Seconds(t_sim)}})}};
 }
 
-json BenchDiagnosis(const BenchConfig& c) {
+GenerateOptions BenchFrictionRecord(double duration_s) {
   GenerateOptions g;
   g.seed = 2024;
-  g.duration = c.quick ? 20 : 60;
+  g.duration = duration_s;
   g.rate = 1000;
   g.effects = 1;
   g.allowed = {"coulomb_friction"};
+  return g;
+}
+
+json BenchDiagnosis(const BenchConfig& c) {
+  const GenerateOptions g = BenchFrictionRecord(c.quick ? 20 : 60);
   const LegParams base = ReadModelFile(DataPath("examples/S1.yaml"));
   const auto t_gen0 = std::chrono::steady_clock::now();
   const GeneratedData data = GenerateMeasured(base, g);
