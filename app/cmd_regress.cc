@@ -40,7 +40,7 @@ CommandRunner RegisterRegress(CLI::App& app) {
   sub->add_option("--jobs,-j", o->jobs, "scenarios run in parallel (default: number of cores)");
   sub->add_flag("--all", o->all, "print every metric, not only those that moved");
   sub->add_flag("--controller-process", o->controller_process,
-                "run the EXOwheel scenarios (plain trials) with exotwin-controller in another process, in lockstep");
+                "run every scenario with exotwin-controller in another process, in lockstep");
   sub->add_option("--controller-bin", o->controller_bin, "the exotwin-controller executable (default: next to exotwin)");
   return [sub, o]() -> int {
     if (!*sub) return -1;

@@ -6,7 +6,6 @@
 #include "app/commands.h"
 #include "core/stop_signal.h"
 #include "core/error.h"
-#include "core/file_text.h"
 #include "protocol/bus_address.h"
 #include "protocol/can_link.h"
 #include "runner/controller_process.h"
@@ -143,26 +142,32 @@ CommandRunner RegisterServe(CLI::App& app) {
     if (o->bus.empty() && o->can.empty()) throw InputError("serve: --bus ADDR or --can IFACE is required");
     InstallStopSignalHandlers();
     const Scenario s = ReadScenario(o->scenario);
-    if (!ServesScenario(s))
-      throw InputError(s.source + ": device: serve runs EXOwheel scenarios with plain trials (not hal3, not emg_calibration)");
     const BusAddress address = o->can.empty() ? ParseBusAddress(o->bus) : ParseBusAddress("can:" + o->can, "--can");
     if (address.kind == BusKind::kUdp && !address.loopback())
       std::fprintf(stderr, "exotwin serve: note: UDP on %s, not loopback: torque commands cross the network\n",
                    address.host.c_str());
     const OutFolderLock lock(o->out);
-    const std::string controller_file = WriteControllerFile(s, o->out);
+    const std::string controller_file = WriteControllerFile(s, o->out, *seed ? o->seed : s.seed);
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
     const ServeClock clock = o->clock == "realtime" ? ServeClock::kRealtime : ServeClock::kLockstep;
     RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, o->timeout);
-    remote.SetConfiguration(ReadTextFile(controller_file, "controller file", "the file serve just wrote"));
-    std::fprintf(stderr, "exotwin serve: %s on %s, %s clock; waiting for the controller (controller file %s/controller.yaml)\n",
-                 s.name.c_str(), link->Describe().c_str(), o->clock.c_str(), o->out.c_str());
+    std::fprintf(stderr, "exotwin serve: %s on %s, %s clock; waiting for the controller (%s)\n", s.name.c_str(),
+                 link->Describe().c_str(), o->clock.c_str(),
+                 controller_file.empty() ? "start it on the scenario file: its trials run different controller files"
+                                         : ("controller file " + controller_file + ", or the scenario file").c_str());
     RunOptions opt;
     opt.out_dir = o->out;
     if (*seed) opt.seed = o->seed;
     opt.can_log = o->can_log;
     opt.remote = &remote;
-    const RunResult r = RunScenario(s, opt);
+    RunResult r;
+    try {
+      r = RunScenario(s, opt);
+    } catch (...) {
+      remote.EndRun();  // the controller's session ends with the twin's
+      throw;
+    }
+    remote.EndRun();
     const CanLinkStatistics& st = link->statistics();
     std::fprintf(stderr, "exotwin serve: link %s: frames received %llu, sent %llu, dropped foreign %llu, malformed %llu%s\n",
                  link->Describe().c_str(), static_cast<unsigned long long>(st.received),

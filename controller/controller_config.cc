@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "core/error.h"
 #include "core/units.h"
+#include "protocol/messages.h"
 
 namespace exotwin {
 
@@ -21,6 +24,20 @@ void ParseControllerSpec(const YamlContext& r, const YAML::Node& n, ControllerSp
   if (n["kd"]) YamlNumberPair(r, n["kd"], "controller.kd", c->kd, 0, 1e4);
   if (n["feedforward"]) c->feedforward = YamlBool(r, n["feedforward"], "controller.feedforward");
   if (n["torque_limit"]) c->torque_limit = YamlNumber(r, n["torque_limit"], "controller.torque_limit", 1, 500);
+}
+
+namespace {
+std::string Num17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+}  // namespace
+
+std::string ControllerSpecYaml(const ControllerSpec& c) {
+  return "controller: {rate_hz: " + Num17(c.rate_hz) + ", kp: [" + Num17(c.kp[0]) + ", " + Num17(c.kp[1]) + "], kd: [" +
+         Num17(c.kd[0]) + ", " + Num17(c.kd[1]) + "], feedforward: " + (c.feedforward ? "true" : "false") +
+         ", torque_limit: " + Num17(c.torque_limit) + "}\n";
 }
 
 namespace controller {
@@ -154,17 +171,188 @@ void ParseReference(const YamlContext& r, const YAML::Node& n, ReferenceSpec* p)
   }
 }
 
-std::string Num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
+std::string Num(double v) { return Num17(v); }
 
 std::string LumpedYaml(const LumpedParams& p) {
   return "{J1: " + Num(p.J1) + ", J2: " + Num(p.J2) + ", X1: " + Num(p.X1) + ", X2: " + Num(p.X2) + ", Y1: " +
          Num(p.Y1) + ", Y2: " + Num(p.Y2) + "}";
 }
 
+
+// The numbers of a HAL-3 controller file's `hal:` mapping: path below `hal`, the field, its range.
+// Derived, not written: hal.rate_hz, velocity.sample_rate_hz (= controller.rate_hz), assist.dt and
+// assist.rls.dt (= 1 / controller.rate_hz, as HalLoopConfigOf sets them), assist.tau_max (= hal.tau_max).
+struct HalNumber {
+  const char* path;
+  double* v;
+  double lo, hi;
+};
+
+std::vector<HalNumber> HalNumbers(HalLoopConfig& c) {
+  HalAssistConfig& a = c.assist;
+  return {{"rms_window", &c.rms_window, 1e-3, 10},
+          {"emg_fs", &c.emg_fs, 1, 1e5},
+          {"tau_max", &c.tau_max, 1e-3, 500},
+          {"status_timeout", &c.status_timeout, 1e-4, 10},
+          {"velocity.velocity_cutoff_hz", &c.velocity.velocity_cutoff_hz, 0.01, 1e4},
+          {"velocity.acceleration_cutoff_hz", &c.velocity.acceleration_cutoff_hz, 0.01, 1e4},
+          {"impedance.actual.I", &c.impedance.actual.I, 0, 100},
+          {"impedance.actual.B", &c.impedance.actual.B, -100, 100},
+          {"impedance.actual.mgl", &c.impedance.actual.mgl, 0, 1000},
+          {"impedance.actual.C", &c.impedance.actual.C, 0, 100},
+          {"impedance.target.I", &c.impedance.target.I, 0, 100},
+          {"impedance.target.B", &c.impedance.target.B, -100, 100},
+          {"impedance.target.mgl", &c.impedance.target.mgl, 0, 1000},
+          {"impedance.target.C", &c.impedance.target.C, 0, 100},
+          {"impedance.coulomb_eps", &c.impedance.coulomb_eps, 1e-6, 100},
+          {"assist.alpha_mu", &a.alpha_mu, 0, 10},
+          {"assist.alpha_zeta", &a.alpha_zeta, 0, 10},
+          {"assist.lambda1", &a.lambda1, 1e-3, 1e5},
+          {"assist.lambda2", &a.lambda2, 1e-3, 1e5},
+          {"assist.friction_C", &a.friction_C, 0, 100},
+          {"assist.friction_eps", &a.friction_eps, 1e-6, 100},
+          {"assist.emg.extensor.a", &a.emg.extensor.a, -1e9, 1e9},
+          {"assist.emg.extensor.b", &a.emg.extensor.b, -1e6, 1e6},
+          {"assist.emg.flexor.a", &a.emg.flexor.a, -1e9, 1e9},
+          {"assist.emg.flexor.b", &a.emg.flexor.b, -1e6, 1e6},
+          {"assist.emg.baseline_e", &a.emg.baseline_e, 0, 100},
+          {"assist.emg.baseline_f", &a.emg.baseline_f, 0, 100},
+          {"assist.rls.rho", &a.rls.rho, 0.5, 1},
+          {"assist.rls.p0", &a.rls.p0, 1e-12, 1e300},
+          {"assist.rls.p_max", &a.rls.p_max, 1e-12, 1e300},
+          {"assist.rls.pf", &a.rls.pf, 1e-6, 1e6},
+          {"assist.rls.R", &a.rls.R, -100, 100},
+          {"assist.rls.mgl", &a.rls.mgl, 0, 1000},
+          {"assist.rls.I0", &a.rls.I0, 1e-6, 100},
+          {"assist.rls.D0", &a.rls.D0, -1e3, 1e3},
+          {"assist.rls.K0", &a.rls.K0, -1e4, 1e4}};
+}
+
+struct HalFlag {
+  const char* path;
+  bool* v;
+};
+
+std::vector<HalFlag> HalFlags(HalLoopConfig& c) {
+  return {{"assist.rls.gravity_in_input", &c.assist.rls.gravity_in_input},
+          {"assist.rls.known_inertia", &c.assist.rls.known_inertia}};
+}
+
+struct HalInteger {
+  const char* path;
+  int* v;
+  int lo, hi;
+};
+
+std::vector<HalInteger> HalIntegers(HalLoopConfig& c) {
+  return {{"extensor_channel", &c.extensor_channel, 0, msg::kEmgChannels - 1},
+          {"flexor_channel", &c.flexor_channel, 0, msg::kEmgChannels - 1},
+          {"velocity.order", &c.velocity.order, 1, 8}};
+}
+
+// The node at `path` (dot-separated) below `n`; an undefined node when a mapping on the way is absent.
+YAML::Node HalNode(const YAML::Node& n, const std::string& path) {
+  if (!n.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
+  const size_t dot = path.find('.');
+  const YAML::Node c = n[path.substr(0, dot)];
+  if (!c || dot == std::string::npos) return c;
+  return HalNode(c, path.substr(dot + 1));
+}
+
+const std::vector<std::string>& HalKeysBelow(const std::string& prefix) {
+  static const std::map<std::string, std::vector<std::string>> keys = [] {
+    std::map<std::string, std::vector<std::string>> k;
+    HalLoopConfig c;
+    std::vector<std::string> paths = {"mode"};
+    for (const HalNumber& f : HalNumbers(c)) paths.push_back(f.path);
+    for (const HalFlag& f : HalFlags(c)) paths.push_back(f.path);
+    for (const HalInteger& f : HalIntegers(c)) paths.push_back(f.path);
+    for (const std::string& p : paths) {
+      size_t from = 0, dot;
+      std::string at;
+      while (true) {
+        dot = p.find('.', from);
+        const std::string part = p.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
+        std::vector<std::string>& v = k[at];
+        if (std::find(v.begin(), v.end(), part) == v.end()) v.push_back(part);
+        if (dot == std::string::npos) break;
+        at += (at.empty() ? "" : ".") + part;
+        from = dot + 1;
+      }
+    }
+    return k;
+  }();
+  static const std::vector<std::string> none;
+  const auto it = keys.find(prefix);
+  return it == keys.end() ? none : it->second;
+}
+
+// Every mapping below `n` (at `prefix`) holds known keys only.
+void CheckHalKeys(const YamlContext& r, const YAML::Node& n, const std::string& prefix) {
+  const std::string key = prefix.empty() ? "hal" : "hal." + prefix;
+  if (!n.IsMap()) r.Fail(key, "expected a mapping" + YamlLine(n));
+  const std::vector<std::string>& known = HalKeysBelow(prefix);
+  YamlCheckKeys(r, n, key, std::set<std::string>(known.begin(), known.end()));
+  for (const auto& kv : n) {
+    const std::string k = kv.first.as<std::string>();
+    const std::string sub = prefix.empty() ? k : prefix + "." + k;
+    if (!HalKeysBelow(sub).empty()) CheckHalKeys(r, kv.second, sub);
+  }
+}
+
+// Reads the `hal:` mapping: every number is required (a HAL controller file is the loop's whole
+// configuration, nothing assumed); rate-derived fields from controller.rate_hz.
+HalLoopConfig ParseHal(const YamlContext& r, const YAML::Node& n, const ControllerSpec& ctrl) {
+  CheckHalKeys(r, n, "");
+  HalLoopConfig c;
+  if (!n["mode"]) r.Fail("hal.mode", "missing, expected none | impedance | assist");
+  const std::string mode = YamlString(r, n["mode"], "hal.mode", {"none", "impedance", "assist"});
+  c.mode = mode == "none" ? HalMode::kNone : (mode == "assist" ? HalMode::kAssist : HalMode::kImpedance);
+  for (const HalNumber& f : HalNumbers(c)) {
+    const YAML::Node v = HalNode(n, f.path);
+    if (!v) r.Fail(std::string("hal.") + f.path, "missing, expected a number");
+    *f.v = YamlNumber(r, v, std::string("hal.") + f.path, f.lo, f.hi);
+  }
+  for (const HalInteger& f : HalIntegers(c)) {
+    const YAML::Node v = HalNode(n, f.path);
+    if (!v) r.Fail(std::string("hal.") + f.path, "missing, expected an integer");
+    const double x = YamlNumber(r, v, std::string("hal.") + f.path, f.lo, f.hi);
+    if (x != std::floor(x)) r.Fail(std::string("hal.") + f.path, "expected an integer" + YamlLine(v));
+    *f.v = static_cast<int>(x);
+  }
+  for (const HalFlag& f : HalFlags(c)) {
+    const YAML::Node v = HalNode(n, f.path);
+    if (!v) r.Fail(std::string("hal.") + f.path, "missing, expected true or false");
+    *f.v = YamlBool(r, v, std::string("hal.") + f.path);
+  }
+  if (c.tau_max > ctrl.torque_limit)
+    r.Fail("hal.tau_max", Num(c.tau_max) + " N m is beyond controller.torque_limit " + Num(ctrl.torque_limit) + " N m");
+  c.rate_hz = ctrl.rate_hz;
+  c.velocity.sample_rate_hz = ctrl.rate_hz;
+  c.assist.dt = 1.0 / ctrl.rate_hz;
+  c.assist.rls.dt = c.assist.dt;
+  c.assist.tau_max = c.tau_max;
+  return c;
+}
+
+// The `hal:` mapping's text, block style, in the order of HalKeysBelow.
+void WriteHal(std::ostream& o, HalLoopConfig c, const std::string& prefix, int indent) {
+  std::map<std::string, std::string> leaf;
+  leaf["mode"] = HalModeName(c.mode);
+  for (const HalNumber& f : HalNumbers(c)) leaf[f.path] = Num(*f.v);
+  for (const HalFlag& f : HalFlags(c)) leaf[f.path] = *f.v ? "true" : "false";
+  for (const HalInteger& f : HalIntegers(c)) leaf[f.path] = std::to_string(*f.v);
+  for (const std::string& k : HalKeysBelow(prefix)) {
+    const std::string path = prefix.empty() ? k : prefix + "." + k;
+    o << std::string(indent, ' ') << k << ":";
+    if (HalKeysBelow(path).empty()) {
+      o << " " << leaf.at(path) << "\n";
+    } else {
+      o << "\n";
+      WriteHal(o, c, path, indent + 2);
+    }
+  }
+}
 }  // namespace
 
 ControllerFile ParseControllerFile(const std::string& text, const std::string& source) {
@@ -174,22 +362,34 @@ ControllerFile ParseControllerFile(const std::string& text, const std::string& s
   if (root["device"])
     r.Fail("model", "a scenario's feed-forward model is computed by the twin from the subject; give the controller "
                     "file `exotwin serve` writes for it (OUT/controller.yaml)");
-  YamlCheckKeys(r, root, "", {"controller", "drivers", "model", "reference", "trials"});
+  YamlCheckKeys(r, root, "", {"controller", "drivers", "model", "reference", "trials", "hal"});
   ControllerFile f;
   f.source = source;
   if (!root["controller"]) r.Fail("controller", "missing, expected {rate_hz, kp, kd, feedforward, torque_limit}");
-  ParseControllerSpec(r, root["controller"], &f.controller, true);
+  const bool hal = static_cast<bool>(root["hal"]);
+  ParseControllerSpec(r, root["controller"], &f.controller, !hal);
+  if (hal) {
+    for (const char* k : {"model", "reference"})
+      if (root[k]) r.Fail(k, "a HAL-3 controller file (hal:) has no " + std::string(k) + YamlLine(root[k]));
+    f.controller.feedforward = false;
+  }
   if (const YAML::Node d = root["drivers"]) {
     YamlCheckKeys(r, d, "drivers", {"torque_limit"});
     if (d["torque_limit"]) f.driver_limit = YamlNumber(r, d["torque_limit"], "drivers.torque_limit", 1, 500, "N m");
   }
-  if (f.controller.torque_limit > f.driver_limit)
+  if (!hal && f.controller.torque_limit > f.driver_limit)  // HAL-3: hal.tau_max is checked below
     r.Fail("controller.torque_limit", Num(f.controller.torque_limit) + " N m is beyond the drivers' range (drivers.torque_limit " +
                                           Num(f.driver_limit) + " N m)");
   if (root["model"]) ParseModel(r, root["model"], &f.model);
   else if (f.controller.feedforward) r.Fail("model", "missing, the feed-forward (controller.feedforward: true) needs the controller's model");
   if (root["reference"]) ParseReference(r, root["reference"], &f.reference);
   if (root["trials"]) f.trials = static_cast<int>(YamlNumber(r, root["trials"], "trials", 1, 100));
+  if (hal) {
+    f.hal = ParseHal(r, root["hal"], f.controller);
+    if (f.hal->tau_max > f.driver_limit)
+      r.Fail("hal.tau_max", Num(f.hal->tau_max) + " N m is beyond the drivers' range (drivers.torque_limit " +
+                                Num(f.driver_limit) + " N m)");
+  }
   return f;
 }
 
@@ -200,11 +400,14 @@ ControllerFile ReadControllerFile(const std::string& path) {
 std::string ControllerFileYaml(const ControllerFile& f, const std::string& comment) {
   std::ostringstream o;
   o << "# " << comment << "\n";
-  const ControllerSpec& c = f.controller;
-  o << "controller: {rate_hz: " << Num(c.rate_hz) << ", kp: [" << Num(c.kp[0]) << ", " << Num(c.kp[1]) << "], kd: ["
-    << Num(c.kd[0]) << ", " << Num(c.kd[1]) << "], feedforward: " << (c.feedforward ? "true" : "false")
-    << ", torque_limit: " << Num(c.torque_limit) << "}\n";
+  o << ControllerSpecYaml(f.controller);
   o << "drivers: {torque_limit: " << Num(f.driver_limit) << "}\n";
+  if (f.hal) {
+    o << "hal:\n";
+    WriteHal(o, *f.hal, "", 2);
+    o << "trials: " << f.trials << "\n";
+    return o.str();
+  }
   o << "model:\n  L1: " << Num(f.model.L1) << "\n  g: " << Num(f.model.g) << "\n  exo: " << LumpedYaml(f.model.exo) << "\n";
   if (f.model.human) o << "  human: " << LumpedYaml(*f.model.human) << "\n";
   o << "  passive: " << (f.model.passive == PassiveModel::kNone ? "none" : "riener1999") << "\n";

@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "controller/exo_controller.h"
+#include "controller/hal_loop.h"
 #include "controller/trajectory.h"
 #include "core/yaml_fields.h"
 #include "model/lumped_params.h"
@@ -24,6 +25,9 @@ struct ControllerSpec {
   bool feedforward = true;     // inverse-dynamics feed-forward from the controller's own model
   double torque_limit = 100;   // N m, supervisor limit
 };
+
+// The `controller:` line of a scenario or controller file for *c (numbers with 17 significant digits).
+std::string ControllerSpecYaml(const ControllerSpec& c);
 
 // Reads the `controller:` mapping `n` (key prefix "controller") into *c; keys absent keep *c's values.
 // With require_gains, kp and kd must be given (a controller file: no gains are assumed).
@@ -55,7 +59,9 @@ struct ReferenceSpec {
 std::shared_ptr<const LegTrajectory> BuildReference(const ReferenceSpec& r, int trial);
 
 // Everything the deployable controller needs: gains and limits, the drivers' range, its feed-forward
-// model and the reference.
+// model and the reference (EXOwheel); or, with `hal`, the HAL-3 knee loop's whole configuration
+// (mode, EMG calibration HKS05 eq. 2, RLS HKS05 eq. 8-13, tau_c of Lee & Sankai), which then replaces
+// the gains, model and reference.
 struct ControllerFile {
   std::string source;
   ControllerSpec controller;
@@ -63,13 +69,15 @@ struct ControllerFile {
   LegParams model;            // the feed-forward model (exoskeleton + the controller's estimate of the subject)
   ReferenceSpec reference;
   int trials = 1;
+  std::optional<HalLoopConfig> hal;  // a HAL-3 knee controller (controller/hal_loop.h)
 };
 
 // The ExoControllerConfig of a controller file: gains, rate, supervisor limits (sensor range
 // min(115, driver_limit) N m, command limit torque_limit, qd 8 rad/s) and the feed-forward model.
 ExoControllerConfig ExoConfigOf(const ControllerFile& f);
 
-// Reads a controller file (DESIGN.md "Controller file"). A scenario file (it has `device:`) is refused
+// Reads a controller file (DESIGN.md "Controller file"); a `hal:` mapping makes it a HAL-3 controller
+// (kp, kd and model then not required; controller.torque_limit bounds hal.tau_max). A scenario file (it has `device:`) is refused
 // with a message pointing to the controller file `exotwin serve` writes, since a scenario's feed-forward
 // model is the twin's to compute (it takes the subject's anthropometry). Throws InputError naming the
 // file and key: missing gains or model, controller.torque_limit above drivers.torque_limit, ...

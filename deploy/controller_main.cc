@@ -3,6 +3,7 @@
 // torque commanded first); 2 on bad input (the file, key or address named on stderr).
 #include <cstring>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 
 #include "controller/controller_config.h"
@@ -51,7 +52,9 @@ int main(int argc, char** argv) {
     const bool scenario = root && root.IsMap() && root["device"];
     ControllerSpec scenario_controller;
     controller::ControllerFile cfg;
+    bool hal3 = false;
     if (scenario) {
+      hal3 = YamlString(YamlContext{config}, root["device"], "device", {"exowheel", "exowheel_exo_only", "hal3"}) == "hal3";
       if (root["controller"]) ParseControllerSpec(YamlContext{config}, root["controller"], &scenario_controller);
     } else {
       cfg = controller::ParseControllerFile(text, config);
@@ -60,11 +63,16 @@ int main(int argc, char** argv) {
     if (address.kind == BusKind::kUdp && !address.loopback())
       std::cerr << "exotwin-controller: note: UDP on " << address.host
                 << ", not loopback: torque commands cross the network" << std::endl;
-    if (!scenario) controller::ExoConfigOf(cfg);  // the supervisor's checks of the limits, before the bus is opened
+    try {  // the loop's and the supervisor's checks, before the bus is opened
+      if (!scenario && cfg.hal) controller::HalLoop(*cfg.hal, nullptr);
+      else if (!scenario) controller::ExoConfigOf(cfg);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(config + ": " + e.what());
+    }
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kController);
     InstallStopSignalHandlers();
     if (scenario) {
-      ControllerNode node(scenario_controller, config, link.get(), std::cerr);
+      ControllerNode node(scenario_controller, hal3, config, link.get(), std::cerr);
       return node.Run();
     }
     ControllerNode node(cfg, link.get(), std::cerr);

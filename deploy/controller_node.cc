@@ -34,16 +34,20 @@ ControllerNode::ControllerNode(const controller::ControllerFile& cfg, CanLink* l
   Configure(cfg);
 }
 
-ControllerNode::ControllerNode(const ControllerSpec& scenario_controller, std::string scenario_source, CanLink* link,
-                               std::ostream& log)
+ControllerNode::ControllerNode(const ControllerSpec& scenario_controller, bool hal3, std::string scenario_source,
+                               CanLink* link, std::ostream& log)
     : link_(link), log_(log), bus_(link) {
+  scenario_mode_ = true;
+  scenario_hal_ = hal3;
   scenario_controller_ = scenario_controller;
-  cfg_.source = std::move(scenario_source);
+  scenario_source_ = std::move(scenario_source);
+  cfg_.source = scenario_source_;
 }
 
 void ControllerNode::Configure(const controller::ControllerFile& cfg) {
+  if (cfg.hal) controller::HalLoop(*cfg.hal, nullptr);  // throws on a configuration the loop cannot run
+  else exo_cfg_ = controller::ExoConfigOf(cfg);
   cfg_ = cfg;
-  exo_cfg_ = controller::ExoConfigOf(cfg_);
   configured_ = true;
 }
 
@@ -58,7 +62,7 @@ void ControllerNode::TakeConfiguration(const CanFrame& end) {
          << " bytes): asking again" << std::endl;
     return;  // the next NMT start asks again
   }
-  const std::string source = "the twin's controller file for " + cfg_.source;
+  const std::string source = "the twin's controller file for " + scenario_source_;
   controller::ControllerFile f;
   try {
     f = controller::ParseControllerFile(text, source);
@@ -69,11 +73,14 @@ void ControllerNode::TakeConfiguration(const CanFrame& end) {
   }
   const ControllerSpec& a = f.controller;
   const ControllerSpec& b = scenario_controller_;
-  if (a.rate_hz != b.rate_hz || a.kp[0] != b.kp[0] || a.kp[1] != b.kp[1] || a.kd[0] != b.kd[0] || a.kd[1] != b.kd[1] ||
-      a.feedforward != b.feedforward || a.torque_limit != b.torque_limit) {
-    log_ << "exotwin-controller: " << cfg_.source << ": controller: the twin serves another controller (rate "
-         << a.rate_hz << " Hz, kp [" << a.kp[0] << ", " << a.kp[1] << "], kd [" << a.kd[0] << ", " << a.kd[1]
-         << "], torque limit " << a.torque_limit << " N m): is the twin serving this scenario?" << std::endl;
+  // A HAL-3 file carries the scenario's controller part except its feed-forward (the HAL loop has none).
+  const bool gains_differ = a.kp[0] != b.kp[0] || a.kp[1] != b.kp[1] || a.kd[0] != b.kd[0] || a.kd[1] != b.kd[1] ||
+                            (!f.hal && a.feedforward != b.feedforward);
+  if (f.hal.has_value() != scenario_hal_ || a.rate_hz != b.rate_hz || a.torque_limit != b.torque_limit || gains_differ) {
+    log_ << "exotwin-controller: " << scenario_source_ << ": controller: the twin serves another controller ("
+         << (f.hal ? "HAL-3" : "EXOwheel") << ", rate " << a.rate_hz << " Hz, kp [" << a.kp[0] << ", " << a.kp[1]
+         << "], kd [" << a.kd[0] << ", " << a.kd[1] << "], torque limit " << a.torque_limit
+         << " N m): is the twin serving this scenario?" << std::endl;
     exit_code_ = 2, done_ = true;
     return;
   }
@@ -85,20 +92,50 @@ void ControllerNode::TakeConfiguration(const CanFrame& end) {
     exit_code_ = 2, done_ = true;
     return;
   }
-  log_ << "exotwin-controller: " << source << " received (" << length << " bytes): feed-forward model and reference"
+  awaiting_config_ = false;
+  configured_start_ = start_sequence_;
+  log_ << "exotwin-controller: " << source << " received (" << length << " bytes): "
+       << (cfg_.hal ? std::string("HAL-3 loop, mode ") + controller::HalModeName(cfg_.hal->mode) +
+                          ", EMG calibration and tau_c"
+                    : std::string("feed-forward model and reference"))
        << std::endl;
 }
 
+// A fresh control loop for trial_ (the configuration held), answered by a ready frame.
+void ControllerNode::StartLoop(uint16_t sequence) {
+  if (cfg_.hal) {
+    ctrl_.reset();
+    hal_ = std::make_unique<controller::HalLoop>(*cfg_.hal, &bus_);
+  } else {
+    hal_.reset();
+    ctrl_ = std::make_unique<controller::ExoController>(exo_cfg_, controller::BuildReference(cfg_.reference, trial_),
+                                                         &bus_);
+  }
+  bus_.pending.clear();
+  have_stamp_ = false;
+  state_ = 0;
+  faults_ = 0;
+  log_ << "exotwin-controller: trial " << trial_ + 1 << ": control loop started" << std::endl;
+  link_->Send(link::ReadyFrame(trial_, sequence));
+}
+
 int ControllerNode::Run() {
-  if (configured_)
+  if (configured_ && cfg_.hal)
+    log_ << "exotwin-controller: " << cfg_.source << ": HAL-3 knee loop, mode " << controller::HalModeName(cfg_.hal->mode)
+         << ", rate " << cfg_.controller.rate_hz << " Hz, torque limit " << cfg_.hal->tau_max << " N m, virtual viscosity "
+         << cfg_.hal->impedance.target.B << " N m s/rad; bus " << link_->Describe() << "; waiting for NMT start"
+         << std::endl;
+  else if (configured_)
     log_ << "exotwin-controller: " << cfg_.source << ": rate " << cfg_.controller.rate_hz << " Hz, kp ["
          << cfg_.controller.kp[0] << ", " << cfg_.controller.kp[1] << "], kd [" << cfg_.controller.kd[0] << ", "
          << cfg_.controller.kd[1] << "], torque limit " << cfg_.controller.torque_limit << " N m, feed-forward "
          << (cfg_.controller.feedforward ? "on" : "off") << "; bus " << link_->Describe() << "; waiting for NMT start"
          << std::endl;
   else
-    log_ << "exotwin-controller: " << cfg_.source << ": a scenario: its controller part, the feed-forward model "
-         << "and reference from the twin; bus " << link_->Describe() << "; waiting for NMT start" << std::endl;
+    log_ << "exotwin-controller: " << scenario_source_ << ": a " << (scenario_hal_ ? "HAL-3" : "EXOwheel")
+         << " scenario: its controller part here, "
+         << (scenario_hal_ ? "the EMG calibration and the HAL-3 loop's configuration" : "the feed-forward model and reference")
+         << " from the twin at each trial; bus " << link_->Describe() << "; waiting for NMT start" << std::endl;
   CanFrame f;
   while (!done_) {
     if (const int sig = StopSignal()) {
@@ -120,31 +157,27 @@ void ControllerNode::Handle(const CanFrame& f) {
     case link::kIdNmt:
       if (f.dlc >= 1 && f.data[0] == link::kNmtStart) {
         trial_ = f.dlc >= 3 ? f.data[2] : 0;
-        if (!configured_) {  // scenario mode: the twin's controller file first
-          CanFrame r = link::ReadyFrame(trial_);
+        const uint16_t sequence = link::StartSequence(f);
+        if (scenario_mode_ && configured_start_ != sequence) {  // this start's controller file from the twin first
+          CanFrame r = link::ReadyFrame(trial_, sequence);
           r.id = link::kIdConfigRequest;
           config_text_.clear();
+          awaiting_config_ = true;
+          start_sequence_ = sequence;
           link_->Send(r);
           return;
         }
-        ctrl_ = std::make_unique<controller::ExoController>(exo_cfg_, controller::BuildReference(cfg_.reference, trial_),
-                                                             &bus_);
-        bus_.pending.clear();
-        have_stamp_ = false;
-        state_ = 0;
-        faults_ = 0;
-        log_ << "exotwin-controller: trial " << trial_ + 1 << ": control loop started" << std::endl;
-        link_->Send(link::ReadyFrame(trial_));
+        StartLoop(sequence);
       } else if (f.dlc >= 1 && f.data[0] == link::kNmtStop) {
         done_ = true;
       }
       return;
     case link::kIdConfigData:
-      if (!configured_ && config_text_.size() < (size_t{1} << 26))
+      if (awaiting_config_ && config_text_.size() < (size_t{1} << 26))
         config_text_.append(reinterpret_cast<const char*>(f.data.data()), f.dlc);
       return;
     case link::kIdConfigEnd:
-      if (!configured_) TakeConfiguration(f);
+      if (awaiting_config_) TakeConfiguration(f);
       return;
     case link::kIdRxStamp:
       have_stamp_ = link::FrameDouble(f, &stamp_);
@@ -154,7 +187,7 @@ void ControllerNode::Handle(const CanFrame& f) {
       return;
     default:
       if (link::IsLinkFrameId(f.id)) return;  // another node's link frame: not for the control loop
-      if (!ctrl_) return;
+      if (!ctrl_ && !hal_) return;
       CanFrame g = f;
       g.t = have_stamp_ ? stamp_ : last_sync_;  // the receive time on the twin's (simulated) clock
       have_stamp_ = false;
@@ -164,8 +197,15 @@ void ControllerNode::Handle(const CanFrame& f) {
 
 void ControllerNode::Tick(double t) {
   last_sync_ = t;
-  if (!ctrl_) {
+  if (!ctrl_ && !hal_) {
     if (syncs_ignored_++ == 0) log_ << "exotwin-controller: SYNC before NMT start: ignored" << std::endl;
+    return;
+  }
+  if (hal_) {
+    hal_->Tick(t);
+    ++ticks_;
+    SendHalTelemetry();
+    link_->Send(link::DoubleFrame(link::kIdCycleDone, t));
     return;
   }
   ctrl_->Tick(t);
@@ -189,7 +229,27 @@ void ControllerNode::Tick(double t) {
   }
 }
 
+void ControllerNode::SendHalTelemetry() {
+  const controller::HalTelemetry& h = hal_->telemetry();
+  double v[link::kHalTelCount];
+  v[link::kHalTelTh] = h.th, v[link::kHalTelStrain] = h.strain, v[link::kHalTelThd] = h.thd;
+  v[link::kHalTelTauCmd] = h.tau_cmd, v[link::kHalTelEe] = h.E_e, v[link::kHalTelEf] = h.E_f;
+  v[link::kHalTelMuHat] = h.assist.mu_hat, v[link::kHalTelD] = h.assist.D, v[link::kHalTelK] = h.assist.K;
+  v[link::kHalTelTauMu] = h.assist.tau_mu, v[link::kHalTelTauZeta] = h.assist.tau_zeta;
+  v[link::kHalTelTauC] = h.assist.tau_c, v[link::kHalTelIHat] = hal_->assist().rls().I();
+  v[link::kHalTelEmgGaps] = h.emg_gaps, v[link::kHalTelEnabled] = h.enabled ? 1.0 : 0.0;
+  for (int i = 0; i < link::kHalTelCount; ++i)
+    link_->Send(link::DoubleFrame(static_cast<uint16_t>(link::kIdTelemetryBase + i), v[i]));
+}
+
 void ControllerNode::ZeroTorque() {
+  if (cfg_.hal || (scenario_mode_ && scenario_hal_)) {
+    msg::HalKneeCommand c;
+    c.torque = 0.0;
+    c.enable = false;
+    link_->Send(msg::Encode(c));
+    return;
+  }
   for (int j = 0; j < 2; ++j) {
     msg::JointCommand c;
     c.joint = static_cast<msg::Joint>(j);

@@ -2,14 +2,19 @@
 // (DESIGN.md "The CAN transport between processes"). Values are IEEE-754 doubles, little-endian,
 // DLC 8, so the simulated times and the controller's telemetry cross the process boundary exactly.
 //   0x000 NMT (CANopen): twin -> controller. data[0] 0x01 start (data[2] the trial, 0-based: the
-//         controller starts a fresh control loop), 0x02 stop (the run is over: the controller exits).
+//         controller starts a fresh control loop; data[3..4] the start's sequence number in the session,
+//         little-endian, the same for the repeats of one start), 0x02 stop (the session is over: the
+//         controller exits).
 //   0x080 SYNC (CANopen COB-ID): twin -> controller, once per controller period; data: the tick's
 //         simulated time t (s). The controller ticks at t on the frames received before it.
-//   0x701 boot-up / ready: controller -> twin, answer to an NMT start; data[0] 0x05, data[1] the trial.
-//   0x780 + i telemetry: controller -> twin after each tick, i = TelemetryIndex (the value logged).
+//   0x701 boot-up / ready: controller -> twin, answer to an NMT start; data[0] 0x05, data[1] the trial,
+//         data[2..3] the start's sequence number.
+//   0x780 + i telemetry: controller -> twin after each tick, i = TelemetryIndex (EXOwheel) or
+//         HalTelemetryIndex (HAL-3): the value logged.
 //   0x7F0 cycle done: controller -> twin, last frame of a tick; data: the SYNC's t echoed.
-//   0x702 configuration request: controller -> twin, answer to an NMT start by a controller started on a
-//         scenario file (its feed-forward model and reference are the twin's): data[1] the trial.
+//   0x702 configuration request: controller -> twin, answer to every NMT start by a controller started on
+//         a scenario file (its feed-forward model, reference or EMG calibration are the twin's, and may
+//         change from one run or trial to the next): data[1] the trial, data[2..3] the start's sequence.
 //   0x7E0 configuration data: twin -> controller, the controller file's text (DESIGN.md "Controller
 //         file"), DLC 1..8 bytes per frame, in order; 0x7E1 configuration end: data[0..3] the text's
 //         length, data[4..7] its FNV-1a 32-bit hash (little-endian): a gap or reordering is detected.
@@ -48,6 +53,14 @@ enum TelemetryIndex {
   kTelCount = kTelEmg0 + 5,
 };
 
+// The telemetry values of the HAL-3 knee loop (HalTelemetry of controller/hal_loop.h), same identifiers.
+enum HalTelemetryIndex {
+  kHalTelTh = 0, kHalTelStrain, kHalTelThd, kHalTelTauCmd, kHalTelEe, kHalTelEf, kHalTelMuHat, kHalTelD,
+  kHalTelK, kHalTelTauMu, kHalTelTauZeta, kHalTelTauC, kHalTelIHat, kHalTelEmgGaps, kHalTelEnabled,
+  kHalTelCount,
+};
+static_assert(kTelCount <= kTelemetryValues && kHalTelCount <= kTelemetryValues, "telemetry beyond 0x78F");
+
 // A DLC 8 frame carrying v.
 inline CanFrame DoubleFrame(uint16_t id, double v) {
   CanFrame f;
@@ -68,21 +81,31 @@ inline bool FrameDouble(const CanFrame& f, double* v) {
   return true;
 }
 
-inline CanFrame NmtFrame(uint8_t command, int trial) {
+// An NMT frame; `sequence` numbers the starts of a session (kNmtStart).
+inline CanFrame NmtFrame(uint8_t command, int trial, uint16_t sequence = 0) {
   CanFrame f;
   f.id = kIdNmt;
-  f.dlc = 3;
+  f.dlc = 5;
   f.data[0] = command;
   f.data[2] = static_cast<uint8_t>(trial);
+  f.data[3] = static_cast<uint8_t>(sequence), f.data[4] = static_cast<uint8_t>(sequence >> 8);
   return f;
 }
 
-inline CanFrame ReadyFrame(int trial) {
+// The sequence number of an NMT start, a ready frame or a configuration request (0 when absent).
+inline uint16_t StartSequence(const CanFrame& f) {
+  const int at = f.id == kIdNmt ? 3 : 2;
+  return f.dlc >= at + 2 ? static_cast<uint16_t>(f.data[at] | (f.data[at + 1] << 8)) : 0;
+}
+
+// The answer to the NMT start `sequence` of trial `trial`.
+inline CanFrame ReadyFrame(int trial, uint16_t sequence = 0) {
   CanFrame f;
   f.id = kIdReady;
-  f.dlc = 2;
+  f.dlc = 4;
   f.data[0] = kStateOperational;
   f.data[1] = static_cast<uint8_t>(trial);
+  f.data[2] = static_cast<uint8_t>(sequence), f.data[3] = static_cast<uint8_t>(sequence >> 8);
   return f;
 }
 

@@ -12,25 +12,38 @@
 #include <thread>
 #include <vector>
 
+#include "analysis/csv_table.h"
 #include "core/data_dir.h"
-
 #include "core/error.h"
 #include "protocol/can_link.h"
 #include "runner/exowheel_setup.h"
+#include "runner/hal_setup.h"
 #include "runner/remote_controller.h"
 
 namespace exotwin {
 namespace fs = std::filesystem;
 
-bool ServesScenario(const Scenario& s) { return s.device != Device::kHal3 && !s.emg_calibration; }
-
-std::string WriteControllerFile(const Scenario& s, const std::string& dir) {
+std::string WriteControllerFile(const Scenario& s, const std::string& dir, uint64_t seed) {
+  if (s.emg_calibration) return "";
   fs::create_directories(dir);
   const std::string path = dir + "/controller.yaml";
+  // Whole or absent (a controller may be started as soon as the file appears).
+  WriteFileAtomic(path, s.device == Device::kHal3
+                            ? controller::ControllerFileYaml(HalControllerFileOf(s, seed, 0),
+                                                             "the HAL-3 controller of " + s.source + ", run 1 of " +
+                                                                 std::to_string(HalRuns(s)) + " (written by exotwin serve)")
+                            : controller::ControllerFileYaml(ControllerFileOf(s, ResolveSubject(s)),
+                                                             "the controller file of " + s.source +
+                                                                 " (written by exotwin serve)"));
+  return path;
+}
+
+std::string WriteControllerScenario(const Scenario& s, const std::string& path) {
   std::ofstream out(path);
-  out << controller::ControllerFileYaml(ControllerFileOf(s, ResolveSubject(s)),
-                                        "the controller file of " + s.source + " (written by exotwin serve)");
-  if (!out) throw InputError(path + ": cannot write the controller file");
+  out << "# the device and controller part of " << s.source << " (exotwin-controller asks the twin for the rest)\n"
+      << "device: " << DeviceName(s.device) << "\n"
+      << ControllerSpecYaml(s.controller);
+  if (!out) throw InputError(path + ": cannot write the controller's scenario file");
   return path;
 }
 
@@ -97,13 +110,10 @@ void Reap(pid_t pid, double seconds) {
 
 RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,
                                    double timeout_s) {
-  if (!ServesScenario(s))
-    throw InputError(s.source + ": device: a controller process runs EXOwheel scenarios with plain trials "
-                                "(not hal3, not emg_calibration)");
   if (controller_bin.empty() || ::access(controller_bin.c_str(), X_OK) != 0)
     throw InputError("exotwin-controller: '" + controller_bin + "' is not an executable");
-  const std::string config = WriteControllerFile(s, opt.out_dir);
   const LinkDir dir;
+  const std::string config = WriteControllerScenario(s, dir.path() + "/scenario.yaml");
   const BusAddress address = ParseBusAddress("unix:" + dir.path() + "/bus");
   std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
   const pid_t pid = StartController(controller_bin, config, address.text, opt.out_dir + "/controller.log");
@@ -117,6 +127,7 @@ RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std:
     Reap(pid, 5.0);
     throw;
   }
+  remote.EndRun();
   Reap(pid, 5.0);
   if (!remote.deterministic()) {  // result.json already written: record the failure in it too
     CheckResult c;

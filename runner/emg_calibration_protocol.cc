@@ -20,6 +20,7 @@
 #include "dsp/mvc.h"
 #include "hwsim/emg_amplifier.h"
 #include "model/leg_dynamics.h"
+#include "runner/remote_controller.h"
 #include "sim/anthropometry.h"
 #include "sim/synthetic_emg.h"
 
@@ -114,6 +115,7 @@ RunResult RunTrial(Scenario sub, const std::string& tag, uint64_t seed, const Ru
   ro.out_dir = opt.out_dir + "/" + tag;
   ro.seed = seed;
   ro.progress = opt.progress;
+  ro.remote = opt.remote;  // the same controller process runs every sub-trial (its configuration per trial)
   fs::remove_all(ro.out_dir);
   RunResult r = RunScenario(sub, ro);
   if (r.interrupted) throw ProtocolInterrupted{*r.interrupted};
@@ -504,6 +506,7 @@ RunResult RunEmgCalibrationScenario(const Scenario& s, const RunOptions& opt) {
   } catch (const ProtocolInterrupted& e) {  // metrics: the subjects completed before the stop
     result.interrupted = e.stop;
   }
+  if (opt.remote) opt.remote->AddMetrics(&result.metrics);
   result.metrics["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   FinishRun(s, result, opt.out_dir + "/result.json");
   return result;

@@ -265,6 +265,9 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   std::unique_ptr<CandumpWriter> can_log;
   if (!opt.can_log.empty()) can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
 
+  if (opt.remote)  // the controller in another process runs the scenario's controller file (ControllerNode)
+    opt.remote->SetConfiguration(controller::ControllerFileYaml(
+        ControllerFileOf(s, truth), "the controller file of " + s.source + " (" + s.name + ")"));
   ExowheelTotals totals;
   const auto wall0 = std::chrono::steady_clock::now();
   ProgressBar bar(static_cast<size_t>(s.protocol.trials * schedule.steps), s.name, opt.progress);
@@ -300,10 +303,7 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   m["torque_max_50ms_after_fault"] = totals.torque_after_fault;
   m["safe_state_entered"] = safe_time >= 0 ? 1.0 : 0.0;
   m["final_state"] = totals.final_state;
-  if (opt.remote) {
-    opt.remote->EndRun();
-    opt.remote->AddMetrics(&m);
-  }
+  if (opt.remote) opt.remote->AddMetrics(&m);
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   FinishRun(s, result, opt.out_dir + "/result.json");

@@ -18,9 +18,9 @@
 #include "core/error.h"
 #include "protocol/candump.h"
 #include "runner/cosim_rig.h"
-#include "runner/hal_emg_calibration.h"
 #include "runner/hal_setup.h"
 #include "runner/progress_bar.h"
+#include "runner/remote_controller.h"
 #include "runner/sweep_plots.h"
 #include "sim/hal3_plant.h"
 #include "sim/muscles.h"
@@ -72,16 +72,14 @@ class HalTrial : public CosimDevice {
  public:
   HalTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, double B_v, int run, int runs,
            RunResult* result, CandumpWriter* can_log, double epoch)
-      : s_(s), opt_(opt), pp_(Hal3PlantParamsOf(s)) {
+      : s_(s), opt_(opt), pp_(Hal3PlantParamsOf(s)), result_(result) {
     plant_.SetParams(pp_);
     dt_ = plant_.timestep();
     schedule_ = ScheduleOf(s, dt_, CosimClock::kPlant);
     ctrl_dt_ = 1.0 / s.controller.rate_hz;
     mp_ = OperatorMuscles(s);
     const SyntheticEmgConfig emg_cfg = DefaultSyntheticEmgConfig();
-    const HalEmgCalibrationSpec cal{kHalExtChannel, kHalFlexChannel, kHalRmsWindow, s.hal.calibration_levels, 0.02, s.hal.calibration_hi,
-                                    s.hal.calibration_rest};
-    coeffs_ = CalibrateHalEmg(mp_, emg_cfg, cal, seed + 11);
+    coeffs_ = HalRunCalibration(s, mp_, seed);
     muscles_ = std::make_unique<MuscleModel>(mp_, dt_);
     TrackingGains gains = KneeSwingBehaviour::KneeSwingGains();
     gains.inertia[1] = pp_.I();  // a rehearsed operator knows its leg + HAL (Hayashi sec. III)
@@ -102,7 +100,14 @@ class HalTrial : public CosimDevice {
     knee_ = std::make_unique<hwsim::Hal3KneeNode>(ks, knee_ep, seed + 1);
     rig_->AttachEmg(emg_ep, muscles_.get(), emg_.get());
     loop_cfg_ = HalLoopConfigOf(s, pp_, coeffs_, B_v);
-    loop_ = std::make_unique<controller::HalLoop>(loop_cfg_, ctrl_ep);
+    if (opt.remote) {  // the controller in another process runs this configuration (ControllerNode)
+      opt.remote->SetConfiguration(controller::ControllerFileYaml(
+          HalControllerFile(s, loop_cfg_), "the HAL-3 controller of " + s.source + ", run " + std::to_string(run + 1)));
+      ctrl_ep_ = ctrl_ep;
+    } else {
+      loop_ = std::make_unique<controller::HalLoop>(loop_cfg_, ctrl_ep);
+    }
+    run_ = run;
 
     if (s.log_measured_csv)
       logs_ = OpenTrialLogs(opt.out_dir, run, runs,
@@ -129,7 +134,9 @@ class HalTrial : public CosimDevice {
   // node samples the instant t after the step, before the tick) and returns the run's metrics.
   // A stop request ending it early is stored in *stop (its trial field left to the caller).
   std::map<std::string, double> Run(const CosimProgress& progress, std::optional<RunInterruption>* stop) {
-    const double t_end = rig_->Run(schedule_, *this, [this](double t) { loop_->Tick(t); }, progress);
+    if (opt_.remote) opt_.remote->BeginTrial(run_, ctrl_ep_, &result_->events);
+    const double t_end = rig_->Run(
+        schedule_, *this, [this](double t) { opt_.remote ? opt_.remote->Tick(t) : loop_->Tick(t); }, progress);
     if (rig_->stopped_by()) *stop = RunInterruption{rig_->stopped_by(), t_end, 0};
     return Metrics();
   }
@@ -168,7 +175,7 @@ class HalTrial : public CosimDevice {
     }
     Dt_ = mt_.D[1] + mp_.gamma[1] * sum_alpha_a, Kt_ = mt_.K[1] - mp_.beta[1] * sum_alpha_a;
     projected_->Add(mu_ - mu_c_, thd, th);  // v = -D thd - K th (up to the ForceFactor clamp)
-    const controller::HalTelemetry& tel = loop_->telemetry();
+    const controller::HalTelemetry& tel = Telemetry();
     if (t >= s_.hal.settle) {
       Eigen::Vector2d qs, qds, qdds;
       KneeSwingBehaviour::Intended(t, s_.hal.swing_freq, qs, qds, qdds);
@@ -193,7 +200,7 @@ class HalTrial : public CosimDevice {
   void LogSample(double t) override {
     const double th = plant_.th(), thd = plant_.thd();
     if (logs_.measured) {
-      const controller::HalTelemetry& tel = loop_->telemetry();
+      const controller::HalTelemetry& tel = Telemetry();
       const auto& o = rig_->emg_node()->last_output();
       const double row[] = {t, tel.th, tel.strain, tel.tau_cmd, o[0], o[1], o[2], o[3], o[4],
                             tel.E_e, tel.E_f, tel.assist.mu_hat, tel.assist.D, tel.assist.K};
@@ -247,18 +254,24 @@ class HalTrial : public CosimDevice {
       // The same error against the stiffness the RLS actually sees, K' = K + G(th) ~ K + Mgl (HKS05 eq. 8):
       // K is ~6 % of K' in the seated swing, so this says how close HKS05 eq. 13 comes on its own scale.
       m["rls_K_err_pct_of_Kprime"] = 100 * std::abs(K_hat_.get() - K_proj_.get()) / (K_proj_.get() + pp_.mgl());
-      m["rls_I_hat"] = loop_->assist().rls().I();
+      m["rls_I_hat"] = opt_.remote ? opt_.remote->hal_I_hat() : loop_->assist().rls().I();
     }
     const hwsim::CanBusStatistics st = rig_->bus().Statistics();
     m["bus_load_pct"] = st.mean_load_percent;
     m["frames_dropped"] = static_cast<double>(st.drops);
-    m["emg_gaps"] = loop_->telemetry().emg_gaps;
+    m["emg_gaps"] = Telemetry().emg_gaps;
     return m;
+  }
+
+  // What the controller's tick saw and did: the in-process loop's, or the remote controller's telemetry.
+  const controller::HalTelemetry& Telemetry() const {
+    return opt_.remote ? opt_.remote->hal_telemetry() : loop_->telemetry();
   }
 
   const Scenario& s_;
   const RunOptions& opt_;
   const Hal3PlantParams pp_;
+  RunResult* result_;
   Hal3Plant plant_;
   double dt_ = 0, ctrl_dt_ = 0;
   CosimSchedule schedule_;
@@ -270,7 +283,9 @@ class HalTrial : public CosimDevice {
   std::unique_ptr<CosimRig> rig_;
   std::unique_ptr<hwsim::Hal3KneeNode> knee_;
   controller::HalLoopConfig loop_cfg_;
-  std::unique_ptr<controller::HalLoop> loop_;
+  std::unique_ptr<controller::HalLoop> loop_;  // in-process controller (null with opt.remote)
+  CanBus* ctrl_ep_ = nullptr;                  // the controller's seat on the bus (opt.remote)
+  int run_ = 0;
   TrialLogs logs_;
   std::unique_ptr<ProjectedViscoelasticity> projected_;
   // The last step: angle at its start, muscle torques, the motor torque held over it and the truth.
@@ -304,14 +319,13 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
 
   const bool sweep = !s.hal.sweep_viscosity.empty();
   const std::vector<double> values = sweep ? s.hal.sweep_viscosity : std::vector<double>{s.hal.virtual_viscosity};
-  const int runs = sweep ? static_cast<int>(values.size()) : s.protocol.trials;
+  const int runs = HalRuns(s);
   std::vector<std::map<std::string, double>> per_run;
   std::unique_ptr<ProgressBar> bar;  // over all runs' steps (the plant's step is known once one is built)
   size_t done = 0;
   for (int i = 0; i < runs; ++i) {
-    const double B_v = sweep ? values[i] : values[0];
-    // A sweep keeps the same seed for every value (common random numbers): only B_v changes.
-    const uint64_t seed = result.seed * 7919ull + static_cast<uint64_t>(sweep ? 0 : i);
+    const double B_v = HalRunViscosity(s, i);
+    const uint64_t seed = HalRunSeed(s, result.seed, i);
     HalTrial trial(s, opt, seed, B_v, i, runs, &result, can_log.get(), i * (s.protocol.duration + 1.0));
     const size_t steps = static_cast<size_t>(trial.schedule().steps);
     if (!bar) bar = std::make_unique<ProgressBar>(runs * steps, s.name, opt.progress);
@@ -369,6 +383,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
     result.files.push_back("sweep.svg");
   }
   m["runs"] = static_cast<double>(per_run.size());  // fewer than planned when interrupted
+  if (opt.remote) opt.remote->AddMetrics(&m);
   m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   FinishRun(s, result, opt.out_dir + "/result.json");

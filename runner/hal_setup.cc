@@ -4,7 +4,9 @@
 #include <algorithm>
 
 #include "core/error.h"
+#include "runner/hal_emg_calibration.h"
 #include "sim/subjects.h"
+#include "sim/synthetic_emg.h"
 
 namespace exotwin {
 
@@ -57,6 +59,43 @@ controller::HalLoopConfig HalLoopConfigOf(const Scenario& s, const Hal3PlantPara
     a.friction_eps = c.impedance.coulomb_eps;
   }
   return c;
+}
+
+int HalRuns(const Scenario& s) {
+  return s.hal.sweep_viscosity.empty() ? s.protocol.trials : static_cast<int>(s.hal.sweep_viscosity.size());
+}
+
+double HalRunViscosity(const Scenario& s, int run) {
+  return s.hal.sweep_viscosity.empty() ? s.hal.virtual_viscosity : s.hal.sweep_viscosity.at(static_cast<size_t>(run));
+}
+
+uint64_t HalRunSeed(const Scenario& s, uint64_t seed, int run) {
+  return seed * 7919ull + static_cast<uint64_t>(s.hal.sweep_viscosity.empty() ? run : 0);
+}
+
+controller::HalEmgCoefficients HalRunCalibration(const Scenario& s, const MuscleParams& operator_muscles,
+                                                 uint64_t run_seed) {
+  const HalEmgCalibrationSpec cal{kHalExtChannel, kHalFlexChannel, kHalRmsWindow, s.hal.calibration_levels, 0.02,
+                                  s.hal.calibration_hi, s.hal.calibration_rest};
+  return CalibrateHalEmg(operator_muscles, DefaultSyntheticEmgConfig(), cal, run_seed + 11);
+}
+
+controller::ControllerFile HalControllerFile(const Scenario& s, const controller::HalLoopConfig& loop) {
+  controller::ControllerFile f;
+  f.source = s.source;
+  f.controller = s.controller;
+  f.controller.feedforward = false;
+  f.driver_limit = std::min(60.0, s.hardware.torque_limit);
+  f.trials = HalRuns(s);
+  f.hal = loop;
+  return f;
+}
+
+controller::ControllerFile HalControllerFileOf(const Scenario& s, uint64_t seed, int run) {
+  const uint64_t run_seed = HalRunSeed(s, seed, run);
+  const Hal3PlantParams pp = Hal3PlantParamsOf(s);
+  return HalControllerFile(s, HalLoopConfigOf(s, pp, HalRunCalibration(s, OperatorMuscles(s), run_seed),
+                                              HalRunViscosity(s, run)));
 }
 
 }  // namespace exotwin

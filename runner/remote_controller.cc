@@ -6,6 +6,8 @@
 #include <sstream>
 #include <thread>
 
+#include <unistd.h>
+
 #include "protocol/link_frames.h"
 #include "protocol/messages.h"
 
@@ -33,27 +35,33 @@ std::string At(double t) {
 }  // namespace
 
 RemoteController::RemoteController(CanLink* link, ServeClock clock, double period_s, double timeout_s)
-    : link_(link), clock_(clock), period_(period_s), timeout_(timeout_s) {}
+    : link_(link), clock_(clock), period_(period_s), timeout_(timeout_s),
+      starts_(static_cast<uint16_t>(static_cast<uint64_t>(MonotonicSeconds() * 1e9) ^ static_cast<uint64_t>(::getpid()))) {}
 
 void RemoteController::BeginTrial(int trial, CanBus* ep, std::vector<std::string>* events) {
   ep_ = ep;
   events_ = events;
   tel_ = controller::ControllerTelemetry{};
   tel_.tau_sensor[0] = tel_.tau_sensor[1] = std::nan("");
+  hal_tel_ = controller::HalTelemetry{};
+  hal_I_hat_ = 0;
   awaiting_ = false;
   ticks_ = 0;
   present_ = false;
   const double start = MonotonicSeconds();
+  const uint16_t sequence = starts_++;
   double last_nmt = -1;
   CanFrame f;
   while (!present_ && MonotonicSeconds() - start < timeout_) {
     if (MonotonicSeconds() - last_nmt >= 0.1) {
-      link_->Send(link::NmtFrame(link::kNmtStart, trial));
+      link_->Send(link::NmtFrame(link::kNmtStart, trial, sequence));
       last_nmt = MonotonicSeconds();
     }
     link_->WaitInput(0.02);
     while (link_->Receive(&f) == CanStatus::kOk) {
-      if (f.id == link::kIdReady && f.dlc >= 2 && f.data[1] == static_cast<uint8_t>(trial)) present_ = true;
+      if (f.id == link::kIdReady && f.dlc >= 2 && f.data[1] == static_cast<uint8_t>(trial) &&
+          link::StartSequence(f) == sequence)
+        present_ = true;
       if (f.id == link::kIdConfigRequest && !configuration_.empty()) {
         for (const CanFrame& c : link::ConfigFrames(configuration_)) link_->Send(c);
         last_nmt = -1;  // the next NMT start right after the configuration
@@ -74,9 +82,11 @@ void RemoteController::Lost(double t, const std::string& why) {
 
 void RemoteController::Take(const CanFrame& f, double t, bool* done) {
   double v = 0;
-  if (f.id >= link::kIdTelemetryBase && f.id < link::kIdTelemetryBase + link::kTelCount) {
+  if (f.id >= link::kIdTelemetryBase && f.id < link::kIdTelemetryBase + link::kTelemetryValues) {
     if (!link::FrameDouble(f, &v)) return;
     const int i = f.id - link::kIdTelemetryBase;
+    TakeHal(i, v);
+    if (i >= link::kTelCount) return;
     if (i == link::kTelEstQHip || i == link::kTelEstQKnee) tel_.est[i - link::kTelEstQHip].q = v;
     else if (i == link::kTelTauSensorHip || i == link::kTelTauSensorKnee) tel_.tau_sensor[i - link::kTelTauSensorHip] = v;
     else if (i == link::kTelTauCmdHip || i == link::kTelTauCmdKnee) tel_.tau_cmd[i - link::kTelTauCmdHip] = v;
@@ -103,6 +113,28 @@ void RemoteController::Take(const CanFrame& f, double t, bool* done) {
     return;
   }
   if (ep_->Send(f) != CanStatus::kOk) ++bus_refused_;
+}
+
+void RemoteController::TakeHal(int i, double v) {
+  controller::HalTelemetry& h = hal_tel_;
+  switch (i) {
+    case link::kHalTelTh: h.th = v; break;
+    case link::kHalTelStrain: h.strain = v; break;
+    case link::kHalTelThd: h.thd = v; break;
+    case link::kHalTelTauCmd: h.tau_cmd = v; break;
+    case link::kHalTelEe: h.E_e = v; break;
+    case link::kHalTelEf: h.E_f = v; break;
+    case link::kHalTelMuHat: h.assist.mu_hat = v; break;
+    case link::kHalTelD: h.assist.D = v; break;
+    case link::kHalTelK: h.assist.K = v; break;
+    case link::kHalTelTauMu: h.assist.tau_mu = v; break;
+    case link::kHalTelTauZeta: h.assist.tau_zeta = v; break;
+    case link::kHalTelTauC: h.assist.tau_c = v; break;
+    case link::kHalTelIHat: hal_I_hat_ = v; break;
+    case link::kHalTelEmgGaps: h.emg_gaps = static_cast<uint32_t>(v); break;
+    case link::kHalTelEnabled: h.enabled = v != 0; break;
+    default: break;
+  }
 }
 
 void RemoteController::Tick(double t) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "controller/exo_controller.h"
+#include "controller/hal_loop.h"
 #include "protocol/can_bus.h"
 #include "protocol/can_link.h"
 
@@ -30,34 +31,46 @@ class RemoteController {
   // link outlives this; period_s: the controller period (s); timeout_s: wall-clock time without an
   // answer after which the controller is gone (also the wait for its ready frame at a trial's start).
   RemoteController(CanLink* link, ServeClock clock, double period_s, double timeout_s);
-  // The controller file's text sent to a controller that asks for it (one started on the scenario
-  // file: link::kIdConfigRequest) before it answers the NMT start.
+  // The controller file's text of the trials that follow (the device runner sets it for each run or
+  // trial): sent to a controller that asks for it (one started on the scenario file asks at every NMT
+  // start: link::kIdConfigRequest) before it answers the NMT start.
   void SetConfiguration(std::string text) { configuration_ = std::move(text); }
   // Starts trial `trial` (0-based) with the rig's controller endpoint `ep`: NMT start, then waits for
   // the controller's ready frame (re-sent every 100 ms). `events` gets the link's events ("t=... ...").
   void BeginTrial(int trial, CanBus* ep, std::vector<std::string>* events);
   // The controller tick at t (s).
   void Tick(double t);
-  // Ends the run: NMT stop.
+  // Ends the session (after the last run): NMT stop, the controller exits.
   void EndRun();
+  // The last telemetry, read as the EXOwheel loop's (link::TelemetryIndex) and as the HAL-3 loop's
+  // (link::HalTelemetryIndex); the device runner reads the one of its device.
   const controller::ControllerTelemetry& telemetry() const { return tel_; }
+  const controller::HalTelemetry& hal_telemetry() const { return hal_tel_; }
+  double hal_I_hat() const { return hal_I_hat_; }  // kg m^2, the RLS's inertia estimate (HKS05 eq. 13)
   // The link's figures for result.json's metrics (link_*).
   void AddMetrics(std::map<std::string, double>* m) const;
   bool deterministic() const { return deterministic_; }
+  // The sequence number the next BeginTrial's NMT start carries (link_frames.h): it starts at a
+  // nonce of the session, so a controller that outlives a twin asks the new twin for its file.
+  uint16_t next_sequence() const { return starts_; }
 
  private:
   void Lost(double t, const std::string& why);
   void Take(const CanFrame& f, double t, bool* done);
+  void TakeHal(int i, double v);
   CanLink* link_;
   ServeClock clock_;
   double period_, timeout_;
   CanBus* ep_ = nullptr;
   std::vector<std::string>* events_ = nullptr;
   controller::ControllerTelemetry tel_;
+  controller::HalTelemetry hal_tel_;
+  double hal_I_hat_ = 0;
   bool present_ = false, deterministic_ = true;
   double lost_at_ = -1;
   double wall0_ = 0;
   long ticks_ = 0;
+  uint16_t starts_;  // the next NMT start's sequence number (from a per-session nonce)
   double awaited_ = 0;  // t of the cycle whose done frame is awaited (realtime)
   bool awaiting_ = false;
   uint64_t unexpected_ = 0, late_ = 0, missed_ = 0, bus_refused_ = 0;

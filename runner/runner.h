@@ -27,7 +27,9 @@ struct RunOptions {
   std::string video_path;        // MP4 of the first trial (side view + overlays); "" = none
   // Called once per logged sample with (t, q_true[2], tau_applied[2]) (e.g. a video renderer).
   std::function<void(double, const double*, const double*)> on_sample;
-  // The controller in another process (`exotwin serve`; EXOwheel plain trials only); null: in-process.
+  // The controller in another process (`exotwin serve`, RunWithControllerProcess): the device runners
+  // set its configuration per run or trial and tick it instead of the in-process controller; the
+  // session's end (RemoteController::EndRun) is the owner's. Null: in-process.
   RemoteController* remote = nullptr;
   // RunScenarioJob (scenario_job.h) only: the exotwin-controller executable to run the scenario's
   // controller in another process (RunWithControllerProcess, controller_process.h); "" = in-process.

@@ -41,7 +41,7 @@ int RunScenarioJob(const Scenario& s, const RunOptions& opt) {
   std::filesystem::remove(opt.out_dir + "/error.txt", ec);
   std::filesystem::remove(opt.out_dir + "/result.json", ec);
   try {
-    const bool remote = !opt.controller_process.empty() && ServesScenario(s);
+    const bool remote = !opt.controller_process.empty();
     return (remote ? RunWithControllerProcess(s, opt, opt.controller_process) : RunScenario(s, opt)).all_passed()
                ? kJobOk
                : kJobCheckFailed;

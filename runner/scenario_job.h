@@ -14,8 +14,8 @@ namespace exotwin {
 // Exit codes of a scenario job (the child's exit code).
 enum JobExit : int { kJobOk = 0, kJobCheckFailed = 1, kJobInputError = 2, kJobDiverged = 3 };
 
-// Runs `s` into opt.out_dir (created) with RunScenario (with opt.controller_process and an EXOwheel
-// scenario of plain trials: RunWithControllerProcess); returns a JobExit. On InputError / SimulationError /
+// Runs `s` into opt.out_dir (created) with RunScenario (with opt.controller_process:
+// RunWithControllerProcess); returns a JobExit. On InputError / SimulationError /
 // another exception, writes the message to out_dir/error.txt instead of throwing. Meant for the child.
 int RunScenarioJob(const Scenario& s, const RunOptions& opt);
 

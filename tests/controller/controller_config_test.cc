@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -93,6 +94,104 @@ TEST(ControllerConfig, BadFilesNameTheKey) {
   std::string bad_exo = kGood;
   bad_exo.replace(bad_exo.find("Y2: 0.18"), 8, "Y3: 0.18");
   EXPECT_NE(ErrorOf(bad_exo).find("model.exo"), std::string::npos);
+}
+
+// A HAL-3 controller file: every field of the loop's configuration travels, bit for bit (each set to
+// a value no short decimal gives), and the rate-derived fields follow controller.rate_hz.
+TEST(ControllerConfig, HalFileCarriesTheWholeLoopBitForBit) {
+  ControllerFile f;
+  f.controller.rate_hz = 500;
+  f.controller.torque_limit = 100;
+  f.driver_limit = 60;
+  f.trials = 3;
+  HalLoopConfig c;
+  c.mode = HalMode::kAssist;
+  c.extensor_channel = 2, c.flexor_channel = 4, c.velocity.order = 3;
+  c.rms_window = 0.1 + 0.2 / 3, c.emg_fs = 1000.0 / 3, c.tau_max = 40.0 / 3, c.status_timeout = 0.02 / 3;
+  c.velocity.velocity_cutoff_hz = 20.0 / 3, c.velocity.acceleration_cutoff_hz = 10.0 / 7;
+  c.impedance.actual = {0.3 / 7, 0.2 / 3, 9.81 / 7, 0.4 / 3};
+  c.impedance.target = {0.3 / 11, 1.56 / 7, 9.81 / 11, 0.0};
+  c.impedance.coulomb_eps = 0.05 / 3;
+  HalAssistConfig& a = c.assist;
+  a.alpha_mu = 1.0 / 3, a.alpha_zeta = 0.5 / 3, a.lambda1 = 60.0 / 7, a.lambda2 = 80.0 / 7;
+  a.friction_C = 0.4 / 7, a.friction_eps = 0.05 / 7;
+  a.emg.extensor = {123.0 / 7, -1.0 / 3}, a.emg.flexor = {99.0 / 7, 2.0 / 3};
+  a.emg.baseline_e = 1e-4 / 3, a.emg.baseline_f = 2e-4 / 7;
+  a.rls.rho = 0.999 - 1e-5 / 3, a.rls.p0 = 1e6 / 3, a.rls.p_max = 1e9 / 7, a.rls.pf = 20.0 / 3;
+  a.rls.R = 0.2 / 3, a.rls.mgl = 9.81 / 3, a.rls.I0 = 0.3 / 7, a.rls.D0 = 1.0 / 7, a.rls.K0 = 5.0 / 7;
+  a.rls.gravity_in_input = true, a.rls.known_inertia = true;
+  f.hal = c;
+  const ControllerFile g = ParseControllerFile(ControllerFileYaml(f, "test"), "hal.yaml");
+  ASSERT_TRUE(g.hal);
+  const HalLoopConfig& h = *g.hal;
+  EXPECT_EQ(h.mode, HalMode::kAssist);
+  EXPECT_EQ(h.extensor_channel, 2);
+  EXPECT_EQ(h.flexor_channel, 4);
+  EXPECT_EQ(h.velocity.order, 3);
+  EXPECT_EQ(h.rms_window, c.rms_window);
+  EXPECT_EQ(h.emg_fs, c.emg_fs);
+  EXPECT_EQ(h.tau_max, c.tau_max);
+  EXPECT_EQ(h.status_timeout, c.status_timeout);
+  EXPECT_EQ(h.velocity.velocity_cutoff_hz, c.velocity.velocity_cutoff_hz);
+  EXPECT_EQ(h.velocity.acceleration_cutoff_hz, c.velocity.acceleration_cutoff_hz);
+  for (const auto& [x, y] : {std::pair{h.impedance.actual, c.impedance.actual}, std::pair{h.impedance.target, c.impedance.target}}) {
+    EXPECT_EQ(x.I, y.I);
+    EXPECT_EQ(x.B, y.B);
+    EXPECT_EQ(x.mgl, y.mgl);
+    EXPECT_EQ(x.C, y.C);
+  }
+  EXPECT_EQ(h.impedance.coulomb_eps, c.impedance.coulomb_eps);
+  const HalAssistConfig& b = h.assist;
+  EXPECT_EQ(b.alpha_mu, a.alpha_mu);
+  EXPECT_EQ(b.alpha_zeta, a.alpha_zeta);
+  EXPECT_EQ(b.lambda1, a.lambda1);
+  EXPECT_EQ(b.lambda2, a.lambda2);
+  EXPECT_EQ(b.friction_C, a.friction_C);
+  EXPECT_EQ(b.friction_eps, a.friction_eps);
+  EXPECT_EQ(b.emg.extensor.a, a.emg.extensor.a);
+  EXPECT_EQ(b.emg.extensor.b, a.emg.extensor.b);
+  EXPECT_EQ(b.emg.flexor.a, a.emg.flexor.a);
+  EXPECT_EQ(b.emg.flexor.b, a.emg.flexor.b);
+  EXPECT_EQ(b.emg.baseline_e, a.emg.baseline_e);
+  EXPECT_EQ(b.emg.baseline_f, a.emg.baseline_f);
+  EXPECT_EQ(b.rls.rho, a.rls.rho);
+  EXPECT_EQ(b.rls.p0, a.rls.p0);
+  EXPECT_EQ(b.rls.p_max, a.rls.p_max);
+  EXPECT_EQ(b.rls.pf, a.rls.pf);
+  EXPECT_EQ(b.rls.R, a.rls.R);
+  EXPECT_EQ(b.rls.mgl, a.rls.mgl);
+  EXPECT_EQ(b.rls.I0, a.rls.I0);
+  EXPECT_EQ(b.rls.D0, a.rls.D0);
+  EXPECT_EQ(b.rls.K0, a.rls.K0);
+  EXPECT_TRUE(b.rls.gravity_in_input);
+  EXPECT_TRUE(b.rls.known_inertia);
+  // Derived from controller.rate_hz and hal.tau_max as the runner's HalLoopConfigOf sets them.
+  EXPECT_EQ(h.rate_hz, 500);
+  EXPECT_EQ(h.velocity.sample_rate_hz, 500);
+  EXPECT_EQ(b.dt, 1.0 / 500);
+  EXPECT_EQ(b.rls.dt, 1.0 / 500);
+  EXPECT_EQ(b.tau_max, c.tau_max);
+  EXPECT_EQ(g.trials, 3);
+  EXPECT_FALSE(g.controller.feedforward);
+
+  // Bad HAL files name the key.
+  const std::string text = ControllerFileYaml(f, "test");
+  std::string missing = text;
+  const size_t at = missing.find("      rho:");
+  missing.erase(at, missing.find('\n', at) + 1 - at);
+  EXPECT_NE(ErrorOf(missing).find("hal.assist.rls.rho: missing"), std::string::npos) << ErrorOf(missing);
+  std::string over = text;
+  over.replace(over.find("drivers: {torque_limit: 60}"), 27, "drivers: {torque_limit: 10}");
+  EXPECT_NE(ErrorOf(over).find("hal.tau_max"), std::string::npos) << ErrorOf(over);
+  std::string mode = text;
+  mode.replace(mode.find("mode: assist"), 12, "mode: boost");
+  EXPECT_NE(ErrorOf(mode).find("hal.mode"), std::string::npos) << ErrorOf(mode);
+  std::string unknown = text;
+  unknown.replace(unknown.find("    lambda1:"), 12, "    lambda9:");
+  EXPECT_NE(ErrorOf(unknown).find("hal.assist"), std::string::npos) << ErrorOf(unknown);
+  std::string channel = text;
+  channel.replace(channel.find("extensor_channel: 2"), 19, "extensor_channel: 7");
+  EXPECT_NE(ErrorOf(channel).find("hal.extensor_channel"), std::string::npos) << ErrorOf(channel);
 }
 
 }  // namespace

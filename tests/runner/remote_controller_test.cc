@@ -76,7 +76,7 @@ TEST(RemoteController, OnlyTheConfiguredControllersFramesReachTheBus) {
   testing::FakeCanBus ep;
   std::vector<std::string> events;
   RemoteController remote(link.get(), ServeClock::kLockstep, 1e-3, 2.0);
-  controller.Send(link::ReadyFrame(0));
+  controller.Send(link::ReadyFrame(0, remote.next_sequence()));
   remote.BeginTrial(0, &ep, &events);
   ASSERT_TRUE(remote.deterministic());
 
@@ -117,7 +117,7 @@ TEST(RemoteController, NoAnswerWithinTheTimeoutLosesTheController) {
   testing::FakeCanBus ep;
   std::vector<std::string> events;
   RemoteController remote(link.get(), ServeClock::kLockstep, 1e-3, 0.2);
-  controller.Send(link::ReadyFrame(0));
+  controller.Send(link::ReadyFrame(0, remote.next_sequence()));
   remote.BeginTrial(0, &ep, &events);
   remote.Tick(0.0005);
   remote.Tick(0.0015);  // no wait once lost
