@@ -1,7 +1,7 @@
 // Writes BGR frames to an MP4 file through FFmpeg's libavcodec/libavformat on a worker thread
 // (encoding overlaps with rendering). The file appears atomically: frames go to PATH-without-.mp4 +
 // ".tmp.mp4", renamed to PATH by Close(); a writer destroyed without Close() removes the temporary
-// file. H.264 is libx264 at constant quality (CRF 18, visually lossless) with the "veryfast" preset
+// file. H.264 is libx264 at constant quality (CRF 18, visually lossless) with the "superfast" preset
 // on one thread: OpenCV's VideoWriter, used before, passes the codec no options, so x264 ran its
 // default "medium" preset at 1.5 x fps x width x height bit/s, about 40 % of a frame's CPU time at
 // 1280x720 (now about a quarter of a smaller total), and its frames were no closer to the picture.
