@@ -380,55 +380,131 @@ void AppendNumberRows(std::string& out, const std::vector<const std::vector<doub
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
 namespace exotwin {
+
+// The writer thread: formats and writes one block at a time; the caller waits for it only when it
+// hands over the next block before the last is written (or on Flush).
+struct CsvStreamWriter::Writer {
+  int fd = -1;
+  size_t columns = 0;
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<double> block;  // owned by the thread while busy
+  bool busy = false, stop = false;
+  std::string error;          // the first write error, reported in the caller's thread
+  std::string text;
+  std::thread thread;
+
+  // Writes `bytes` whole (EINTR retried); "" or the error's text.
+  std::string WriteAll(const char* bytes, size_t size) {
+    size_t off = 0;
+    while (off < size) {
+      const ssize_t w = ::write(fd, bytes + off, size - off);
+      if (w < 0) {
+        if (errno == EINTR) continue;
+        return std::strerror(errno);
+      }
+      off += static_cast<size_t>(w);
+    }
+    return "";
+  }
+
+  void Run() {
+    std::unique_lock<std::mutex> lock(m);
+    for (;;) {
+      cv.wait(lock, [this] { return busy || stop; });
+      if (!busy) return;
+      lock.unlock();
+      // Shortest text that reads back to the same double (std::to_chars, as AppendNumber), at most 24
+      // characters + the separator per column, written in place.
+      constexpr size_t kMaxField = 25;
+      const size_t rows = block.size() / columns;
+      text.resize(rows * (columns * kMaxField + 1));
+      char* p = text.data();
+      char* const end = p + text.size();
+      for (size_t r = 0; r < rows; ++r) {
+        const double* v = block.data() + r * columns;
+        for (size_t c = 0; c < columns; ++c) {
+          if (c) *p++ = ',';
+          p = std::to_chars(p, end, v[c]).ptr;
+        }
+        *p++ = '\n';
+      }
+      const std::string e = WriteAll(text.data(), static_cast<size_t>(p - text.data()));
+      lock.lock();
+      if (!e.empty() && error.empty()) error = e;
+      block.clear();
+      busy = false;
+      cv.notify_all();
+    }
+  }
+};
 
 CsvStreamWriter::CsvStreamWriter(const std::string& path, const std::vector<std::string>& names,
                                  const std::vector<std::string>& comments, size_t flush_rows)
-    : path_(path), columns_(names.size()), flush_rows_(flush_rows ? flush_rows : 1) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd_ < 0) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
-  buffer_ += std::string(kStreamMarker) + "\n";
-  for (const auto& c : comments) buffer_ += "# " + c + "\n";
-  for (size_t i = 0; i < names.size(); ++i) buffer_ += (i ? "," : "") + names[i];
-  buffer_ += "\n";
-  Flush();
+    : path_(path), columns_(std::max<size_t>(names.size(), 1)), flush_rows_(flush_rows ? flush_rows : 1),
+      writer_(std::make_unique<Writer>()) {
+  Writer& w = *writer_;
+  w.fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (w.fd < 0) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
+  std::string head = std::string(kStreamMarker) + "\n";
+  for (const auto& c : comments) head += "# " + c + "\n";
+  for (size_t i = 0; i < names.size(); ++i) head += (i ? "," : "") + names[i];
+  head += "\n";
+  const std::string e = w.WriteAll(head.data(), head.size());
+  if (!e.empty()) {
+    ::close(w.fd);
+    throw InputError(path + ": write failed (" + e + ")");
+  }
+  w.columns = columns_;
+  block_.reserve(flush_rows_ * columns_);
+  w.block.reserve(flush_rows_ * columns_);
+  w.text.reserve(flush_rows_ * (columns_ * 25 + 1));  // Run's kMaxField: no allocation after start
+  w.thread = std::thread([&w] { w.Run(); });
 }
 
 CsvStreamWriter::~CsvStreamWriter() {
-  Flush();
-  if (fd_ >= 0) ::close(fd_);
+  try {
+    Flush();
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+  }
+  {
+    std::lock_guard<std::mutex> lock(writer_->m);
+    writer_->stop = true;
+  }
+  writer_->cv.notify_all();
+  writer_->thread.join();
+  ::close(writer_->fd);
 }
 
 void CsvStreamWriter::Row(const double* values, size_t n) {
-  // Shortest text that reads back to the same double (std::to_chars, no locale, no printf cost),
-  // written in place at the buffer's end: at most 24 characters + the separator per column.
-  constexpr size_t kMaxField = 25;
-  const size_t start = buffer_.size();
-  buffer_.resize(start + columns_ * kMaxField + 1);
-  char* p = buffer_.data() + start;
-  char* const end = buffer_.data() + buffer_.size();
-  for (size_t c = 0; c < columns_; ++c) {
-    if (c) *p++ = ',';
-    p = std::to_chars(p, end, c < n ? values[c] : 0.0).ptr;
-  }
-  *p++ = '\n';
-  buffer_.resize(static_cast<size_t>(p - buffer_.data()));
+  for (size_t c = 0; c < columns_; ++c) block_.push_back(c < n ? values[c] : 0.0);
   ++rows_;
-  if (++pending_ >= flush_rows_) Flush();
+  if (block_.size() >= flush_rows_ * columns_) HandOver();
+}
+
+// Gives the block to the writer thread once it is idle (its capacity comes back as the next block).
+void CsvStreamWriter::HandOver() {
+  Writer& w = *writer_;
+  std::unique_lock<std::mutex> lock(w.m);
+  w.cv.wait(lock, [&w] { return !w.busy; });
+  if (!w.error.empty()) throw InputError(path_ + ": write failed (" + w.error + ")");
+  w.block.swap(block_);
+  w.busy = true;
+  w.cv.notify_all();
 }
 
 void CsvStreamWriter::Flush() {
-  size_t off = 0;
-  while (off < buffer_.size() && fd_ >= 0) {
-    const ssize_t w = ::write(fd_, buffer_.data() + off, buffer_.size() - off);
-    if (w < 0) {
-      if (errno == EINTR) continue;
-      throw InputError(path_ + ": write failed (" + std::strerror(errno) + ")");
-    }
-    off += static_cast<size_t>(w);
-  }
-  buffer_.clear();
-  pending_ = 0;
+  if (!block_.empty()) HandOver();
+  Writer& w = *writer_;
+  std::unique_lock<std::mutex> lock(w.m);
+  w.cv.wait(lock, [&w] { return !w.busy; });
+  if (!w.error.empty()) throw InputError(path_ + ": write failed (" + w.error + ")");
 }
 
 }  // namespace exotwin

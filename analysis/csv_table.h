@@ -2,6 +2,7 @@
 // header row of column names, then one record per line. Every CSV exotwin reads goes through
 // CsvReader: measured data and column maps' inputs (ReadCsv), sweep tables (runner/sweep_table.cc).
 #pragma once
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -113,28 +114,38 @@ void WriteFileAtomic(const std::string& path, const std::string& text);
 
 namespace exotwin {
 
-// Streams rows to a CSV file as a run produces them, so that an abort loses at most the rows of the
-// last `flush_rows`. The buffer holds whole lines only, but a SIGKILL can still cut a write(2) to a
-// regular file at a page boundary (Linux checks for fatal signals between pages), so the last line
-// of a killed run may be cut. The file's first line is kStreamMarker; ReadCsv drops an unterminated
-// last line of such a file (and says so), and keeps every complete row.
+// Streams rows to a CSV file as a run produces them. Rows are collected as numbers in blocks of
+// `flush_rows`; a writer thread turns each full block into text (as AppendNumber) and writes it while
+// the caller goes on (the text costs as much as the simulation of the row on one core), so that an
+// abort (SIGKILL) loses at most the rows of the last two blocks, and an exception none (the destructor
+// writes every row). Blocks are written whole lines at a time, but a SIGKILL can still cut a write(2)
+// to a regular file at a page boundary (Linux checks for fatal signals between pages), so the last
+// line of a killed run may be cut. The file's first line is kStreamMarker; ReadCsv drops an
+// unterminated last line of such a file (and says so), and keeps every complete row. Row and Flush
+// allocate nothing once the first block is full.
 class CsvStreamWriter {
  public:
   // Opens (truncates) `path` and writes the comments and the header. Throws InputError if it cannot.
   CsvStreamWriter(const std::string& path, const std::vector<std::string>& names,
                   const std::vector<std::string>& comments = {}, size_t flush_rows = 100);
+  // Writes the rows not written yet (a write error then is reported on stderr, not thrown).
   ~CsvStreamWriter();
   CsvStreamWriter(const CsvStreamWriter&) = delete;
   CsvStreamWriter& operator=(const CsvStreamWriter&) = delete;
-  // Appends one row (values.size() == number of columns).
+  // Appends one row: values[0..n), missing columns 0. Throws InputError when an earlier block could
+  // not be written.
   void Row(const double* values, size_t n);
+  // Returns once every row appended so far is written. Throws InputError on a write error.
   void Flush();
   size_t rows() const { return rows_; }
 
  private:
-  int fd_ = -1;
-  std::string path_, buffer_;
-  size_t columns_, flush_rows_, pending_ = 0, rows_ = 0;
+  struct Writer;  // the thread and the block it writes (csv_table.cc)
+  void HandOver();
+  std::string path_;
+  size_t columns_, flush_rows_, rows_ = 0;
+  std::vector<double> block_;  // the rows appended since the last hand-over, row-major
+  std::unique_ptr<Writer> writer_;
 };
 
 }  // namespace exotwin

@@ -65,6 +65,46 @@ TEST(CsvStreamWriter, ACutAnywhereInTheLastRowKeepsEveryCompleteRow) {
   std::filesystem::remove(path);
 }
 
+// The writer thread's text is WriteCsv's (AppendNumber), row for row and in order across many blocks;
+// Flush returns once every row so far is in the file; a missing value is written as 0.
+TEST(CsvStreamWriter, WritesWhatWriteCsvWritesAndFlushMakesRowsVisible) {
+  const std::string path = TempPath("stream_blocks.csv"), plain = TempPath("plain_blocks.csv");
+  std::vector<double> t, a, b;
+  for (int i = 0; i < 1037; ++i) t.push_back(1e-3 * i), a.push_back(std::sin(0.37 * i) / 3), b.push_back(-1e-9 * i * i);
+  {
+    CsvStreamWriter w(path, {"t", "a", "b"}, {}, 64);
+    for (size_t i = 0; i < t.size(); ++i) {
+      const double row[3] = {t[i], a[i], b[i]};
+      w.Row(row, 3);
+      if (i == 500) {
+        w.Flush();
+        EXPECT_EQ(ReadCsv(path).rows(), 501u);  // every row appended so far, none waiting in a block
+      }
+    }
+    const double short_row[1] = {2.0};
+    w.Row(short_row, 1);
+    EXPECT_EQ(w.rows(), t.size() + 1);
+  }
+  t.push_back(2.0), a.push_back(0.0), b.push_back(0.0);
+  WriteCsv(plain, {"t", "a", "b"}, {&t, &a, &b});
+  const std::string streamed = Slurp(path), written = Slurp(plain);
+  const size_t body = streamed.find("t,a,b\n");
+  ASSERT_NE(body, std::string::npos);
+  EXPECT_TRUE(streamed.substr(body) == written.substr(written.find("t,a,b\n")));
+  std::filesystem::remove(path);
+  std::filesystem::remove(plain);
+}
+
+// A write error is reported as an InputError naming the file (here: /dev/full, no space left).
+TEST(CsvStreamWriter, AWriteErrorIsAnInputErrorNamingTheFile) {
+  try {
+    CsvStreamWriter w("/dev/full", {"t"}, {}, 4);
+    FAIL() << "the header cannot be written to /dev/full";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/full: write failed"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ReadCsv, ACutRowWithoutTheStreamMarkerIsAnError) {
   const std::string path = TempPath("plain.csv");
   Spit(path, "t,a,b\n0,1,2\n0.1,1.");
