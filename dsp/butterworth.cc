@@ -149,23 +149,32 @@ void SosFilter::Reset() {
   for (auto& z : z_) z = {0.0, 0.0};
 }
 
-std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x) {
   const size_t n = x.size();
-  if (n == 0) return {};
+  if (n == 0) return;
   size_t pad = 3 * (2 * sos.size() + 1);
   if (pad >= n) pad = n - 1;
-  std::vector<double> ext;
-  ext.reserve(n + 2 * pad);
-  for (size_t i = pad; i >= 1; --i) ext.push_back(2.0 * x[0] - x[i]);
-  ext.insert(ext.end(), x.begin(), x.end());
-  for (size_t i = 1; i <= pad; ++i) ext.push_back(2.0 * x[n - 1] - x[n - 1 - i]);
+  // The odd-reflected extension [head, x, tail] is filtered piecewise, in the order a padded copy
+  // would be: the same operations on the same values.
+  std::vector<double> head(pad), tail(pad);
+  for (size_t k = 0; k < pad; ++k) head[k] = 2.0 * x[0] - x[pad - k];
+  for (size_t i = 1; i <= pad; ++i) tail[i - 1] = 2.0 * x[n - 1] - x[n - 1 - i];
 
   SosFilter f(sos);
-  f.ResetSteady(ext.front());
-  for (double& v : ext) v = f.Step(v);
-  f.ResetSteady(ext.back());
-  for (auto it = ext.rbegin(); it != ext.rend(); ++it) *it = f.Step(*it);
-  return std::vector<double>(ext.begin() + pad, ext.begin() + pad + n);
+  f.ResetSteady(pad > 0 ? head.front() : x.front());
+  for (double& v : head) v = f.Step(v);
+  for (double& v : x) v = f.Step(v);
+  for (double& v : tail) v = f.Step(v);
+  f.ResetSteady(pad > 0 ? tail.back() : x.back());
+  for (auto it = tail.rbegin(); it != tail.rend(); ++it) *it = f.Step(*it);
+  for (auto it = x.rbegin(); it != x.rend(); ++it) *it = f.Step(*it);
+  // The head's backward pass only shapes samples that are cropped.
+}
+
+std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {
+  std::vector<double> y = x;
+  FiltFiltInPlace(sos, y);
+  return y;
 }
 
 }  // namespace exotwin::dsp

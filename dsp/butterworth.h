@@ -42,5 +42,7 @@ class SosFilter {
 // and steady-state initial conditions, like scipy.signal.sosfiltfilt. Inputs shorter than the pad
 // length use the whole signal as the pad.
 std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x);
+// FiltFilt(sos, x) written over x, bit for bit, without a padded copy of the signal.
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x);
 
 }  // namespace exotwin::dsp
