@@ -1,5 +1,6 @@
 #include "dsp/butterworth.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
@@ -18,6 +19,31 @@ cd EvalCascade(const std::vector<Biquad>& sos, cd z) {
   for (const Biquad& s : sos)
     h *= (s.b0 + s.b1 * zi + s.b2 * zi * zi) / (1.0 + s.a1 * zi + s.a2 * zi * zi);
   return h;
+}
+
+// One sample through the cascade with its state z (one pair per section; transposed direct
+// form II).
+inline double StepCascade(const std::vector<Biquad>& sos, std::array<double, 2>* z, double x) {
+  for (size_t i = 0; i < sos.size(); ++i) {
+    const Biquad& s = sos[i];
+    const double y = s.b0 * x + z[i][0];
+    z[i][0] = s.b1 * x - s.a1 * y + z[i][1];
+    z[i][1] = s.b2 * x - s.a2 * y;
+    x = y;
+  }
+  return x;
+}
+
+// The state z of the cascade's steady state for a constant input x.
+inline void ResetCascade(const std::vector<Biquad>& sos, std::array<double, 2>* z, double x) {
+  for (size_t i = 0; i < sos.size(); ++i) {
+    const Biquad& s = sos[i];
+    const double den = 1.0 + s.a1 + s.a2;
+    const double y = std::abs(den) > 1e-300 ? x * (s.b0 + s.b1 + s.b2) / den : 0.0;
+    z[i][1] = s.b2 * x - s.a2 * y;
+    z[i][0] = s.b1 * x - s.a1 * y + z[i][1];
+    x = y;
+  }
 }
 
 }  // namespace
@@ -122,53 +148,57 @@ double MagnitudeResponse(const std::vector<Biquad>& sos, double fs, double f) {
 
 SosFilter::SosFilter(std::vector<Biquad> sos) : sos_(std::move(sos)), z_(sos_.size(), {0.0, 0.0}) {}
 
-double SosFilter::Step(double x) {
-  for (size_t i = 0; i < sos_.size(); ++i) {
-    const Biquad& s = sos_[i];
-    auto& z = z_[i];
-    const double y = s.b0 * x + z[0];
-    z[0] = s.b1 * x - s.a1 * y + z[1];
-    z[1] = s.b2 * x - s.a2 * y;
-    x = y;
-  }
-  return x;
-}
+double SosFilter::Step(double x) { return StepCascade(sos_, z_.data(), x); }
 
-void SosFilter::ResetSteady(double x) {
-  for (size_t i = 0; i < sos_.size(); ++i) {
-    const Biquad& s = sos_[i];
-    const double den = 1.0 + s.a1 + s.a2;
-    const double y = std::abs(den) > 1e-300 ? x * (s.b0 + s.b1 + s.b2) / den : 0.0;
-    z_[i][1] = s.b2 * x - s.a2 * y;
-    z_[i][0] = s.b1 * x - s.a1 * y + z_[i][1];
-    x = y;
-  }
-}
+void SosFilter::ResetSteady(double x) { ResetCascade(sos_, z_.data(), x); }
 
 void SosFilter::Reset() {
   for (auto& z : z_) z = {0.0, 0.0};
 }
 
-void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x) {
-  const size_t n = x.size();
-  if (n == 0) return;
-  size_t pad = 3 * (2 * sos.size() + 1);
-  if (pad >= n) pad = n - 1;
-  // The odd-reflected extension [head, x, tail] is filtered piecewise, in the order a padded copy
-  // would be: the same operations on the same values.
-  std::vector<double> head(pad), tail(pad);
-  for (size_t k = 0; k < pad; ++k) head[k] = 2.0 * x[0] - x[pad - k];
-  for (size_t i = 1; i <= pad; ++i) tail[i - 1] = 2.0 * x[n - 1] - x[n - 1 - i];
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count) {
+  // Up to kBlock signals at a time, interleaved sample by sample: their recursions are independent,
+  // so the processor overlaps them, and each signal goes through exactly the operations a padded
+  // copy of it would: the odd-reflected extension [head, x, tail] forward, then backward (the
+  // head's backward pass only shapes samples that are cropped).
+  constexpr size_t kBlock = 4;
+  const size_t sections = sos.size();
+  for (size_t first = 0; first < count; first += kBlock) {
+    const size_t K = std::min(kBlock, count - first);
+    const size_t n = xs[first]->size();
+    for (size_t k = 1; k < K; ++k)
+      if (xs[first + k]->size() != n) throw std::invalid_argument("FiltFiltInPlace: signals of different lengths");
+    if (n == 0) continue;
+    size_t pad = 3 * (2 * sections + 1);
+    if (pad >= n) pad = n - 1;
+    double* x[kBlock];
+    std::vector<double> head[kBlock], tail[kBlock];
+    std::vector<std::array<double, 2>> z[kBlock];
+    for (size_t k = 0; k < K; ++k) {
+      x[k] = xs[first + k]->data();
+      head[k].resize(pad), tail[k].resize(pad);
+      for (size_t i = 0; i < pad; ++i) head[k][i] = 2.0 * x[k][0] - x[k][pad - i];
+      for (size_t i = 1; i <= pad; ++i) tail[k][i - 1] = 2.0 * x[k][n - 1] - x[k][n - 1 - i];
+      z[k].assign(sections, {0.0, 0.0});
+      ResetCascade(sos, z[k].data(), pad > 0 ? head[k].front() : x[k][0]);
+    }
+    for (size_t i = 0; i < pad; ++i)
+      for (size_t k = 0; k < K; ++k) head[k][i] = StepCascade(sos, z[k].data(), head[k][i]);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k].data(), x[k][i]);
+    for (size_t i = 0; i < pad; ++i)
+      for (size_t k = 0; k < K; ++k) tail[k][i] = StepCascade(sos, z[k].data(), tail[k][i]);
+    for (size_t k = 0; k < K; ++k) ResetCascade(sos, z[k].data(), pad > 0 ? tail[k].back() : x[k][n - 1]);
+    for (size_t i = pad; i-- > 0;)
+      for (size_t k = 0; k < K; ++k) tail[k][i] = StepCascade(sos, z[k].data(), tail[k][i]);
+    for (size_t i = n; i-- > 0;)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k].data(), x[k][i]);
+  }
+}
 
-  SosFilter f(sos);
-  f.ResetSteady(pad > 0 ? head.front() : x.front());
-  for (double& v : head) v = f.Step(v);
-  for (double& v : x) v = f.Step(v);
-  for (double& v : tail) v = f.Step(v);
-  f.ResetSteady(pad > 0 ? tail.back() : x.back());
-  for (auto it = tail.rbegin(); it != tail.rend(); ++it) *it = f.Step(*it);
-  for (auto it = x.rbegin(); it != x.rend(); ++it) *it = f.Step(*it);
-  // The head's backward pass only shapes samples that are cropped.
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x) {
+  std::vector<double>* one = &x;
+  FiltFiltInPlace(sos, &one, 1);
 }
 
 std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {

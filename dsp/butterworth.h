@@ -2,6 +2,7 @@
 // causal filtering for the real-time path and zero-phase forward-backward filtering for off-line use.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <vector>
 
 namespace exotwin::dsp {
@@ -44,5 +45,9 @@ class SosFilter {
 std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x);
 // FiltFilt(sos, x) written over x, bit for bit, without a padded copy of the signal.
 void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x);
+// The same for count signals of one length (*xs[0] .. *xs[count - 1]), each bit for bit as alone,
+// filtered a few at a time (faster than one by one). Throws std::invalid_argument for signals of
+// different lengths.
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count);
 
 }  // namespace exotwin::dsp
