@@ -165,14 +165,21 @@ TimeBaseLowPass::TimeBaseLowPass(const Sampling& s, const std::vector<double>& t
   if (!uniform_) t_ = t, grid_ = s.grid;
 }
 
-void TimeBaseLowPass::Apply(std::vector<double>& x) const {
+void TimeBaseLowPass::Apply(std::vector<double>* const* xs, size_t count) const {
   if (uniform_) {
-    dsp::FiltFiltInPlace(sos_, x);
+    dsp::FiltFiltInPlace(sos_, xs, count);
     return;
   }
-  std::vector<double> on_grid = Interpolate(t_, x, grid_);
-  dsp::FiltFiltInPlace(sos_, on_grid);
-  x = Interpolate(grid_, on_grid, t_);
+  std::vector<std::vector<double>> on_grid(count);
+  std::vector<std::vector<double>*> ptr(count);
+  for (size_t k = 0; k < count; ++k) on_grid[k] = Interpolate(t_, *xs[k], grid_), ptr[k] = &on_grid[k];
+  dsp::FiltFiltInPlace(sos_, ptr.data(), count);
+  for (size_t k = 0; k < count; ++k) *xs[k] = Interpolate(grid_, on_grid[k], t_);
+}
+
+void TimeBaseLowPass::Apply(std::vector<double>& x) const {
+  std::vector<double>* one = &x;
+  Apply(&one, 1);
 }
 
 std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::vector<double>& x,

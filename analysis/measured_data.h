@@ -96,6 +96,8 @@ class TimeBaseLowPass {
   // With t's sampling already examined (s = ExamineSampling(t, source)).
   TimeBaseLowPass(const Sampling& s, const std::vector<double>& t, double cutoff_hz, const std::string& source);
   void Apply(std::vector<double>& x) const;  // x (one value per time of t) filtered in place
+  // Apply to *xs[0] .. *xs[count - 1], faster than one by one (dsp::FiltFiltInPlace of several).
+  void Apply(std::vector<double>* const* xs, size_t count) const;
   std::vector<double> operator()(std::vector<double> x) const {
     Apply(x);
     return x;
