@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 
 #include <Eigen/Eigenvalues>
 
@@ -122,6 +123,8 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     }
   }
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
+  constexpr size_t kBatch = 4;                  // columns low-passed together
+  std::vector<double> batch[kBatch];
   for (double fc : c.candidates_hz) {
     // Per record, on the rows: the regressor (parallel: from the angles differentiated at
     // DerivativeCutoffHz(fc), each column and the torque low-passed at fc; else differentiated at
@@ -160,40 +163,59 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
         for (int j = 0; j < 2; ++j)
           for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -(*tau[j])[at[a]], R.u_raw[a][j] = -(*tau[j])[at[a]];
       } else {
-        // Each column of RegressorRows over all samples, low-passed, taken at the rows. The columns
-        // RegressorRows leaves zero stay zero (the low-pass of zeros is zero).
+        // Each column of RegressorRows over all samples, low-passed, taken at the rows, then the
+        // torque; four at a time through one low-pass. The columns RegressorRows leaves zero stay
+        // zero (the low-pass of zeros is zero).
         const TimeBaseLowPass low(B.sampling, d.t, fc, d.source);
-        auto take = [&](std::vector<double>& x, int j, int col) {
-          low.Apply(x);
-          for (size_t a = 0; a < at.size(); ++a) R.Y[a](j, col) = x[at[a]];
+        enum Kind { kRegressor, kOnes, kSign, kRate, kTorque };
+        struct Col {
+          Kind kind;
+          int j, col;  // row and column of R.Y (kOnes: both offsets; kTorque: u_f)
         };
-        // FullRegressor's entries, three per pass over the samples.
-        const std::pair<int, int> groups[3][3] = {{{0, 0}, {0, 1}, {0, 2}}, {{0, 3}, {0, 4}, {0, 5}}, {{1, 1}, {1, 3}, {1, 5}}};
-        std::vector<double> x[3];
-        for (const auto& group : groups) {
-          for (auto& v : x) v.resize(n);
-          for (size_t i = 0; i < n; ++i) {
-            const Matrix26 Y = FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
-            for (int e = 0; e < 3; ++e) x[e][i] = Y(group[e].first, group[e].second);
+        static constexpr Col kFiltered[] = {
+            {kRegressor, 0, 0}, {kRegressor, 0, 1}, {kRegressor, 0, 2}, {kRegressor, 0, 3},
+            {kRegressor, 0, 4}, {kRegressor, 0, 5}, {kRegressor, 1, 1}, {kRegressor, 1, 3},
+            {kRegressor, 1, 5}, {kOnes, 0, 6},      {kSign, 0, 7},      {kSign, 1, 10},
+            {kRate, 0, 8},      {kRate, 1, 11},     {kTorque, 0, 0},    {kTorque, 1, 0}};
+        for (size_t c0 = 0; c0 < std::size(kFiltered); c0 += kBatch) {
+          bool regressor = false;
+          for (size_t e = 0; e < kBatch; ++e) {
+            const Col& c = kFiltered[c0 + e];
+            std::vector<double>& v = batch[e];
+            v.resize(n);
+            if (c.kind == kRegressor) regressor = true;
+            if (c.kind == kOnes) std::fill(v.begin(), v.end(), 1.0);
+            if (c.kind == kRate) std::copy(qd[c.j]->begin(), qd[c.j]->end(), v.begin());
+            if (c.kind == kTorque) std::copy(tau[c.j]->begin(), tau[c.j]->end(), v.begin());
+            if (c.kind == kSign)
+              for (size_t i = 0; i < n; ++i) {
+                const double w = (*qd[c.j])[i];
+                v[i] = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
+              }
           }
-          for (int e = 0; e < 3; ++e) take(x[e], group[e].first, group[e].second);
-        }
-        x[1].clear(), x[1].shrink_to_fit(), x[2].clear(), x[2].shrink_to_fit();
-        std::vector<double>& v = x[0];
-        v.assign(n, 1.0);  // the offset column, both joints
-        low.Apply(v);
-        for (size_t a = 0; a < at.size(); ++a) R.Y[a](0, 6) = v[at[a]], R.Y[a](1, 9) = v[at[a]];
-        for (int j = 0; j < 2; ++j) {
-          for (size_t i = 0; i < n; ++i) {
-            const double w = (*qd[j])[i];
-            v[i] = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
+          if (regressor)
+            for (size_t i = 0; i < n; ++i) {
+              const Matrix26 Y =
+                  FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
+              for (size_t e = 0; e < kBatch; ++e)
+                if (kFiltered[c0 + e].kind == kRegressor) batch[e][i] = Y(kFiltered[c0 + e].j, kFiltered[c0 + e].col);
+            }
+          std::vector<double>* ptr[kBatch];
+          for (size_t e = 0; e < kBatch; ++e) ptr[e] = &batch[e];
+          low.Apply(ptr, kBatch);
+          for (size_t e = 0; e < kBatch; ++e) {
+            const Col& c = kFiltered[c0 + e];
+            const std::vector<double>& v = batch[e];
+            for (size_t a = 0; a < at.size(); ++a) {
+              if (c.kind == kTorque) {
+                R.u_f[a][c.j] = -v[at[a]], R.u_raw[a][c.j] = -(*tau[c.j])[at[a]];
+              } else if (c.kind == kOnes) {
+                R.Y[a](0, 6) = v[at[a]], R.Y[a](1, 9) = v[at[a]];
+              } else {
+                R.Y[a](c.j, c.col) = v[at[a]];
+              }
+            }
           }
-          take(v, j, 7 + 3 * j);
-          v = *qd[j];
-          take(v, j, 8 + 3 * j);
-          v = *tau[j];
-          low.Apply(v);
-          for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -v[at[a]], R.u_raw[a][j] = -(*tau[j])[at[a]];
         }
       }
       for (size_t a = 0; a < at.size(); ++a) {
