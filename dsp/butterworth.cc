@@ -21,17 +21,61 @@ cd EvalCascade(const std::vector<Biquad>& sos, cd z) {
   return h;
 }
 
-// One sample through the cascade with its state z (one pair per section; transposed direct
-// form II).
+// One sample through one section with its state (z0, z1) (transposed direct form II).
+inline double StepSection(double b0, double b1, double b2, double a1, double a2, double& z0, double& z1,
+                          double x) {
+  const double y = b0 * x + z0;
+  z0 = b1 * x - a1 * y + z1;
+  z1 = b2 * x - a2 * y;
+  return y;
+}
+
+// One sample through the cascade with its state z (one pair per section).
 inline double StepCascade(const std::vector<Biquad>& sos, std::array<double, 2>* z, double x) {
   for (size_t i = 0; i < sos.size(); ++i) {
     const Biquad& s = sos[i];
-    const double y = s.b0 * x + z[i][0];
-    z[i][0] = s.b1 * x - s.a1 * y + z[i][1];
-    z[i][1] = s.b2 * x - s.a2 * y;
-    x = y;
+    x = StepSection(s.b0, s.b1, s.b2, s.a1, s.a2, z[i][0], z[i][1], x);
   }
   return x;
+}
+
+// x[k][0 .. n) of K signals through one section, interleaved sample by sample, forward or
+// backward, with the coefficients and the states z[k] held in registers.
+template <size_t K>
+void RunOneSection(const Biquad& s, std::array<double, 2>* const* z, double* const* x, size_t n, bool backward) {
+  const double b0 = s.b0, b1 = s.b1, b2 = s.b2, a1 = s.a1, a2 = s.a2;
+  double z0[K], z1[K];
+  for (size_t k = 0; k < K; ++k) z0[k] = z[k][0][0], z1[k] = z[k][0][1];
+  if (!backward) {
+    for (size_t i = 0; i < n; ++i)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepSection(b0, b1, b2, a1, a2, z0[k], z1[k], x[k][i]);
+  } else {
+    for (size_t i = n; i-- > 0;)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepSection(b0, b1, b2, a1, a2, z0[k], z1[k], x[k][i]);
+  }
+  for (size_t k = 0; k < K; ++k) z[k][0][0] = z0[k], z[k][0][1] = z1[k];
+}
+
+// x[k][0 .. n) of K (1 .. 4) signals through the cascade, interleaved sample by sample (their
+// recursions are independent, so the processor overlaps them), forward or backward, states z[k].
+void RunCascade(const std::vector<Biquad>& sos, std::array<double, 2>* const* z, double* const* x, size_t K,
+                size_t n, bool backward) {
+  if (sos.size() == 1) {
+    switch (K) {
+      case 1: return RunOneSection<1>(sos[0], z, x, n, backward);
+      case 2: return RunOneSection<2>(sos[0], z, x, n, backward);
+      case 3: return RunOneSection<3>(sos[0], z, x, n, backward);
+      case 4: return RunOneSection<4>(sos[0], z, x, n, backward);
+      default: break;
+    }
+  }
+  if (!backward) {
+    for (size_t i = 0; i < n; ++i)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k], x[k][i]);
+  } else {
+    for (size_t i = n; i-- > 0;)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k], x[k][i]);
+  }
 }
 
 // The state z of the cascade's steady state for a constant input x.
@@ -157,8 +201,7 @@ void SosFilter::Reset() {
 }
 
 void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count) {
-  // Up to kBlock signals at a time, interleaved sample by sample: their recursions are independent,
-  // so the processor overlaps them, and each signal goes through exactly the operations a padded
+  // Up to kBlock signals at a time (RunCascade); each goes through exactly the operations a padded
   // copy of it would: the odd-reflected extension [head, x, tail] forward, then backward (the
   // head's backward pass only shapes samples that are cropped).
   constexpr size_t kBlock = 4;
@@ -182,17 +225,15 @@ void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const*
       z[k].assign(sections, {0.0, 0.0});
       ResetCascade(sos, z[k].data(), pad > 0 ? head[k].front() : x[k][0]);
     }
-    for (size_t i = 0; i < pad; ++i)
-      for (size_t k = 0; k < K; ++k) head[k][i] = StepCascade(sos, z[k].data(), head[k][i]);
-    for (size_t i = 0; i < n; ++i)
-      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k].data(), x[k][i]);
-    for (size_t i = 0; i < pad; ++i)
-      for (size_t k = 0; k < K; ++k) tail[k][i] = StepCascade(sos, z[k].data(), tail[k][i]);
+    double *h[kBlock], *t[kBlock];
+    std::array<double, 2>* zk[kBlock];
+    for (size_t k = 0; k < K; ++k) h[k] = head[k].data(), t[k] = tail[k].data(), zk[k] = z[k].data();
+    RunCascade(sos, zk, h, K, pad, false);
+    RunCascade(sos, zk, x, K, n, false);
+    RunCascade(sos, zk, t, K, pad, false);
     for (size_t k = 0; k < K; ++k) ResetCascade(sos, z[k].data(), pad > 0 ? tail[k].back() : x[k][n - 1]);
-    for (size_t i = pad; i-- > 0;)
-      for (size_t k = 0; k < K; ++k) tail[k][i] = StepCascade(sos, z[k].data(), tail[k][i]);
-    for (size_t i = n; i-- > 0;)
-      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k].data(), x[k][i]);
+    RunCascade(sos, zk, t, K, pad, true);
+    RunCascade(sos, zk, x, K, n, true);
   }
 }
 
