@@ -655,6 +655,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   Lap("columns + ripple search");
   UseSecantDelayColumns(recs, w, &banks);
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
+  for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
   Lap("grams + noise");
 
