@@ -118,12 +118,12 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     for (int j = 0; j < 2; ++j)
       for (int k = 0; k < 2; ++k) B.recorded[j][k] = d.Column(std::string(k == 0 ? "qd_" : "qdd_") + names[j]);
     if (parallel) {
-      B.trig.resize(n);
-      for (size_t i = 0; i < n; ++i) B.trig[i] = TrigOf({d.q_hip[i], d.q_knee[i]});
+      B.trig.reserve(n);
+      for (size_t i = 0; i < n; ++i) B.trig.push_back(TrigOf({d.q_hip[i], d.q_knee[i]}));
     }
   }
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
-  constexpr size_t kBatch = 4;                  // columns low-passed together
+  constexpr size_t kBatch = 8;                  // columns low-passed together
   std::vector<double> batch[kBatch];
   for (double fc : c.candidates_hz) {
     // Per record, on the rows: the regressor (parallel: from the angles differentiated at
@@ -164,7 +164,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
           for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -(*tau[j])[at[a]], R.u_raw[a][j] = -(*tau[j])[at[a]];
       } else {
         // Each column of RegressorRows over all samples, low-passed, taken at the rows, then the
-        // torque; four at a time through one low-pass. The columns RegressorRows leaves zero stay
+        // torque; eight at a time through one low-pass. The columns RegressorRows leaves zero stay
         // zero (the low-pass of zeros is zero).
         const TimeBaseLowPass low(B.sampling, d.t, fc, d.source);
         enum Kind { kRegressor, kOnes, kSign, kRate, kTorque };

@@ -21,14 +21,19 @@ cd EvalCascade(const std::vector<Biquad>& sos, cd z) {
   return h;
 }
 
-// One sample through one section with its state (z0, z1) (transposed direct form II).
-inline double StepSection(double b0, double b1, double b2, double a1, double a2, double& z0, double& z1,
-                          double x) {
-  const double y = b0 * x + z0;
+// One sample through one section with its state (z0, z1) (transposed direct form II); T is
+// double or Pair.
+template <class T>
+inline T StepSection(T b0, T b1, T b2, T a1, T a2, T& z0, T& z1, T x) {
+  const T y = b0 * x + z0;
   z0 = b1 * x - a1 * y + z1;
   z1 = b2 * x - a2 * y;
   return y;
 }
+
+// Two signals' values, one per lane: SSE2's packed operations are, lane by lane, the IEEE
+// operations on one double (x86-64 has no fused multiply-add unless the build asks for it).
+using Pair = double __attribute__((vector_size(16)));
 
 // One sample through the cascade with its state z (one pair per section).
 inline double StepCascade(const std::vector<Biquad>& sos, std::array<double, 2>* z, double x) {
@@ -39,24 +44,40 @@ inline double StepCascade(const std::vector<Biquad>& sos, std::array<double, 2>*
   return x;
 }
 
-// x[k][0 .. n) of K signals through one section, interleaved sample by sample, forward or
-// backward, with the coefficients and the states z[k] held in registers.
+// x[k][0 .. n) of K signals through one section, interleaved sample by sample (two per Pair),
+// forward or backward, with the coefficients and the states z[k] held in registers.
 template <size_t K>
 void RunOneSection(const Biquad& s, std::array<double, 2>* const* z, double* const* x, size_t n, bool backward) {
+  constexpr size_t P = K / 2;  // pairs; an odd K leaves one signal on its own
   const double b0 = s.b0, b1 = s.b1, b2 = s.b2, a1 = s.a1, a2 = s.a2;
-  double z0[K], z1[K];
-  for (size_t k = 0; k < K; ++k) z0[k] = z[k][0][0], z1[k] = z[k][0][1];
-  if (!backward) {
-    for (size_t i = 0; i < n; ++i)
-      for (size_t k = 0; k < K; ++k) x[k][i] = StepSection(b0, b1, b2, a1, a2, z0[k], z1[k], x[k][i]);
-  } else {
-    for (size_t i = n; i-- > 0;)
-      for (size_t k = 0; k < K; ++k) x[k][i] = StepSection(b0, b1, b2, a1, a2, z0[k], z1[k], x[k][i]);
+  const Pair B0 = {b0, b0}, B1 = {b1, b1}, B2 = {b2, b2}, A1 = {a1, a1}, A2 = {a2, a2};
+  Pair z0[P + 1], z1[P + 1];
+  double z0_odd = 0, z1_odd = 0;
+  for (size_t p = 0; p < P; ++p) {
+    z0[p] = Pair{z[2 * p][0][0], z[2 * p + 1][0][0]};
+    z1[p] = Pair{z[2 * p][0][1], z[2 * p + 1][0][1]};
   }
-  for (size_t k = 0; k < K; ++k) z[k][0][0] = z0[k], z[k][0][1] = z1[k];
+  if (K % 2) z0_odd = z[K - 1][0][0], z1_odd = z[K - 1][0][1];
+  auto step = [&](size_t i) {
+    for (size_t p = 0; p < P; ++p) {
+      const Pair y = StepSection(B0, B1, B2, A1, A2, z0[p], z1[p], Pair{x[2 * p][i], x[2 * p + 1][i]});
+      x[2 * p][i] = y[0], x[2 * p + 1][i] = y[1];
+    }
+    if (K % 2) x[K - 1][i] = StepSection(b0, b1, b2, a1, a2, z0_odd, z1_odd, x[K - 1][i]);
+  };
+  if (!backward) {
+    for (size_t i = 0; i < n; ++i) step(i);
+  } else {
+    for (size_t i = n; i-- > 0;) step(i);
+  }
+  for (size_t p = 0; p < P; ++p) {
+    z[2 * p][0][0] = z0[p][0], z[2 * p + 1][0][0] = z0[p][1];
+    z[2 * p][0][1] = z1[p][0], z[2 * p + 1][0][1] = z1[p][1];
+  }
+  if (K % 2) z[K - 1][0][0] = z0_odd, z[K - 1][0][1] = z1_odd;
 }
 
-// x[k][0 .. n) of K (1 .. 4) signals through the cascade, interleaved sample by sample (their
+// x[k][0 .. n) of K (1 .. 8) signals through the cascade, interleaved sample by sample (their
 // recursions are independent, so the processor overlaps them), forward or backward, states z[k].
 void RunCascade(const std::vector<Biquad>& sos, std::array<double, 2>* const* z, double* const* x, size_t K,
                 size_t n, bool backward) {
@@ -66,6 +87,10 @@ void RunCascade(const std::vector<Biquad>& sos, std::array<double, 2>* const* z,
       case 2: return RunOneSection<2>(sos[0], z, x, n, backward);
       case 3: return RunOneSection<3>(sos[0], z, x, n, backward);
       case 4: return RunOneSection<4>(sos[0], z, x, n, backward);
+      case 5: return RunOneSection<5>(sos[0], z, x, n, backward);
+      case 6: return RunOneSection<6>(sos[0], z, x, n, backward);
+      case 7: return RunOneSection<7>(sos[0], z, x, n, backward);
+      case 8: return RunOneSection<8>(sos[0], z, x, n, backward);
       default: break;
     }
   }
@@ -204,7 +229,7 @@ void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const*
   // Up to kBlock signals at a time (RunCascade); each goes through exactly the operations a padded
   // copy of it would: the odd-reflected extension [head, x, tail] forward, then backward (the
   // head's backward pass only shapes samples that are cropped).
-  constexpr size_t kBlock = 4;
+  constexpr size_t kBlock = 8;
   const size_t sections = sos.size();
   for (size_t first = 0; first < count; first += kBlock) {
     const size_t K = std::min(kBlock, count - first);

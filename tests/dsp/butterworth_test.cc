@@ -99,14 +99,14 @@ TEST(FiltFilt, InPlaceAndBatchedEqualThePaddedCopyBitForBit) {
   for (const auto& sos : designs)
     for (size_t n : {1, 2, 5, 9, 16, 1000}) {
       SCOPED_TRACE(std::to_string(sos.size()) + " sections, n " + std::to_string(n));
-      std::vector<std::vector<double>> xs(6, std::vector<double>(n));
+      std::vector<std::vector<double>> xs(11, std::vector<double>(n));
       for (size_t k = 0; k < xs.size(); ++k)
         for (size_t i = 0; i < n; ++i) xs[k][i] = std::sin(0.01 * (k + 1) * i) + 0.1 * std::cos(1.7 * i * i + k);
       std::vector<std::vector<double>> ref, batched = xs;
       for (const auto& x : xs) ref.push_back(PaddedFiltFilt(sos, x));
-      std::vector<double>* ptr[6];
-      for (size_t k = 0; k < 6; ++k) ptr[k] = &batched[k];
-      FiltFiltInPlace(sos, ptr, 6);  // a block of four, then two
+      std::vector<double>* ptr[11];
+      for (size_t k = 0; k < 11; ++k) ptr[k] = &batched[k];
+      FiltFiltInPlace(sos, ptr, 11);  // a block of eight (four pairs), then three (a pair and one)
       for (size_t k = 0; k < xs.size(); ++k) {
         EXPECT_EQ(FiltFilt(sos, xs[k]), ref[k]);
         std::vector<double> one = xs[k];
