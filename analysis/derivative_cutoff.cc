@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 
 #include <Eigen/Eigenvalues>
 
@@ -19,18 +20,30 @@ constexpr double kTrainFraction = 0.7;
 constexpr size_t kMaxRowsPerRecord = 20000;
 constexpr int kCols = 6 + 2 * 3;  // lumped [J1 J2 X1 X2 Y1 Y2], per joint offset, Coulomb, viscous
 
-// Regressor rows (hip, knee) of the generic torque model at one sample; target tau_R = -tau_S.
-void RegressorRows(double L1, double g, const Kinematics& k, size_t i, Eigen::Matrix<double, 2, kCols>* Y) {
+// Regressor rows (hip, knee) of the generic torque model at sample i of angles q, rates qd, qdd;
+// target tau_R = -tau_S.
+void RegressorRows(double L1, double g, const std::vector<double>* q[2], const std::vector<double>* qd[2],
+                   const std::vector<double>* qdd[2], size_t i, Eigen::Matrix<double, 2, kCols>* Y) {
   Y->setZero();
-  Y->leftCols<6>() = FullRegressor(L1, g, {k.q[0][i], k.q[1][i]}, {k.qd[0][i], k.qd[1][i]},
-                                   {k.qdd[0][i], k.qdd[1][i]});
+  Y->leftCols<6>() = FullRegressor(L1, g, {(*q[0])[i], (*q[1])[i]}, {(*qd[0])[i], (*qd[1])[i]},
+                                   {(*qdd[0])[i], (*qdd[1])[i]});
   for (int j = 0; j < 2; ++j) {
-    const double v = k.qd[j][i];
+    const double v = (*qd[j])[i];
     (*Y)(j, 6 + 3 * j) = 1.0;
     (*Y)(j, 7 + 3 * j) = v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0);
     (*Y)(j, 8 + 3 * j) = v;
   }
 }
+
+// What no candidate cutoff changes in a record: its sampling, the rows scored, the recorded rate
+// columns, and (parallel filtering) the angles' trigonometry per sample.
+struct RecordBase {
+  Sampling sampling;
+  std::vector<size_t> at;  // the rows: every stride-th sample, filter edges left out
+  size_t split = 0;        // first held-out sample
+  const std::vector<double>* recorded[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};  // qd_*, qdd_*
+  std::vector<RegressorTrig> trig;
+};
 
 }  // namespace
 
@@ -91,10 +104,30 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       for (double v : j == 0 ? d->tau_hip : d->tau_knee) s += v, ss += v * v, n += 1;
     var[j] = std::max(ss / n - (s / n) * (s / n), 1e-12);
   }
+  std::vector<RecordBase> base(records.size());
+  for (size_t r = 0; r < records.size(); ++r) {
+    const MeasuredData& d = *records[r];
+    RecordBase& B = base[r];
+    const size_t n = d.size();
+    B.sampling = ExamineSampling(d.t, d.source);
+    const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 / B.sampling.dt));  // filter edges
+    B.split = static_cast<size_t>(kTrainFraction * static_cast<double>(n));
+    const size_t stride = std::max<size_t>(1, n / kMaxRowsPerRecord);
+    for (size_t i = edge; i + edge < n; i += stride) B.at.push_back(i);
+    const char* names[2] = {"hip", "knee"};
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k) B.recorded[j][k] = d.Column(std::string(k == 0 ? "qd_" : "qdd_") + names[j]);
+    if (parallel) {
+      B.trig.reserve(n);
+      for (size_t i = 0; i < n; ++i) B.trig.push_back(TrigOf({d.q_hip[i], d.q_knee[i]}));
+    }
+  }
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
+  constexpr size_t kBatch = 8;                  // columns low-passed together
+  std::vector<double> batch[kBatch];
   for (double fc : c.candidates_hz) {
-    // Per record, on every stride-th sample: the regressor (parallel: from the angles differentiated
-    // at DerivativeCutoffHz(fc), each column and the torque low-passed at fc; else differentiated at
+    // Per record, on the rows: the regressor (parallel: from the angles differentiated at
+    // DerivativeCutoffHz(fc), each column and the torque low-passed at fc; else differentiated at
     // fc), and the raw torque the score is taken against.
     struct Rows {
       std::vector<Eigen::Matrix<double, 2, kCols>> Y;
@@ -106,32 +139,87 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     Eigen::Matrix<double, kCols, 1> b = Eigen::Matrix<double, kCols, 1>::Zero();
     for (size_t r = 0; r < records.size(); ++r) {
       const MeasuredData& d = *records[r];
+      const RecordBase& B = base[r];
       const size_t n = d.size();
-      const Kinematics k = DeriveKinematics(d, parallel ? DerivativeCutoffHz(fc, 1.0 / MedianStep(d.t)) : fc);
-      auto filter = [&](const std::vector<double>& x) { return parallel ? LowPassOnTimeBase(d.t, x, fc, d.source) : x; };
-      const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 / MedianStep(d.t)));  // filter edges
-      const size_t split = static_cast<size_t>(kTrainFraction * static_cast<double>(n));
-      const size_t stride = std::max<size_t>(1, n / kMaxRowsPerRecord);
-      std::vector<size_t> at;
-      for (size_t i = edge; i + edge < n; i += stride) at.push_back(i);
+      const std::vector<size_t>& at = B.at;
+      // The rates DeriveKinematics(d, cutoff) gives: a recorded column as recorded.
+      const double cutoff = parallel ? DerivativeCutoffHz(fc, 1.0 / B.sampling.dt) : fc;
+      AngleRates derived[2];
+      const std::vector<double>* q[2] = {&d.q_hip, &d.q_knee};
+      const std::vector<double>* qd[2];
+      const std::vector<double>* qdd[2];
+      for (int j = 0; j < 2; ++j) {
+        if (!B.recorded[j][0] || !B.recorded[j][1])
+          derived[j] = DeriveAngleRates(B.sampling, d.t, *q[j], cutoff, d.source);
+        qd[j] = B.recorded[j][0] ? B.recorded[j][0] : &derived[j].qd;
+        qdd[j] = B.recorded[j][1] ? B.recorded[j][1] : &derived[j].qdd;
+      }
       Rows& R = rows[r];
       R.Y.assign(at.size(), Eigen::Matrix<double, 2, kCols>::Zero());
       R.u_f.resize(at.size()), R.u_raw.resize(at.size()), R.train.resize(at.size());
-      std::vector<Eigen::Matrix<double, 2, kCols>> full(n);
-      for (size_t i = 0; i < n; ++i) RegressorRows(L1, g, k, i, &full[i]);
-      std::vector<double> x(n);
-      for (int j = 0; j < 2; ++j) {
-        for (int col = 0; col < kCols; ++col) {
-          for (size_t i = 0; i < n; ++i) x[i] = full[i](j, col);
-          const std::vector<double> xf = filter(x);
-          for (size_t a = 0; a < at.size(); ++a) R.Y[a](j, col) = xf[at[a]];
+      const std::vector<double>* tau[2] = {&d.tau_hip, &d.tau_knee};
+      if (!parallel) {
+        for (size_t a = 0; a < at.size(); ++a) RegressorRows(L1, g, q, qd, qdd, at[a], &R.Y[a]);
+        for (int j = 0; j < 2; ++j)
+          for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -(*tau[j])[at[a]], R.u_raw[a][j] = -(*tau[j])[at[a]];
+      } else {
+        // Each column of RegressorRows over all samples, low-passed, taken at the rows, then the
+        // torque; eight at a time through one low-pass. The columns RegressorRows leaves zero stay
+        // zero (the low-pass of zeros is zero).
+        const TimeBaseLowPass low(B.sampling, d.t, fc, d.source);
+        enum Kind { kRegressor, kOnes, kSign, kRate, kTorque };
+        struct Col {
+          Kind kind;
+          int j, col;  // row and column of R.Y (kOnes: both offsets; kTorque: u_f)
+        };
+        static constexpr Col kFiltered[] = {
+            {kRegressor, 0, 0}, {kRegressor, 0, 1}, {kRegressor, 0, 2}, {kRegressor, 0, 3},
+            {kRegressor, 0, 4}, {kRegressor, 0, 5}, {kRegressor, 1, 1}, {kRegressor, 1, 3},
+            {kRegressor, 1, 5}, {kOnes, 0, 6},      {kSign, 0, 7},      {kSign, 1, 10},
+            {kRate, 0, 8},      {kRate, 1, 11},     {kTorque, 0, 0},    {kTorque, 1, 0}};
+        for (size_t c0 = 0; c0 < std::size(kFiltered); c0 += kBatch) {
+          bool regressor = false;
+          for (size_t e = 0; e < kBatch; ++e) {
+            const Col& c = kFiltered[c0 + e];
+            std::vector<double>& v = batch[e];
+            v.resize(n);
+            if (c.kind == kRegressor) regressor = true;
+            if (c.kind == kOnes) std::fill(v.begin(), v.end(), 1.0);
+            if (c.kind == kRate) std::copy(qd[c.j]->begin(), qd[c.j]->end(), v.begin());
+            if (c.kind == kTorque) std::copy(tau[c.j]->begin(), tau[c.j]->end(), v.begin());
+            if (c.kind == kSign)
+              for (size_t i = 0; i < n; ++i) {
+                const double w = (*qd[c.j])[i];
+                v[i] = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
+              }
+          }
+          if (regressor)
+            for (size_t i = 0; i < n; ++i) {
+              const Matrix26 Y =
+                  FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
+              for (size_t e = 0; e < kBatch; ++e)
+                if (kFiltered[c0 + e].kind == kRegressor) batch[e][i] = Y(kFiltered[c0 + e].j, kFiltered[c0 + e].col);
+            }
+          std::vector<double>* ptr[kBatch];
+          for (size_t e = 0; e < kBatch; ++e) ptr[e] = &batch[e];
+          low.Apply(ptr, kBatch);
+          for (size_t e = 0; e < kBatch; ++e) {
+            const Col& c = kFiltered[c0 + e];
+            const std::vector<double>& v = batch[e];
+            for (size_t a = 0; a < at.size(); ++a) {
+              if (c.kind == kTorque) {
+                R.u_f[a][c.j] = -v[at[a]], R.u_raw[a][c.j] = -(*tau[c.j])[at[a]];
+              } else if (c.kind == kOnes) {
+                R.Y[a](0, 6) = v[at[a]], R.Y[a](1, 9) = v[at[a]];
+              } else {
+                R.Y[a](c.j, c.col) = v[at[a]];
+              }
+            }
+          }
         }
-        const std::vector<double>& tau = j == 0 ? d.tau_hip : d.tau_knee;
-        const std::vector<double> tf = filter(tau);
-        for (size_t a = 0; a < at.size(); ++a) R.u_f[a][j] = -tf[at[a]], R.u_raw[a][j] = -tau[at[a]];
       }
       for (size_t a = 0; a < at.size(); ++a) {
-        R.train[a] = at[a] < split;
+        R.train[a] = at[a] < B.split;
         if (!R.train[a]) continue;
         A.noalias() += R.Y[a].transpose() * R.Y[a];
         b.noalias() += R.Y[a].transpose() * R.u_f[a];

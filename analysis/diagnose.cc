@@ -1,11 +1,14 @@
 #include "analysis/diagnose.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -33,18 +36,19 @@ const char* kJoint[2] = {"hip", "knee"};
 struct Rec {
   const MeasuredData* data = nullptr;
   Kinematics kin;
-  std::vector<double> raw[2];           // measured tau_S
+  const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
   std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
   double hz = 0;                        // the parallel low-pass (0: none)
   std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque, reading with its effects
   std::vector<double> resid[2];
   size_t split = 0;
+  std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
   size_t n() const { return kin.t.size(); }
   // The residual's low-pass (parallel filtering: measured and predicted torque filtered alike) of x,
   // whose samples are those of kin.t from `from` on.
-  std::vector<double> Filter(const std::vector<double>& x, size_t from = 0) const {
+  std::vector<double> Filter(std::vector<double> x, size_t from = 0) const {
     if (!(hz > 0)) return x;
-    if (from == 0 && x.size() == kin.t.size()) return LowPassOnTimeBase(kin.t, x, hz, data->source);
+    if (from == 0 && x.size() == kin.t.size()) return (*low)(std::move(x));
     const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
     return LowPassOnTimeBase(t, x, hz, data->source);
   }
@@ -114,7 +118,7 @@ double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, 
   for (int j = 0; j < 2; ++j) {
     std::vector<double> e(b - a);
     for (size_t i = 0; i < b - a; ++i) e[i] = rc.raw[j][a + i] - ts[j][i];
-    e = rc.Filter(e, a);
+    e = rc.Filter(std::move(e), a);
     for (size_t i = lo; i + lo < b - a; ++i) s += std::pow(w[j] * e[i], 2);
   }
   return s;
@@ -131,6 +135,18 @@ Kinematics Slice(const Kinematics& kin, size_t a, size_t b) {
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
   k.derivative_source = kin.derivative_source;
   return k;
+}
+
+// kin cut to its samples [a, b) in place (what Slice(kin, a, b) holds, without a copy).
+void TrimTo(Kinematics* kin, size_t a, size_t b) {
+  auto cut = [&](std::vector<double>& v) {
+    v.erase(v.begin() + static_cast<long>(b), v.end());
+    v.erase(v.begin(), v.begin() + static_cast<long>(a));
+  };
+  cut(kin->t);
+  for (int j = 0; j < 2; ++j) cut(kin->q[j]), cut(kin->qd[j]), cut(kin->qdd[j]);
+  for (auto& ch : kin->emg) cut(ch.second);
+  kin->resampled = false;  // as Slice
 }
 
 // Dominant frequency (Hz) of x[a, b) by a direct DFT of a strided copy, 0.05 .. 25 Hz.
@@ -191,22 +207,22 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, const Cuto
   // Parallel filtering (as in robot identification practice): the residual is low-passed at the
   // chosen cutoff fc, the angles differentiated at DerivativeCutoffHz(fc), flat where fc passes,
   // so that measured and predicted torque see one and the same filter.
-  const Kinematics full = DeriveKinematics(
+  rc.kin = DeriveKinematics(
       data, cutoff.from_columns ? 20.0 : DerivativeCutoffHz(cutoff.hz, 1.0 / MedianStep(data.t)));
-  const bool filtered = full.derivative_source != "measured columns";
+  const bool filtered = rc.kin.derivative_source != "measured columns";
   rc.hz = filtered ? cutoff.hz : 0.0;
-  const std::vector<double> meas[2] = {data.tau_hip, data.tau_knee};
   // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
-  const double T = full.t.back() - full.t.front();
+  const std::vector<double>& t = rc.kin.t;
+  const double T = t.back() - t.front();
   const double edge = std::min(0.5, 0.05 * T);
-  const size_t a = static_cast<size_t>(
-      std::lower_bound(full.t.begin(), full.t.end(), full.t.front() + edge) - full.t.begin());
-  const size_t b = static_cast<size_t>(
-      std::upper_bound(full.t.begin(), full.t.end(), full.t.back() - edge) - full.t.begin());
-  rc.kin = Slice(full, a, b);
+  const size_t a = static_cast<size_t>(std::lower_bound(t.begin(), t.end(), t.front() + edge) - t.begin());
+  const size_t b = static_cast<size_t>(std::upper_bound(t.begin(), t.end(), t.back() - edge) - t.begin());
+  TrimTo(&rc.kin, a, b);
+  if (filtered) rc.low.emplace(rc.kin.t, rc.hz, data.source);
+  const std::vector<double>* meas[2] = {&data.tau_hip, &data.tau_knee};
   for (int j = 0; j < 2; ++j) {
-    rc.raw[j].assign(meas[j].begin() + a, meas[j].begin() + b);
-    rc.meas[j] = rc.Filter(rc.raw[j]);
+    rc.raw[j] = meas[j]->data() + a;
+    rc.meas[j] = rc.Filter(std::vector<double>(rc.raw[j], rc.raw[j] + (b - a)));
   }
   const Kinematics& kin = rc.kin;
   const size_t n = kin.t.size();
@@ -221,12 +237,14 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, const Cuto
                                                {kin.qdd[0][i], kin.qdd[1][i]});
     rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
   }
-  std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
-  ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
+  {
+    std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
+    ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
+  }
   for (int j = 0; j < 2; ++j) {
     rc.resid[j].resize(n);
     for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.raw[j][i] - rc.tau_S[j][i];
-    rc.resid[j] = rc.Filter(rc.resid[j]);
+    rc.resid[j] = rc.Filter(std::move(rc.resid[j]));
   }
 }
 
@@ -487,7 +505,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
     for (int j = 0; j < 2; ++j) {
       std::vector<double> ea(n - warm);
       for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
-      ea = rc.Filter(ea, warm);
+      ea = rc.Filter(std::move(ea), warm);
       double b = 0, a = 0;
       for (size_t i = rc.split; i < n; ++i) {
         b += std::pow(rc.resid[j][i], 2);
@@ -520,7 +538,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
       for (int j = 0; j < 2; ++j) {
         std::vector<double> ea(n);
         for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
-        ea = rc.Filter(ea);
+        ea = rc.Filter(std::move(ea));
         double b = 0, a = 0;
         for (size_t i = 0; i < n; ++i) b += std::pow(rc.resid[j][i], 2), a += std::pow(ea[i], 2);
         rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
@@ -601,7 +619,8 @@ std::string MethodText(const Diagnosis& D, const DiagnoseOptions& opt) {
 
 }  // namespace
 
-// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time to stderr.
+// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time and the
+// process's peak memory at its end to stderr.
 Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
                    const DiagnoseOptions& opt) {
   const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
@@ -609,7 +628,10 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   auto Lap = [&](const char* what) {
     if (!timing) return;
     const auto now = std::chrono::steady_clock::now();
-    std::fprintf(stderr, "diagnose: %-28s %8.3f s\n", what, std::chrono::duration<double>(now - clock0).count());
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s, peak %6.1f MB\n", what,
+                 std::chrono::duration<double>(now - clock0).count(), ru.ru_maxrss / 1024.0);
     clock0 = now;
   };
   CheckInputs(records, opt);
@@ -633,6 +655,7 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   Lap("columns + ripple search");
   UseSecantDelayColumns(recs, w, &banks);
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
+  for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
   Lap("grams + noise");
 

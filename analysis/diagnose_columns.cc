@@ -17,12 +17,18 @@ namespace {
 
 double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
+// The index of a new column of the bank (X grown when full).
+int NewColumn(ColumnBank& b) {
+  const int c = b.used++;
+  if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);
+  return c;
+}
+
 // Appends one column given as (hip row value, knee row value) per fit row.
 template <class F>
 int AddColumn(ColumnBank& b, const double w[2], F f) {
   const size_t m = b.sample.size();
-  const int c = b.used++;
-  if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);
+  const int c = NewColumn(b);
   if (b.filter) {
     std::vector<double> v[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
     for (size_t i = 0; i < b.n; ++i) {
@@ -41,6 +47,28 @@ int AddColumn(ColumnBank& b, const double w[2], F f) {
 }
 
 Eigen::Vector2d Row(int j, double v) { return j == 0 ? Eigen::Vector2d(v, 0) : Eigen::Vector2d(0, v); }
+
+// Column c from the values x_j of its joint-j rows on the fit rows (the other joint's rows zero),
+// weighted by w as SetColumn stores them.
+void SetJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vector<double>& x_j) {
+  const size_t m = b.sample.size();
+  for (size_t k = 0; k < m; ++k) {
+    b.X(j * m + k, c) = w[j] * x_j[k];
+    b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
+  }
+}
+
+// Column c as SetColumn stores per-sample values Row(j, x[i]); returns x, filtered as the column's
+// rows are, on the fit rows (before the weight).
+std::vector<double> SetJointColumn(ColumnBank& b, int c, const double w[2], int j, std::vector<double> x) {
+  bool zero = true;
+  for (double v : x) zero &= v == 0.0;
+  if (!zero && b.filter) x = b.filter(x);
+  std::vector<double> rows(b.sample.size());
+  for (size_t k = 0; k < rows.size(); ++k) rows[k] = x[b.sample[k]];
+  SetJointRows(b, c, w, j, rows);
+  return rows;
+}
 
 }  // namespace
 
@@ -79,17 +107,10 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
   auto Q = [&](size_t i) { return Eigen::Vector2d(kin.q[0][i], kin.q[1][i]); };
   auto QD = [&](size_t i) { return Eigen::Vector2d(kin.qd[0][i], kin.qd[1][i]); };
   auto QDD = [&](size_t i) { return Eigen::Vector2d(kin.qdd[0][i], kin.qdd[1][i]); };
-  // Time derivative of the predicted reading (for the delay), on the full record.
-  std::vector<double> dS[2];
-  for (int j = 0; j < 2; ++j) {
-    dS[j].resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
-      dS[j][i] = (tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]);
-    }
-  }
   const double g = params.g;
-  std::vector<std::vector<double>> envelopes;
+  // The envelope columns are the same at both joints but for the rows they fill: the hip's are kept
+  // on the fit rows (filtered, unweighted) for the knee's.
+  std::vector<std::vector<double>> envelope_rows;
   b.X.resize(2 * m, 40);
   for (int j = 0; j < 2; ++j) {
     auto add = [&](const std::string& name, std::vector<int> cols, const std::string& axis = "") {
@@ -129,14 +150,29 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
         })});
     add("sensor_offset", {off});
     add("sensor_gain", {AddColumn(b, w, [&](size_t i) { return Row(j, tau_S[j][i]); })});
-    add("sensor_delay", {AddColumn(b, w, [&](size_t i) { return Row(j, -dS[j][i]); })});
+    {
+      // Time derivative of the predicted reading (for the delay), on the full record.
+      std::vector<double> dS(n);
+      for (size_t i = 0; i < n; ++i) {
+        const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
+        dS[i] = (tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]);
+      }
+      add("sensor_delay", {AddColumn(b, w, [&](size_t i) { return Row(j, -dS[i]); })});
+    }
     if (!kin.emg.empty()) {
       std::vector<int> cols;
       std::vector<std::string> chans;
       for (const auto& ch : kin.emg) {
-        if (j == 0) envelopes.push_back(EmgEnvelope(kin.t, ch.second));
-        const std::vector<double>& env = envelopes[chans.size()];
-        cols.push_back(AddColumn(b, w, [&](size_t i) { return Row(j, -env[i]); }));
+        if (j == 0) {
+          std::vector<double> x = EmgEnvelope(kin.t, ch.second);
+          for (double& v : x) v = -v;
+          cols.push_back(NewColumn(b));
+          envelope_rows.push_back(SetJointColumn(b, cols.back(), w, 0, std::move(x)));
+        } else {
+          const int c = NewColumn(b);
+          SetJointRows(b, c, w, j, envelope_rows[chans.size()]);
+          cols.push_back(c);
+        }
         chans.push_back(ch.first);
       }
       add("muscle_activity", cols)->channels = chans;
@@ -196,15 +232,14 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       b.X.col(c0).setZero();
       b.X.col(c0 + 1).setZero();
       const size_t n = kins[r]->t.size();
-      std::vector<double> vs[2] = {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
-      std::vector<double> vc[2] = {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+      std::vector<double> vs(n), vc(n);  // joint j's rows (the other joint's are zero)
       for (size_t i = 0; i < n; ++i) {
         const double x = 2 * M_PI * f * kins[r]->q[j][i];
-        vs[j][i] = -std::sin(x), vc[j][i] = -std::cos(x);
+        vs[i] = -std::sin(x), vc[i] = -std::cos(x);
       }
       const double ww[2] = {j == 0 ? w : 0.0, j == 1 ? w : 0.0};
-      SetColumn(b, c0, ww, vs);
-      SetColumn(b, c0 + 1, ww, vc);
+      SetJointColumn(b, c0, ww, j, std::move(vs));
+      SetJointColumn(b, c0 + 1, ww, j, std::move(vc));
       Candidate c;
       c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
       b.candidates.push_back(c);

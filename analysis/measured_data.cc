@@ -120,16 +120,18 @@ std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<
 
 namespace {
 
-// The record's sampling: median step, and a uniform grid at that step when any step is off it by
-// more than 1 % (else the record's own times).
-struct SampleGrid {
-  double dt = 0;
-  bool uniform = true;
-  std::vector<double> grid;
-};
+// Throws unless cutoff_hz is below half the sample rate of s.
+void CheckCutoff(const Sampling& s, double cutoff_hz, const std::string& source) {
+  if (!(cutoff_hz < 0.5 / s.dt))
+    throw InputError(source + ": sample period " + NumberText(s.dt) + " s is too long for the " +
+                     NumberText(cutoff_hz) + " Hz derivative filter, expected a sample rate above " +
+                     NumberText(2 * cutoff_hz) + " Hz");
+}
 
-SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, double cutoff_hz) {
-  SampleGrid s;
+}  // namespace
+
+Sampling ExamineSampling(const std::vector<double>& t, const std::string& source) {
+  Sampling s;
   const size_t n = t.size();
   s.dt = MedianStep(t);
   if (!(s.dt >= 1e-6))
@@ -137,9 +139,7 @@ SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, dou
                      " s, expected at least 1e-6 s (a sample rate up to 1 MHz)");
   for (size_t i = 0; i + 1 < n; ++i)
     if (std::abs(t[i + 1] - t[i] - s.dt) > 0.01 * s.dt) { s.uniform = false; break; }
-  if (s.uniform) {
-    s.grid = t;
-  } else {
+  if (!s.uniform) {
     const double span = t.back() - t.front();
     const double points = std::floor(span / s.dt) + 1;
     if (!(points <= std::max(100.0 * static_cast<double>(n), 1e6)))
@@ -151,21 +151,54 @@ SampleGrid MakeGrid(const std::vector<double>& t, const std::string& source, dou
     s.grid.resize(m);
     for (size_t i = 0; i < m; ++i) s.grid[i] = t.front() + s.dt * static_cast<double>(i);
   }
-  if (!(cutoff_hz < 0.5 / s.dt))
-    throw InputError(source + ": sample period " + NumberText(s.dt) + " s is too long for the " +
-                     NumberText(cutoff_hz) + " Hz derivative filter, expected a sample rate above " +
-                     NumberText(2 * cutoff_hz) + " Hz");
   return s;
 }
 
-}  // namespace
+TimeBaseLowPass::TimeBaseLowPass(const std::vector<double>& t, double cutoff_hz, const std::string& source)
+    : TimeBaseLowPass(ExamineSampling(t, source), t, cutoff_hz, source) {}
+
+TimeBaseLowPass::TimeBaseLowPass(const Sampling& s, const std::vector<double>& t, double cutoff_hz,
+                                 const std::string& source)
+    : uniform_(s.uniform) {
+  CheckCutoff(s, cutoff_hz, source);
+  sos_ = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, cutoff_hz);
+  if (!uniform_) t_ = t, grid_ = s.grid;
+}
+
+void TimeBaseLowPass::Apply(std::vector<double>* const* xs, size_t count) const {
+  if (uniform_) {
+    dsp::FiltFiltInPlace(sos_, xs, count);
+    return;
+  }
+  std::vector<std::vector<double>> on_grid(count);
+  std::vector<std::vector<double>*> ptr(count);
+  for (size_t k = 0; k < count; ++k) on_grid[k] = Interpolate(t_, *xs[k], grid_), ptr[k] = &on_grid[k];
+  dsp::FiltFiltInPlace(sos_, ptr.data(), count);
+  for (size_t k = 0; k < count; ++k) *xs[k] = Interpolate(grid_, on_grid[k], t_);
+}
+
+void TimeBaseLowPass::Apply(std::vector<double>& x) const {
+  std::vector<double>* one = &x;
+  Apply(&one, 1);
+}
 
 std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::vector<double>& x,
                                       double cutoff_hz, const std::string& source) {
-  const SampleGrid s = MakeGrid(t, source, cutoff_hz);
-  const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, cutoff_hz);
-  if (s.uniform) return dsp::FiltFilt(sos, x);
-  return Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(t, x, s.grid)), t);
+  return TimeBaseLowPass(t, cutoff_hz, source)(x);
+}
+
+AngleRates DeriveAngleRates(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
+                            double cutoff_hz, const std::string& source) {
+  CheckCutoff(s, cutoff_hz, source);
+  AngleRates r;
+  dsp::Derivatives der = dsp::ZeroPhaseDerivatives(s.uniform ? q : Interpolate(t, q, s.grid), s.dt, cutoff_hz);
+  r.qd = std::move(der.first);
+  r.qdd = std::move(der.second);
+  if (!s.uniform) {
+    r.qd = Interpolate(s.grid, r.qd, t);
+    r.qdd = Interpolate(s.grid, r.qdd, t);
+  }
+  return r;
 }
 
 namespace {
@@ -188,26 +221,17 @@ void Derive(const std::vector<double>* measured[2][2], const std::string& source
     k.derivative_source = "measured columns";
     return;
   }
-  const SampleGrid s = MakeGrid(k.t, source, cutoff_hz);
+  const Sampling s = ExamineSampling(k.t, source);
+  CheckCutoff(s, cutoff_hz, source);
   k.resampled = !s.uniform;
   for (int j = 0; j < 2; ++j) {
     const auto* qd = measured[j][0];
     const auto* qdd = measured[j][1];
-    std::vector<double> v, a;
-    {
-      dsp::Derivatives der =
-          dsp::ZeroPhaseDerivatives(s.uniform ? k.q[j] : Interpolate(k.t, k.q[j], s.grid), s.dt, cutoff_hz);
-      v = std::move(der.first);
-      a = std::move(der.second);
-    }
-    if (!s.uniform) {
-      v = Interpolate(s.grid, v, k.t);
-      a = Interpolate(s.grid, a, k.t);
-    }
+    AngleRates r = DeriveAngleRates(s, k.t, k.q[j], cutoff_hz, source);
     if (qd) k.qd[j] = *qd;
-    else k.qd[j] = std::move(v);
+    else k.qd[j] = std::move(r.qd);
     if (qdd) k.qdd[j] = *qdd;
-    else k.qdd[j] = std::move(a);
+    else k.qdd[j] = std::move(r.qdd);
   }
   k.derivative_source = "butterworth " + NumberText(cutoff_hz) + " Hz";
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "analysis/csv_table.h"
+#include "dsp/butterworth.h"
 
 namespace exotwin {
 
@@ -73,6 +74,49 @@ Kinematics DeriveKinematics(MeasuredData&& data, double cutoff_hz = 20.0);
 // the record in messages.
 std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::vector<double>& x,
                                       double cutoff_hz, const std::string& source);
+
+// The sampling of a record's times t as DeriveKinematics and LowPassOnTimeBase see it: the median
+// step, and whether every step is within 1 % of it (uniform: the filters run on t's own samples;
+// else on a uniform grid at the median step, from t's first time).
+struct Sampling {
+  double dt = 0;              // median step, s
+  bool uniform = true;
+  std::vector<double> grid;   // non-uniform only: t.front() + i dt
+};
+// Throws InputError naming `source` for a median step below 1e-6 s or a record too irregular to
+// resample (as DeriveKinematics does).
+Sampling ExamineSampling(const std::vector<double>& t, const std::string& source);
+
+// LowPassOnTimeBase for many signals on one time base: the sampling examined and the filter
+// designed once. Apply(x) gives LowPassOnTimeBase(t, x, cutoff_hz, source) bit for bit, without
+// copying x. Keeps a copy of t when t is non-uniform (else no reference to it).
+class TimeBaseLowPass {
+ public:
+  TimeBaseLowPass(const std::vector<double>& t, double cutoff_hz, const std::string& source);
+  // With t's sampling already examined (s = ExamineSampling(t, source)).
+  TimeBaseLowPass(const Sampling& s, const std::vector<double>& t, double cutoff_hz, const std::string& source);
+  void Apply(std::vector<double>& x) const;  // x (one value per time of t) filtered in place
+  // Apply to *xs[0] .. *xs[count - 1], faster than one by one (dsp::FiltFiltInPlace of several).
+  void Apply(std::vector<double>* const* xs, size_t count) const;
+  std::vector<double> operator()(std::vector<double> x) const {
+    Apply(x);
+    return x;
+  }
+
+ private:
+  bool uniform_ = true;
+  std::vector<double> t_, grid_;  // non-uniform only
+  std::vector<dsp::Biquad> sos_;
+};
+
+// The velocity and acceleration DeriveKinematics derives from angle q (one value per time of t)
+// at cutoff_hz, on t's sampling s = ExamineSampling(t, source). Throws InputError naming `source`
+// when cutoff_hz is not below half the sample rate.
+struct AngleRates {
+  std::vector<double> qd, qdd;
+};
+AngleRates DeriveAngleRates(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
+                            double cutoff_hz, const std::string& source);
 
 // Median sample period (s) of strictly increasing times (>= 2 samples).
 double MedianStep(const std::vector<double>& t);

@@ -8,6 +8,7 @@
 #include "analysis/measured_data.h"
 #include "analysis/model_file.h"
 #include "app/commands.h"
+#include "core/heap_policy.h"
 
 namespace exotwin {
 namespace {
@@ -36,6 +37,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
   sub->add_option("--max-effects", o->max_effects, "most effects named together (0..6, default 6)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
+    KeepFreedMemoryForReuse();
     const LegParams params = ReadModelFile(o->params);
     DiagnoseOptions opt;
     opt.holdout_fraction = o->holdout;

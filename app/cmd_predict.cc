@@ -11,6 +11,7 @@
 #include "analysis/predict.h"
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/heap_policy.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -42,6 +43,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
                   "prediction error, as diagnose does); default 20 (Hwang & Jeon sec. 3.2)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
+    KeepFreedMemoryForReuse();
     const LegParams params = ReadModelFile(o->params);
     MapReport map_report;
     MeasuredData data = ReadMeasuredKinematics(o->measured, o->map, o->side, 20, &map_report);

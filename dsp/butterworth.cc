@@ -1,5 +1,6 @@
 #include "dsp/butterworth.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
@@ -18,6 +19,100 @@ cd EvalCascade(const std::vector<Biquad>& sos, cd z) {
   for (const Biquad& s : sos)
     h *= (s.b0 + s.b1 * zi + s.b2 * zi * zi) / (1.0 + s.a1 * zi + s.a2 * zi * zi);
   return h;
+}
+
+// One sample through one section with its state (z0, z1) (transposed direct form II); T is
+// double or Pair.
+template <class T>
+inline T StepSection(T b0, T b1, T b2, T a1, T a2, T& z0, T& z1, T x) {
+  const T y = b0 * x + z0;
+  z0 = b1 * x - a1 * y + z1;
+  z1 = b2 * x - a2 * y;
+  return y;
+}
+
+// Two signals' values, one per lane: SSE2's packed operations are, lane by lane, the IEEE
+// operations on one double (x86-64 has no fused multiply-add unless the build asks for it).
+using Pair = double __attribute__((vector_size(16)));
+
+// One sample through the cascade with its state z (one pair per section).
+inline double StepCascade(const std::vector<Biquad>& sos, std::array<double, 2>* z, double x) {
+  for (size_t i = 0; i < sos.size(); ++i) {
+    const Biquad& s = sos[i];
+    x = StepSection(s.b0, s.b1, s.b2, s.a1, s.a2, z[i][0], z[i][1], x);
+  }
+  return x;
+}
+
+// x[k][0 .. n) of K signals through one section, interleaved sample by sample (two per Pair),
+// forward or backward, with the coefficients and the states z[k] held in registers.
+template <size_t K>
+void RunOneSection(const Biquad& s, std::array<double, 2>* const* z, double* const* x, size_t n, bool backward) {
+  constexpr size_t P = K / 2;  // pairs; an odd K leaves one signal on its own
+  const double b0 = s.b0, b1 = s.b1, b2 = s.b2, a1 = s.a1, a2 = s.a2;
+  const Pair B0 = {b0, b0}, B1 = {b1, b1}, B2 = {b2, b2}, A1 = {a1, a1}, A2 = {a2, a2};
+  Pair z0[P + 1], z1[P + 1];
+  double z0_odd = 0, z1_odd = 0;
+  for (size_t p = 0; p < P; ++p) {
+    z0[p] = Pair{z[2 * p][0][0], z[2 * p + 1][0][0]};
+    z1[p] = Pair{z[2 * p][0][1], z[2 * p + 1][0][1]};
+  }
+  if (K % 2) z0_odd = z[K - 1][0][0], z1_odd = z[K - 1][0][1];
+  auto step = [&](size_t i) {
+    for (size_t p = 0; p < P; ++p) {
+      const Pair y = StepSection(B0, B1, B2, A1, A2, z0[p], z1[p], Pair{x[2 * p][i], x[2 * p + 1][i]});
+      x[2 * p][i] = y[0], x[2 * p + 1][i] = y[1];
+    }
+    if (K % 2) x[K - 1][i] = StepSection(b0, b1, b2, a1, a2, z0_odd, z1_odd, x[K - 1][i]);
+  };
+  if (!backward) {
+    for (size_t i = 0; i < n; ++i) step(i);
+  } else {
+    for (size_t i = n; i-- > 0;) step(i);
+  }
+  for (size_t p = 0; p < P; ++p) {
+    z[2 * p][0][0] = z0[p][0], z[2 * p + 1][0][0] = z0[p][1];
+    z[2 * p][0][1] = z1[p][0], z[2 * p + 1][0][1] = z1[p][1];
+  }
+  if (K % 2) z[K - 1][0][0] = z0_odd, z[K - 1][0][1] = z1_odd;
+}
+
+// x[k][0 .. n) of K (1 .. 8) signals through the cascade, interleaved sample by sample (their
+// recursions are independent, so the processor overlaps them), forward or backward, states z[k].
+void RunCascade(const std::vector<Biquad>& sos, std::array<double, 2>* const* z, double* const* x, size_t K,
+                size_t n, bool backward) {
+  if (sos.size() == 1) {
+    switch (K) {
+      case 1: return RunOneSection<1>(sos[0], z, x, n, backward);
+      case 2: return RunOneSection<2>(sos[0], z, x, n, backward);
+      case 3: return RunOneSection<3>(sos[0], z, x, n, backward);
+      case 4: return RunOneSection<4>(sos[0], z, x, n, backward);
+      case 5: return RunOneSection<5>(sos[0], z, x, n, backward);
+      case 6: return RunOneSection<6>(sos[0], z, x, n, backward);
+      case 7: return RunOneSection<7>(sos[0], z, x, n, backward);
+      case 8: return RunOneSection<8>(sos[0], z, x, n, backward);
+      default: break;
+    }
+  }
+  if (!backward) {
+    for (size_t i = 0; i < n; ++i)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k], x[k][i]);
+  } else {
+    for (size_t i = n; i-- > 0;)
+      for (size_t k = 0; k < K; ++k) x[k][i] = StepCascade(sos, z[k], x[k][i]);
+  }
+}
+
+// The state z of the cascade's steady state for a constant input x.
+inline void ResetCascade(const std::vector<Biquad>& sos, std::array<double, 2>* z, double x) {
+  for (size_t i = 0; i < sos.size(); ++i) {
+    const Biquad& s = sos[i];
+    const double den = 1.0 + s.a1 + s.a2;
+    const double y = std::abs(den) > 1e-300 ? x * (s.b0 + s.b1 + s.b2) / den : 0.0;
+    z[i][1] = s.b2 * x - s.a2 * y;
+    z[i][0] = s.b1 * x - s.a1 * y + z[i][1];
+    x = y;
+  }
 }
 
 }  // namespace
@@ -122,50 +217,60 @@ double MagnitudeResponse(const std::vector<Biquad>& sos, double fs, double f) {
 
 SosFilter::SosFilter(std::vector<Biquad> sos) : sos_(std::move(sos)), z_(sos_.size(), {0.0, 0.0}) {}
 
-double SosFilter::Step(double x) {
-  for (size_t i = 0; i < sos_.size(); ++i) {
-    const Biquad& s = sos_[i];
-    auto& z = z_[i];
-    const double y = s.b0 * x + z[0];
-    z[0] = s.b1 * x - s.a1 * y + z[1];
-    z[1] = s.b2 * x - s.a2 * y;
-    x = y;
-  }
-  return x;
-}
+double SosFilter::Step(double x) { return StepCascade(sos_, z_.data(), x); }
 
-void SosFilter::ResetSteady(double x) {
-  for (size_t i = 0; i < sos_.size(); ++i) {
-    const Biquad& s = sos_[i];
-    const double den = 1.0 + s.a1 + s.a2;
-    const double y = std::abs(den) > 1e-300 ? x * (s.b0 + s.b1 + s.b2) / den : 0.0;
-    z_[i][1] = s.b2 * x - s.a2 * y;
-    z_[i][0] = s.b1 * x - s.a1 * y + z_[i][1];
-    x = y;
-  }
-}
+void SosFilter::ResetSteady(double x) { ResetCascade(sos_, z_.data(), x); }
 
 void SosFilter::Reset() {
   for (auto& z : z_) z = {0.0, 0.0};
 }
 
-std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {
-  const size_t n = x.size();
-  if (n == 0) return {};
-  size_t pad = 3 * (2 * sos.size() + 1);
-  if (pad >= n) pad = n - 1;
-  std::vector<double> ext;
-  ext.reserve(n + 2 * pad);
-  for (size_t i = pad; i >= 1; --i) ext.push_back(2.0 * x[0] - x[i]);
-  ext.insert(ext.end(), x.begin(), x.end());
-  for (size_t i = 1; i <= pad; ++i) ext.push_back(2.0 * x[n - 1] - x[n - 1 - i]);
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count) {
+  // Up to kBlock signals at a time (RunCascade); each goes through exactly the operations a padded
+  // copy of it would: the odd-reflected extension [head, x, tail] forward, then backward (the
+  // head's backward pass only shapes samples that are cropped).
+  constexpr size_t kBlock = 8;
+  const size_t sections = sos.size();
+  for (size_t first = 0; first < count; first += kBlock) {
+    const size_t K = std::min(kBlock, count - first);
+    const size_t n = xs[first]->size();
+    for (size_t k = 1; k < K; ++k)
+      if (xs[first + k]->size() != n) throw std::invalid_argument("FiltFiltInPlace: signals of different lengths");
+    if (n == 0) continue;
+    size_t pad = 3 * (2 * sections + 1);
+    if (pad >= n) pad = n - 1;
+    double* x[kBlock];
+    std::vector<double> head[kBlock], tail[kBlock];
+    std::vector<std::array<double, 2>> z[kBlock];
+    for (size_t k = 0; k < K; ++k) {
+      x[k] = xs[first + k]->data();
+      head[k].resize(pad), tail[k].resize(pad);
+      for (size_t i = 0; i < pad; ++i) head[k][i] = 2.0 * x[k][0] - x[k][pad - i];
+      for (size_t i = 1; i <= pad; ++i) tail[k][i - 1] = 2.0 * x[k][n - 1] - x[k][n - 1 - i];
+      z[k].assign(sections, {0.0, 0.0});
+      ResetCascade(sos, z[k].data(), pad > 0 ? head[k].front() : x[k][0]);
+    }
+    double *h[kBlock], *t[kBlock];
+    std::array<double, 2>* zk[kBlock];
+    for (size_t k = 0; k < K; ++k) h[k] = head[k].data(), t[k] = tail[k].data(), zk[k] = z[k].data();
+    RunCascade(sos, zk, h, K, pad, false);
+    RunCascade(sos, zk, x, K, n, false);
+    RunCascade(sos, zk, t, K, pad, false);
+    for (size_t k = 0; k < K; ++k) ResetCascade(sos, z[k].data(), pad > 0 ? tail[k].back() : x[k][n - 1]);
+    RunCascade(sos, zk, t, K, pad, true);
+    RunCascade(sos, zk, x, K, n, true);
+  }
+}
 
-  SosFilter f(sos);
-  f.ResetSteady(ext.front());
-  for (double& v : ext) v = f.Step(v);
-  f.ResetSteady(ext.back());
-  for (auto it = ext.rbegin(); it != ext.rend(); ++it) *it = f.Step(*it);
-  return std::vector<double>(ext.begin() + pad, ext.begin() + pad + n);
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x) {
+  std::vector<double>* one = &x;
+  FiltFiltInPlace(sos, &one, 1);
+}
+
+std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {
+  std::vector<double> y = x;
+  FiltFiltInPlace(sos, y);
+  return y;
 }
 
 }  // namespace exotwin::dsp

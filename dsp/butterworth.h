@@ -2,6 +2,7 @@
 // causal filtering for the real-time path and zero-phase forward-backward filtering for off-line use.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <vector>
 
 namespace exotwin::dsp {
@@ -42,5 +43,11 @@ class SosFilter {
 // and steady-state initial conditions, like scipy.signal.sosfiltfilt. Inputs shorter than the pad
 // length use the whole signal as the pad.
 std::vector<double> FiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x);
+// FiltFilt(sos, x) written over x, bit for bit, without a padded copy of the signal.
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x);
+// The same for count signals of one length (*xs[0] .. *xs[count - 1]), each bit for bit as alone,
+// filtered a few at a time (faster than one by one). Throws std::invalid_argument for signals of
+// different lengths.
+void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count);
 
 }  // namespace exotwin::dsp

@@ -34,11 +34,22 @@ LumpedParams FromVector(const Vector6& v) {
   return p;
 }
 
+RegressorTrig TrigOf(const Eigen::Vector2d& q) {
+  RegressorTrig r;
+  r.c2 = std::cos(q[1]), r.s2 = std::sin(q[1]);
+  r.s1 = std::sin(q[0]), r.c1 = std::cos(q[0]);
+  r.s12 = std::sin(q[0] + q[1]), r.c12 = std::cos(q[0] + q[1]);
+  return r;
+}
+
 Matrix26 FullRegressor(double L1, double g, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                        const Eigen::Vector2d& qdd) {
-  const double c2 = std::cos(q[1]), s2 = std::sin(q[1]);
-  const double s1 = std::sin(q[0]), c1 = std::cos(q[0]);
-  const double s12 = std::sin(q[0] + q[1]), c12 = std::cos(q[0] + q[1]);
+  return FullRegressorOfTrig(L1, g, TrigOf(q), qd, qdd);
+}
+
+Matrix26 FullRegressorOfTrig(double L1, double g, const RegressorTrig& trig, const Eigen::Vector2d& qd,
+                       const Eigen::Vector2d& qdd) {
+  const double c2 = trig.c2, s2 = trig.s2, s1 = trig.s1, c1 = trig.c1, s12 = trig.s12, c12 = trig.c12;
   const double a = 2.0 * qdd[0] + qdd[1];               // coefficient of h in row 1
   const double v = qd[1] * qd[1] + 2.0 * qd[0] * qd[1];  // Coriolis/centrifugal combination, row 1
   Matrix26 Y;

@@ -17,6 +17,15 @@ LumpedParams FromVector(const Vector6& v);
 // Full regressor Y(q, qd, qdd) with M qdd + V + G = Y * [J1 J2 X1 X2 Y1 Y2]^T, any state.
 Matrix26 FullRegressor(double L1, double g, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                        const Eigen::Vector2d& qdd);
+// The sines and cosines of th1, th2 and th1 + th2 that FullRegressor uses.
+struct RegressorTrig {
+  double c2, s2, s1, c1, s12, c12;
+};
+RegressorTrig TrigOf(const Eigen::Vector2d& q);
+// FullRegressor(L1, g, q, qd, qdd) with trig = TrigOf(q), the same numbers: for a caller that
+// evaluates the regressor of one angle at several velocities.
+Matrix26 FullRegressorOfTrig(double L1, double g, const RegressorTrig& trig, const Eigen::Vector2d& qd,
+                       const Eigen::Vector2d& qdd);
 
 // One row of a step regressor: u* = w^T phi (HJ15 eq. 18).
 struct StepRow {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "dsp/butterworth.h"
 
 namespace exotwin {
 namespace {
@@ -98,6 +99,44 @@ TEST(DeriveKinematics, TakingTheColumnsEqualsCopyingThem) {
       EXPECT_EQ(a.resampled, b.resampled);
       EXPECT_EQ(a.derivative_source, b.derivative_source);
     }
+}
+
+
+// TimeBaseLowPass (the sampling examined once, the filter designed once, several signals at a
+// time) gives LowPassOnTimeBase's composition bit for bit: FiltFilt on a uniform record, through
+// the median-step grid and back on a non-uniform one; DeriveAngleRates gives DeriveKinematics' rates.
+TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
+  for (bool uniform : {true, false}) {
+    SCOPED_TRACE(uniform ? "uniform" : "non-uniform");
+    const MeasuredData d = Record(uniform, false);
+    const Sampling s = ExamineSampling(d.t, d.source);
+    EXPECT_EQ(s.uniform, uniform);
+    EXPECT_EQ(s.dt, MedianStep(d.t));
+    const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, 7.0);
+    const TimeBaseLowPass low(s, d.t, 7.0, d.source);
+    std::vector<double> xs[5] = {d.q_hip, d.q_knee, d.tau_hip, *d.Column("emg_VM"), d.t};
+    std::vector<double>* ptr[5];
+    for (int k = 0; k < 5; ++k) ptr[k] = &xs[k];
+    std::vector<double> batched[5] = {xs[0], xs[1], xs[2], xs[3], xs[4]};
+    std::vector<double>* bptr[5];
+    for (int k = 0; k < 5; ++k) bptr[k] = &batched[k];
+    low.Apply(bptr, 5);
+    for (int k = 0; k < 5; ++k) {
+      const std::vector<double> ref =
+          uniform ? dsp::FiltFilt(sos, xs[k]) : Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(d.t, xs[k], s.grid)), d.t);
+      EXPECT_EQ(low(xs[k]), ref);
+      EXPECT_EQ(TimeBaseLowPass(d.t, 7.0, d.source)(xs[k]), ref);
+      EXPECT_EQ(LowPassOnTimeBase(d.t, xs[k], 7.0, d.source), ref);
+      EXPECT_EQ(batched[k], ref);
+    }
+    const Kinematics k = DeriveKinematics(d, 15.0);
+    for (int j = 0; j < 2; ++j) {
+      const AngleRates r = DeriveAngleRates(s, d.t, j == 0 ? d.q_hip : d.q_knee, 15.0, d.source);
+      EXPECT_EQ(r.qd, k.qd[j]);
+      EXPECT_EQ(r.qdd, k.qdd[j]);
+    }
+    EXPECT_THROW(TimeBaseLowPass(s, d.t, 600.0, d.source), InputError);  // above half the sample rate
+  }
 }
 
 }  // namespace

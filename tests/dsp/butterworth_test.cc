@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace exotwin::dsp {
 namespace {
@@ -69,6 +71,61 @@ TEST(Butterworth, RejectsBadDesigns) {
   EXPECT_THROW(DesignButterworth(0, BandType::kLowPass, 1000, 20), std::invalid_argument);
   EXPECT_THROW(DesignButterworth(2, BandType::kLowPass, 1000, 600), std::invalid_argument);
   EXPECT_THROW(DesignButterworth(2, BandType::kBandPass, 1000, 450, 20), std::invalid_argument);
+}
+
+
+// FiltFilt as a padded copy filtered forward then backward (scipy's sosfiltfilt layout): the
+// reference the in-place and batched versions must match bit for bit.
+std::vector<double> PaddedFiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x) {
+  const size_t n = x.size();
+  size_t pad = 3 * (2 * sos.size() + 1);
+  if (pad >= n) pad = n - 1;
+  std::vector<double> ext;
+  for (size_t i = pad; i >= 1; --i) ext.push_back(2.0 * x[0] - x[i]);
+  ext.insert(ext.end(), x.begin(), x.end());
+  for (size_t i = 1; i <= pad; ++i) ext.push_back(2.0 * x[n - 1] - x[n - 1 - i]);
+  SosFilter f(sos);
+  f.ResetSteady(ext.front());
+  for (double& v : ext) v = f.Step(v);
+  f.ResetSteady(ext.back());
+  for (auto it = ext.rbegin(); it != ext.rend(); ++it) *it = f.Step(*it);
+  return std::vector<double>(ext.begin() + pad, ext.begin() + pad + n);
+}
+
+TEST(FiltFilt, InPlaceAndBatchedEqualThePaddedCopyBitForBit) {
+  const std::vector<Biquad> designs[] = {DesignButterworth(2, BandType::kLowPass, 1000.0, 7.0),
+                                         DesignButterworth(4, BandType::kLowPass, 500.0, 30.0),
+                                         DesignButterworth(2, BandType::kBandPass, 1000.0, 20.0, 80.0)};
+  for (const auto& sos : designs)
+    for (size_t n : {1, 2, 5, 9, 16, 1000}) {
+      SCOPED_TRACE(std::to_string(sos.size()) + " sections, n " + std::to_string(n));
+      std::vector<std::vector<double>> xs(11, std::vector<double>(n));
+      for (size_t k = 0; k < xs.size(); ++k)
+        for (size_t i = 0; i < n; ++i) xs[k][i] = std::sin(0.01 * (k + 1) * i) + 0.1 * std::cos(1.7 * i * i + k);
+      std::vector<std::vector<double>> ref, batched = xs;
+      for (const auto& x : xs) ref.push_back(PaddedFiltFilt(sos, x));
+      std::vector<double>* ptr[11];
+      for (size_t k = 0; k < 11; ++k) ptr[k] = &batched[k];
+      FiltFiltInPlace(sos, ptr, 11);  // a block of eight (four pairs), then three (a pair and one)
+      for (size_t k = 0; k < xs.size(); ++k) {
+        EXPECT_EQ(FiltFilt(sos, xs[k]), ref[k]);
+        std::vector<double> one = xs[k];
+        FiltFiltInPlace(sos, one);
+        EXPECT_EQ(one, ref[k]);
+        EXPECT_EQ(batched[k], ref[k]);
+      }
+    }
+  std::vector<double> a(10), b(11);
+  std::vector<double>* ab[2] = {&a, &b};
+  EXPECT_THROW(FiltFiltInPlace(designs[0], ab, 2), std::invalid_argument);
+}
+
+// The low-pass of zeros is +0 everywhere (a column that is zero needs no filtering).
+TEST(FiltFilt, ZerosStayPositiveZeros) {
+  for (double fc : {1.5, 20.0, 50.0}) {
+    const std::vector<double> y = FiltFilt(DesignButterworth(2, BandType::kLowPass, 500.0, fc), std::vector<double>(300, 0.0));
+    for (double v : y) EXPECT_TRUE(v == 0.0 && !std::signbit(v));
+  }
 }
 
 }  // namespace

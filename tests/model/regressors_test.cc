@@ -96,5 +96,19 @@ TEST(Regressors, PrintedSignOfEq15IsWrong) {
   EXPECT_NEAR(u - printed, 4 * lp.L1 * lp.exo.Y2 * ydd, 1e-9);
 }
 
+
+// The regressor from precomputed trigonometry is FullRegressor's, bit for bit.
+TEST(Regressors, FullRegressorOfTrigEqualsFullRegressor) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector2d q(u(rng), u(rng)), qd(u(rng), u(rng)), qdd(u(rng), u(rng));
+    const Matrix26 a = FullRegressor(0.41, 9.81, q, qd, qdd);
+    const Matrix26 b = FullRegressorOfTrig(0.41, 9.81, TrigOf(q), qd, qdd);
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 6; ++c) EXPECT_EQ(a(r, c), b(r, c));
+  }
+}
+
 }  // namespace
 }  // namespace exotwin
