@@ -115,8 +115,6 @@ TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
     const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, 7.0);
     const TimeBaseLowPass low(s, d.t, 7.0, d.source);
     std::vector<double> xs[5] = {d.q_hip, d.q_knee, d.tau_hip, *d.Column("emg_VM"), d.t};
-    std::vector<double>* ptr[5];
-    for (int k = 0; k < 5; ++k) ptr[k] = &xs[k];
     std::vector<double> batched[5] = {xs[0], xs[1], xs[2], xs[3], xs[4]};
     std::vector<double>* bptr[5];
     for (int k = 0; k < 5; ++k) bptr[k] = &batched[k];
