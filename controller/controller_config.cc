@@ -27,7 +27,8 @@ void ParseControllerSpec(const YamlContext& r, const YAML::Node& n, ControllerSp
 }
 
 namespace {
-std::string Num17(double v) {
+// 17 significant digits: the text reads back to the same double.
+std::string Num(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.17g", v);
   return b;
@@ -35,9 +36,9 @@ std::string Num17(double v) {
 }  // namespace
 
 std::string ControllerSpecYaml(const ControllerSpec& c) {
-  return "controller: {rate_hz: " + Num17(c.rate_hz) + ", kp: [" + Num17(c.kp[0]) + ", " + Num17(c.kp[1]) + "], kd: [" +
-         Num17(c.kd[0]) + ", " + Num17(c.kd[1]) + "], feedforward: " + (c.feedforward ? "true" : "false") +
-         ", torque_limit: " + Num17(c.torque_limit) + "}\n";
+  return "controller: {rate_hz: " + Num(c.rate_hz) + ", kp: [" + Num(c.kp[0]) + ", " + Num(c.kp[1]) + "], kd: [" +
+         Num(c.kd[0]) + ", " + Num(c.kd[1]) + "], feedforward: " + (c.feedforward ? "true" : "false") +
+         ", torque_limit: " + Num(c.torque_limit) + "}\n";
 }
 
 namespace controller {
@@ -171,8 +172,6 @@ void ParseReference(const YamlContext& r, const YAML::Node& n, ReferenceSpec* p)
   }
 }
 
-std::string Num(double v) { return Num17(v); }
-
 std::string LumpedYaml(const LumpedParams& p) {
   return "{J1: " + Num(p.J1) + ", J2: " + Num(p.J2) + ", X1: " + Num(p.X1) + ", X2: " + Num(p.X2) + ", Y1: " +
          Num(p.Y1) + ", Y2: " + Num(p.Y2) + "}";
@@ -180,8 +179,8 @@ std::string LumpedYaml(const LumpedParams& p) {
 
 
 // The numbers of a HAL-3 controller file's `hal:` mapping: path below `hal`, the field, its range.
-// Derived, not written: hal.rate_hz, velocity.sample_rate_hz (= controller.rate_hz), assist.dt and
-// assist.rls.dt (= 1 / controller.rate_hz, as HalLoopConfigOf sets them), assist.tau_max (= hal.tau_max).
+// Derived, not written (SetRateAndLimit from controller.rate_hz and hal.tau_max): hal.rate_hz,
+// velocity.sample_rate_hz, assist.dt, assist.rls.dt, assist.tau_max.
 struct HalNumber {
   const char* path;
   double* v;
@@ -327,21 +326,14 @@ HalLoopConfig ParseHal(const YamlContext& r, const YAML::Node& n, const Controll
   }
   if (c.tau_max > ctrl.torque_limit)
     r.Fail("hal.tau_max", Num(c.tau_max) + " N m is beyond controller.torque_limit " + Num(ctrl.torque_limit) + " N m");
-  c.rate_hz = ctrl.rate_hz;
-  c.velocity.sample_rate_hz = ctrl.rate_hz;
-  c.assist.dt = 1.0 / ctrl.rate_hz;
-  c.assist.rls.dt = c.assist.dt;
-  c.assist.tau_max = c.tau_max;
+  SetRateAndLimit(&c, ctrl.rate_hz);
   return c;
 }
 
-// The `hal:` mapping's text, block style, in the order of HalKeysBelow.
-void WriteHal(std::ostream& o, HalLoopConfig c, const std::string& prefix, int indent) {
-  std::map<std::string, std::string> leaf;
-  leaf["mode"] = HalModeName(c.mode);
-  for (const HalNumber& f : HalNumbers(c)) leaf[f.path] = Num(*f.v);
-  for (const HalFlag& f : HalFlags(c)) leaf[f.path] = *f.v ? "true" : "false";
-  for (const HalInteger& f : HalIntegers(c)) leaf[f.path] = std::to_string(*f.v);
+// The mapping at `prefix` of the `hal:` text, block style, in the order of HalKeysBelow; `leaf` holds
+// each value's text by path.
+void WriteHalMapping(std::ostream& o, const std::map<std::string, std::string>& leaf, const std::string& prefix,
+                     int indent) {
   for (const std::string& k : HalKeysBelow(prefix)) {
     const std::string path = prefix.empty() ? k : prefix + "." + k;
     o << std::string(indent, ' ') << k << ":";
@@ -349,9 +341,19 @@ void WriteHal(std::ostream& o, HalLoopConfig c, const std::string& prefix, int i
       o << " " << leaf.at(path) << "\n";
     } else {
       o << "\n";
-      WriteHal(o, c, path, indent + 2);
+      WriteHalMapping(o, leaf, path, indent + 2);
     }
   }
+}
+
+// The `hal:` mapping's entries (two-space indent) for `c`.
+void WriteHal(std::ostream& o, HalLoopConfig c) {
+  std::map<std::string, std::string> leaf;
+  leaf["mode"] = HalModeName(c.mode);
+  for (const HalNumber& f : HalNumbers(c)) leaf[f.path] = Num(*f.v);
+  for (const HalFlag& f : HalFlags(c)) leaf[f.path] = *f.v ? "true" : "false";
+  for (const HalInteger& f : HalIntegers(c)) leaf[f.path] = std::to_string(*f.v);
+  WriteHalMapping(o, leaf, "", 2);
 }
 }  // namespace
 
@@ -404,7 +406,7 @@ std::string ControllerFileYaml(const ControllerFile& f, const std::string& comme
   o << "drivers: {torque_limit: " << Num(f.driver_limit) << "}\n";
   if (f.hal) {
     o << "hal:\n";
-    WriteHal(o, *f.hal, "", 2);
+    WriteHal(o, *f.hal);
     o << "trials: " << f.trials << "\n";
     return o.str();
   }

@@ -18,6 +18,14 @@ const char* HalModeName(HalMode m) {
   return "?";
 }
 
+void SetRateAndLimit(HalLoopConfig* c, double rate_hz) {
+  c->rate_hz = rate_hz;
+  c->velocity.sample_rate_hz = rate_hz;
+  c->assist.dt = 1.0 / rate_hz;
+  c->assist.rls.dt = c->assist.dt;
+  c->assist.tau_max = c->tau_max;
+}
+
 namespace {
 HalLoopConfig Checked(const HalLoopConfig& c) {
   if (!(c.rate_hz > 0) || !(c.tau_max > 0) || !(c.status_timeout > 0) ||

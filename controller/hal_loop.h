@@ -38,6 +38,11 @@ struct HalLoopConfig {
   double status_timeout = 0.02;     // s without a status frame -> torque off (enable = false)
 };
 
+// Sets the fields that follow the loop's rate and command limit: rate_hz, the velocity filter's sample
+// rate, the assist's and the RLS's dt (1 / rate_hz, the T_d of HKS05 eq. 11) and assist.tau_max
+// (= tau_max). The runner and the controller file's reader both derive them here.
+void SetRateAndLimit(HalLoopConfig* c, double rate_hz);
+
 // What one tick saw and did.
 struct HalTelemetry {
   double t = 0;

@@ -243,7 +243,7 @@ void ControllerNode::SendHalTelemetry() {
 }
 
 void ControllerNode::ZeroTorque() {
-  if (cfg_.hal || (scenario_mode_ && scenario_hal_)) {
+  if (cfg_.hal || scenario_hal_) {  // a HAL-3 file, or a HAL-3 scenario before its first download
     msg::HalKneeCommand c;
     c.torque = 0.0;
     c.enable = false;

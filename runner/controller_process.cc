@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <thread>
 #include <vector>
 
@@ -39,11 +38,9 @@ std::string WriteControllerFile(const Scenario& s, const std::string& dir, uint6
 }
 
 std::string WriteControllerScenario(const Scenario& s, const std::string& path) {
-  std::ofstream out(path);
-  out << "# the device and controller part of " << s.source << " (exotwin-controller asks the twin for the rest)\n"
-      << "device: " << DeviceName(s.device) << "\n"
-      << ControllerSpecYaml(s.controller);
-  if (!out) throw InputError(path + ": cannot write the controller's scenario file");
+  WriteFileAtomic(path, "# the device and controller part of " + s.source +
+                            " (exotwin-controller asks the twin for the rest)\ndevice: " + DeviceName(s.device) + "\n" +
+                            ControllerSpecYaml(s.controller));
   return path;
 }
 

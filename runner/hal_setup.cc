@@ -31,24 +31,19 @@ controller::HalLoopConfig HalLoopConfigOf(const Scenario& s, const Hal3PlantPara
   const std::string& mode = s.hal.mode;
   c.mode = mode == "none" ? controller::HalMode::kNone
                           : (mode == "assist" ? controller::HalMode::kAssist : controller::HalMode::kImpedance);
-  c.rate_hz = s.controller.rate_hz;
   c.rms_window = kHalRmsWindow;
   c.tau_max = std::min(60.0, s.controller.torque_limit);
   c.extensor_channel = kHalExtChannel;
   c.flexor_channel = kHalFlexChannel;
-  c.velocity.sample_rate_hz = s.controller.rate_hz;
   // tau_c (Lee & Sankai; HKS05 eq. 6): identified exoskeleton (HKS05 eq. 15; the twin hands over its
   // true values: identification itself is tested in tests/controller/hal_assist_test.cc). Inertia
   // is not compensated (I_v = I: a causal acceleration estimate from a potentiometer is too noisy).
   c.impedance.actual = {pp.hal_I(), pp.R, pp.hal_mgl(), pp.C};
   c.impedance.target = {pp.hal_I(), B_v, pp.hal_mgl(), 0.0};
   controller::HalAssistConfig& a = c.assist;
-  a.dt = 1.0 / s.controller.rate_hz;
   a.alpha_mu = s.hal.alpha_mu;
   a.alpha_zeta = s.hal.alpha_zeta;
   a.emg = emg;
-  a.tau_max = c.tau_max;
-  a.rls.dt = a.dt;
   a.rls.R = pp.R;        // HKS05 eq. 15
   a.rls.mgl = pp.mgl();  // HKS05 eq. 14
   a.rls.I0 = pp.I();
@@ -58,6 +53,7 @@ controller::HalLoopConfig HalLoopConfigOf(const Scenario& s, const Hal3PlantPara
     a.friction_C = c.impedance.actual.C;
     a.friction_eps = c.impedance.coulomb_eps;
   }
+  controller::SetRateAndLimit(&c, s.controller.rate_hz);
   return c;
 }
 
