@@ -247,7 +247,7 @@ MeasuredData ApplyColumnMap(const ColumnMap& map, const CsvTable& in, const std:
     throw InputError(std::string(e.what()) + " (after the column map " + map.source + ")");
   }
   rep.rows_out = d.size();
-  StepStatistics(d.t, &rep);
+  StepStatistics(d.t(), &rep);
   if (report) *report = rep;
   return d;
 }

@@ -82,7 +82,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     if (d->size() < 200)
       throw InputError(d->source + ": " + std::to_string(d->size()) +
                        " samples, expected at least 200 to choose the derivative cutoff");
-    fs_min = std::min(fs_min, 1.0 / MedianStep(d->t));
+    fs_min = std::min(fs_min, 1.0 / MedianStep(d->t()));
     for (const char* n : {"qd_hip", "qdd_hip", "qd_knee", "qdd_knee"}) all_columns &= d->Column(n) != nullptr;
   }
   if (all_columns) {
@@ -101,7 +101,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   for (int j = 0; j < 2; ++j) {
     double s = 0, ss = 0, n = 0;
     for (const MeasuredData* d : records)
-      for (double v : j == 0 ? d->tau_hip : d->tau_knee) s += v, ss += v * v, n += 1;
+      for (double v : j == 0 ? d->tau_hip() : d->tau_knee()) s += v, ss += v * v, n += 1;
     var[j] = std::max(ss / n - (s / n) * (s / n), 1e-12);
   }
   std::vector<RecordBase> base(records.size());
@@ -109,7 +109,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     const MeasuredData& d = *records[r];
     RecordBase& B = base[r];
     const size_t n = d.size();
-    B.sampling = ExamineSampling(d.t, d.source);
+    B.sampling = ExamineSampling(d.t(), d.source);
     const size_t edge = std::min<size_t>(n / 20, static_cast<size_t>(0.5 / B.sampling.dt));  // filter edges
     B.split = static_cast<size_t>(kTrainFraction * static_cast<double>(n));
     const size_t stride = std::max<size_t>(1, n / kMaxRowsPerRecord);
@@ -119,11 +119,11 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       for (int k = 0; k < 2; ++k) B.recorded[j][k] = d.Column(std::string(k == 0 ? "qd_" : "qdd_") + names[j]);
     if (parallel) {
       B.trig.reserve(n);
-      for (size_t i = 0; i < n; ++i) B.trig.push_back(TrigOf({d.q_hip[i], d.q_knee[i]}));
+      for (size_t i = 0; i < n; ++i) B.trig.push_back(TrigOf({d.q_hip()[i], d.q_knee()[i]}));
     }
   }
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
-  constexpr size_t kBatch = 8;                  // columns low-passed together
+  constexpr size_t kBatch = 6;                  // columns low-passed together (memory: kBatch records)
   std::vector<double> batch[kBatch];
   for (double fc : c.candidates_hz) {
     // Per record, on the rows: the regressor (parallel: from the angles differentiated at
@@ -145,19 +145,19 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       // The rates DeriveKinematics(d, cutoff) gives: a recorded column as recorded.
       const double cutoff = parallel ? DerivativeCutoffHz(fc, 1.0 / B.sampling.dt) : fc;
       AngleRates derived[2];
-      const std::vector<double>* q[2] = {&d.q_hip, &d.q_knee};
+      const std::vector<double>* q[2] = {&d.q_hip(), &d.q_knee()};
       const std::vector<double>* qd[2];
       const std::vector<double>* qdd[2];
       for (int j = 0; j < 2; ++j) {
         if (!B.recorded[j][0] || !B.recorded[j][1])
-          derived[j] = DeriveAngleRates(B.sampling, d.t, *q[j], cutoff, d.source);
+          derived[j] = DeriveAngleRates(B.sampling, d.t(), *q[j], cutoff, d.source);
         qd[j] = B.recorded[j][0] ? B.recorded[j][0] : &derived[j].qd;
         qdd[j] = B.recorded[j][1] ? B.recorded[j][1] : &derived[j].qdd;
       }
       Rows& R = rows[r];
       R.Y.assign(at.size(), Eigen::Matrix<double, 2, kCols>::Zero());
       R.u_f.resize(at.size()), R.u_raw.resize(at.size()), R.train.resize(at.size());
-      const std::vector<double>* tau[2] = {&d.tau_hip, &d.tau_knee};
+      const std::vector<double>* tau[2] = {&d.tau_hip(), &d.tau_knee()};
       if (!parallel) {
         for (size_t a = 0; a < at.size(); ++a) RegressorRows(L1, g, q, qd, qdd, at[a], &R.Y[a]);
         for (int j = 0; j < 2; ++j)
@@ -166,7 +166,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
         // Each column of RegressorRows over all samples, low-passed, taken at the rows, then the
         // torque; eight at a time through one low-pass. The columns RegressorRows leaves zero stay
         // zero (the low-pass of zeros is zero).
-        const TimeBaseLowPass low(B.sampling, d.t, fc, d.source);
+        const TimeBaseLowPass low(B.sampling, d.t(), fc, d.source);
         enum Kind { kRegressor, kOnes, kSign, kRate, kTorque };
         struct Col {
           Kind kind;
@@ -178,8 +178,9 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
             {kRegressor, 1, 5}, {kOnes, 0, 6},      {kSign, 0, 7},      {kSign, 1, 10},
             {kRate, 0, 8},      {kRate, 1, 11},     {kTorque, 0, 0},    {kTorque, 1, 0}};
         for (size_t c0 = 0; c0 < std::size(kFiltered); c0 += kBatch) {
+          const size_t K = std::min(kBatch, std::size(kFiltered) - c0);
           bool regressor = false;
-          for (size_t e = 0; e < kBatch; ++e) {
+          for (size_t e = 0; e < K; ++e) {
             const Col& c = kFiltered[c0 + e];
             std::vector<double>& v = batch[e];
             v.resize(n);
@@ -197,13 +198,13 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
             for (size_t i = 0; i < n; ++i) {
               const Matrix26 Y =
                   FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
-              for (size_t e = 0; e < kBatch; ++e)
+              for (size_t e = 0; e < K; ++e)
                 if (kFiltered[c0 + e].kind == kRegressor) batch[e][i] = Y(kFiltered[c0 + e].j, kFiltered[c0 + e].col);
             }
           std::vector<double>* ptr[kBatch];
-          for (size_t e = 0; e < kBatch; ++e) ptr[e] = &batch[e];
-          low.Apply(ptr, kBatch);
-          for (size_t e = 0; e < kBatch; ++e) {
+          for (size_t e = 0; e < K; ++e) ptr[e] = &batch[e];
+          low.Apply(ptr, K);
+          for (size_t e = 0; e < K; ++e) {
             const Col& c = kFiltered[c0 + e];
             const std::vector<double>& v = batch[e];
             for (size_t a = 0; a < at.size(); ++a) {

@@ -22,6 +22,7 @@
 #include "analysis/predict.h"
 #include "analysis/statistics.h"
 #include "core/error.h"
+#include "core/heap_policy.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
 #include "sim/plant.h"
@@ -34,12 +35,14 @@ const char* kJoint[2] = {"hip", "knee"};
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
 struct Rec {
-  const MeasuredData* data = nullptr;
+  std::string source;  // the record's name, for messages
+  size_t samples = 0;  // the record's samples (before the trim)
   Kinematics kin;
+  std::vector<double> taken[2];         // the record's tau_hip, tau_knee when Diagnose took it over
   const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
   std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
   double hz = 0;                        // the parallel low-pass (0: none)
-  std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque, reading with its effects
+  std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque (after stage 2 only on [0, RefineRows)), reading with its effects
   std::vector<double> resid[2];
   size_t split = 0;
   std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
@@ -50,11 +53,11 @@ struct Rec {
     if (!(hz > 0)) return x;
     if (from == 0 && x.size() == kin.t.size()) return (*low)(std::move(x));
     const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
-    return LowPassOnTimeBase(t, x, hz, data->source);
+    return LowPassOnTimeBase(t, x, hz, source);
   }
-  std::function<std::vector<double>(const std::vector<double>&)> FilterFn() const {
+  std::function<void(std::vector<double>&)> FilterFn() const {
     if (!(hz > 0)) return {};
-    return [this](const std::vector<double>& x) { return Filter(x); };
+    return [this](std::vector<double>& x) { x = Filter(std::move(x)); };
   }
 };
 
@@ -79,7 +82,7 @@ void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
   };
   const MeasuredData& a = *records[0];
   const std::set<std::string> ka = known(a);
-  const double dta = MedianStep(a.t);
+  const double dta = MedianStep(a.t());
   for (size_t i = 1; i < records.size(); ++i) {
     const MeasuredData& b = *records[i];
     if (known(b) != ka) {
@@ -90,9 +93,9 @@ void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
                        ") differ from " + a.source + "'s (" + (sa.empty() ? " none" : sa) +
                        "), expected records of one device with the same columns");
     }
-    const double r = MedianStep(b.t) / dta;
+    const double r = MedianStep(b.t()) / dta;
     if (!(r < 5 && r > 0.2))
-      throw InputError(b.source + ": median time step " + NumberText(MedianStep(b.t)) + " s against " +
+      throw InputError(b.source + ": median time step " + NumberText(MedianStep(b.t())) + " s against " +
                        NumberText(dta) + " s in " + a.source +
                        ", expected records of one device in the same time unit (s)");
   }
@@ -199,16 +202,28 @@ CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const Meas
 
 // Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
 // transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of its time,
-// the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual.
-void PrepareRecord(const LegParams& params, const MeasuredData& data, const CutoffChoice& cutoff,
-                   double holdout_fraction, Rec* out) {
+// the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual. With `owned`
+// (the record itself, which Diagnose may consume) its columns are moved, not copied: the record is
+// left empty.
+void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
+                   const CutoffChoice& cutoff, double holdout_fraction, Rec* out) {
   Rec& rc = *out;
-  rc.data = &data;
+  rc.source = data.source;
+  rc.samples = data.size();
   // Parallel filtering (as in robot identification practice): the residual is low-passed at the
   // chosen cutoff fc, the angles differentiated at DerivativeCutoffHz(fc), flat where fc passes,
   // so that measured and predicted torque see one and the same filter.
-  rc.kin = DeriveKinematics(
-      data, cutoff.from_columns ? 20.0 : DerivativeCutoffHz(cutoff.hz, 1.0 / MedianStep(data.t)));
+  const double hz = cutoff.from_columns ? 20.0 : DerivativeCutoffHz(cutoff.hz, 1.0 / MedianStep(data.t()));
+  const std::vector<double>* meas[2] = {&data.tau_hip(), &data.tau_knee()};
+  if (owned) {
+    for (int j = 0; j < 2; ++j) {
+      rc.taken[j] = std::move(owned->column_at(j == 0 ? kColTauHip : kColTauKnee));
+      meas[j] = &rc.taken[j];
+    }
+    rc.kin = DeriveKinematics(std::move(*owned), hz);
+  } else {
+    rc.kin = DeriveKinematics(data, hz);
+  }
   const bool filtered = rc.kin.derivative_source != "measured columns";
   rc.hz = filtered ? cutoff.hz : 0.0;
   // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
@@ -218,12 +233,8 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, const Cuto
   const size_t a = static_cast<size_t>(std::lower_bound(t.begin(), t.end(), t.front() + edge) - t.begin());
   const size_t b = static_cast<size_t>(std::upper_bound(t.begin(), t.end(), t.back() - edge) - t.begin());
   TrimTo(&rc.kin, a, b);
-  if (filtered) rc.low.emplace(rc.kin.t, rc.hz, data.source);
-  const std::vector<double>* meas[2] = {&data.tau_hip, &data.tau_knee};
-  for (int j = 0; j < 2; ++j) {
-    rc.raw[j] = meas[j]->data() + a;
-    rc.meas[j] = rc.Filter(std::vector<double>(rc.raw[j], rc.raw[j] + (b - a)));
-  }
+  if (filtered) rc.low.emplace(rc.kin.t, rc.hz, rc.source);
+  for (int j = 0; j < 2; ++j) rc.raw[j] = meas[j]->data() + a;
   const Kinematics& kin = rc.kin;
   const size_t n = kin.t.size();
   const double t_split = kin.t.front() + (1 - holdout_fraction) * (kin.t.back() - kin.t.front());
@@ -246,6 +257,13 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, const Cuto
     for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.raw[j][i] - rc.tau_S[j][i];
     rc.resid[j] = rc.Filter(std::move(rc.resid[j]));
   }
+}
+
+// Stage 3c: the measured torque filtered as the residual, into rc.meas (after the candidate columns,
+// whose temporaries are gone by then: a long record's peak memory).
+void FilterMeasured(std::vector<Rec>* recs) {
+  for (Rec& rc : *recs)
+    for (int j = 0; j < 2; ++j) rc.meas[j] = rc.Filter(std::vector<double>(rc.raw[j], rc.raw[j] + rc.n()));
 }
 
 // Stage 2b: white noise per joint (N m, >= 1e-6) from the first differences of the residuals,
@@ -286,7 +304,7 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, const std::vec
   std::vector<ColumnBank> banks;
   std::vector<const Kinematics*> kins;
   for (const Rec& rc : recs) {
-    banks.push_back(BuildColumns(params, rc.kin, rc.tau_R, rc.tau_S, rc.resid, w, rc.split,
+    banks.push_back(BuildColumns(params, rc.kin, rc.tau_S, rc.resid, w, rc.split,
                                  std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn()));
     kins.push_back(&rc.kin);
   }
@@ -432,6 +450,9 @@ void ScoreCandidates(const ColumnBank& bank, const Grams& g, const PhysicalScale
     }
 }
 
+// The samples [0, RefineRows) of a record on which stage 5 refines (of R records).
+size_t RefineRows(const Rec& rc, size_t R) { return std::min<size_t>(rc.split, 6000 / R + 1); }
+
 // Stage 5: the extension D->extended = params + the chosen effects (D->effects); delay, backlash
 // and strap stiffness refined by golden search on the exact model (fit rows); each effect's share of
 // the held-out residual (leave-one-effect-out). Returns each effect's refined / linear value ratio.
@@ -452,8 +473,7 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
       LegParams p = D->extended;
       p.effects[idx].value = v;
       double s = 0;
-      for (const Rec& rc : recs)
-        s += ExactSse(p, rc, w, 0, std::min<size_t>(rc.split, 6000 / R + 1));
+      for (const Rec& rc : recs) s += ExactSse(p, rc, w, 0, RefineRows(rc, R));
       return s;
     };
     double lo = 0.6 * v0, hi = 1.6 * v0;
@@ -495,8 +515,8 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
     const Rec& rc = recs[r];
     const size_t n = rc.n();
     RecordScore rs;
-    rs.source = rc.data->source;
-    rs.samples = rc.data->size();
+    rs.source = rc.source;
+    rs.samples = rc.samples;
     // The held-out run starts 1 s early so that its filters (EMG envelope, delay) have settled;
     // only the held-out samples are scored.
     const size_t warm = static_cast<size_t>(
@@ -526,7 +546,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
       LegParams p = params;
       const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
       if (!cols.empty() && x.size() == 0)
-        throw InputError(rc.data->source + ": without this record the chosen effects are not identifiable");
+        throw InputError(rc.source + ": without this record the chosen effects are not identifiable");
       for (size_t k = 0; k < chosen.size(); ++k) {
         Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
         e.value *= refine_ratio[k];
@@ -621,8 +641,12 @@ std::string MethodText(const Diagnosis& D, const DiagnoseOptions& opt) {
 
 // The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time and the
 // process's peak memory at its end to stderr.
-Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
-                   const DiagnoseOptions& opt) {
+namespace {
+
+// Diagnose of `records`; with `owned` (the same records, which the caller gives up), each record's
+// columns are moved into the analysis once the cutoff is chosen instead of copied.
+Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                          std::vector<MeasuredData>* owned, const DiagnoseOptions& opt) {
   const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
   auto clock0 = std::chrono::steady_clock::now();
   auto Lap = [&](const char* what) {
@@ -641,18 +665,27 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   D.leave_one_out = R >= 2;
 
   D.cutoff = ResolveCutoff(params, records, opt);
+  ReturnFreedMemory();
   Lap("cutoff choice");
 
   Plant plant(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);
   plant.SetParams(params);  // validates the realization
   std::vector<Rec> recs(R);  // in place: Rec::FilterFn captures its record
-  for (size_t r = 0; r < R; ++r) PrepareRecord(params, *records[r], D.cutoff, opt.holdout_fraction, &recs[r]);
+  for (size_t r = 0; r < R; ++r)
+    PrepareRecord(params, *records[r], owned ? &(*owned)[r] : nullptr, D.cutoff, opt.holdout_fraction, &recs[r]);
   double w[2];
   NoiseAndWeights(recs, D.noise, w);
+  for (Rec& rc : recs)  // the rigid torque is needed only where stage 5 refines (a long record's memory)
+    for (int j = 0; j < 2; ++j) {
+      rc.tau_R[j].resize(RefineRows(rc, R));
+      rc.tau_R[j].shrink_to_fit();
+    }
+  ReturnFreedMemory();
   Lap("kinematics + twin");
 
   std::vector<ColumnBank> banks = CandidateColumns(params, recs, w, opt);
   Lap("columns + ripple search");
+  FilterMeasured(&recs);
   UseSecantDelayColumns(recs, w, &banks);
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
   for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
@@ -671,6 +704,8 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   Lap("refinement");
 
+  for (Rec& rc : recs)  // the twin's torques are done with (a long record's memory)
+    for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_R[j]), std::vector<double>().swap(rc.tau_S[j]);
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
   // Effects in order of what they explain.
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
@@ -686,6 +721,19 @@ Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData
   Lap("unexplained");
   D.method = MethodText(D, opt);
   return D;
+}
+
+}  // namespace
+
+Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                   const DiagnoseOptions& opt) {
+  return DiagnoseRecords(params, records, nullptr, opt);
+}
+
+Diagnosis Diagnose(const LegParams& params, std::vector<MeasuredData>&& records, const DiagnoseOptions& opt) {
+  std::vector<const MeasuredData*> pointers;
+  for (const MeasuredData& m : records) pointers.push_back(&m);
+  return DiagnoseRecords(params, pointers, &records, opt);
 }
 
 }  // namespace exotwin

@@ -46,7 +46,6 @@ int AddColumn(ColumnBank& b, const double w[2], F f) {
   return c;
 }
 
-Eigen::Vector2d Row(int j, double v) { return j == 0 ? Eigen::Vector2d(v, 0) : Eigen::Vector2d(0, v); }
 
 // Column c from the values x_j of its joint-j rows on the fit rows (the other joint's rows zero),
 // weighted by w as SetColumn stores them.
@@ -58,16 +57,59 @@ void SetJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vec
   }
 }
 
-// Column c as SetColumn stores per-sample values Row(j, x[i]); returns x, filtered as the column's
+// Column c as SetColumn stores per-sample values x[i] on joint j's rows (0 on the other's); returns x, filtered as the column's
 // rows are, on the fit rows (before the weight).
 std::vector<double> SetJointColumn(ColumnBank& b, int c, const double w[2], int j, std::vector<double> x) {
   bool zero = true;
   for (double v : x) zero &= v == 0.0;
-  if (!zero && b.filter) x = b.filter(x);
+  if (!zero && b.filter) b.filter(x);
   std::vector<double> rows(b.sample.size());
   for (size_t k = 0; k < rows.size(); ++k) rows[k] = x[b.sample[k]];
   SetJointRows(b, c, w, j, rows);
   return rows;
+}
+
+// Appends a column of joint j alone: g(i) on its joint-j rows, zero on the other joint's (the column
+// AddColumn gives for (g(i), 0) or (0, g(i)), with one record-long temporary instead of two).
+template <class G>
+int AddJointColumn(ColumnBank& b, const double w[2], int j, G g) {
+  const int c = NewColumn(b);
+  if (b.filter) {
+    std::vector<double> x(b.n);
+    for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
+    SetJointColumn(b, c, w, j, std::move(x));
+    return c;
+  }
+  const size_t m = b.sample.size();
+  for (size_t k = 0; k < m; ++k) {
+    b.X(j * m + k, c) = w[j] * g(b.sample[k]);
+    b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
+  }
+  return c;
+}
+
+// Appends a column whose hip and knee rows hold the same g(i) (the column AddColumn gives for
+// (g(i), g(i)): both rows filtered alike, from one record-long temporary).
+template <class G>
+int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
+  const int c = NewColumn(b);
+  const size_t m = b.sample.size();
+  if (b.filter) {
+    std::vector<double> x(b.n);
+    for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
+    bool zero = true;
+    for (double v : x) zero &= v == 0.0;
+    if (!zero) b.filter(x);
+    for (int j = 0; j < 2; ++j)
+      for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * x[b.sample[k]];
+    return c;
+  }
+  for (size_t k = 0; k < m; ++k) {
+    const double v = g(b.sample[k]);
+    b.X(k, c) = w[0] * v;
+    b.X(m + k, c) = w[1] * v;
+  }
+  return c;
 }
 
 }  // namespace
@@ -77,15 +119,15 @@ void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]
   for (int j = 0; j < 2; ++j) {
     bool zero = true;
     for (double x : v[j]) zero &= x == 0.0;
-    if (!zero && b.filter) v[j] = b.filter(v[j]);
+    if (!zero && b.filter) b.filter(v[j]);
     for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * v[j][b.sample[k]];
   }
 }
 
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
-                        const std::vector<double> tau_R[2], const std::vector<double> tau_S[2],
+                        const std::vector<double> tau_S[2],
                         const std::vector<double> resid[2], const double w[2], size_t split,
-                        size_t max_rows, std::function<std::vector<double>(const std::vector<double>&)> filter) {
+                        size_t max_rows, std::function<void(std::vector<double>&)> filter) {
   ColumnBank b;
   const size_t n = kin.t.size();
   b.filter = std::move(filter);
@@ -119,26 +161,28 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       b.candidates.push_back(c);
       return &b.candidates.back();
     };
-    const int off = AddColumn(b, w, [&](size_t) { return Row(j, 1.0); });
-    add("coulomb_friction", {AddColumn(b, w, [&](size_t i) { return Row(j, -Sign(kin.qd[j][i])); })});
-    add("viscous_friction", {AddColumn(b, w, [&](size_t i) { return Row(j, -kin.qd[j][i]); })});
-    add("inertia_error", {AddColumn(b, w, [&](size_t i) { return Row(j, -kin.qdd[j][i]); })});
+    const int off = AddJointColumn(b, w, j, [&](size_t) { return 1.0; });
+    add("coulomb_friction", {AddJointColumn(b, w, j, [&](size_t i) { return -Sign(kin.qd[j][i]); })});
+    add("viscous_friction", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.qd[j][i]; })});
+    add("inertia_error", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.qdd[j][i]; })});
     for (const char* axis : {"X", "Y"}) {
       const bool is_x = axis[0] == 'X';
-      add("gravity_error", {AddColumn(b, w, [&](size_t i) {
-            const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
-            const double v = -g * (is_x ? std::sin(ang) : std::cos(ang));
-            return Eigen::Vector2d(v, j == 1 ? v : 0.0);
-          })}, axis);
+      // The hip's angle moves the hip rows only; the thigh + shank angle both joints' rows alike.
+      auto G = [&](size_t i) {
+        const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
+        return -g * (is_x ? std::sin(ang) : std::cos(ang));
+      };
+      add("gravity_error", {j == 0 ? AddJointColumn(b, w, 0, G) : AddBothJointsColumn(b, w, G)}, axis);
     }
-    add("joint_stiffness", {AddColumn(b, w, [&](size_t i) { return Row(j, -kin.q[j][i]); }), off});
+    add("joint_stiffness", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.q[j][i]; }), off});
     // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b).
     add("backlash", {AddColumn(b, w, [&](size_t i) {
           Eigen::Vector2d qa = Q(i), qb = Q(i);
           qa[j] += 1e-5, qb[j] -= 1e-5;
           const Eigen::Vector2d d = (ActuatorTorque(rigid, qa, QD(i), QDD(i)) -
                                      ActuatorTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
-          return Eigen::Vector2d(0.5 * std::tanh(tau_R[j][i] / kBacklashTorqueWidth) * d);
+          const double tau_R = ActuatorTorque(rigid, Q(i), QD(i), QDD(i))[j];
+          return Eigen::Vector2d(0.5 * std::tanh(tau_R / kBacklashTorqueWidth) * d);
         })});
     // Straps: Delta tau_S = (1/k) dtau_C/dq_j tau_C,j (first order in 1/k).
     add("series_compliance", {AddColumn(b, w, [&](size_t i) {
@@ -149,16 +193,12 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
           return Eigen::Vector2d(d * CompliantPartTorque(rigid, Q(i), QD(i), QDD(i))[j]);
         })});
     add("sensor_offset", {off});
-    add("sensor_gain", {AddColumn(b, w, [&](size_t i) { return Row(j, tau_S[j][i]); })});
-    {
-      // Time derivative of the predicted reading (for the delay), on the full record.
-      std::vector<double> dS(n);
-      for (size_t i = 0; i < n; ++i) {
-        const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
-        dS[i] = (tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]);
-      }
-      add("sensor_delay", {AddColumn(b, w, [&](size_t i) { return Row(j, -dS[i]); })});
-    }
+    add("sensor_gain", {AddJointColumn(b, w, j, [&](size_t i) { return tau_S[j][i]; })});
+    // Time derivative of the predicted reading (for the delay), central differences on the record.
+    add("sensor_delay", {AddJointColumn(b, w, j, [&](size_t i) {
+          const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
+          return -((tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]));
+        })});
     if (!kin.emg.empty()) {
       std::vector<int> cols;
       std::vector<std::string> chans;
@@ -232,14 +272,15 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       b.X.col(c0).setZero();
       b.X.col(c0 + 1).setZero();
       const size_t n = kins[r]->t.size();
-      std::vector<double> vs(n), vc(n);  // joint j's rows (the other joint's are zero)
-      for (size_t i = 0; i < n; ++i) {
-        const double x = 2 * M_PI * f * kins[r]->q[j][i];
-        vs[i] = -std::sin(x), vc[i] = -std::cos(x);
-      }
       const double ww[2] = {j == 0 ? w : 0.0, j == 1 ? w : 0.0};
-      SetJointColumn(b, c0, ww, j, std::move(vs));
-      SetJointColumn(b, c0 + 1, ww, j, std::move(vc));
+      for (int k = 0; k < 2; ++k) {  // -sin, then -cos: joint j's rows (the other joint's are zero)
+        std::vector<double> v(n);
+        for (size_t i = 0; i < n; ++i) {
+          const double x = 2 * M_PI * f * kins[r]->q[j][i];
+          v[i] = k == 0 ? -std::sin(x) : -std::cos(x);
+        }
+        SetJointColumn(b, c0 + k, ww, j, std::move(v));
+      }
       Candidate c;
       c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
       b.candidates.push_back(c);

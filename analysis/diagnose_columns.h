@@ -33,17 +33,17 @@ struct ColumnBank {
   int used = 0;                // columns in use (X may be over-allocated while building)
   // The residual's low-pass (parallel filtering): every column is evaluated on all n samples and
   // filtered by it before its fit rows are taken. Empty: no filter.
-  std::function<std::vector<double>(const std::vector<double>&)> filter;
+  std::function<void(std::vector<double>&)> filter;  // in place
   size_t n = 0;                // samples of the record
 };
 
-// Builds every candidate for both joints. tau_R, tau_S: the twin's prediction (N m) on all samples;
-// resid[j]: measured - predicted tau_S; w[j]: row weights (1/N m); split: first held-out sample.
-ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
-                        const std::vector<double> tau_R[2], const std::vector<double> tau_S[2],
+// Builds every candidate for both joints. tau_S: the twin's prediction (N m) on all samples (its rigid
+// tau_R, ActuatorTorque, is evaluated where a column needs it); resid[j]: measured - predicted
+// tau_S; w[j]: row weights (1/N m); split: first held-out sample.
+ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin, const std::vector<double> tau_S[2],
                         const std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows,
-                        std::function<std::vector<double>(const std::vector<double>&)> filter = {});
+                        std::function<void(std::vector<double>&)> filter = {});
 
 // Stores column c of the bank from per-sample values v[0] (hip rows), v[1] (knee rows), n each,
 // filtered by bank.filter when set and weighted by w.

@@ -136,7 +136,7 @@ EmgRecording ReadEmgRecording(const std::string& emg_path, const std::string& ki
 
   // Common time range.
   const std::vector<double>& te = emg.Time();
-  double lo = std::max(te.front(), md.t.front()), hi = std::min(te.back(), md.t.back());
+  double lo = std::max(te.front(), md.t().front()), hi = std::min(te.back(), md.t().back());
   if (!moments_path.empty()) lo = std::max(lo, id.Time().front()), hi = std::min(hi, id.Time().back());
   const double eps = 1e-9 * std::max(1.0, std::abs(hi));
   std::vector<size_t> keep;
@@ -144,8 +144,8 @@ EmgRecording ReadEmgRecording(const std::string& emg_path, const std::string& ki
     if (te[i] >= lo - eps && te[i] <= hi + eps) keep.push_back(i);
   if (keep.size() < kMinSamples)
     throw InputError(emg_path + ": the time bases of " + emg_path + " (" + NumberText(te.front()) + ".." +
-                     NumberText(te.back()) + " s), " + kinematics_path + " (" + NumberText(md.t.front()) + ".." +
-                     NumberText(md.t.back()) + " s)" +
+                     NumberText(te.back()) + " s), " + kinematics_path + " (" + NumberText(md.t().front()) + ".." +
+                     NumberText(md.t().back()) + " s)" +
                      (moments_path.empty() ? "" : " and " + moments_path) + " share fewer than " +
                      std::to_string(kMinSamples) + " EMG samples");
   if (keep.size() < te.size())

@@ -158,22 +158,23 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
   const double enc = 2 * M_PI / 524288.0, res = 0.005;
   MeasuredData& d = g.data;
   d.source = "generated(seed " + std::to_string(opt.seed) + ")";
-  d.t = kin.t;
-  d.q_hip.resize(n), d.q_knee.resize(n), d.tau_hip.resize(n), d.tau_knee.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    d.q_hip[i] = enc * std::round(kin.q[0][i] / enc);
-    d.q_knee[i] = enc * std::round(kin.q[1][i] / enc);
-    d.tau_hip[i] = res * std::round((truth.tau_S[0][i] + g.torque_noise * rng.Normal()) / res);
-    d.tau_knee[i] = res * std::round((truth.tau_S[1][i] + g.torque_noise * rng.Normal()) / res);
-  }
   d.table.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
-  d.table.columns = {d.t, d.q_hip, d.q_knee, d.tau_hip, d.tau_knee};
+  d.table.columns.assign(5, std::vector<double>(n));
+  d.table.columns[0] = kin.t;
+  std::vector<double>* col = d.table.columns.data();
+  for (size_t i = 0; i < n; ++i) {
+    col[1][i] = enc * std::round(kin.q[0][i] / enc);
+    col[2][i] = enc * std::round(kin.q[1][i] / enc);
+    col[3][i] = res * std::round((truth.tau_S[0][i] + g.torque_noise * rng.Normal()) / res);
+    col[4][i] = res * std::round((truth.tau_S[1][i] + g.torque_noise * rng.Normal()) / res);
+  }
   for (int c = 0; c < 5; ++c) {
     d.table.names.push_back(std::string("emg_") + kEmgChannels[c]);
     d.table.columns.push_back(emg[c]);
   }
   d.table.line_of_row.resize(n);
   for (size_t i = 0; i < n; ++i) d.table.line_of_row[i] = static_cast<int>(i) + 2;
+  d.BindRequired();
   return g;
 }
 

@@ -21,7 +21,7 @@ struct GenerateOptions {
 };
 
 struct GeneratedData {
-  MeasuredData data;  // t, q_*, tau_* (sensor), emg_* columns; `table` holds them in file order
+  MeasuredData data;  // t, q_*, tau_* (sensor), emg_* columns, in this order
   LegParams truth;    // the model file's params plus the hidden effects
   double torque_noise = 0;  // sensor noise standard deviation, N m
 };

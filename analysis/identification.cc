@@ -35,7 +35,7 @@ const char* ConfigurationName(IdConfiguration c) {
 
 JointRanges ComputeJointRanges(const MeasuredData& data) {
   JointRanges r{};
-  const std::vector<double>* q[2] = {&data.q_hip, &data.q_knee};
+  const std::vector<double>* q[2] = {&data.q_hip(), &data.q_knee()};
   for (int j = 0; j < 2; ++j) {
     const auto mm = std::minmax_element(q[j]->begin(), q[j]->end());
     r.min[j] = *mm.first;
@@ -66,19 +66,19 @@ void AppendSamples(const MeasuredData& data, bool select_passive, const Identifi
   const Kinematics kin = DeriveKinematics(data, opt.cutoff_hz);
   std::vector<char> keep(data.size(), 1);
   if (select_passive) keep = SelectPassiveSamples(data, opt.selection).passive;
-  const double t0 = data.t.front() + opt.trim_s, t1 = data.t.back() - opt.trim_s;
+  const double t0 = data.t().front() + opt.trim_s, t1 = data.t().back() - opt.trim_s;
   const size_t before = into->size();
   for (int j = 0; j < 2; ++j)
     for (auto* v : {&into->q[j], &into->qd[j], &into->qdd[j], &into->u[j]}) v->reserve(before + data.size());
   for (size_t i = 0; i < data.size(); ++i) {
-    if (!keep[i] || data.t[i] < t0 || data.t[i] > t1) continue;
+    if (!keep[i] || data.t()[i] < t0 || data.t()[i] > t1) continue;
     for (int j = 0; j < 2; ++j) {
       into->q[j].push_back(kin.q[j][i]);
       into->qd[j].push_back(kin.qd[j][i]);
       into->qdd[j].push_back(kin.qdd[j][i]);
     }
-    into->u[0].push_back(-data.tau_hip[i]);  // tau_R = -tau_S, HJ15 eq. 8
-    into->u[1].push_back(-data.tau_knee[i]);
+    into->u[0].push_back(-data.tau_hip()[i]);  // tau_R = -tau_S, HJ15 eq. 8
+    into->u[1].push_back(-data.tau_knee()[i]);
   }
   if (into->size() == before)
     throw InputError(data.source + ": no usable sample after trimming " + Fmt("%g", opt.trim_s) +

@@ -100,20 +100,6 @@ std::vector<MeasuredData> ProtocolData::All() const {
   return all;
 }
 
-MeasuredData MakeMeasuredData(CsvTable table, const std::string& source) {
-  MeasuredData d;
-  d.source = source;
-  for (const char* req : {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"})
-    if (table.Find(req) < 0) throw InputError(source + ": missing required column '" + req + "'");
-  d.t = table.columns[table.Find("t")];
-  d.q_hip = table.columns[table.Find("q_hip")];
-  d.q_knee = table.columns[table.Find("q_knee")];
-  d.tau_hip = table.columns[table.Find("tau_hip")];
-  d.tau_knee = table.columns[table.Find("tau_knee")];
-  d.table = std::move(table);
-  return d;
-}
-
 MeasuredData WithTorqueSensor(const MeasuredData& d, const TorqueSensorModel& sm, uint64_t seed) {
   const int cmd[2] = {d.table.Find("cmd_hip"), d.table.Find("cmd_knee")};
   if (cmd[0] < 0 || cmd[1] < 0)

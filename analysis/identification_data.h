@@ -76,7 +76,5 @@ MeasuredData WithTorqueSensor(const MeasuredData& d, const TorqueSensorModel& se
 // Writes every trial as DIR/<prefix>knee_<i>.csv and DIR/<prefix>hip_<i>.csv (i = 1..trials).
 void WriteProtocolCsv(const ProtocolData& data, const std::string& dir, const std::string& prefix = "");
 
-// Builds a MeasuredData from a table holding at least t, q_hip, q_knee, tau_hip, tau_knee.
-MeasuredData MakeMeasuredData(CsvTable table, const std::string& source);
 
 }  // namespace exotwin

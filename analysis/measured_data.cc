@@ -17,6 +17,32 @@ const std::vector<double>* MeasuredData::Column(const std::string& name) const {
   return i < 0 ? nullptr : &table.columns[i];
 }
 
+namespace {
+const char* const kRequired[5] = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+}  // namespace
+
+const std::vector<double>& MeasuredData::Required(int k) const {
+  static const std::vector<double> kNone;
+  return at_[k] < 0 ? kNone : table.columns[at_[k]];
+}
+
+void MeasuredData::BindRequired() {
+  for (int k = 0; k < 5; ++k) {
+    at_[k] = table.Find(kRequired[k]);
+    if (at_[k] < 0)
+      throw InputError(source + ": missing required column '" + kRequired[k] +
+                       "' (expected t, q_hip, q_knee, tau_hip, tau_knee)");
+  }
+}
+
+MeasuredData MakeMeasuredData(CsvTable table, const std::string& source) {
+  MeasuredData d;
+  d.source = source;
+  d.table = std::move(table);
+  d.BindRequired();
+  return d;
+}
+
 bool IsMeasuredColumn(const std::string& n) {
   static const char* kKnown[] = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "qd_hip", "qd_knee",
                                  "qdd_hip", "qdd_knee", "cmd_hip", "cmd_knee"};
@@ -40,11 +66,8 @@ MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t
   MeasuredData d;
   d.source = source;
   d.table = std::move(table);
+  d.BindRequired();
   const CsvTable& t = d.table;
-  for (const char* req : {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"})
-    if (t.Find(req) < 0)
-      throw InputError(source + ": missing required column '" + req +
-                       "' (expected t, q_hip, q_knee, tau_hip, tau_knee)");
   if (t.rows() < min_samples)
     throw InputError(source + ": " + std::to_string(t.rows()) + " samples, expected at least " +
                      std::to_string(min_samples));
@@ -70,11 +93,6 @@ MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t
     if (!(tc[r] > tc[r - 1]))
       throw InputError(Where(source, t, r, "t") + std::to_string(tc[r]) + " not greater than the previous " +
                        std::to_string(tc[r - 1]) + ", expected strictly increasing time");
-  d.t = tc;
-  d.q_hip = t.columns[t.Find("q_hip")];
-  d.q_knee = t.columns[t.Find("q_knee")];
-  d.tau_hip = t.columns[t.Find("tau_hip")];
-  d.tau_knee = t.columns[t.Find("tau_knee")];
   return d;
 }
 
@@ -90,8 +108,8 @@ MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
 }
 
 void CheckHumanJointRange(const MeasuredData& data) {
-  const std::pair<const char*, const std::vector<double>*> angles[] = {{"q_hip", &data.q_hip},
-                                                                      {"q_knee", &data.q_knee}};
+  const std::pair<const char*, const std::vector<double>*> angles[] = {{"q_hip", &data.q_hip()},
+                                                                      {"q_knee", &data.q_knee()}};
   for (const auto& [name, q] : angles)
     for (size_t r = 0; r < q->size(); ++r)
       if (std::abs((*q)[r]) > kMaxHumanJointAngle)
@@ -242,9 +260,9 @@ bool IsEmgChannel(const std::string& name) { return name.rfind("emg_", 0) == 0 &
 
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
   Kinematics k;
-  k.t = data.t;
-  k.q[0] = data.q_hip;
-  k.q[1] = data.q_knee;
+  k.t = data.t();
+  k.q[0] = data.q_hip();
+  k.q[1] = data.q_knee();
   for (size_t c = 0; c < data.table.names.size(); ++c)
     if (IsEmgChannel(data.table.names[c])) k.emg[data.table.names[c].substr(4)] = data.table.columns[c];
   const char* names[2] = {"hip", "knee"};
@@ -259,9 +277,9 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
 
 Kinematics DeriveKinematics(MeasuredData&& data, double cutoff_hz) {
   Kinematics k;
-  k.t = std::move(data.t);
-  k.q[0] = std::move(data.q_hip);
-  k.q[1] = std::move(data.q_knee);
+  k.t = std::move(data.column_at(kColT));
+  k.q[0] = std::move(data.column_at(kColQHip));
+  k.q[1] = std::move(data.column_at(kColQKnee));
   CsvTable& tab = data.table;
   const char* names[2] = {"hip", "knee"};
   std::vector<double> columns[2][2];  // qd_*, qdd_* when recorded

@@ -27,17 +27,18 @@ MeasuredData KinematicsFromStorage(const StorageTable& table, const LegCoordinat
   if (table.rows() < min_samples)
     throw InputError(table.source + ": " + std::to_string(table.rows()) + " rows of data, expected at least " +
                      std::to_string(min_samples));
-  md.t = table.Time();
-  md.q_hip = table.AngleRad(coords.hip);
-  md.q_knee = table.AngleRad(coords.knee);
-  for (const auto* q : {&md.q_hip, &md.q_knee}) {
-    const std::string& name = q == &md.q_hip ? coords.hip : coords.knee;
+  // No torque: tau_hip and tau_knee are empty columns (HasTorque).
+  md.table.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+  md.table.columns = {table.Time(), table.AngleRad(coords.hip), table.AngleRad(coords.knee), {}, {}};
+  md.BindRequired();
+  for (const auto* q : {&md.q_hip(), &md.q_knee()}) {
+    const std::string& name = q == &md.q_hip() ? coords.hip : coords.knee;
     for (size_t i = 0; i < q->size(); ++i) {
       const std::string at = table.source + ": line " + std::to_string(table.line_of_row[i]) + ": ";
       if (!std::isfinite((*q)[i]) || std::abs((*q)[i]) > kMaxHumanJointAngle)
         throw InputError(at + "angle " + NumberText((*q)[i]) + " rad in column '" + name +
                          "' (expected a finite human joint angle)");
-      if (q == &md.q_knee && (*q)[i] > kMaxKneeHyperextension)
+      if (q == &md.q_knee() && (*q)[i] > kMaxKneeHyperextension)
         throw InputError(at + "'" + name + "' = " + NumberText((*q)[i] * kDegPerRad) +
                          " deg: a knee extended beyond +15 deg; the twin reads knee_angle as gait2392 defines it "
                          "(0 straight, flexion negative), not flexion-positive (e.g. Rajagopal 2015): negate the "

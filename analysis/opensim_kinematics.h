@@ -31,7 +31,7 @@ struct LegCoordinates {
   std::string hip, knee;
 };
 // False for kinematics alone (a motion file read by KinematicsFromStorage): tau_hip, tau_knee empty.
-inline bool HasTorque(const MeasuredData& d) { return !d.tau_hip.empty(); }
+inline bool HasTorque(const MeasuredData& d) { return !d.tau_hip().empty(); }
 
 // side "r" or "l" (throws InputError otherwise; `where` names the setting in the message).
 LegCoordinates CoordinatesOfSide(const std::string& side, const std::string& where);

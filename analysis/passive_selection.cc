@@ -38,11 +38,11 @@ PassiveSelection SelectPassiveSamples(const MeasuredData& data, const PassiveSel
     sel.kept = n;
     return sel;
   }
-  const double dt = n > 1 ? (data.t.back() - data.t.front()) / static_cast<double>(n - 1) : 1e-3;
+  const double dt = n > 1 ? (data.t().back() - data.t().front()) / static_cast<double>(n - 1) : 1e-3;
   size_t w = opt.envelope_s > 0 ? static_cast<size_t>(std::lround(opt.envelope_s / dt)) : 1;
   if (w % 2 == 0) ++w;
   size_t n_ref = 0;
-  while (n_ref < n && data.t[n_ref] - data.t.front() < opt.reference_s) ++n_ref;
+  while (n_ref < n && data.t()[n_ref] - data.t().front() < opt.reference_s) ++n_ref;
 
   for (size_t k = 0; k < cols.size(); ++k) {
     const std::string& name = sel.channels[k];

@@ -82,8 +82,8 @@ std::pair<double, double> GaitTorqueRmse(const MeasuredData& gait, const LegPara
     if (kin.t[i] < t_from || kin.t[i] > t_to) continue;
     const Vec2 tau_R = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
                                       {kin.qdd[0][i], kin.qdd[1][i]});
-    const double e_hip = gait.tau_hip[i] - (-tau_R[0]);  // tau_S = -tau_R, HJ15 eq. 8
-    const double e_knee = gait.tau_knee[i] - (-tau_R[1]);
+    const double e_hip = gait.tau_hip()[i] - (-tau_R[0]);  // tau_S = -tau_R, HJ15 eq. 8
+    const double e_knee = gait.tau_knee()[i] - (-tau_R[1]);
     s2[0] += e_hip * e_hip;
     s2[1] += e_knee * e_knee;
     ++n;
@@ -114,7 +114,7 @@ void ComputeTable5Rmse(const MeasuredData& gait, double t_from, double t_to, dou
     *knee[k] = r.second;
   }
   size_t n = 0;
-  for (double t : gait.t) n += t >= t_from && t <= t_to;
+  for (double t : gait.t()) n += t >= t_from && t <= t_to;
   entry->gait_samples = static_cast<double>(n);
 }
 

@@ -53,9 +53,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
       if (params.human) CheckHumanJointRange(data.back());
       names += (names.empty() ? "" : ", ") + m;
     }
-    std::vector<const MeasuredData*> records;
-    for (const auto& m : data) records.push_back(&m);
-    const Diagnosis d = Diagnose(params, records, opt);
+    const Diagnosis d = Diagnose(params, std::move(data), opt);
     WriteDiagnosis(d, o->out, o->params, names);
     std::printf("diagnose: derivative cutoff %s\n", d.cutoff.why.c_str());
     for (const auto& e : d.effects)

@@ -49,13 +49,13 @@ void ReadPredicted(const std::string& path, const MeasuredData& data, std::vecto
   for (size_t i = 1; i < t.size(); ++i)
     if (!(t[i] > t[i - 1]))
       throw InputError(path + ":" + std::to_string(p.line_of_row[i]) + ": column 't' must be strictly increasing");
-  const double tol = 1.5 * MedianStep(data.t);
-  if (t.front() > data.t.front() + tol || t.back() < data.t.back() - tol)
+  const double tol = 1.5 * MedianStep(data.t());
+  if (t.front() > data.t().front() + tol || t.back() < data.t().back() - tol)
     std::fprintf(stderr, "render-replay: %s covers [%g, %g] s but the measurement covers [%g, %g] s; the "
-                 "estimate is held constant outside\n", path.c_str(), t.front(), t.back(), data.t.front(),
-                 data.t.back());
-  est[0] = Interpolate(t, p.columns[p.Find("tau_hip")], data.t);
-  est[1] = Interpolate(t, p.columns[p.Find("tau_knee")], data.t);
+                 "estimate is held constant outside\n", path.c_str(), t.front(), t.back(), data.t().front(),
+                 data.t().back());
+  est[0] = Interpolate(t, p.columns[p.Find("tau_hip")], data.t());
+  est[1] = Interpolate(t, p.columns[p.Find("tau_knee")], data.t());
 }
 
 CommandRunner RegisterRenderReplay(CLI::App& app) {
@@ -97,7 +97,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
       est[1] = p.tau_S[1];
     }
 
-    const double dt = MedianStep(data.t);
+    const double dt = MedianStep(data.t());
     std::vector<std::vector<double>> emg;
     for (const char* m : {"GMAX", "VM", "RF", "ST", "GAS"})
       if (const std::vector<double>* col = data.Column(std::string("emg_") + m)) {
@@ -109,19 +109,19 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
     const std::unique_ptr<VideoSink> video = OpenVideo(plant.model(), o->out, o->render);
     for (size_t i = 0; i < data.size(); ++i) {
       OverlaySample s;
-      s.t = data.t[i];
-      s.q_hip = data.q_hip[i];
-      s.q_knee = data.q_knee[i];
-      s.tau_meas[0] = HasTorque(data) ? data.tau_hip[i] : NAN;  // NaN: not drawn
-      s.tau_meas[1] = HasTorque(data) ? data.tau_knee[i] : NAN;
+      s.t = data.t()[i];
+      s.q_hip = data.q_hip()[i];
+      s.q_knee = data.q_knee()[i];
+      s.tau_meas[0] = HasTorque(data) ? data.tau_hip()[i] : NAN;  // NaN: not drawn
+      s.tau_meas[1] = HasTorque(data) ? data.tau_knee()[i] : NAN;
       s.tau_est[0] = est[0][i];
       s.tau_est[1] = est[1][i];
       for (const auto& e : emg) s.emg.push_back(e[i]);
       video->AddSample(s);
     }
-    video->Finish(data.t.back() + dt);
+    video->Finish(data.t().back() + dt);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    const double duration = data.t.back() + dt - data.t.front();
+    const double duration = data.t().back() + dt - data.t().front();
     std::fprintf(stderr, "render-replay: wrote %s: %ld frames (%.2f s at %g fps, %dx%d, %s) in %.2f s wall, "
                  "%.2fx real time\n", o->out.c_str(), video->frames(), duration, o->render.fps,
                  o->render.width, o->render.height, video->codec().c_str(), wall, duration / wall);

@@ -27,16 +27,16 @@ LegParams S1() {
 }
 
 MeasuredData Data() {
-  MeasuredData d;
+  CsvTable tab;
+  tab.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+  tab.columns.assign(5, std::vector<double>(kSamples, 0.0));
   for (int i = 0; i < kSamples; ++i) {
     const double t = i * 1e-3;
-    d.t.push_back(t);
-    d.q_hip.push_back(0.35 + 0.2 * std::sin(2 * M_PI * 0.5 * t));
-    d.q_knee.push_back(-0.7 + 0.4 * std::sin(2 * M_PI * 0.5 * t + 1));
-    d.tau_hip.push_back(0);
-    d.tau_knee.push_back(0);
+    tab.columns[0][i] = t;
+    tab.columns[1][i] = 0.35 + 0.2 * std::sin(2 * M_PI * 0.5 * t);
+    tab.columns[2][i] = -0.7 + 0.4 * std::sin(2 * M_PI * 0.5 * t + 1);
   }
-  return d;
+  return MakeMeasuredData(std::move(tab), "bench");
 }
 
 void BM_BareMjInverse(benchmark::State& state) {

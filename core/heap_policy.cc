@@ -9,4 +9,6 @@ void KeepFreedMemoryForReuse() {
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
 
+void ReturnFreedMemory() { malloc_trim(0); }
+
 }  // namespace exotwin

@@ -13,4 +13,9 @@ namespace exotwin {
 
 void KeepFreedMemoryForReuse();
 
+// Gives the pages of the heap's free blocks back to the system (malloc_trim): called between the
+// stages of a whole-record analysis, so that the blocks one stage freed do not stay resident while
+// the next one lays out its own (the peak memory stays that of the live vectors).
+void ReturnFreedMemory();
+
 }  // namespace exotwin

@@ -7,7 +7,8 @@
 namespace exotwin::dsp {
 namespace {
 
-// FiltFilt of x extended by `pad` odd-reflected samples at both ends, cropped back to x's samples.
+// FiltFilt of x extended by `pad` odd-reflected samples at both ends, cropped back to x's samples
+// (in place in the one padded copy: a long record's envelope costs one record of memory).
 std::vector<double> PaddedFiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x, size_t pad) {
   const size_t n = x.size();
   if (n == 0) return {};
@@ -18,8 +19,10 @@ std::vector<double> PaddedFiltFilt(const std::vector<Biquad>& sos, const std::ve
   for (size_t k = pad; k >= 1; --k) y.push_back(2 * x[0] - x[k]);
   y.insert(y.end(), x.begin(), x.end());
   for (size_t k = 1; k <= pad; ++k) y.push_back(2 * x[n - 1] - x[n - 1 - k]);
-  const std::vector<double> f = FiltFilt(sos, y);
-  return std::vector<double>(f.begin() + pad, f.begin() + pad + n);
+  FiltFiltInPlace(sos, y);
+  y.erase(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(pad));
+  y.resize(n);
+  return y;
 }
 
 }  // namespace

@@ -202,13 +202,13 @@ IsometricResult IsometricStage(const Scenario& s, int j, const MuscleParams& mp,
   const std::string path = opt.out_dir + "/" + tag + "/measured.csv";
   const MeasuredData d = ReadMeasuredCsv(path);
   const std::vector<std::vector<double>> env = Envelopes(d.table, path);
-  const std::vector<double>& tau_S = j == 0 ? d.tau_hip : d.tau_knee;
+  const std::vector<double>& tau_S = j == 0 ? d.tau_hip() : d.tau_knee();
   // The sensor reads gravity of the held leg plus the muscles: its relaxed reading before the
   // first contraction is subtracted, so tau^ISO is the muscular torque alone (sec. 4.3).
-  const auto base = Window(d.t, kHoldRamp + 0.1, prog.blocks().front().t_start);
+  const auto base = Window(d.t(), kHoldRamp + 0.1, prog.blocks().front().t_start);
   if (base.second - base.first < 100) throw InputError(s.source + ": isometric trial: no relaxed lead-in");
   const double offset = RestLevel(tau_S, base.first, base.second);  // mean relaxed reading
-  const auto all = Window(d.t, kHoldRamp + 0.1, prog.duration() + 0.5);
+  const auto all = Window(d.t(), kHoldRamp + 0.1, prog.duration() + 0.5);
   std::vector<MuscleVec> le;
   std::vector<double> tau;
   for (size_t k = all.first; k < all.second; ++k) {
@@ -224,7 +224,7 @@ IsometricResult IsometricStage(const Scenario& s, int j, const MuscleParams& mp,
       const bool plus_q = b % 2 == 0;
       const bool flexion = j == 0 ? plus_q : !plus_q;  // hip flexion +q, knee flexion -q
       if (flexion != (dir == 0)) continue;
-      const auto w = Window(d.t, blk.t_start, blk.t_start + 2 * blk.ramp + blk.hold);
+      const auto w = Window(d.t(), blk.t_start, blk.t_start + 2 * blk.ramp + blk.hold);
       for (size_t k = w.first; k < w.second; ++k) {
         y.push_back(tau_S[k] - offset);
         yhat.push_back(IsometricTorque(j, iso.fit.alpha, Normalized(env, k, mvc)));
@@ -298,7 +298,7 @@ GaitSamples DynamicTrialStage(const Scenario& s, const Subject& subject, const M
   model[2].human = Table4AnthropometricLumped(AnthropometricModel::kDempster, subject.weight, model[0].L1, subject.L2);
   // Fitted window: the exaggerated strides, or the whole trial after the gait fade-in (fit_window).
   const double t_fit = cal.fit_window == "trial" ? std::min(kGaitRamp, s.human.active_from) : s.human.active_from;
-  const auto w = Window(d.t, t_fit, t_end);
+  const auto w = Window(d.t(), t_fit, t_end);
   m["dyn_fit_window_s"] = t_end - t_fit;
   GaitSamples g;
   for (size_t k = w.first; k < w.second; ++k) {
@@ -312,7 +312,7 @@ GaitSamples DynamicTrialStage(const Scenario& s, const Subject& subject, const M
     for (int mi = 0; mi < 3; ++mi) {
       // HJ15 eq. 9-10: tau_M = tau_S - tau_PAS, tau_PAS = -(the actuator torque the relaxed leg needs).
       const Eigen::Vector2d tm =
-          controller::MuscularTorque(model[mi], qk, qdk, qddk, Eigen::Vector2d(d.tau_hip[k], d.tau_knee[k]));
+          controller::MuscularTorque(model[mi], qk, qdk, qddk, Eigen::Vector2d(d.tau_hip()[k], d.tau_knee()[k]));
       for (int j = 0; j < 2; ++j) g.tau_M[mi][j].push_back(tm[j]);
     }
   }

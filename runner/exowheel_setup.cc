@@ -57,18 +57,18 @@ Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, 
 // (controller::ReferenceKind::kSamples, played by TabulatedTrajectory).
 void RecordedSamples(const ProtocolSpec& p, controller::ReferenceSpec* r) {
   const MeasuredData m = ReadOpenSimKinematics(p.path, p.side);
-  const double dt = MedianStep(m.t);
-  const double span = m.t.back() - m.t.front();
+  const double dt = MedianStep(m.t());
+  const double span = m.t().back() - m.t().front();
   const size_t n = static_cast<size_t>(std::floor(span / dt + 1e-9)) + 1;
   std::vector<double> grid(n);
-  for (size_t i = 0; i < n; ++i) grid[i] = m.t.front() + static_cast<double>(i) * dt;
+  for (size_t i = 0; i < n; ++i) grid[i] = m.t().front() + static_cast<double>(i) * dt;
   if (!(p.cutoff < 0.5 / dt))
     throw InputError(p.path + ": sampled at " + NumberText(1.0 / dt) + " Hz; protocol.cutoff " + NumberText(p.cutoff) +
                      " Hz must lie below its Nyquist frequency " + NumberText(0.5 / dt) + " Hz");
   r->kind = controller::ReferenceKind::kSamples;
   r->sample_dt = dt;
-  r->sample_hip = Interpolate(m.t, m.q_hip, grid);
-  r->sample_knee = Interpolate(m.t, m.q_knee, grid);
+  r->sample_hip = Interpolate(m.t(), m.q_hip(), grid);
+  r->sample_knee = Interpolate(m.t(), m.q_knee(), grid);
   r->sample_loop = p.extend != "hold";
   r->sample_cutoff = p.cutoff;
 }

@@ -6,7 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 JOBS="${JOBS:-$(nproc)}"
-cmake -S . -B build-asan -DEXOTWIN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+# -g1 (line tables, no variable info) instead of RelWithDebInfo's -g: the sanitizers' stack traces keep
+# their file:line, and the build takes about a third less time (analysis/identification.cc: 50 s -> 33 s).
+cmake -S . -B build-asan -DEXOTWIN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" >/dev/null
 cmake --build build-asan -j"$JOBS"
 
 # halt_on_error: the first report ends the process with a non-zero code, so the test fails.

@@ -65,11 +65,11 @@ TEST(ColumnMap, RenameScaleOffsetUnitsAndSignAgainstHandComputedValues) {
   ASSERT_EQ(d.size(), 30u);
   EXPECT_EQ(d.table.names, (std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "emg_VM"}));
   for (int i = 0; i < 30; ++i) {
-    EXPECT_DOUBLE_EQ(d.t[i], 2e-3 * i);
-    EXPECT_NEAR(d.q_hip[i], (10.0 + i - 90.0) * kRadPerDeg, 1e-15);  // offset in degrees, then to rad
-    EXPECT_DOUBLE_EQ(d.q_knee[i], 2 * 0.01 * i + 0.1);
-    EXPECT_DOUBLE_EQ(d.tau_hip[i], -0.5 * i);
-    EXPECT_DOUBLE_EQ(d.tau_knee[i], 0.125 * i);
+    EXPECT_DOUBLE_EQ(d.t()[i], 2e-3 * i);
+    EXPECT_NEAR(d.q_hip()[i], (10.0 + i - 90.0) * kRadPerDeg, 1e-15);  // offset in degrees, then to rad
+    EXPECT_DOUBLE_EQ(d.q_knee()[i], 2 * 0.01 * i + 0.1);
+    EXPECT_DOUBLE_EQ(d.tau_hip()[i], -0.5 * i);
+    EXPECT_DOUBLE_EQ(d.tau_knee()[i], 0.125 * i);
     EXPECT_DOUBLE_EQ((*d.Column("emg_VM"))[i], 3e-3 * i);
     EXPECT_EQ(d.table.line_of_row[i], i + 3);  // messages keep naming the foreign file's lines
   }
@@ -91,8 +91,8 @@ TEST(ColumnMap, ShorthandAndRequiredTargetsFirst) {
                         "  q_hip: deg1\n  t: ms\n");
   const MeasuredData d = ReadMeasured(f.csv, f.map);
   EXPECT_EQ(d.table.names, (std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "emg_VM"}));
-  EXPECT_DOUBLE_EQ(d.t[3], 6.0);
-  EXPECT_DOUBLE_EQ(d.q_hip[3], 13.0);
+  EXPECT_DOUBLE_EQ(d.t()[3], 6.0);
+  EXPECT_DOUBLE_EQ(d.q_hip()[3], 13.0);
 }
 
 // Rows 2-4 share t = 0.004, rows 10-11 share t = 0.020; steps otherwise 2 ms.
@@ -117,12 +117,12 @@ TEST(ColumnMap, RepeatedTimeStampsAveragedCountedAndLocated) {
   EXPECT_EQ(rep.rows_merged, 3u);
   EXPECT_EQ(rep.repeated_lines, (std::vector<int>{5, 6, 13}));  // header on line 1, row i on line i + 2
   ASSERT_EQ(d.size(), 20u);
-  EXPECT_DOUBLE_EQ(d.t[2], 0.004);
-  EXPECT_DOUBLE_EQ(d.q_hip[2], (2 + 3 + 4) / 3.0);
-  EXPECT_DOUBLE_EQ(d.q_knee[2], (4 + 6 + 8) / 3.0);
-  EXPECT_DOUBLE_EQ(d.tau_hip[2], -(2 + 3 + 4) / 3.0);
-  EXPECT_DOUBLE_EQ(d.q_hip[3], 5);                 // the rows after a merge are untouched
-  EXPECT_DOUBLE_EQ(d.q_hip[8], (10 + 11) / 2.0);   // second group
+  EXPECT_DOUBLE_EQ(d.t()[2], 0.004);
+  EXPECT_DOUBLE_EQ(d.q_hip()[2], (2 + 3 + 4) / 3.0);
+  EXPECT_DOUBLE_EQ(d.q_knee()[2], (4 + 6 + 8) / 3.0);
+  EXPECT_DOUBLE_EQ(d.tau_hip()[2], -(2 + 3 + 4) / 3.0);
+  EXPECT_DOUBLE_EQ(d.q_hip()[3], 5);                 // the rows after a merge are untouched
+  EXPECT_DOUBLE_EQ(d.q_hip()[8], (10 + 11) / 2.0);   // second group
   EXPECT_EQ(d.table.line_of_row[2], 4);            // a merged row keeps its first line
   EXPECT_NE(rep.Summary().find("repeated time stamps: 2 (3 rows merged by average; lines 5 6 13)"),
             std::string::npos) << rep.Summary();
@@ -136,8 +136,8 @@ TEST(ColumnMap, RepeatedTimeStampsFirstKeptOrRejected) {
   MapReport rep;
   const MeasuredData d = ReadMeasured(f.csv, f.map, 5, &rep);
   ASSERT_EQ(d.size(), 20u);
-  EXPECT_DOUBLE_EQ(d.q_hip[2], 2);
-  EXPECT_DOUBLE_EQ(d.q_hip[8], 10);
+  EXPECT_DOUBLE_EQ(d.q_hip()[2], 2);
+  EXPECT_DOUBLE_EQ(d.q_hip()[8], 10);
   EXPECT_EQ(rep.rows_merged, 3u);
 
   const Files e = Write("duperr", RepeatingCsv(), std::string(kRepeatingMap) + "time: {duplicates: error}\n");
@@ -182,17 +182,17 @@ TEST(ColumnMap, ShippedMapOnShippedRecords) {
     EXPECT_EQ(rep.repeated_stamps, 0u);
     const auto& col = [&](const char* n) { return raw.columns[raw.Find(n)]; };
     for (size_t i = 0; i < d.size(); ++i) {
-      ASSERT_EQ(d.t[i], col("time")[i]);
-      ASSERT_EQ(d.q_hip[i], col("pos_meas1")[i]);
-      ASSERT_EQ(d.q_knee[i], col("pos_meas2")[i]);
-      ASSERT_EQ(d.tau_hip[i], -col("tau_meas1")[i]);
-      ASSERT_EQ(d.tau_knee[i], -col("tau_meas2")[i]);
+      ASSERT_EQ(d.t()[i], col("time")[i]);
+      ASSERT_EQ(d.q_hip()[i], col("pos_meas1")[i]);
+      ASSERT_EQ(d.q_knee()[i], col("pos_meas2")[i]);
+      ASSERT_EQ(d.tau_hip()[i], -col("tau_meas1")[i]);
+      ASSERT_EQ(d.tau_knee()[i], -col("tau_meas2")[i]);
       ASSERT_EQ((*d.Column("cmd_hip"))[i], col("tau_con1")[i]);
     }
     EXPECT_GT(rep.jitter, 0.0);  // the rig's steps jitter
   }
   const MeasuredData d = ReadMeasured(dir + "trajectory_05.csv", dir + "dfki_double_pendulum_A0.map.yaml");
-  const auto [lo, hi] = std::minmax_element(d.q_knee.begin(), d.q_knee.end());
+  const auto [lo, hi] = std::minmax_element(d.q_knee().begin(), d.q_knee().end());
   EXPECT_GT(*hi - *lo, 11.0);
   EXPECT_GT(*hi, kMaxHumanJointAngle);
   EXPECT_THROW(CheckHumanJointRange(d), InputError);

@@ -33,7 +33,7 @@ double TorqueRmsDiff(const LegParams& p, const MeasuredData& a, double fa, const
   }
   double s = 0, n = 0;
   for (auto& x : d) {
-    if (post > 0) x = LowPassOnTimeBase(a.t, x, post, a.source);
+    if (post > 0) x = LowPassOnTimeBase(a.t(), x, post, a.source);
     for (size_t i = 500; i + 500 < x.size(); ++i) s += x[i] * x[i], n += 1;
   }
   return std::sqrt(s / n);
@@ -53,7 +53,7 @@ TEST(DerivativeCutoff, CleanRecordKeepsTheMotionCoarseEncoderPredictsBetterThanT
   // The same motion through a 12-bit encoder (4096 counts per turn), as on a low-cost rig.
   MeasuredData coarse = fine;
   const double count = 2 * M_PI / 4096;
-  for (auto* q : {&coarse.q_hip, &coarse.q_knee})
+  for (auto* q : {&coarse.column_at(kColQHip), &coarse.column_at(kColQKnee)})
     for (double& v : *q) v = count * std::round(v / count);
   const CutoffChoice cc = ChooseCutoff({&coarse}, p.L1, p.g, use);
   EXPECT_LE(cc.hz, cf.hz) << cc.why;

@@ -116,13 +116,13 @@ TEST(Generate, SameSeedSameBitsOtherSeedOtherData) {
   GenerateOptions g;
   g.seed = 42, g.duration = 5, g.rate = 500;
   const GeneratedData a = GenerateMeasured(S1(), g), b = GenerateMeasured(S1(), g);
-  EXPECT_EQ(a.data.tau_knee, b.data.tau_knee);
+  EXPECT_EQ(a.data.tau_knee(), b.data.tau_knee());
   EXPECT_EQ(ModelToYaml(a.truth), ModelToYaml(b.truth));
   g.seed = 43;
-  EXPECT_NE(GenerateMeasured(S1(), g).data.tau_knee, a.data.tau_knee);
+  EXPECT_NE(GenerateMeasured(S1(), g).data.tau_knee(), a.data.tau_knee());
   // Angles stay in the stated ranges.
-  for (double q : a.data.q_hip) EXPECT_TRUE(q > 4.9 * kRadPerDeg && q < 40.1 * kRadPerDeg);
-  for (double q : a.data.q_knee) EXPECT_TRUE(q > -70.1 * kRadPerDeg && q < -4.9 * kRadPerDeg);
+  for (double q : a.data.q_hip()) EXPECT_TRUE(q > 4.9 * kRadPerDeg && q < 40.1 * kRadPerDeg);
+  for (double q : a.data.q_knee()) EXPECT_TRUE(q > -70.1 * kRadPerDeg && q < -4.9 * kRadPerDeg);
 }
 
 TEST(Generate, RejectsBadOptions) {

@@ -33,7 +33,7 @@ ProtocolData Subset(const ProtocolData& d, int trials, double seconds) {
   auto cut = [&](const MeasuredData& m) {
     CsvTable t = m.table;
     size_t n = 0;
-    while (n < m.size() && m.t[n] < seconds) ++n;
+    while (n < m.size() && m.t()[n] < seconds) ++n;
     for (auto& c : t.columns) c.resize(n);
     t.line_of_row.resize(n);
     return MakeMeasuredData(t, m.source);

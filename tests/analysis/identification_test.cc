@@ -159,7 +159,7 @@ TEST(Identification, NormalEquationsMatchQr) {
   MeasuredData d = ClosedFormRecording(truth, true, 0.01, 10);
   std::mt19937_64 rng(9);
   std::normal_distribution<double> N(0, 0.5);  // test-only noise, bit-exactness not needed
-  for (double& v : d.tau_knee) v += N(rng);
+  for (double& v : d.column_at(kColTauKnee)) v += N(rng);
   IdentificationSamples s;
   s.config = IdConfiguration::kKneeSwing;
   IdentificationOptions opt;

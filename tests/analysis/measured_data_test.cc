@@ -29,7 +29,7 @@ CsvTable Table(int row, double q) {
 
 TEST(MeasuredAngles, ARecordMayTurnThroughSeveralRevolutions) {
   const MeasuredData d = MeasuredFromTable(Table(7, 11.0), "rig.csv");
-  EXPECT_DOUBLE_EQ(d.q_knee[7], 11.0);
+  EXPECT_DOUBLE_EQ(d.q_knee()[7], 11.0);
   EXPECT_NO_THROW(MeasuredFromTable(Table(7, -kMaxRecordedAngle), "rig.csv"));
 }
 
@@ -78,6 +78,31 @@ MeasuredData Record(bool uniform, bool qd_column) {
   return MeasuredFromTable(t, "record.csv");
 }
 
+// The required columns are views of the table (one copy of a record's data): a copy of the record
+// views its own table, writes through column_at show in the table, an empty record has empty views.
+TEST(MeasuredData, RequiredColumnsAreViewsOfTheTable) {
+  const MeasuredData d = Record(true, true);
+  EXPECT_EQ(&d.t(), &d.table.columns[0]);
+  EXPECT_EQ(&d.tau_knee(), &d.table.columns[4]);
+  EXPECT_EQ(d.size(), 2000u);
+  MeasuredData c = d;
+  EXPECT_EQ(&c.q_hip(), &c.table.columns[1]);
+  c.column_at(kColQKnee)[7] = 1.25;
+  EXPECT_EQ(c.table.columns[2][7], 1.25);
+  EXPECT_NE(d.q_knee()[7], 1.25);
+  const MeasuredData none;
+  EXPECT_EQ(none.size(), 0u);
+  EXPECT_TRUE(none.tau_hip().empty());
+  CsvTable t = d.table;
+  t.names[3] = "torque_hip";
+  try {
+    MakeMeasuredData(t, "rig.csv");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rig.csv: missing required column 'tau_hip'"), std::string::npos) << e.what();
+  }
+}
+
 // DeriveKinematics taking the record's columns gives what the copying one gives, to the bit.
 TEST(DeriveKinematics, TakingTheColumnsEqualsCopyingThem) {
   for (bool uniform : {true, false})
@@ -109,31 +134,31 @@ TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
   for (bool uniform : {true, false}) {
     SCOPED_TRACE(uniform ? "uniform" : "non-uniform");
     const MeasuredData d = Record(uniform, false);
-    const Sampling s = ExamineSampling(d.t, d.source);
+    const Sampling s = ExamineSampling(d.t(), d.source);
     EXPECT_EQ(s.uniform, uniform);
-    EXPECT_EQ(s.dt, MedianStep(d.t));
+    EXPECT_EQ(s.dt, MedianStep(d.t()));
     const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, 7.0);
-    const TimeBaseLowPass low(s, d.t, 7.0, d.source);
-    std::vector<double> xs[5] = {d.q_hip, d.q_knee, d.tau_hip, *d.Column("emg_VM"), d.t};
+    const TimeBaseLowPass low(s, d.t(), 7.0, d.source);
+    std::vector<double> xs[5] = {d.q_hip(), d.q_knee(), d.tau_hip(), *d.Column("emg_VM"), d.t()};
     std::vector<double> batched[5] = {xs[0], xs[1], xs[2], xs[3], xs[4]};
     std::vector<double>* bptr[5];
     for (int k = 0; k < 5; ++k) bptr[k] = &batched[k];
     low.Apply(bptr, 5);
     for (int k = 0; k < 5; ++k) {
       const std::vector<double> ref =
-          uniform ? dsp::FiltFilt(sos, xs[k]) : Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(d.t, xs[k], s.grid)), d.t);
+          uniform ? dsp::FiltFilt(sos, xs[k]) : Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(d.t(), xs[k], s.grid)), d.t());
       EXPECT_EQ(low(xs[k]), ref);
-      EXPECT_EQ(TimeBaseLowPass(d.t, 7.0, d.source)(xs[k]), ref);
-      EXPECT_EQ(LowPassOnTimeBase(d.t, xs[k], 7.0, d.source), ref);
+      EXPECT_EQ(TimeBaseLowPass(d.t(), 7.0, d.source)(xs[k]), ref);
+      EXPECT_EQ(LowPassOnTimeBase(d.t(), xs[k], 7.0, d.source), ref);
       EXPECT_EQ(batched[k], ref);
     }
     const Kinematics k = DeriveKinematics(d, 15.0);
     for (int j = 0; j < 2; ++j) {
-      const AngleRates r = DeriveAngleRates(s, d.t, j == 0 ? d.q_hip : d.q_knee, 15.0, d.source);
+      const AngleRates r = DeriveAngleRates(s, d.t(), j == 0 ? d.q_hip() : d.q_knee(), 15.0, d.source);
       EXPECT_EQ(r.qd, k.qd[j]);
       EXPECT_EQ(r.qdd, k.qdd[j]);
     }
-    EXPECT_THROW(TimeBaseLowPass(s, d.t, 600.0, d.source), InputError);  // above half the sample rate
+    EXPECT_THROW(TimeBaseLowPass(s, d.t(), 600.0, d.source), InputError);  // above half the sample rate
   }
 }
 

@@ -44,9 +44,9 @@ void ExpectSwing(const MeasuredData& m, const Swing& s, double tol) {
   ASSERT_EQ(m.size(), s.t.size());
   EXPECT_FALSE(HasTorque(m));
   for (size_t i = 0; i < s.t.size(); ++i) {
-    EXPECT_DOUBLE_EQ(m.t[i], s.t[i]);
-    EXPECT_NEAR(m.q_hip[i], s.hip[i], tol) << i;
-    EXPECT_NEAR(m.q_knee[i], s.knee[i], tol) << i;
+    EXPECT_DOUBLE_EQ(m.t()[i], s.t[i]);
+    EXPECT_NEAR(m.q_hip()[i], s.hip[i], tol) << i;
+    EXPECT_NEAR(m.q_knee()[i], s.knee[i], tol) << i;
   }
 }
 

@@ -187,19 +187,19 @@ TEST(EmgCalibrationProtocol, DynamicScenarioMuscularTorqueAndTable7) {
   double rest_tm2[2] = {0, 0}, rest_sh2[2] = {0, 0};
   size_t n_rest = 0;
   for (size_t k = 0; k < d.size(); ++k) {
-    if (d.t[k] < t_start || d.t[k] > d.t.back() - 1.0) continue;
+    if (d.t()[k] < t_start || d.t()[k] > d.t().back() - 1.0) continue;
     const Vec2 qk(kin.q[0][k], kin.q[1][k]), qdk(kin.qd[0][k], kin.qd[1][k]), qddk(kin.qdd[0][k], kin.qdd[1][k]);
-    const Vec2 tm = Vec2(d.tau_hip[k], d.tau_knee[k]) + ActuatorTorque(id, qk, qdk, qddk);
+    const Vec2 tm = Vec2(d.tau_hip()[k], d.tau_knee()[k]) + ActuatorTorque(id, qk, qdk, qddk);
     const Vec2 shift = ActuatorTorque(deleva, qk, qdk, qddk) - ActuatorTorque(id, qk, qdk, qddk);
     for (int j = 0; j < 2; ++j) {
       e2[j] += std::pow(tm[j] - (*truth_tau[j])[k], 2);
       t2[j] += std::pow((*truth_tau[j])[k], 2);
       sh[j] += shift[j], tmv[j] += tm[j];
       sh2[j] += shift[j] * shift[j], m2[j] += tm[j] * tm[j], shm[j] += shift[j] * tm[j];
-      if (d.t[k] < s.human.active_from) rest_tm2[j] += tm[j] * tm[j], rest_sh2[j] += shift[j] * shift[j];
+      if (d.t()[k] < s.human.active_from) rest_tm2[j] += tm[j] * tm[j], rest_sh2[j] += shift[j] * shift[j];
     }
     ++n;
-    if (d.t[k] < s.human.active_from) ++n_rest;
+    if (d.t()[k] < s.human.active_from) ++n_rest;
   }
   // Fig. 9: relaxed, the identified set's tau_M is near zero (the passive torque removed), while De
   // Leva's stays off by its Table 5 error, with no EMG there for HJ15 eq. 28's beta to absorb it.
