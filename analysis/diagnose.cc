@@ -248,7 +248,9 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
                                                {kin.qdd[0][i], kin.qdd[1][i]});
     rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
   }
-  {
+  if (params.effects.empty()) {
+    ApplyEffects(params, kin, rc.tau_R, rc.tau_S);  // leaves rc.tau_R as it is
+  } else {
     std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
     ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
   }
@@ -680,7 +682,6 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
       rc.tau_R[j].resize(RefineRows(rc, R));
       rc.tau_R[j].shrink_to_fit();
     }
-  ReturnFreedMemory();
   Lap("kinematics + twin");
 
   std::vector<ColumnBank> banks = CandidateColumns(params, recs, w, opt);

@@ -78,7 +78,12 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
   const size_t n = kin.t.size();
   LegParams rigid = params;
   rigid.effects.clear();
-  const std::vector<double> tau_rigid[2] = {tau_R[0], tau_R[1]};
+  std::vector<double> tau_rigid[2];  // the rigid torque, for the effects that depend on it (backlash)
+  for (const Effect& e : params.effects)
+    if (e.name == "backlash") {
+      tau_rigid[0] = tau_R[0], tau_rigid[1] = tau_R[1];
+      break;
+    }
   for (const Effect& e : params.effects) {
     const int j = EffectJoint(e);
     auto& tr = tau_R[j];

@@ -33,15 +33,50 @@ struct BenchMachine {
 BenchMachine MeasureMachine();
 nlohmann::ordered_json MachineJson(const BenchMachine& m);
 
-// The table: a header with the machine's load at the start and at the end, then one line per row
-// (ratio, goal, work, baseline, detail), as Markdown.
+// The speed of one CPU: the seconds of a bare mj_step loop pinned to it. A machine's CPUs can differ
+// (a virtual machine's vCPUs: on one 2-core machine the same loop took 1.53x longer on CPU 1 than on
+// CPU 0, alone or not), so a ratio holds only with both of its halves on one CPU: the single-threaded
+// probes run pinned to the fastest CPU (ScopedCpuPin), and a 2-job sweep's speed-up is bounded by
+// SpeedupBoundOfCpus, not by 2.
+struct BenchCpu {
+  int cpu = 0;        // CPU number (sched_getaffinity)
+  double step_s = 0;  // best of repeat: 20000 bare mj_step (quick: 2000)
+};
+
+// The table: a header with the machine's load at the start and at the end (and its CPUs' speeds),
+// then one line per row (ratio, goal, work, baseline, detail), as Markdown.
 void PrintBenchTable(std::FILE* out, const std::vector<BenchRow>& rows, const BenchMachine& start,
-                     const BenchMachine& end);
+                     const BenchMachine& end, const std::vector<BenchCpu>& cpus = {});
 
 struct BenchConfig {
   int repeat = 3;             // repetitions per timing (the minimum is kept)
   bool quick = false;         // small problem sizes (tests)
   std::string scratch = "/tmp";  // folder for temporary outputs
+  std::vector<BenchCpu> cpus;    // MeasureCpus; empty: unknown (no pinning)
+};
+
+// Every CPU this process may run on, each measured pinned to it (the affinity is restored).
+std::vector<BenchCpu> MeasureCpus(const BenchConfig& c);
+// The fastest CPU's number; -1 if `cpus` is empty.
+int FastestCpu(const std::vector<BenchCpu>& cpus);
+// The speed-up that running on all of `cpus` gives at most over running on the fastest alone: the
+// sum over CPUs of t_fastest / t_cpu (2 for two equal CPUs; 1 if empty).
+double SpeedupBoundOfCpus(const std::vector<BenchCpu>& cpus);
+nlohmann::ordered_json CpusJson(const std::vector<BenchCpu>& cpus);
+
+// Pins the calling thread, and the processes it starts from then on, to one CPU until destroyed,
+// then restores the previous affinity. cpu < 0, or a mask the system refuses: no change.
+class ScopedCpuPin {
+ public:
+  explicit ScopedCpuPin(int cpu);
+  ~ScopedCpuPin();
+  ScopedCpuPin(const ScopedCpuPin&) = delete;
+  ScopedCpuPin& operator=(const ScopedCpuPin&) = delete;
+  bool pinned() const { return pinned_; }
+
+ private:
+  std::vector<unsigned char> saved_;  // the previous cpu_set_t, as bytes
+  bool pinned_ = false;
 };
 
 // Closed loop (gait, plant + CAN + sensors + controller, no logs) vs bare mj_step, same model and

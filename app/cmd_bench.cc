@@ -64,11 +64,17 @@ CommandRunner RegisterBench(CLI::App& app) {
     nlohmann::ordered_json j;
     const BenchMachine start = MeasureMachine();
     j["machine"] = MachineJson(start);
+    c.cpus = MeasureCpus(c);
+    j["machine"]["cpus"] = CpusJson(c.cpus);
     j["quick"] = o->quick;
     j["repeat"] = o->repeat;
     std::vector<BenchRow> rows;
     for (const std::string& name : selected) {
       std::fprintf(stderr, "bench: %s...\n", name.c_str());
+      // Single-threaded work runs on the fastest CPU, its baseline too (bench_probes.h BenchCpu); the
+      // render (llvmpipe and encoder threads), `run` (its log writer thread) and the sweep use them all.
+      const bool threaded = name == "render" || name == "run" || name == "sweep";
+      const ScopedCpuPin pin(threaded ? -1 : FastestCpu(c.cpus));
       if (name == "startup") j[name] = BenchStartup(c);
       if (name == "run") j[name] = BenchRunCommand(c);
       if (name == "closed_loop") j[name] = BenchClosedLoop(c);
@@ -78,12 +84,13 @@ CommandRunner RegisterBench(CLI::App& app) {
       if (name == "sweep") j[name] = BenchSweep(c);
       if (name == "predict_long") j[name] = BenchPredictLong(c);
       if (name == "diagnose_long") j[name] = BenchDiagnoseLong(c);
+      if (pin.pinned()) j[name]["pinned_cpu"] = FastestCpu(c.cpus);
       for (const BenchRow& r : BenchRowsFromJson(j[name])) rows.push_back(r);
     }
     const BenchMachine end = MeasureMachine();
     j["machine_at_end"] = MachineJson(end);
     std::filesystem::remove_all(c.scratch);
-    PrintBenchTable(stderr, rows, start, end);
+    PrintBenchTable(stderr, rows, start, end, c.cpus);
     const std::string text = j.dump(2) + "\n";
     std::fputs(text.c_str(), stdout);
     if (!o->out.empty()) WriteFileAtomic(o->out, text);

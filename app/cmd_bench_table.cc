@@ -1,8 +1,11 @@
 // The table of `exotwin bench` (app/bench_probes.h): rows as JSON and back, the machine's load, the
 // Markdown printer.
+#include <sched.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 
 #include "app/bench_probes.h"
@@ -49,12 +52,61 @@ nlohmann::ordered_json MachineJson(const BenchMachine& m) {
   return {{"cores", m.cores}, {"load_avg_1min", m.load[0]}, {"load_avg_5min", m.load[1]}, {"load_avg_15min", m.load[2]}};
 }
 
+int FastestCpu(const std::vector<BenchCpu>& cpus) {
+  if (cpus.empty()) return -1;
+  return std::min_element(cpus.begin(), cpus.end(), [](const BenchCpu& a, const BenchCpu& b) {
+           return a.step_s < b.step_s;
+         })->cpu;
+}
+
+double SpeedupBoundOfCpus(const std::vector<BenchCpu>& cpus) {
+  if (cpus.empty()) return 1.0;
+  double fastest = cpus.front().step_s, sum = 0;
+  for (const BenchCpu& c : cpus) fastest = std::min(fastest, c.step_s);
+  for (const BenchCpu& c : cpus) sum += fastest / c.step_s;
+  return sum;
+}
+
+nlohmann::ordered_json CpusJson(const std::vector<BenchCpu>& cpus) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::array();
+  const int fastest = FastestCpu(cpus);
+  for (const BenchCpu& c : cpus) j.push_back({{"cpu", c.cpu}, {"bare_mj_step_s", c.step_s}, {"fastest", c.cpu == fastest}});
+  return j;
+}
+
+ScopedCpuPin::ScopedCpuPin(int cpu) {
+  if (cpu < 0 || cpu >= CPU_SETSIZE) return;
+  cpu_set_t old, one;
+  if (sched_getaffinity(0, sizeof old, &old) != 0) return;
+  CPU_ZERO(&one);
+  CPU_SET(cpu, &one);
+  if (sched_setaffinity(0, sizeof one, &one) != 0) return;
+  saved_.resize(sizeof old);
+  std::memcpy(saved_.data(), &old, sizeof old);
+  pinned_ = true;
+}
+
+ScopedCpuPin::~ScopedCpuPin() {
+  if (!pinned_) return;
+  cpu_set_t old;
+  std::memcpy(&old, saved_.data(), sizeof old);
+  sched_setaffinity(0, sizeof old, &old);
+}
+
 void PrintBenchTable(std::FILE* out, const std::vector<BenchRow>& rows, const BenchMachine& start,
-                     const BenchMachine& end) {
+                     const BenchMachine& end, const std::vector<BenchCpu>& cpus) {
   std::fprintf(out, "machine: %u cores (nproc); load average (1/5/15 min) %.2f/%.2f/%.2f at the start, %.2f/%.2f/%.2f at the end",
                start.cores, start.load[0], start.load[1], start.load[2], end.load[0], end.load[1], end.load[2]);
   std::fprintf(out, start.load[0] > 0.5 * start.cores ? " (busy: other load shares the cores, every figure is noisy)\n\n"
                                                        : "\n\n");
+  if (!cpus.empty()) {
+    double fastest = cpus.front().step_s;
+    for (const BenchCpu& c : cpus) fastest = std::min(fastest, c.step_s);
+    std::fprintf(out, "CPUs (a bare mj_step loop pinned to each, time against the fastest):");
+    for (const BenchCpu& c : cpus) std::fprintf(out, " cpu%d %.2fx", c.cpu, c.step_s / fastest);
+    std::fprintf(out, "; single-threaded probes run on cpu%d; all CPUs together allow a %.2fx speed-up\n\n",
+                 FastestCpu(cpus), SpeedupBoundOfCpus(cpus));
+  }
   std::fprintf(out, "| ratio | goal | work | against | figures |\n| --- | --- | --- | --- | --- |\n");
   for (const BenchRow& r : rows)
     std::fprintf(out, "| %.3g%s | %s | %s | %s | %s |\n", r.ratio, r.unit == "%" ? " %" : r.unit.c_str(),
