@@ -1,12 +1,15 @@
 // `exotwin bench`: JSON with each probe's timing and its ratio against the in-run baseline.
 // Quick sizes, start-up, closed loop and sweep only (render, identification and diagnosis have their
 // own benches). No timing is asserted: the machines are shared.
+#include <sched.h>
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
 #include <fstream>
 
+#include "app/bench_probes.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin::testing {
@@ -38,6 +41,54 @@ TEST(BenchCli, QuickJsonHasRatios) {
   EXPECT_NE(r.output.find("| ratio | goal | work | against | figures |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("closed loop without logs, EMG"), std::string::npos);
   EXPECT_NE(r.output.find("machine: "), std::string::npos);
+  // Every CPU the process may use, measured pinned to it; the single-threaded probes ran on the
+  // fastest, the sweep's two jobs on all of them, bounded by what the CPUs allow.
+  const auto& cpus = j["machine"]["cpus"];
+  ASSERT_GE(cpus.size(), 1u);
+  int fastest = -1;
+  double t_fastest = 1e300;
+  for (const auto& c : cpus) {
+    EXPECT_GT(c["bare_mj_step_s"].get<double>(), 0.0);
+    if (c["bare_mj_step_s"].get<double>() < t_fastest) t_fastest = c["bare_mj_step_s"], fastest = c["cpu"];
+  }
+  EXPECT_EQ(j["closed_loop"]["pinned_cpu"], fastest);
+  EXPECT_EQ(j["startup"]["pinned_cpu"], fastest);
+  EXPECT_FALSE(j["sweep"].contains("pinned_cpu"));
+  EXPECT_EQ(j["sweep"]["jobs1_pinned_to_fastest_cpu"], fastest);
+  const double bound = j["sweep"]["speedup_bound_of_these_cpus"].get<double>();
+  EXPECT_GE(bound, 1.0);
+  EXPECT_LE(bound, static_cast<double>(cpus.size()) + 1e-12);
+  EXPECT_NE(r.output.find("single-threaded probes run on cpu" + std::to_string(fastest)), std::string::npos) << r.output;
+}
+
+// The CPUs' speed-up bound: the sum over CPUs of t_fastest / t_cpu.
+TEST(BenchTable, SpeedupBoundOfUnequalCpus) {
+  EXPECT_DOUBLE_EQ(SpeedupBoundOfCpus({{0, 0.12}, {1, 0.18}}), 1.0 + 0.12 / 0.18);
+  EXPECT_DOUBLE_EQ(SpeedupBoundOfCpus({{0, 0.2}, {1, 0.2}}), 2.0);
+  EXPECT_DOUBLE_EQ(SpeedupBoundOfCpus({}), 1.0);
+  EXPECT_EQ(FastestCpu({{0, 0.3}, {3, 0.1}, {5, 0.2}}), 3);
+  EXPECT_EQ(FastestCpu({}), -1);
+}
+
+// ScopedCpuPin sets this thread's affinity to one CPU and restores the previous mask.
+TEST(BenchTable, ScopedCpuPinRestoresTheAffinity) {
+  cpu_set_t before;
+  ASSERT_EQ(sched_getaffinity(0, sizeof before, &before), 0);
+  int first = -1;
+  for (int c = 0; c < CPU_SETSIZE && first < 0; ++c)
+    if (CPU_ISSET(c, &before)) first = c;
+  {
+    const ScopedCpuPin pin(first);
+    ASSERT_TRUE(pin.pinned());
+    cpu_set_t now;
+    ASSERT_EQ(sched_getaffinity(0, sizeof now, &now), 0);
+    EXPECT_EQ(CPU_COUNT(&now), 1);
+    EXPECT_TRUE(CPU_ISSET(first, &now));
+  }
+  cpu_set_t after;
+  ASSERT_EQ(sched_getaffinity(0, sizeof after, &after), 0);
+  EXPECT_TRUE(CPU_EQUAL(&before, &after));
+  EXPECT_FALSE(ScopedCpuPin(-1).pinned());
 }
 
 // The long-record rows: ratio against the strtod read of the same file first, the child's peak memory
