@@ -43,7 +43,7 @@ struct Rec {
   std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
   double hz = 0;                        // the parallel low-pass (0: none)
   std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque (after stage 2 only on [0, RefineRows)), reading with its effects
-  std::vector<double> resid[2];
+  std::vector<double> resid[2];         // Residual(j); released once the candidate columns took their rows
   size_t split = 0;
   std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
   size_t n() const { return kin.t.size(); }
@@ -54,6 +54,13 @@ struct Rec {
     if (from == 0 && x.size() == kin.t.size()) return (*low)(std::move(x));
     const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
     return LowPassOnTimeBase(t, x, hz, source);
+  }
+  // The filtered residual of joint j, measured - twin (raw - tau_S), on kin.t's samples: the same
+  // bits wherever it is computed.
+  std::vector<double> Residual(int j) const {
+    std::vector<double> e(n());
+    for (size_t i = 0; i < e.size(); ++i) e[i] = raw[j][i] - tau_S[j][i];
+    return Filter(std::move(e));
   }
   std::function<void(std::vector<double>&)> FilterFn() const {
     if (!(hz > 0)) return {};
@@ -254,11 +261,7 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
     std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
     ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
   }
-  for (int j = 0; j < 2; ++j) {
-    rc.resid[j].resize(n);
-    for (size_t i = 0; i < n; ++i) rc.resid[j][i] = rc.raw[j][i] - rc.tau_S[j][i];
-    rc.resid[j] = rc.Filter(std::move(rc.resid[j]));
-  }
+  for (int j = 0; j < 2; ++j) rc.resid[j] = rc.Residual(j);
 }
 
 // Stage 3c: the measured torque filtered as the residual, into rc.meas (after the candidate columns,
@@ -300,12 +303,12 @@ std::vector<Eigen::VectorXd> KitchenSinkResiduals(const std::vector<ColumnBank>&
 
 // Stage 3: the candidate columns of every record (the same columns in each bank, rows weighted by
 // w), with the ripple candidates' frequency searched.
-std::vector<ColumnBank> CandidateColumns(const LegParams& params, const std::vector<Rec>& recs,
+std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Rec>& recs,
                                          const double w[2], const DiagnoseOptions& opt) {
   const size_t R = recs.size();
   std::vector<ColumnBank> banks;
   std::vector<const Kinematics*> kins;
-  for (const Rec& rc : recs) {
+  for (Rec& rc : recs) {  // BuildColumns releases rc.resid (a long record's memory)
     banks.push_back(BuildColumns(params, rc.kin, rc.tau_S, rc.resid, w, rc.split,
                                  std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn()));
     kins.push_back(&rc.kin);
@@ -504,7 +507,7 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
 // Stage 6: the extended twin (predict with D->extended) on every record's held-out part: the scores
 // per record and pooled (D->records, D->joints) and the first record's plot series; with several
 // records, each whole record predicted by the effects fitted on the others (D->left_out).
-void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, const ColumnBank& bank,
+void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const ColumnBank& bank,
                        const Grams& g, const std::vector<int>& chosen, const std::vector<double>& refine_ratio,
                        const DiagnoseOptions& opt, Diagnosis* D_out) {
   Diagnosis& D = *D_out;
@@ -514,8 +517,11 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
   double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
   const std::vector<int> cols = ColumnsOf(bank, chosen);
   for (size_t r = 0; r < R; ++r) {
-    const Rec& rc = recs[r];
+    Rec& rc = recs[r];
     const size_t n = rc.n();
+    // The residual again (released by the candidate columns), then the twin's reading is done with.
+    const std::vector<double> resid[2] = {rc.Residual(0), rc.Residual(1)};
+    for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_S[j]);
     RecordScore rs;
     rs.source = rc.source;
     rs.samples = rc.samples;
@@ -530,7 +536,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
       ea = rc.Filter(std::move(ea), warm);
       double b = 0, a = 0;
       for (size_t i = rc.split; i < n; ++i) {
-        b += std::pow(rc.resid[j][i], 2);
+        b += std::pow(resid[j][i], 2);
         a += std::pow(ea[i - warm], 2);
       }
       rs.split[j] = ScoreOf(b, a, static_cast<double>(std::max<size_t>(1, n - rc.split)));
@@ -538,7 +544,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
       if (r == 0) {
         D.measured[j] = rc.meas[j];
         D.before[j].resize(n);
-        for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - rc.resid[j][i];
+        for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - resid[j][i];
         D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
         for (size_t i = rc.split; i < n; ++i) D.after[j][i] = rc.meas[j][i] - ea[i - warm];
       }
@@ -562,7 +568,7 @@ void ScoreExtendedTwin(const LegParams& params, const std::vector<Rec>& recs, co
         for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
         ea = rc.Filter(std::move(ea));
         double b = 0, a = 0;
-        for (size_t i = 0; i < n; ++i) b += std::pow(rc.resid[j][i], 2), a += std::pow(ea[i], 2);
+        for (size_t i = 0; i < n; ++i) b += std::pow(resid[j][i], 2), a += std::pow(ea[i], 2);
         rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
         lb[j] += b, la[j] += a;
       }
@@ -705,8 +711,8 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   Lap("refinement");
 
-  for (Rec& rc : recs)  // the twin's torques are done with (a long record's memory)
-    for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_R[j]), std::vector<double>().swap(rc.tau_S[j]);
+  for (Rec& rc : recs)  // the rigid torque is done with (a long record's memory)
+    for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_R[j]);
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
   // Effects in order of what they explain.
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {

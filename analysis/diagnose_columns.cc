@@ -126,7 +126,7 @@ void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]
 
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         const std::vector<double> tau_S[2],
-                        const std::vector<double> resid[2], const double w[2], size_t split,
+                        std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows, std::function<void(std::vector<double>&)> filter) {
   ColumnBank b;
   const size_t n = kin.t.size();
@@ -144,6 +144,7 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
     b.r[k] = w[0] * resid[0][b.sample[k]];
     b.r[m + k] = w[1] * resid[1][b.sample[k]];
   }
+  for (int j = 0; j < 2; ++j) std::vector<double>().swap(resid[j]);
   LegParams rigid = params;
   rigid.effects.clear();
   auto Q = [&](size_t i) { return Eigen::Vector2d(kin.q[0][i], kin.q[1][i]); };

@@ -39,9 +39,10 @@ struct ColumnBank {
 
 // Builds every candidate for both joints. tau_S: the twin's prediction (N m) on all samples (its rigid
 // tau_R, ActuatorTorque, is evaluated where a column needs it); resid[j]: measured - predicted
-// tau_S; w[j]: row weights (1/N m); split: first held-out sample.
+// tau_S, released (left empty) once the fit rows' values are taken; w[j]: row weights (1/N m);
+// split: first held-out sample.
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin, const std::vector<double> tau_S[2],
-                        const std::vector<double> resid[2], const double w[2], size_t split,
+                        std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows,
                         std::function<void(std::vector<double>&)> filter = {});
 

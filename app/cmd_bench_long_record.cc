@@ -1,7 +1,8 @@
 // The long-record rows of `exotwin bench` (app/bench_probes.h): `predict` and `diagnose` of a
 // generated 1 kHz record (600 s; quick: 20 s), each run as a child process of this executable, against
 // reading the same file once with strtod per field (the floor of any CSV reader) in the same run.
-// Peak memory is the child's ru_maxrss (wait4), next to that of `exotwin --help` (start-up alone).
+// Peak memory is the child's own VmHWM (EXOTWIN_PEAK_FILE, app/main.cc; its ru_maxrss would also
+// count this process's pages it shared until exec), next to that of `exotwin --help` (start-up alone).
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -65,11 +66,15 @@ ChildRun RunSelf(std::vector<std::string> args) {
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  const std::string peak_file =
+      (std::filesystem::temp_directory_path() / ("exotwin_bench_peak_" + std::to_string(getpid()))).string();
+  std::remove(peak_file.c_str());
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("bench: fork failed");
   if (pid == 0) {
     if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr)) _exit(127);
+    setenv("EXOTWIN_PEAK_FILE", peak_file.c_str(), 1);
     execv("/proc/self/exe", argv.data());
     _exit(127);
   }
@@ -81,6 +86,12 @@ ChildRun RunSelf(std::vector<std::string> args) {
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.cpu_s = ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   r.max_rss_mb = ru.ru_maxrss / 1024.0;
+  if (std::FILE* f = std::fopen(peak_file.c_str(), "r")) {
+    long kb = 0;
+    if (std::fscanf(f, "%ld", &kb) == 1 && kb > 0) r.max_rss_mb = kb / 1024.0;
+    std::fclose(f);
+    std::remove(peak_file.c_str());
+  }
   return r;
 }
 

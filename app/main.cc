@@ -2,14 +2,44 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "app/commands.h"
 #include "core/error.h"
 #include "sim/plant.h"
 
+namespace {
+
+// EXOTWIN_PEAK_FILE=PATH: at exit, the process's peak resident memory (VmHWM of /proc/self/status,
+// kB) is written to PATH. `exotwin bench` reads it for its child processes: their ru_maxrss also
+// counts the pages they shared with the parent between fork and exec.
+std::string g_peak_file;
+
+void WritePeak() {
+  std::FILE* in = std::fopen("/proc/self/status", "r");
+  if (!in) return;
+  char line[256];
+  long kb = -1;
+  while (std::fgets(line, sizeof line, in))
+    if (std::sscanf(line, "VmHWM: %ld kB", &kb) == 1) break;
+  std::fclose(in);
+  if (kb < 0) return;
+  if (std::FILE* out = std::fopen(g_peak_file.c_str(), "w")) {
+    std::fprintf(out, "%ld\n", kb);
+    std::fclose(out);
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  if (const char* f = std::getenv("EXOTWIN_PEAK_FILE"); f && *f) {
+    g_peak_file = f;
+    std::atexit(WritePeak);
+  }
   CLI::App app{"exotwin: digital twin of a leg in a rehabilitation exoskeleton"};
   app.require_subcommand(1);
   std::vector<exotwin::CommandRunner> runners;
