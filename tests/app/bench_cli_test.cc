@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <fstream>
 
 #include "app/bench_probes.h"
@@ -109,7 +110,24 @@ TEST(BenchCli, QuickLongRecordRows) {
     EXPECT_EQ(j[row]["samples"], 20001);  // 20 s at 1 kHz, both ends
     EXPECT_GT(j[row]["peak_rss_mb"].get<double>(), 0.0);
     EXPECT_GT(j[row]["start_up_peak_rss_mb"].get<double>(), 0.0);
+    // The child's own peak (not the bench's pages it shared until exec): above its start-up's.
+    EXPECT_GT(j[row]["data_peak_rss_mb"].get<double>(), 0.0);
   }
+}
+
+// EXOTWIN_PEAK_FILE: the process's peak resident memory (VmHWM, kB) written at exit.
+TEST(BenchCli, PeakFileHoldsThePeakMemory) {
+  const testing::ScopedTempDir tmp("peak");
+  const std::string file = tmp.path() + "/peak";
+  ASSERT_EQ(setenv("EXOTWIN_PEAK_FILE", file.c_str(), 1), 0);
+  const RunResult r = RunExotwin("--help");
+  unsetenv("EXOTWIN_PEAK_FILE");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream f(file);
+  long kb = -1;
+  ASSERT_TRUE(f >> kb) << "no number in " << file;
+  EXPECT_GT(kb, 1000);       // the program and its libraries: megabytes
+  EXPECT_LT(kb, 1000000);    // --help reads no data: far below a gigabyte
 }
 
 TEST(BenchCli, UnknownProbeExits2) {
