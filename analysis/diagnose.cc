@@ -42,7 +42,9 @@ struct Rec {
   const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
   std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
   double hz = 0;                        // the parallel low-pass (0: none)
-  std::vector<double> tau_R[2], tau_S[2];  // the twin: rigid actuator torque (after stage 2 only on [0, RefineRows)), reading with its effects
+  // The twin: the rigid actuator torque (after stage 2 only on [0, RefineRows)) and the reading
+  // with the model's effects (released by stage 6).
+  std::vector<double> tau_R[2], tau_S[2];
   std::vector<double> resid[2];         // Residual(j); released once the candidate columns took their rows
   size_t split = 0;
   std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
@@ -647,11 +649,10 @@ std::string MethodText(const Diagnosis& D, const DiagnoseOptions& opt) {
 
 }  // namespace
 
-// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time and the
-// process's peak memory at its end to stderr.
 namespace {
 
-// Diagnose of `records`; with `owned` (the same records, which the caller gives up), each record's
+// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time and the
+// process's peak memory at its end to stderr. Diagnose of `records`; with `owned` (the same records, which the caller gives up), each record's
 // columns are moved into the analysis once the cutoff is chosen instead of copied.
 Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const MeasuredData*>& records,
                           std::vector<MeasuredData>* owned, const DiagnoseOptions& opt) {
@@ -711,8 +712,6 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   Lap("refinement");
 
-  for (Rec& rc : recs)  // the rigid torque is done with (a long record's memory)
-    for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_R[j]);
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
   // Effects in order of what they explain.
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {

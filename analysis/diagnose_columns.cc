@@ -46,6 +46,15 @@ int AddColumn(ColumnBank& b, const double w[2], F f) {
   return c;
 }
 
+// x filtered in place by the bank's filter, unless x is all zero (the low-pass of zeros is zero).
+void FilterColumn(const ColumnBank& b, std::vector<double>& x) {
+  if (!b.filter) return;
+  for (double v : x)
+    if (v != 0.0) {
+      b.filter(x);
+      return;
+    }
+}
 
 // Column c from the values x_j of its joint-j rows on the fit rows (the other joint's rows zero),
 // weighted by w as SetColumn stores them.
@@ -57,12 +66,10 @@ void SetJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vec
   }
 }
 
-// Column c as SetColumn stores per-sample values x[i] on joint j's rows (0 on the other's); returns x, filtered as the column's
-// rows are, on the fit rows (before the weight).
+// Column c as SetColumn stores per-sample values x[i] on joint j's rows (0 on the other's); returns
+// x, filtered as the column's rows are, on the fit rows (before the weight).
 std::vector<double> SetJointColumn(ColumnBank& b, int c, const double w[2], int j, std::vector<double> x) {
-  bool zero = true;
-  for (double v : x) zero &= v == 0.0;
-  if (!zero && b.filter) b.filter(x);
+  FilterColumn(b, x);
   std::vector<double> rows(b.sample.size());
   for (size_t k = 0; k < rows.size(); ++k) rows[k] = x[b.sample[k]];
   SetJointRows(b, c, w, j, rows);
@@ -97,9 +104,7 @@ int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
   if (b.filter) {
     std::vector<double> x(b.n);
     for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
-    bool zero = true;
-    for (double v : x) zero &= v == 0.0;
-    if (!zero) b.filter(x);
+    FilterColumn(b, x);
     for (int j = 0; j < 2; ++j)
       for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * x[b.sample[k]];
     return c;
@@ -117,9 +122,7 @@ int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
 void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]) {
   const size_t m = b.sample.size();
   for (int j = 0; j < 2; ++j) {
-    bool zero = true;
-    for (double x : v[j]) zero &= x == 0.0;
-    if (!zero && b.filter) b.filter(v[j]);
+    FilterColumn(b, v[j]);
     for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * v[j][b.sample[k]];
   }
 }

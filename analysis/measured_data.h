@@ -11,20 +11,23 @@
 
 namespace exotwin {
 
+// The required columns of a record, in MeasuredData::column_at's numbering.
+enum RequiredColumn { kColT = 0, kColQHip = 1, kColQKnee = 2, kColTauHip = 3, kColTauKnee = 4 };
+
 // A record in the measured-data schema. The table is the one home of every column (a long record's
 // columns are not copied): t(), q_hip(), ... are views of the required columns in it. Built by
 // MeasuredFromTable (validated) or MakeMeasuredData (trusted input); a default-constructed record is
 // empty (size() == 0, the views empty).
 struct MeasuredData {
   std::string source;  // file name, for messages
-  CsvTable table;      // every column as read, in file order (t, q_*, tau_*, qd_*, qdd_*, cmd_*, emg_*, ...)
+  CsvTable table;      // every column as read, in file order (t, q_*, tau_*, qd_*, cmd_*, emg_*, ...)
 
   // The required columns: t (s, strictly increasing), q_hip, q_knee (rad), tau_hip, tau_knee (N m).
-  const std::vector<double>& t() const { return Required(0); }
-  const std::vector<double>& q_hip() const { return Required(1); }
-  const std::vector<double>& q_knee() const { return Required(2); }
-  const std::vector<double>& tau_hip() const { return Required(3); }
-  const std::vector<double>& tau_knee() const { return Required(4); }
+  const std::vector<double>& t() const { return Required(kColT); }
+  const std::vector<double>& q_hip() const { return Required(kColQHip); }
+  const std::vector<double>& q_knee() const { return Required(kColQKnee); }
+  const std::vector<double>& tau_hip() const { return Required(kColTauHip); }
+  const std::vector<double>& tau_knee() const { return Required(kColTauKnee); }
   // The same, writable (values only: the table keeps its shape). Precondition: bound (built by
   // MeasuredFromTable / MakeMeasuredData, or BindRequired called).
   std::vector<double>& column_at(int required) { return table.columns[at_[required]]; }
@@ -41,9 +44,6 @@ struct MeasuredData {
   const std::vector<double>& Required(int k) const;
   int at_[5] = {-1, -1, -1, -1, -1};  // table column of t, q_hip, q_knee, tau_hip, tau_knee
 };
-
-// Indices of MeasuredData::column_at.
-enum RequiredColumn { kColT = 0, kColQHip = 1, kColQKnee = 2, kColTauHip = 3, kColTauKnee = 4 };
 
 // A MeasuredData of a table holding at least t, q_hip, q_knee, tau_hip, tau_knee, without the value
 // checks of MeasuredFromTable (tables exotwin made itself). Throws InputError for a missing column.

@@ -2,6 +2,7 @@
 // its own in-run baseline and the ratio against it. Times are wall-clock seconds, best of `repeat`.
 #pragma once
 #include <nlohmann/json.hpp>
+#include <sched.h>
 
 #include <cstdio>
 #include <string>
@@ -75,7 +76,7 @@ class ScopedCpuPin {
   bool pinned() const { return pinned_; }
 
  private:
-  std::vector<unsigned char> saved_;  // the previous cpu_set_t, as bytes
+  cpu_set_t saved_;  // the previous affinity
   bool pinned_ = false;
 };
 

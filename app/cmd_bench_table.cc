@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <cstdlib>
 
 #include "app/bench_probes.h"
@@ -52,18 +51,22 @@ nlohmann::ordered_json MachineJson(const BenchMachine& m) {
   return {{"cores", m.cores}, {"load_avg_1min", m.load[0]}, {"load_avg_5min", m.load[1]}, {"load_avg_15min", m.load[2]}};
 }
 
-int FastestCpu(const std::vector<BenchCpu>& cpus) {
-  if (cpus.empty()) return -1;
-  return std::min_element(cpus.begin(), cpus.end(), [](const BenchCpu& a, const BenchCpu& b) {
-           return a.step_s < b.step_s;
-         })->cpu;
+namespace {
+
+// The fastest of non-empty `cpus`.
+const BenchCpu& Fastest(const std::vector<BenchCpu>& cpus) {
+  return *std::min_element(cpus.begin(), cpus.end(),
+                           [](const BenchCpu& a, const BenchCpu& b) { return a.step_s < b.step_s; });
 }
+
+}  // namespace
+
+int FastestCpu(const std::vector<BenchCpu>& cpus) { return cpus.empty() ? -1 : Fastest(cpus).cpu; }
 
 double SpeedupBoundOfCpus(const std::vector<BenchCpu>& cpus) {
   if (cpus.empty()) return 1.0;
-  double fastest = cpus.front().step_s, sum = 0;
-  for (const BenchCpu& c : cpus) fastest = std::min(fastest, c.step_s);
-  for (const BenchCpu& c : cpus) sum += fastest / c.step_s;
+  double sum = 0;
+  for (const BenchCpu& c : cpus) sum += Fastest(cpus).step_s / c.step_s;
   return sum;
 }
 
@@ -74,23 +77,17 @@ nlohmann::ordered_json CpusJson(const std::vector<BenchCpu>& cpus) {
   return j;
 }
 
-ScopedCpuPin::ScopedCpuPin(int cpu) {
+ScopedCpuPin::ScopedCpuPin(int cpu) : saved_() {
   if (cpu < 0 || cpu >= CPU_SETSIZE) return;
-  cpu_set_t old, one;
-  if (sched_getaffinity(0, sizeof old, &old) != 0) return;
+  if (sched_getaffinity(0, sizeof saved_, &saved_) != 0) return;
+  cpu_set_t one;
   CPU_ZERO(&one);
   CPU_SET(cpu, &one);
-  if (sched_setaffinity(0, sizeof one, &one) != 0) return;
-  saved_.resize(sizeof old);
-  std::memcpy(saved_.data(), &old, sizeof old);
-  pinned_ = true;
+  pinned_ = sched_setaffinity(0, sizeof one, &one) == 0;
 }
 
 ScopedCpuPin::~ScopedCpuPin() {
-  if (!pinned_) return;
-  cpu_set_t old;
-  std::memcpy(&old, saved_.data(), sizeof old);
-  sched_setaffinity(0, sizeof old, &old);
+  if (pinned_) sched_setaffinity(0, sizeof saved_, &saved_);
 }
 
 void PrintBenchTable(std::FILE* out, const std::vector<BenchRow>& rows, const BenchMachine& start,
@@ -100,10 +97,8 @@ void PrintBenchTable(std::FILE* out, const std::vector<BenchRow>& rows, const Be
   std::fprintf(out, start.load[0] > 0.5 * start.cores ? " (busy: other load shares the cores, every figure is noisy)\n\n"
                                                        : "\n\n");
   if (!cpus.empty()) {
-    double fastest = cpus.front().step_s;
-    for (const BenchCpu& c : cpus) fastest = std::min(fastest, c.step_s);
     std::fprintf(out, "CPUs (a bare mj_step loop pinned to each, time against the fastest):");
-    for (const BenchCpu& c : cpus) std::fprintf(out, " cpu%d %.2fx", c.cpu, c.step_s / fastest);
+    for (const BenchCpu& c : cpus) std::fprintf(out, " cpu%d %.2fx", c.cpu, c.step_s / Fastest(cpus).step_s);
     std::fprintf(out, "; single-threaded probes run on cpu%d; all CPUs together allow a %.2fx speed-up\n\n",
                  FastestCpu(cpus), SpeedupBoundOfCpus(cpus));
   }

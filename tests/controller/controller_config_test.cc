@@ -1,6 +1,7 @@
 #include "controller/controller_config.h"
 
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -180,18 +181,19 @@ TEST(ControllerConfig, HalFileCarriesTheWholeLoopBitForBit) {
   const size_t at = missing.find("      rho:");
   missing.erase(at, missing.find('\n', at) + 1 - at);
   EXPECT_NE(ErrorOf(missing).find("hal.assist.rls.rho: missing"), std::string::npos) << ErrorOf(missing);
-  std::string over = text;
-  over.replace(over.find("drivers: {torque_limit: 60}"), 27, "drivers: {torque_limit: 10}");
-  EXPECT_NE(ErrorOf(over).find("hal.tau_max"), std::string::npos) << ErrorOf(over);
-  std::string mode = text;
-  mode.replace(mode.find("mode: assist"), 12, "mode: boost");
-  EXPECT_NE(ErrorOf(mode).find("hal.mode"), std::string::npos) << ErrorOf(mode);
-  std::string unknown = text;
-  unknown.replace(unknown.find("    lambda1:"), 12, "    lambda9:");
-  EXPECT_NE(ErrorOf(unknown).find("hal.assist"), std::string::npos) << ErrorOf(unknown);
-  std::string channel = text;
-  channel.replace(channel.find("extensor_channel: 2"), 19, "extensor_channel: 7");
-  EXPECT_NE(ErrorOf(channel).find("hal.extensor_channel"), std::string::npos) << ErrorOf(channel);
+  const struct {
+    const char *from, *to, *key;
+  } edits[] = {{"drivers: {torque_limit: 60}", "drivers: {torque_limit: 10}", "hal.tau_max"},
+               {"mode: assist", "mode: boost", "hal.mode"},
+               {"    lambda1:", "    lambda9:", "hal.assist"},
+               {"extensor_channel: 2", "extensor_channel: 7", "hal.extensor_channel"}};
+  for (const auto& e : edits) {
+    std::string bad = text;
+    const size_t where = bad.find(e.from);
+    ASSERT_NE(where, std::string::npos) << e.from;
+    bad.replace(where, std::strlen(e.from), e.to);
+    EXPECT_NE(ErrorOf(bad).find(e.key), std::string::npos) << ErrorOf(bad);
+  }
 }
 
 }  // namespace
