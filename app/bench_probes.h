@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/generate.h"
+#include "diagnosis/generate.h"
 
 namespace exotwin {
 

@@ -13,7 +13,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "app/bench_probes.h"
 #include "app/commands.h"
 #include "core/error.h"

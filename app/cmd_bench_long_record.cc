@@ -18,8 +18,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "analysis/generate.h"
-#include "analysis/model_file.h"
+#include "diagnosis/generate.h"
+#include "formats/model_file.h"
 #include "app/bench_probes.h"
 #include "core/data_dir.h"
 #include "core/file_text.h"

@@ -19,19 +19,19 @@
 
 #include "app/bench_probes.h"
 #include "core/data_dir.h"
-#include "runner/fork_pool.h"
+#include "batch/fork_pool.h"
 #include "runner/runner.h"
-#include "runner/scenario_job.h"
+#include "batch/scenario_job.h"
 #include "runner/sweep_plan.h"
 #include "sim/plant.h"
 #include "sim/subjects.h"
 
 #include "render/render_plugin.h"
-#include "analysis/identification.h"
-#include "analysis/identification_data.h"
-#include "analysis/diagnose.h"
-#include "analysis/generate.h"
-#include "analysis/model_file.h"
+#include "identification/identification.h"
+#include "identification/identification_data.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/generate.h"
+#include "formats/model_file.h"
 
 namespace exotwin {
 namespace {

@@ -5,8 +5,8 @@
 
 #include <cstdio>
 
-#include "analysis/column_map.h"
-#include "analysis/csv_table.h"
+#include "formats/column_map.h"
+#include "formats/csv_table.h"
 #include "app/commands.h"
 
 namespace exotwin {

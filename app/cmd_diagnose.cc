@@ -3,10 +3,10 @@
 
 #include <cstdio>
 
-#include "analysis/column_map.h"
-#include "analysis/diagnose.h"
-#include "analysis/measured_data.h"
-#include "analysis/model_file.h"
+#include "formats/column_map.h"
+#include "diagnosis/diagnose.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
 #include "app/commands.h"
 #include "core/heap_policy.h"
 

@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <memory>
 
-#include "analysis/csv_table.h"
-#include "analysis/emg_diagnose.h"
-#include "analysis/emg_recording.h"
-#include "analysis/number_text.h"
+#include "formats/csv_table.h"
+#include "emg/emg_diagnose.h"
+#include "emg/emg_recording.h"
+#include "formats/number_text.h"
 #include "app/commands.h"
 #include "core/error.h"
 

@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "analysis/csv_table.h"
-#include "analysis/emg_recording.h"
-#include "analysis/emg_torque_model.h"
+#include "formats/csv_table.h"
+#include "emg/emg_recording.h"
+#include "emg/emg_torque_model.h"
 #include "app/commands.h"
 
 namespace exotwin {

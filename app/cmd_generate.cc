@@ -1,11 +1,11 @@
-// `exotwin generate`: synthetic measured data with hidden effects drawn by a seed (analysis/generate.h).
+// `exotwin generate`: synthetic measured data with hidden effects drawn by a seed (diagnosis/generate.h).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 
-#include "analysis/csv_table.h"
-#include "analysis/generate.h"
-#include "analysis/model_file.h"
+#include "formats/csv_table.h"
+#include "diagnosis/generate.h"
+#include "formats/model_file.h"
 #include "app/commands.h"
 
 namespace exotwin {

@@ -11,13 +11,13 @@
 #include <filesystem>
 #include <map>
 
-#include "analysis/column_map.h"
-#include "analysis/derivative_cutoff.h"
-#include "analysis/csv_table.h"
-#include "analysis/identification.h"
-#include "analysis/measured_data.h"
-#include "analysis/model_file.h"
-#include "analysis/number_text.h"
+#include "formats/column_map.h"
+#include "diagnosis/derivative_cutoff.h"
+#include "formats/csv_table.h"
+#include "identification/identification.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
+#include "formats/number_text.h"
 #include "app/commands.h"
 #include "core/error.h"
 #include "sim/realizability.h"

@@ -2,13 +2,13 @@
 
 #include <cstdio>
 
-#include "analysis/column_map.h"
-#include "analysis/csv_table.h"
-#include "analysis/derivative_cutoff.h"
-#include "analysis/measured_data.h"
-#include "analysis/model_file.h"
-#include "analysis/opensim_kinematics.h"
-#include "analysis/predict.h"
+#include "formats/column_map.h"
+#include "formats/csv_table.h"
+#include "diagnosis/derivative_cutoff.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
+#include "formats/opensim_kinematics.h"
+#include "diagnosis/predict.h"
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/heap_policy.h"

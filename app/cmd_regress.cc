@@ -12,14 +12,14 @@
 
 #include <unistd.h>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "app/commands.h"
 #include "core/data_dir.h"
 #include "core/error.h"
-#include "runner/controller_process.h"
-#include "runner/fork_pool.h"
+#include "batch/controller_process.h"
+#include "batch/fork_pool.h"
 #include "runner/progress_bar.h"
-#include "runner/regress.h"
+#include "batch/regress.h"
 
 namespace exotwin {
 namespace {

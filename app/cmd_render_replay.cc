@@ -9,11 +9,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "analysis/csv_table.h"
-#include "analysis/measured_data.h"
-#include "analysis/model_file.h"
-#include "analysis/opensim_kinematics.h"
-#include "analysis/predict.h"
+#include "formats/csv_table.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
+#include "formats/opensim_kinematics.h"
+#include "diagnosis/predict.h"
 #include "app/commands.h"
 #include "core/error.h"
 #include "dsp/butterworth.h"

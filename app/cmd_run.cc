@@ -2,13 +2,13 @@
 
 #include <cstdio>
 
-#include "analysis/opensim_storage.h"
+#include "formats/opensim_storage.h"
 #include "app/commands.h"
 #include "core/stop_signal.h"
 #include "core/error.h"
 #include "protocol/bus_address.h"
 #include "protocol/can_link.h"
-#include "runner/controller_process.h"
+#include "batch/controller_process.h"
 #include "runner/out_folder_lock.h"
 #include "runner/remote_controller.h"
 #include "runner/runner.h"
@@ -36,7 +36,7 @@ int Report(const RunResult& r, const std::string& out_dir) {
 }
 
 // --sto: every measured[_trialN].csv and truth[_trialN].csv the run wrote (r.files, relative to
-// out_dir) also as an OpenSim storage file beside it (same name, .sto; analysis/opensim_storage.h
+// out_dir) also as an OpenSim storage file beside it (same name, .sto; formats/opensim_storage.h
 // CsvToStorage: inDegrees=no, SI values unchanged). Returns the files written.
 std::vector<std::string> WriteStorageCopies(const RunResult& r, const std::string& out_dir) {
   std::vector<std::string> written;

@@ -12,7 +12,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "runner/progress_bar.h"
-#include "runner/sweep_run.h"
+#include "batch/sweep_run.h"
 
 namespace exotwin {
 namespace {

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <sstream>
 
-#include "analysis/csv_table.h"
-#include "analysis/table5.h"
+#include "formats/csv_table.h"
+#include "identification/table5.h"
 #include "app/commands.h"
 #include "core/error.h"
 #include "runner/table5_protocol.h"

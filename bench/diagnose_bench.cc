@@ -4,9 +4,9 @@
 
 #include <map>
 
-#include "analysis/diagnose.h"
-#include "analysis/generate.h"
-#include "analysis/model_file.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/generate.h"
+#include "formats/model_file.h"
 #include "core/data_dir.h"
 
 namespace exotwin {

@@ -1,5 +1,5 @@
 // Identification time (issue 5: target < 0.1 s for 200 s of 1 kHz data). The data are simulated once
-// (analysis/identification_data.h, subject S1); the timed part is Identify(): derivative filtering,
+// (identification/identification_data.h, subject S1); the timed part is Identify(): derivative filtering,
 // trimming, EMG selection, regressor rows, least squares, standard errors, condition numbers.
 //   BM_IdentifyExo/200        steps 1-2, 100 s knee swing + 100 s hip swing (200 s in all)
 //   BM_IdentifyHuman/200      steps 3-4, same, with 5 EMG channels (HJ15 eq. 13) and the passive model
@@ -12,8 +12,8 @@
 #include <map>
 #include <string>
 
-#include "analysis/identification.h"
-#include "analysis/identification_data.h"
+#include "identification/identification.h"
+#include "identification/identification_data.h"
 #include "tests/temp_dir.h"
 
 namespace exotwin {

@@ -8,8 +8,8 @@
 
 #include <cmath>
 
-#include "analysis/measured_data.h"
-#include "analysis/predict.h"
+#include "formats/measured_data.h"
+#include "diagnosis/predict.h"
 #include "sim/plant.h"
 
 namespace exotwin {

@@ -15,7 +15,8 @@ if(CMAKE_SCRIPT_MODE_FILE)
   cmake_minimum_required(VERSION 3.16)  # policies of the project (IN_LIST) in script mode too
 endif()
 
-set(EXOTWIN_LAYERS core model dsp protocol controller deploy sim hwsim analysis render runner app)
+set(EXOTWIN_LAYERS core model dsp protocol controller deploy sim hwsim formats identification diagnosis emg render
+                   runner batch app)
 set(EXOTWIN_GUARDED_LIBS mujoco opencv2)
 
 # What each layer's sources may include besides the layer itself.
@@ -27,10 +28,17 @@ set(EXOTWIN_ALLOWED_controller core model dsp protocol)
 set(EXOTWIN_ALLOWED_deploy core model dsp protocol controller)
 set(EXOTWIN_ALLOWED_sim core model dsp mujoco)
 set(EXOTWIN_ALLOWED_hwsim core model dsp protocol)
-set(EXOTWIN_ALLOWED_analysis core model dsp sim mujoco)
+set(EXOTWIN_ALLOWED_formats core model dsp)
+set(EXOTWIN_ALLOWED_identification core model dsp sim formats mujoco)
+set(EXOTWIN_ALLOWED_diagnosis core model dsp sim formats mujoco)
+set(EXOTWIN_ALLOWED_emg core model dsp sim formats diagnosis mujoco)
 set(EXOTWIN_ALLOWED_render core mujoco opencv2)
-set(EXOTWIN_ALLOWED_runner core model dsp protocol controller sim hwsim analysis render mujoco)
-set(EXOTWIN_ALLOWED_app core model dsp protocol controller sim hwsim analysis render runner mujoco)
+set(EXOTWIN_ALLOWED_runner core model dsp protocol controller sim hwsim formats identification diagnosis emg
+                           render mujoco)
+set(EXOTWIN_ALLOWED_batch core model dsp protocol controller sim hwsim formats identification diagnosis emg render
+                          runner mujoco)
+set(EXOTWIN_ALLOWED_app core model dsp protocol controller sim hwsim formats identification diagnosis emg render
+                        runner batch mujoco)
 
 # Fails (FATAL_ERROR) listing every forbidden include in the layer folders under `root`.
 function(exotwin_check_layer_includes root)

@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "analysis/measured_data.h"
-#include "analysis/model_file.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
 #include "core/error.h"
 
 namespace exotwin::fuzz {

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "hwsim/emg_node.h"
 #include "hwsim/virtual_can_bus.h"
 #include "protocol/candump.h"

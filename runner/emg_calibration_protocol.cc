@@ -10,10 +10,10 @@
 #include <filesystem>
 #include <map>
 
-#include "analysis/csv_table.h"
-#include "analysis/emg_calibration.h"
-#include "analysis/measured_data.h"
-#include "analysis/statistics.h"
+#include "formats/csv_table.h"
+#include "emg/emg_calibration.h"
+#include "formats/measured_data.h"
+#include "dsp/statistics.h"
 #include "controller/muscular_torque.h"
 #include "core/error.h"
 #include "dsp/emg_envelope.h"
@@ -142,7 +142,7 @@ struct TrialTotals {
 };
 
 // LE = envelope / MVC at sample k, as the paper (no resting-level subtraction; see the Table 7 error
-// budget in tests/analysis/emg_calibration_test.cc).
+// budget in tests/emg/emg_calibration_test.cc).
 MuscleVec Normalized(const std::vector<std::vector<double>>& env, size_t k, const MuscleVec& mvc) {
   return NormalizedEnvelope(env, k, MuscleVec::Zero(), mvc);
 }

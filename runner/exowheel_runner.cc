@@ -8,7 +8,7 @@
 #include <memory>
 #include <optional>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "controller/exo_controller.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "analysis/number_text.h"
-#include "analysis/opensim_kinematics.h"
+#include "formats/number_text.h"
+#include "formats/opensim_kinematics.h"
 #include "core/error.h"
 #include "runner/runner.h"
 #include "sim/anthropometry.h"
@@ -51,9 +51,9 @@ Eigen::Vector2d CoContractionPosture(const Scenario& s, const MuscleParams& mp, 
   return mp.q_rest;
 }
 
-// trajectory: file. The OpenSim motion file's hip and knee (analysis/opensim_kinematics.h), its first
+// trajectory: file. The OpenSim motion file's hip and knee (formats/opensim_kinematics.h), its first
 // sample at t = 0; a non-uniform record is interpolated linearly onto a uniform grid at its median
-// step (as analysis/measured_data.h DeriveKinematics does), then handed to the controller as samples
+// step (as formats/measured_data.h DeriveKinematics does), then handed to the controller as samples
 // (controller::ReferenceKind::kSamples, played by TabulatedTrajectory).
 void RecordedSamples(const ProtocolSpec& p, controller::ReferenceSpec* r) {
   const MeasuredData m = ReadOpenSimKinematics(p.path, p.side);

@@ -10,8 +10,8 @@
 #include <memory>
 #include <optional>
 
-#include "analysis/csv_table.h"
-#include "analysis/stress_metrics.h"
+#include "formats/csv_table.h"
+#include "runner/stress_metrics.h"
 #include "controller/hal_loop.h"
 #include "hwsim/emg_node.h"
 #include "hwsim/hal3_knee_node.h"

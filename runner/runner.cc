@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <limits>
 
-#include "analysis/csv_table.h"
-#include "analysis/model_file.h"
+#include "formats/csv_table.h"
+#include "formats/model_file.h"
 #include "core/error.h"
 #include "core/stop_signal.h"
 #include "runner/emg_calibration_protocol.h"

@@ -5,7 +5,7 @@
 #include <cctype>
 #include <cstdio>
 
-#include "analysis/statistics.h"
+#include "dsp/statistics.h"
 #include "core/error.h"
 #include "runner/sweep_table.h"
 

@@ -12,8 +12,8 @@
 #include <set>
 #include <sstream>
 
-#include "analysis/csv_table.h"
-#include "analysis/statistics.h"
+#include "formats/csv_table.h"
+#include "dsp/statistics.h"
 #include "core/error.h"
 #include "core/file_text.h"
 #include "runner/sweep_plots.h"

@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "analysis/identification.h"
-#include "analysis/measured_data.h"
-#include "analysis/model_file.h"
-#include "analysis/csv_table.h"
+#include "identification/identification.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
+#include "formats/csv_table.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "runner/runner.h"

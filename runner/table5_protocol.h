@@ -1,14 +1,14 @@
 // The whole Table 5 protocol of Hwang & Jeon 2015 on the twin, per subject: identification steps 1-4
 // (scenarios/identification/*.yaml through RunScenario: plant, virtual CAN, joint modules, the real
-// controller), least squares in-process (analysis/identification.h: exo, then human), then relaxed
-// passive-mode gait at 2 km/h (scenarios/gait_2kmh.yaml) and the RMS errors of analysis/table5.h.
+// controller), least squares in-process (identification/identification.h: exo, then human), then relaxed
+// passive-mode gait at 2 km/h (scenarios/gait_2kmh.yaml) and the RMS errors of identification/table5.h.
 #pragma once
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "analysis/table5.h"
+#include "identification/table5.h"
 
 namespace exotwin {
 

@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 JOBS="${JOBS:-$(nproc)}"
 # -g1 (line tables, no variable info) instead of RelWithDebInfo's -g: the sanitizers' stack traces keep
-# their file:line, and the build takes about a third less time (analysis/identification.cc: 50 s -> 33 s).
+# their file:line, and the build takes about a third less time (identification/identification.cc: 50 s -> 33 s).
 cmake -S . -B build-asan -DEXOTWIN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" >/dev/null
 cmake --build build-asan -j"$JOBS"

@@ -1,5 +1,5 @@
 // OpenSim motion files (.mot / .sto) written by the tests themselves, in each variant the format
-// allows (analysis/opensim_storage.h): no third-party motion file is copied into the project.
+// allows (formats/opensim_storage.h): no third-party motion file is copied into the project.
 #pragma once
 #include <cmath>
 #include <cstdio>

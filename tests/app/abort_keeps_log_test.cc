@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/measured_data.h"
+#include "formats/measured_data.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin {

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "analysis/column_map.h"
-#include "analysis/csv_table.h"
+#include "formats/column_map.h"
+#include "formats/csv_table.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin {

@@ -7,9 +7,9 @@
 #include <fstream>
 #include <iterator>
 
-#include "analysis/csv_table.h"
-#include "analysis/identification_data.h"
-#include "analysis/model_file.h"
+#include "formats/csv_table.h"
+#include "identification/identification_data.h"
+#include "formats/model_file.h"
 #include "core/units.h"
 #include "tests/app/cli_test_util.h"
 

@@ -10,8 +10,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "analysis/csv_table.h"
-#include "analysis/opensim_storage.h"
+#include "formats/csv_table.h"
+#include "formats/opensim_storage.h"
 #include "tests/app/cli_test_util.h"
 #include "tests/motion_file.h"
 #include "tests/winter_stride.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin {

@@ -23,7 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin {

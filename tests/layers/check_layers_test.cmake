@@ -1,6 +1,6 @@
 # ctest layers.check: cmake/check_layers.cmake (the configure-time layer rule) run standalone
-#  - on tests/layers/fixture: fails, naming exactly the three forbidden includes (MuJoCo and sim/ in
-#    controller/, model/ in core/) and none of the allowed ones;
+#  - on tests/layers/fixture: fails, naming exactly the four forbidden includes (MuJoCo and sim/ in
+#    controller/, model/ in core/, diagnosis/ in formats/) and none of the allowed ones;
 #  - on the source tree: passes.
 # Args: -DSOURCE=<source tree>.
 set(_check ${SOURCE}/cmake/check_layers.cmake)
@@ -14,7 +14,8 @@ if(_rc EQUAL 0)
 endif()
 foreach(_expected "controller/forbidden.cc: #include <mujoco/mujoco.h>"
                   "controller/forbidden.cc: #  include \"sim/plant.h\""
-                  "core/forbidden.h: #include \"model/lumped_params.h\"")
+                  "core/forbidden.h: #include \"model/lumped_params.h\""
+                  "formats/forbidden.h: #include \"diagnosis/diagnose.h\"")
   string(FIND "${_all}" "${_expected}" _at)
   if(_at EQUAL -1)
     message(FATAL_ERROR "the check did not name '${_expected}':\n${_all}")
@@ -22,8 +23,8 @@ foreach(_expected "controller/forbidden.cc: #include <mujoco/mujoco.h>"
 endforeach()
 string(REGEX MATCHALL "[a-z]+/[a-z_]+\\.(h|cc): #" _named "${_all}")
 list(LENGTH _named _n)
-if(NOT _n EQUAL 3)
-  message(FATAL_ERROR "expected 3 forbidden includes, the check named ${_n}:\n${_all}")
+if(NOT _n EQUAL 4)
+  message(FATAL_ERROR "expected 4 forbidden includes, the check named ${_n}:\n${_all}")
 endif()
 
 execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${SOURCE} -P ${_check}
@@ -31,4 +32,4 @@ execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${SOURCE} -P ${_check}
 if(NOT _rc EQUAL 0)
   message(FATAL_ERROR "the source tree breaks the layer rule:\n${_out}${_err}")
 endif()
-message(STATUS "layer check: fixture refused (3 forbidden includes named), source tree accepted")
+message(STATUS "layer check: fixture refused (4 forbidden includes named), source tree accepted")

@@ -13,9 +13,9 @@
 #include <fstream>
 #include <optional>
 
-#include "analysis/csv_table.h"
-#include "analysis/emg_calibration.h"
-#include "analysis/measured_data.h"
+#include "formats/csv_table.h"
+#include "emg/emg_calibration.h"
+#include "formats/measured_data.h"
 #include "core/error.h"
 #include "dsp/emg_envelope.h"
 #include "model/leg_dynamics.h"

@@ -12,7 +12,7 @@
 #include <iterator>
 #include <vector>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 #include "core/error.h"
 
 namespace exotwin {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "analysis/csv_table.h"
+#include "formats/csv_table.h"
 
 namespace exotwin {
 namespace {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "tests/temp_dir.h"
-#include "analysis/diagnose.h"
-#include "analysis/measured_data.h"
+#include "diagnosis/diagnose.h"
+#include "formats/measured_data.h"
 #include "runner/runner.h"
 
 namespace exotwin {

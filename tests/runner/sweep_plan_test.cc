@@ -84,7 +84,7 @@ TEST(SweepTable, CsvRoundTripsBitForBit) {
   EXPECT_THROW(ParseSweepCsv("a,b\n", "z.csv"), InputError);
 }
 
-// A sweep table goes through the CSV reader of every other CSV (analysis/csv_table.h): a byte-order
+// A sweep table goes through the CSV reader of every other CSV (formats/csv_table.h): a byte-order
 // mark, CRLF, quotes and comments read as in a measured-data file; errors name file and line.
 TEST(SweepTable, ReadByTheSharedCsvReader) {
   const auto rows = ParseSweepCsv(

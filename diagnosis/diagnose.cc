@@ -1,0 +1,745 @@
+#include "diagnosis/diagnose.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+
+#include "diagnosis/diagnose_columns.h"
+#include "diagnosis/diagnose_select.h"
+#include "diagnosis/effects.h"
+#include "diagnosis/generate.h"
+#include "formats/number_text.h"
+#include "diagnosis/predict.h"
+#include "dsp/statistics.h"
+#include "core/error.h"
+#include "core/heap_policy.h"
+#include "dsp/butterworth.h"
+#include "model/leg_dynamics.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+namespace {
+
+const char* kJoint[2] = {"hip", "knee"};
+
+// One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
+// the twin's prediction and the residual.
+struct Rec {
+  std::string source;  // the record's name, for messages
+  size_t samples = 0;  // the record's samples (before the trim)
+  Kinematics kin;
+  std::vector<double> taken[2];         // the record's tau_hip, tau_knee when Diagnose took it over
+  const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
+  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
+  double hz = 0;                        // the parallel low-pass (0: none)
+  // The twin: the rigid actuator torque (after stage 2 only on [0, RefineRows)) and the reading
+  // with the model's effects (released by stage 6).
+  std::vector<double> tau_R[2], tau_S[2];
+  std::vector<double> resid[2];         // Residual(j); released once the candidate columns took their rows
+  size_t split = 0;
+  std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
+  size_t n() const { return kin.t.size(); }
+  // The residual's low-pass (parallel filtering: measured and predicted torque filtered alike) of x,
+  // whose samples are those of kin.t from `from` on.
+  std::vector<double> Filter(std::vector<double> x, size_t from = 0) const {
+    if (!(hz > 0)) return x;
+    if (from == 0 && x.size() == kin.t.size()) return (*low)(std::move(x));
+    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
+    return LowPassOnTimeBase(t, x, hz, source);
+  }
+  // The filtered residual of joint j, measured - twin (raw - tau_S), on kin.t's samples: the same
+  // bits wherever it is computed.
+  std::vector<double> Residual(int j) const {
+    std::vector<double> e(n());
+    for (size_t i = 0; i < e.size(); ++i) e[i] = raw[j][i] - tau_S[j][i];
+    return Filter(std::move(e));
+  }
+  std::function<void(std::vector<double>&)> FilterFn() const {
+    if (!(hz > 0)) return {};
+    return [this](std::vector<double>& x) { x = Filter(std::move(x)); };
+  }
+};
+
+// Autocorrelation length (in rows) of a residual of 2m rows (hip block, knee block): the longer.
+double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
+  return std::max(AutocorrelationLength(e.data(), m), AutocorrelationLength(e.data() + m, m));
+}
+
+// Held-out scores from the sums of squares before / after over `count` samples.
+JointScore ScoreOf(double sse_before, double sse_after, double count) {
+  return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
+          sse_before > 0 ? 100 * (1 - std::sqrt(sse_after / sse_before)) : 0};
+}
+
+// Records of one device: the same columns the analysis reads, and sample rates within a factor 5.
+void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
+  auto known = [](const MeasuredData& d) {
+    std::set<std::string> s;
+    for (const auto& n : d.table.names)
+      if (n.rfind("emg_", 0) == 0 || n.rfind("qd_", 0) == 0 || n.rfind("qdd_", 0) == 0) s.insert(n);
+    return s;
+  };
+  const MeasuredData& a = *records[0];
+  const std::set<std::string> ka = known(a);
+  const double dta = MedianStep(a.t());
+  for (size_t i = 1; i < records.size(); ++i) {
+    const MeasuredData& b = *records[i];
+    if (known(b) != ka) {
+      std::string sa, sb;
+      for (const auto& n : ka) sa += " " + n;
+      for (const auto& n : known(b)) sb += " " + n;
+      throw InputError(b.source + ": columns (emg_*, qd_*, qdd_*:" + (sb.empty() ? " none" : sb) +
+                       ") differ from " + a.source + "'s (" + (sa.empty() ? " none" : sa) +
+                       "), expected records of one device with the same columns");
+    }
+    const double r = MedianStep(b.t()) / dta;
+    if (!(r < 5 && r > 0.2))
+      throw InputError(b.source + ": median time step " + NumberText(MedianStep(b.t())) + " s against " +
+                       NumberText(dta) + " s in " + a.source +
+                       ", expected records of one device in the same time unit (s)");
+  }
+}
+
+// Weighted SSE of the filtered (measured - (base tau_R through ApplyEffects(p))) on samples [a, b).
+double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, size_t b) {
+  if (b <= a + 2) return 0;
+  const Kinematics& kin = rc.kin;
+  Kinematics k;
+  k.t.assign(kin.t.begin() + a, kin.t.begin() + b);
+  std::vector<double> tr[2], ts[2];
+  for (int j = 0; j < 2; ++j) {
+    k.q[j].assign(kin.q[j].begin() + a, kin.q[j].begin() + b);
+    k.qd[j].assign(kin.qd[j].begin() + a, kin.qd[j].begin() + b);
+    k.qdd[j].assign(kin.qdd[j].begin() + a, kin.qdd[j].begin() + b);
+    tr[j].assign(rc.tau_R[j].begin() + a, rc.tau_R[j].begin() + b);
+  }
+  for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
+  ApplyEffects(p, k, tr, ts);
+  double s = 0;
+  const size_t lo = std::min<size_t>(200, (b - a) / 10);  // skip the edges (delay, filters)
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> e(b - a);
+    for (size_t i = 0; i < b - a; ++i) e[i] = rc.raw[j][a + i] - ts[j][i];
+    e = rc.Filter(std::move(e), a);
+    for (size_t i = lo; i + lo < b - a; ++i) s += std::pow(w[j] * e[i], 2);
+  }
+  return s;
+}
+
+Kinematics Slice(const Kinematics& kin, size_t a, size_t b) {
+  Kinematics k;
+  k.t.assign(kin.t.begin() + a, kin.t.begin() + b);
+  for (int j = 0; j < 2; ++j) {
+    k.q[j].assign(kin.q[j].begin() + a, kin.q[j].begin() + b);
+    k.qd[j].assign(kin.qd[j].begin() + a, kin.qd[j].begin() + b);
+    k.qdd[j].assign(kin.qdd[j].begin() + a, kin.qdd[j].begin() + b);
+  }
+  for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
+  k.derivative_source = kin.derivative_source;
+  return k;
+}
+
+// kin cut to its samples [a, b) in place (what Slice(kin, a, b) holds, without a copy).
+void TrimTo(Kinematics* kin, size_t a, size_t b) {
+  auto cut = [&](std::vector<double>& v) {
+    v.erase(v.begin() + static_cast<long>(b), v.end());
+    v.erase(v.begin(), v.begin() + static_cast<long>(a));
+  };
+  cut(kin->t);
+  for (int j = 0; j < 2; ++j) cut(kin->q[j]), cut(kin->qd[j]), cut(kin->qdd[j]);
+  for (auto& ch : kin->emg) cut(ch.second);
+  kin->resampled = false;  // as Slice
+}
+
+// Dominant frequency (Hz) of x[a, b) by a direct DFT of a strided copy, 0.05 .. 25 Hz.
+double DominantHz(const std::vector<double>& t, const std::vector<double>& x, size_t a, size_t b) {
+  const size_t stride = std::max<size_t>(1, (b - a) / 8000);
+  std::vector<double> tt, xx;
+  double mean = 0;
+  for (size_t i = a; i < b; i += stride) tt.push_back(t[i]), xx.push_back(x[i]), mean += x[i];
+  mean /= static_cast<double>(xx.size());
+  const double T = tt.back() - tt.front();
+  const double fmax = std::min(25.0, 0.5 * static_cast<double>(xx.size()) / std::max(T, 1e-9));
+  double best = 0, best_f = 0;
+  for (double f = std::max(0.05, 1.0 / std::max(T, 1e-9)); f <= fmax; f += 0.5 / std::max(T, 1.0)) {
+    double re = 0, im = 0;
+    for (size_t i = 0; i < xx.size(); ++i) {
+      const double ph = 2 * M_PI * f * tt[i];
+      re += (xx[i] - mean) * std::cos(ph), im += (xx[i] - mean) * std::sin(ph);
+    }
+    if (re * re + im * im > best) best = re * re + im * im, best_f = f;
+  }
+  return best_f;
+}
+
+// Stage 0: the records and options are fit for a diagnosis (>= 200 samples each, holdout 0.1..0.5,
+// 0..6 effects, one device); throws InputError otherwise.
+void CheckInputs(const std::vector<const MeasuredData*>& records, const DiagnoseOptions& opt) {
+  if (records.empty()) throw InputError("diagnose: expected at least one measured record");
+  for (const MeasuredData* d : records)
+    if (d->size() < 200)
+      throw InputError(d->source + ": " + std::to_string(d->size()) +
+                       " samples, expected at least 200 for a diagnosis (fit and held-out parts)");
+  if (!(opt.holdout_fraction >= 0.1 && opt.holdout_fraction <= 0.5))
+    throw InputError("holdout fraction: expected 0.1 .. 0.5");
+  if (!(opt.max_effects >= 0 && opt.max_effects <= 6)) throw InputError("max effects: expected 0 .. 6");
+  CheckSameDevice(records);
+}
+
+// Stage 1: the derivative cutoff (Hz), given by the options (> 0) or chosen from the data for
+// parallel filtering (derivative_cutoff.h, CutoffUse::kParallel).
+CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                           const DiagnoseOptions& opt) {
+  if (opt.cutoff_hz > 0) {
+    CutoffChoice c;
+    c.hz = opt.cutoff_hz;
+    c.why = "given (--cutoff " + NumberText(opt.cutoff_hz) + ")";
+    return c;
+  }
+  return ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel);
+}
+
+// Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
+// transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of its time,
+// the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual. With `owned`
+// (the record itself, which Diagnose may consume) its columns are moved, not copied: the record is
+// left empty.
+void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
+                   const CutoffChoice& cutoff, double holdout_fraction, Rec* out) {
+  Rec& rc = *out;
+  rc.source = data.source;
+  rc.samples = data.size();
+  // Parallel filtering (as in robot identification practice): the residual is low-passed at the
+  // chosen cutoff fc, the angles differentiated at DerivativeCutoffHz(fc), flat where fc passes,
+  // so that measured and predicted torque see one and the same filter.
+  const double hz = cutoff.from_columns ? 20.0 : DerivativeCutoffHz(cutoff.hz, 1.0 / MedianStep(data.t()));
+  const std::vector<double>* meas[2] = {&data.tau_hip(), &data.tau_knee()};
+  if (owned) {
+    for (int j = 0; j < 2; ++j) {
+      rc.taken[j] = std::move(owned->column_at(j == 0 ? kColTauHip : kColTauKnee));
+      meas[j] = &rc.taken[j];
+    }
+    rc.kin = DeriveKinematics(std::move(*owned), hz);
+  } else {
+    rc.kin = DeriveKinematics(data, hz);
+  }
+  const bool filtered = rc.kin.derivative_source != "measured columns";
+  rc.hz = filtered ? cutoff.hz : 0.0;
+  // The zero-phase filters' start and end transients (about 0.5 s) are not data: trim.
+  const std::vector<double>& t = rc.kin.t;
+  const double T = t.back() - t.front();
+  const double edge = std::min(0.5, 0.05 * T);
+  const size_t a = static_cast<size_t>(std::lower_bound(t.begin(), t.end(), t.front() + edge) - t.begin());
+  const size_t b = static_cast<size_t>(std::upper_bound(t.begin(), t.end(), t.back() - edge) - t.begin());
+  TrimTo(&rc.kin, a, b);
+  if (filtered) rc.low.emplace(rc.kin.t, rc.hz, rc.source);
+  for (int j = 0; j < 2; ++j) rc.raw[j] = meas[j]->data() + a;
+  const Kinematics& kin = rc.kin;
+  const size_t n = kin.t.size();
+  const double t_split = kin.t.front() + (1 - holdout_fraction) * (kin.t.back() - kin.t.front());
+  rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
+  // The twin: HJ15 eq. 5-7 + P(q) + the model's own effects, which equals predict's MuJoCo inverse
+  // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
+  // run (ScoreExtendedTwin) is predict itself.
+  for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
+                                               {kin.qdd[0][i], kin.qdd[1][i]});
+    rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
+  }
+  if (params.effects.empty()) {
+    ApplyEffects(params, kin, rc.tau_R, rc.tau_S);  // leaves rc.tau_R as it is
+  } else {
+    std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
+    ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
+  }
+  for (int j = 0; j < 2; ++j) rc.resid[j] = rc.Residual(j);
+}
+
+// Stage 3c: the measured torque filtered as the residual, into rc.meas (after the candidate columns,
+// whose temporaries are gone by then: a long record's peak memory).
+void FilterMeasured(std::vector<Rec>* recs) {
+  for (Rec& rc : *recs)
+    for (int j = 0; j < 2; ++j) rc.meas[j] = rc.Filter(std::vector<double>(rc.raw[j], rc.raw[j] + rc.n()));
+}
+
+// Stage 2b: white noise per joint (N m, >= 1e-6) from the first differences of the residuals,
+// pooled over records, into noise[]; the row weights 1/noise into w[].
+void NoiseAndWeights(const std::vector<Rec>& recs, double noise[2], double w[2]) {
+  for (int j = 0; j < 2; ++j) {
+    double s = 0, cnt = 0;
+    for (const Rec& rc : recs)
+      for (size_t i = 1; i < rc.n(); ++i) s += std::pow(rc.resid[j][i] - rc.resid[j][i - 1], 2), cnt += 1;
+    noise[j] = std::max(1e-6, std::sqrt(s / (2.0 * std::max(cnt, 1.0))));
+    w[j] = 1.0 / noise[j];
+  }
+}
+
+// Residual of every bank after the kitchen-sink fit: all candidate columns at once, least squares
+// pooled over the banks (lightly regularized).
+std::vector<Eigen::VectorXd> KitchenSinkResiduals(const std::vector<ColumnBank>& banks) {
+  const Eigen::Index C = banks[0].X.cols();
+  Eigen::MatrixXd Gr = Eigen::MatrixXd::Zero(C, C);
+  Eigen::VectorXd br = Eigen::VectorXd::Zero(C);
+  for (const ColumnBank& b : banks) {
+    Gr.selfadjointView<Eigen::Lower>().rankUpdate(b.X.transpose());
+    br += b.X.transpose() * b.r;
+  }
+  Gr = Gr.selfadjointView<Eigen::Lower>();
+  Gr.diagonal() += 1e-9 * Gr.diagonal().cwiseMax(1e-300);
+  const Eigen::VectorXd c = Gr.ldlt().solve(br);
+  std::vector<Eigen::VectorXd> out;
+  for (const ColumnBank& b : banks) out.push_back(b.r - b.X * c);
+  return out;
+}
+
+// Stage 3: the candidate columns of every record (the same columns in each bank, rows weighted by
+// w), with the ripple candidates' frequency searched.
+std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Rec>& recs,
+                                         const double w[2], const DiagnoseOptions& opt) {
+  const size_t R = recs.size();
+  std::vector<ColumnBank> banks;
+  std::vector<const Kinematics*> kins;
+  for (Rec& rc : recs) {  // BuildColumns releases rc.resid (a long record's memory)
+    banks.push_back(BuildColumns(params, rc.kin, rc.tau_S, rc.resid, w, rc.split,
+                                 std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn()));
+    kins.push_back(&rc.kin);
+  }
+  std::vector<Eigen::VectorXd> raw;
+  const std::vector<Eigen::VectorXd> e = KitchenSinkResiduals(banks);
+  for (const ColumnBank& b : banks) raw.push_back(b.r);
+  // Ripple frequency searched on what the other candidates leave and on the raw residual (a slow
+  // ripple, ~1 cycle over the range, is otherwise absorbed by the stiffness/gravity columns).
+  AddRippleCandidates(banks, kins, e);
+  AddRippleCandidates(banks, kins, raw);
+  return banks;
+}
+
+// Stage 3b: every sensor_delay column replaced by the secant (tau_S(t - d) - tau_S(t)) / d at the
+// single fit's delay d (s, pooled over records; kept when 1e-4 < d < 0.5), twice, so the
+// second-order term is not left for sensor_gain.
+void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io) {
+  std::vector<ColumnBank>& banks = *banks_io;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const auto& c : banks[0].candidates) {
+      if (c.name != "sensor_delay") continue;
+      const int j = c.joint;
+      double xr = 0, xx = 0;
+      for (const ColumnBank& b : banks) {
+        const size_t m = b.sample.size();
+        for (size_t k = 0; k < m; ++k) {
+          if (!b.train[k]) continue;
+          const double x = b.X(j * m + k, c.cols[0]);
+          xr += x * b.r[j * m + k], xx += x * x;
+        }
+      }
+      const double d = xx > 0 ? xr / xx : 0;
+      if (!(d > 1e-4 && d < 0.5)) continue;
+      for (size_t r = 0; r < recs.size(); ++r) {
+        const Rec& rc = recs[r];
+        ColumnBank& b = banks[r];
+        std::vector<double> tq(rc.n());
+        for (size_t i = 0; i < rc.n(); ++i) tq[i] = rc.kin.t[i] - d;
+        const std::vector<double> shifted = Interpolate(rc.kin.t, rc.tau_S[j], tq);
+        std::vector<double> v[2] = {std::vector<double>(rc.n(), 0.0), std::vector<double>(rc.n(), 0.0)};
+        for (size_t i = 0; i < rc.n(); ++i) v[j][i] = (shifted[i] - rc.tau_S[j][i]) / d;
+        SetColumn(b, c.cols[0], w, v);
+      }
+    }
+  }
+}
+
+// Stage 3c: the pooled Gram matrices of the banks, the measured torque's scale on the held-out rows
+// (materiality), and the effective sample size from the autocorrelation length (rows, *tau_eff) of
+// what no candidate explains.
+Grams PooledGrams(const std::vector<Rec>& recs, const std::vector<ColumnBank>& banks, const double w[2],
+                  double* tau_eff) {
+  Grams g = MakeGrams(banks);
+  for (size_t r = 0; r < recs.size(); ++r)
+    for (size_t k = 0; k < banks[r].sample.size(); ++k)
+      if (!banks[r].train[k])
+        for (int j = 0; j < 2; ++j) g.tt_te[j] += std::pow(w[j] * recs[r].meas[j][banks[r].sample[k]], 2);
+  // Autocorrelation length of what no candidate explains: kitchen sink incl. ripple.
+  const std::vector<Eigen::VectorXd> e = KitchenSinkResiduals(banks);
+  *tau_eff = 1;
+  for (size_t r = 0; r < recs.size(); ++r)
+    *tau_eff = std::max(*tau_eff, AutocorrLength(e[r], banks[r].sample.size()));
+  g.n_eff = g.n_tr / *tau_eff;
+  return g;
+}
+
+// Stage 4: the physical scale of the records (angle and torque ranges, mean M_jj, the strap's
+// neglected dynamics J_c w^2, the compliant part's torque) for the plausibility ranges.
+PhysicalScale ScaleOf(const LegParams& params, const std::vector<Rec>& recs) {
+  PhysicalScale scale;
+  const LumpedParams tot = params.Total();
+  const double Xd[2] = {tot.X1, tot.X2}, Yd[2] = {tot.Y1, tot.Y2};
+  LegParams rigid = params;
+  rigid.effects.clear();
+  for (int j = 0; j < 2; ++j) {
+    scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
+    scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
+    // Means over every record (strided): the twin's M_jj, the compliant part's J_c (the human when
+    // there is one, else the whole chain), and the motion's effective angular frequency
+    // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
+    // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
+    const LumpedParams& compliant = params.human ? *params.human : tot;
+    double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
+    for (const Rec& rc : recs) {
+      for (size_t i = 0; i < rc.n(); ++i) {
+        scale.q_min[j] = std::min(scale.q_min[j], rc.kin.q[j][i]);
+        scale.q_max[j] = std::max(scale.q_max[j], rc.kin.q[j][i]);
+        scale.tau_max[j] = std::max(scale.tau_max[j], std::abs(rc.meas[j][i]));
+      }
+      const size_t stride = std::max<size_t>(1, rc.n() / 4000);
+      for (size_t i = 0; i < rc.n(); i += stride) {
+        const Eigen::Vector2d q(rc.kin.q[0][i], rc.kin.q[1][i]), qd(rc.kin.qd[0][i], rc.kin.qd[1][i]),
+            qdd(rc.kin.qdd[0][i], rc.kin.qdd[1][i]);
+        msum += MassMatrix(tot, params.L1, q[1])(j, j);
+        jc += MassMatrix(compliant, params.L1, q[1])(j, j);
+        v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
+        scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
+      }
+    }
+    scale.M_jj[j] = msum / cnt;
+    scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
+  }
+  return scale;
+}
+
+// Stage 4b: the report's candidate table into D->scores (the 12 best single candidates by BIC, then
+// the chosen set), single fits outside their physical range into D->implausible, and nearly
+// collinear candidate pairs (|cos| > 0.95 of their first columns, train rows) into D->collinear.
+void ScoreCandidates(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale, const Fit& f0,
+                     const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D) {
+  auto gain = [&](const Fit& f) { return f0.sse_te > 0 ? 1 - f.sse_te / f0.sse_te : 0.0; };
+  std::vector<std::pair<double, size_t>> order;
+  std::vector<Fit> singles;
+  for (size_t c = 0; c < bank.candidates.size(); ++c) {
+    singles.push_back(FitCols(g, bank.candidates[c].cols));
+    order.push_back({singles.back().ok ? singles.back().bic : 1e300, c});
+  }
+  std::sort(order.begin(), order.end());
+  for (size_t i = 0; i < order.size() && i < 12; ++i) {
+    const Fit& f = singles[order[i].second];
+    const Candidate& c = bank.candidates[order[i].second];
+    D->scores.push_back({c.Label(), f.ok ? f.bic - f0.bic : 0, 100 * gain(f),
+                         std::find(chosen.begin(), chosen.end(), static_cast<int>(order[i].second)) != chosen.end()});
+    if (!f.ok || !(f.bic < f0.bic - kBicMargin)) continue;
+    const DiagnosedEffect e = ToEffect(c, f);
+    std::string why;
+    if (!Plausible(e, scale, &why))
+      D->implausible.push_back(c.Label() + " = " + NumberText(e.effect.value) + " " + e.effect.unit + ": " + why);
+  }
+  if (!chosen.empty()) {
+    std::string label;
+    for (int c : chosen) label += (label.empty() ? "" : " + ") + bank.candidates[c].Label();
+    D->scores.push_back({label, chosen_fit.bic - f0.bic, 100 * gain(chosen_fit), true});
+  }
+  for (size_t a = 0; a < bank.candidates.size(); ++a)
+    for (size_t b = a + 1; b < bank.candidates.size(); ++b) {
+      const int ca = bank.candidates[a].cols[0], cb = bank.candidates[b].cols[0];
+      if (ca == cb) continue;
+      const double r = g.Gtr(ca, cb) / std::sqrt(g.Gtr(ca, ca) * g.Gtr(cb, cb) + 1e-300);
+      if (std::abs(r) > 0.95)
+        D->collinear.push_back(bank.candidates[a].Label() + " ~ " + bank.candidates[b].Label() +
+                               " (|cos| = " + std::to_string(std::abs(r)).substr(0, 5) + ")");
+    }
+}
+
+// The samples [0, RefineRows) of a record on which stage 5 refines (of R records).
+size_t RefineRows(const Rec& rc, size_t R) { return std::min<size_t>(rc.split, 6000 / R + 1); }
+
+// Stage 5: the extension D->extended = params + the chosen effects (D->effects); delay, backlash
+// and strap stiffness refined by golden search on the exact model (fit rows); each effect's share of
+// the held-out residual (leave-one-effect-out). Returns each effect's refined / linear value ratio.
+std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
+                                    const ColumnBank& bank, const Grams& g, const Fit& f0,
+                                    const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D) {
+  const size_t R = recs.size();
+  D->extended = params;
+  std::vector<double> refine_ratio(chosen.size(), 1.0);
+  for (int c : chosen) D->effects.push_back(ToEffect(bank.candidates[c], chosen_fit));
+  for (auto& de : D->effects) D->extended.effects.push_back(de.effect);
+  for (size_t k = 0; k < D->effects.size(); ++k) {
+    const std::string& nm = D->effects[k].effect.name;
+    if (nm != "sensor_delay" && nm != "backlash" && nm != "series_compliance") continue;
+    const size_t idx = params.effects.size() + k;
+    const double v0 = D->extended.effects[idx].value;
+    auto obj = [&](double v) {
+      LegParams p = D->extended;
+      p.effects[idx].value = v;
+      double s = 0;
+      for (const Rec& rc : recs) s += ExactSse(p, rc, w, 0, RefineRows(rc, R));
+      return s;
+    };
+    double lo = 0.6 * v0, hi = 1.6 * v0;
+    const double gr = 0.5 * (std::sqrt(5.0) - 1);
+    double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo), f1 = obj(x1), f2 = obj(x2);
+    for (int it = 0; it < 16; ++it) {
+      if (f1 < f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - gr * (hi - lo), f1 = obj(x1);
+      else lo = x1, x1 = x2, f1 = f2, x2 = lo + gr * (hi - lo), f2 = obj(x2);
+    }
+    const double v = 0.5 * (lo + hi);
+    refine_ratio[k] = v / v0;
+    D->extended.effects[idx].value = v;
+    D->effects[k].effect.value = v;
+    D->effects[k].ci_lo *= v / v0, D->effects[k].ci_hi *= v / v0;
+  }
+  // Share of the held-out residual each effect removes (joint linear model, leave-one-effect-out).
+  for (size_t k = 0; k < chosen.size(); ++k) {
+    std::vector<int> rest = chosen;
+    rest.erase(rest.begin() + static_cast<long>(k));
+    const Fit fr = FitCols(g, ColumnsOf(bank, rest));
+    D->effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
+  }
+  return refine_ratio;
+}
+
+// Stage 6: the extended twin (predict with D->extended) on every record's held-out part: the scores
+// per record and pooled (D->records, D->joints) and the first record's plot series; with several
+// records, each whole record predicted by the effects fitted on the others (D->left_out).
+void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const ColumnBank& bank,
+                       const Grams& g, const std::vector<int>& chosen, const std::vector<double>& refine_ratio,
+                       const DiagnoseOptions& opt, Diagnosis* D_out) {
+  Diagnosis& D = *D_out;
+  const size_t R = recs.size();
+  Plant ext_plant(opt.mjcf.empty() ? ExowheelMjcfPath(D.extended.human.has_value()) : opt.mjcf);
+  ext_plant.SetParams(D.extended);
+  double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
+  const std::vector<int> cols = ColumnsOf(bank, chosen);
+  for (size_t r = 0; r < R; ++r) {
+    Rec& rc = recs[r];
+    const size_t n = rc.n();
+    // The residual again (released by the candidate columns), then the twin's reading is done with.
+    const std::vector<double> resid[2] = {rc.Residual(0), rc.Residual(1)};
+    for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_S[j]);
+    RecordScore rs;
+    rs.source = rc.source;
+    rs.samples = rc.samples;
+    // The held-out run starts 1 s early so that its filters (EMG envelope, delay) have settled;
+    // only the held-out samples are scored.
+    const size_t warm = static_cast<size_t>(
+        std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
+    const Prediction held = PredictTorque(ext_plant, Slice(rc.kin, warm, n));
+    for (int j = 0; j < 2; ++j) {
+      std::vector<double> ea(n - warm);
+      for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
+      ea = rc.Filter(std::move(ea), warm);
+      double b = 0, a = 0;
+      for (size_t i = rc.split; i < n; ++i) {
+        b += std::pow(resid[j][i], 2);
+        a += std::pow(ea[i - warm], 2);
+      }
+      rs.split[j] = ScoreOf(b, a, static_cast<double>(std::max<size_t>(1, n - rc.split)));
+      sb[j] += b, sa[j] += a;
+      if (r == 0) {
+        D.measured[j] = rc.meas[j];
+        D.before[j].resize(n);
+        for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - resid[j][i];
+        D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
+        for (size_t i = rc.split; i < n; ++i) D.after[j][i] = rc.meas[j][i] - ea[i - warm];
+      }
+    }
+    cnt += static_cast<double>(n - rc.split);
+    if (D.leave_one_out) {
+      LegParams p = params;
+      const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
+      if (!cols.empty() && x.size() == 0)
+        throw InputError(rc.source + ": without this record the chosen effects are not identifiable");
+      for (size_t k = 0; k < chosen.size(); ++k) {
+        Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
+        e.value *= refine_ratio[k];
+        p.effects.push_back(e);
+      }
+      Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
+      loo_plant.SetParams(p);
+      const Prediction whole = PredictTorque(loo_plant, rc.kin);
+      for (int j = 0; j < 2; ++j) {
+        std::vector<double> ea(n);
+        for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
+        ea = rc.Filter(std::move(ea));
+        double b = 0, a = 0;
+        for (size_t i = 0; i < n; ++i) b += std::pow(resid[j][i], 2), a += std::pow(ea[i], 2);
+        rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
+        lb[j] += b, la[j] += a;
+      }
+      lcnt += static_cast<double>(n);
+    }
+    D.records.push_back(rs);
+  }
+  for (int j = 0; j < 2; ++j) {
+    D.joints[j] = ScoreOf(sb[j], sa[j], cnt);
+    if (D.leave_one_out) D.left_out[j] = ScoreOf(lb[j], la[j], lcnt);
+  }
+}
+
+// Stage 7: structure the extended twin leaves in the first record's held-out residual (5 Hz
+// low-passed rms above 4x the low-passed noise, 0.05 N m and 15 % of rmse_before) into
+// D->unexplained, with its dominant frequency and correlations. Needs D->kin, split, measured, after.
+void FindUnexplained(Diagnosis* D_out) {
+  Diagnosis& D = *D_out;
+  const Kinematics& kin = D.kin;
+  const size_t n = kin.t.size();
+  const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
+  const double fs = 1.0 / dt;
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> e(n - D.split);
+    for (size_t i = D.split; i < n; ++i) e[i - D.split] = D.measured[j][i] - D.after[j][i];
+    std::vector<double> elp = e;
+    if (fs > 12) elp = dsp::FiltFilt(dsp::DesignButterworth(2, dsp::BandType::kLowPass, fs, 5.0), e);
+    double mean = 0, rms = 0;
+    for (double v : elp) mean += v;
+    mean /= static_cast<double>(elp.size());
+    for (double v : elp) rms += (v - mean) * (v - mean);
+    rms = std::sqrt(rms / static_cast<double>(elp.size()));
+    const double white_lp = D.noise[j] * std::sqrt(std::min(1.0, 10.0 / fs));
+    if (rms > std::max(4.0 * white_lp, 0.05) && rms > 0.15 * D.joints[j].rmse_before) {
+      UnexplainedStructure u;
+      u.joint = kJoint[j];
+      u.rms = rms;
+      std::vector<double> full(n, 0.0);
+      for (size_t i = D.split; i < n; ++i) full[i] = D.measured[j][i] - D.after[j][i];
+      u.dominant_hz = DominantHz(kin.t, full, D.split, n);
+      u.corr_q = Pearson(full, kin.q[j], D.split, n);
+      u.corr_qd = Pearson(full, kin.qd[j], D.split, n);
+      u.corr_qdd = Pearson(full, kin.qdd[j], D.split, n);
+      u.corr_t = Pearson(full, kin.t, D.split, n);
+      const double cs[4] = {std::abs(u.corr_q), std::abs(u.corr_qd), std::abs(u.corr_qdd), std::abs(u.corr_t)};
+      const char* what[4] = {"angle", "velocity", "acceleration", "time (drift)"};
+      const int k = static_cast<int>(std::max_element(cs, cs + 4) - cs);
+      u.hint = cs[k] > 0.3 ? std::string("follows the ") + what[k]
+                           : "not a function of angle, velocity, acceleration or time alone";
+      D.unexplained.push_back(u);
+    }
+  }
+}
+
+// The method in words, for the report (D.cutoff, D.leave_one_out and the options).
+std::string MethodText(const Diagnosis& D, const DiagnoseOptions& opt) {
+  std::ostringstream m_os;
+  m_os << (D.cutoff.from_columns
+               ? std::string("derivatives from the measured qd/qdd columns, no filter")
+               : "measured minus predicted torque low-passed at " + NumberText(D.cutoff.hz) +
+                     " Hz (zero-phase 2nd-order Butterworth, parallel filtering), angles differentiated at " +
+                     NumberText(kDerivativeCutoffFactor * D.cutoff.hz) + " Hz (at most 0.4 fs)")
+       << "; time split: fit on the first " << 100 * (1 - opt.holdout_fraction)
+       << " % of every record, rmse by the extended twin (predict) on the last " << 100 * opt.holdout_fraction
+       << " %" << (D.leave_one_out ? "; every whole record also left out in turn" : "")
+       << "; every DESIGN effect per joint as a linearized least-squares candidate (ripple frequency"
+          " by grid + golden search; delay, backlash, strap stiffness refined by golden search on the"
+          " exact model); forward selection with backward elimination of up to " << opt.max_effects
+       << " effects fitted together, each significant (|t| > " << kMinT << "), inside its physical range,"
+          " lowering BIC (effective sample size from the residual autocorrelation) by more than "
+       << kBicMargin << " and the held-out error at its joint by at least " << 100 * kMinHeldoutGain
+       << " % and by (" << 100 * kMinTorqueShare << " % of the torque RMS)^2; fewer parameters preferred unless the richer effect lowers the held-out error by more than "
+       << 100 * kParsimony << " %";
+  return m_os.str();
+}
+
+}  // namespace
+
+namespace {
+
+// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time and the
+// process's peak memory at its end to stderr. Diagnose of `records`; with `owned` (the same records, which the caller gives up), each record's
+// columns are moved into the analysis once the cutoff is chosen instead of copied.
+Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                          std::vector<MeasuredData>* owned, const DiagnoseOptions& opt) {
+  const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
+  auto clock0 = std::chrono::steady_clock::now();
+  auto Lap = [&](const char* what) {
+    if (!timing) return;
+    const auto now = std::chrono::steady_clock::now();
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s, peak %6.1f MB\n", what,
+                 std::chrono::duration<double>(now - clock0).count(), ru.ru_maxrss / 1024.0);
+    clock0 = now;
+  };
+  CheckInputs(records, opt);
+  Diagnosis D;
+  D.holdout_fraction = opt.holdout_fraction;
+  const size_t R = records.size();
+  D.leave_one_out = R >= 2;
+
+  D.cutoff = ResolveCutoff(params, records, opt);
+  ReturnFreedMemory();
+  Lap("cutoff choice");
+
+  Plant plant(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);
+  plant.SetParams(params);  // validates the realization
+  std::vector<Rec> recs(R);  // in place: Rec::FilterFn captures its record
+  for (size_t r = 0; r < R; ++r)
+    PrepareRecord(params, *records[r], owned ? &(*owned)[r] : nullptr, D.cutoff, opt.holdout_fraction, &recs[r]);
+  double w[2];
+  NoiseAndWeights(recs, D.noise, w);
+  for (Rec& rc : recs)  // the rigid torque is needed only where stage 5 refines (a long record's memory)
+    for (int j = 0; j < 2; ++j) {
+      rc.tau_R[j].resize(RefineRows(rc, R));
+      rc.tau_R[j].shrink_to_fit();
+    }
+  Lap("kinematics + twin");
+
+  std::vector<ColumnBank> banks = CandidateColumns(params, recs, w, opt);
+  Lap("columns + ripple search");
+  FilterMeasured(&recs);
+  UseSecantDelayColumns(recs, w, &banks);
+  const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
+  for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
+  const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
+  Lap("grams + noise");
+
+  const PhysicalScale scale = ScaleOf(params, recs);
+  const Fit f0 = FitCols(g, {});
+  Fit chosen_fit;
+  SelectionTrace trace;
+  const std::vector<int> chosen = SelectEffects(bank, g, scale, opt.max_effects, D.leave_one_out, &chosen_fit, &trace);
+  D.selection = trace.steps;
+  ScoreCandidates(bank, g, scale, f0, chosen, chosen_fit, &D);
+  Lap("selection");
+
+  const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
+  Lap("refinement");
+
+  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  // Effects in order of what they explain.
+  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
+    return a.explained_pct > b.explained_pct;
+  });
+  D.extended.effects.resize(params.effects.size());
+  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  D.kin = std::move(recs[0].kin);  // recs are done with: the plot series take the first record's kinematics
+  D.split = recs[0].split;
+  Lap("extended twin");
+
+  FindUnexplained(&D);
+  Lap("unexplained");
+  D.method = MethodText(D, opt);
+  return D;
+}
+
+}  // namespace
+
+Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                   const DiagnoseOptions& opt) {
+  return DiagnoseRecords(params, records, nullptr, opt);
+}
+
+Diagnosis Diagnose(const LegParams& params, std::vector<MeasuredData>&& records, const DiagnoseOptions& opt) {
+  std::vector<const MeasuredData*> pointers;
+  for (const MeasuredData& m : records) pointers.push_back(&m);
+  return DiagnoseRecords(params, pointers, &records, opt);
+}
+
+}  // namespace exotwin

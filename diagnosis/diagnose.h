@@ -1,0 +1,120 @@
+// `exotwin diagnose` (DESIGN.md): where the twin and the measured data disagree, which effects of
+// the DESIGN list explain it (with values and 95 % intervals), the extended model, and the held-out
+// gain; on one record or on several records of one device.
+//
+// Method (diagnose.cc, diagnose_select.h):
+//  1. derivatives: the cutoff of the zero-phase derivative filter is chosen from the data
+//     (derivative_cutoff.h) unless given; the measured torque is filtered alike (parallel
+//     filtering), so the filter's lag and attenuation, and the noise that differentiation injects
+//     into the prediction above the cutoff, never show as a discrepancy.
+//  2. residual r = filtered measured tau_S - twin tau_S, per joint; white-noise level per joint from
+//     the first differences of r; rows weighted by 1/noise.
+//  3. candidates: every effect per joint, each as columns of a linear model of r (first order in the
+//     effect: sign(qd), qd, qdd, g sin/cos, [q, 1], (b/2) s(tau) dtau/dq, dtau_C/dq tau_C,
+//     sin/cos(2 pi f q), 1, tau_S, -dtau_S/dt, EMG envelopes). The ripple frequency is found by grid
+//     + golden search; delay, backlash and strap stiffness are refined by golden search on the exact
+//     model after selection.
+//  4. the effects are selected jointly (forward selection with backward elimination, up to
+//     max_effects, diagnose_select.h), fitted on the first 70 % of every record; each must be
+//     significant, physically plausible (DESIGN.md's ranges), and pay on held-out data (the last
+//     30 % of every record and, with several records, every whole record left out in turn).
+//  5. the extended twin (predict with the effects) runs on the held-out parts: rmse_after; with
+//     several records, each whole record is also predicted by the effects fitted on the others.
+//  6. structure left in the held-out residual (low-passed rms well above the noise) is reported as
+//     unexplained with its dominant frequency and its correlation with angle, velocity, accel, time.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "diagnosis/derivative_cutoff.h"
+#include "formats/measured_data.h"
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+struct DiagnosedEffect {
+  Effect effect;
+  double ci_lo = 0, ci_hi = 0;  // 95 % interval of effect.value
+  double explained_pct = 0;     // % of the held-out residual sum of squares this effect removes
+};
+
+struct UnexplainedStructure {
+  std::string joint;
+  double rms = 0;                // N m, low-passed (5 Hz) held-out residual after the extension
+  double dominant_hz = 0;        // peak of the residual spectrum
+  double corr_q = 0, corr_qd = 0, corr_qdd = 0, corr_t = 0;  // Pearson correlation with r
+  std::string hint;              // words: what it looks like
+};
+
+struct CandidateScore {
+  std::string label;  // e.g. "coulomb_friction(knee)" or "a + b"
+  double delta_bic = 0, heldout_gain_pct = 0;
+  bool selected = false;
+};
+
+struct JointScore {
+  double rmse_before = 0, rmse_after = 0, gain_pct = 0;  // on the held-out part, N m
+};
+
+// Scores of one record.
+struct RecordScore {
+  std::string source;
+  size_t samples = 0;
+  JointScore split[2];     // its last 30 %, effects fitted on the first 70 % of every record
+  JointScore left_out[2];  // the whole record, effects fitted on the other records (>= 2 records)
+};
+
+struct Diagnosis {
+  std::vector<DiagnosedEffect> effects;
+  std::vector<UnexplainedStructure> unexplained;
+  JointScore joints[2];
+  double holdout_fraction = 0.3;
+  std::string method;
+  LegParams extended;                   // params + effects
+  std::vector<CandidateScore> scores;   // singles (best first) and the best pairs, for the report
+  std::vector<std::string> collinear;   // nearly collinear candidate pairs on this record, in words
+  std::vector<std::string> selection;   // the selection's steps, in words
+  std::vector<std::string> implausible; // candidates that fit alone but fall outside their range
+  CutoffChoice cutoff;                  // derivative (and parallel torque) filter, and why
+  std::vector<RecordScore> records;     // per record (first: the plotted one)
+  bool leave_one_out = false;           // several records: whole records left out in turn
+  JointScore left_out[2];               // pooled over the left-out records
+  double noise[2] = {0, 0};             // white noise of the residual, N m
+  double tau_eff = 1;                   // residual autocorrelation length (fit rows)
+  // Series for plots (first record): measured (filtered alike), twin before, extended twin after
+  // (held-out part); split index.
+  Kinematics kin;
+  std::vector<double> measured[2], before[2], after[2];
+  size_t split = 0;
+};
+
+struct DiagnoseOptions {
+  double holdout_fraction = 0.3;
+  size_t max_fit_rows = 60000;  // per joint; longer records are strided
+  int max_effects = 6;
+  double cutoff_hz = 0;          // derivative and parallel torque filter, Hz; 0 = chosen from the data
+  std::string mjcf;              // MJCF instead of the shipped model
+};
+
+// Runs the discrepancy analysis. `params` is the twin to confront, `records` the measured records of
+// one device (each >= 200 samples, the same columns, comparable sample rates). Throws InputError on
+// unusable input (e.g. too short, records of different devices), SimulationError if the twin cannot
+// be evaluated.
+Diagnosis Diagnose(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                   const DiagnoseOptions& opt = {});
+// The same, consuming the records (left empty): their columns are moved into the analysis instead
+// of copied, for long records (`exotwin diagnose`). The same result, bit for bit.
+Diagnosis Diagnose(const LegParams& params, std::vector<MeasuredData>&& records, const DiagnoseOptions& opt = {});
+inline Diagnosis Diagnose(const LegParams& params, const MeasuredData& data, const DiagnoseOptions& opt = {}) {
+  return Diagnose(params, std::vector<const MeasuredData*>{&data}, opt);
+}
+
+// diagnosis.json text (DESIGN.md format plus `signature` fields in unexplained).
+std::string DiagnosisJson(const Diagnosis& d);
+
+// Writes DIR/diagnosis.json, DIR/extended.yaml and DIR/report.html (creates DIR). measured_path
+// names the record(s), for the report.
+void WriteDiagnosis(const Diagnosis& d, const std::string& dir, const std::string& params_path,
+                    const std::string& measured_path);
+
+}  // namespace exotwin

@@ -1,0 +1,295 @@
+#include "diagnosis/diagnose_columns.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "diagnosis/effects.h"
+#include "dsp/butterworth.h"
+#include "model/leg_dynamics.h"
+
+namespace exotwin {
+
+std::string Candidate::Label() const {
+  return name + (axis.empty() ? "" : "." + axis) + (joint == 0 ? "(hip)" : "(knee)");
+}
+
+namespace {
+
+double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+// The index of a new column of the bank (X grown when full).
+int NewColumn(ColumnBank& b) {
+  const int c = b.used++;
+  if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);
+  return c;
+}
+
+// Appends one column given as (hip row value, knee row value) per fit row.
+template <class F>
+int AddColumn(ColumnBank& b, const double w[2], F f) {
+  const size_t m = b.sample.size();
+  const int c = NewColumn(b);
+  if (b.filter) {
+    std::vector<double> v[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
+    for (size_t i = 0; i < b.n; ++i) {
+      const Eigen::Vector2d x = f(i);
+      v[0][i] = x[0], v[1][i] = x[1];
+    }
+    SetColumn(b, c, w, v);
+    return c;
+  }
+  for (size_t k = 0; k < m; ++k) {
+    const Eigen::Vector2d v = f(b.sample[k]);
+    b.X(k, c) = w[0] * v[0];
+    b.X(m + k, c) = w[1] * v[1];
+  }
+  return c;
+}
+
+// x filtered in place by the bank's filter, unless x is all zero (the low-pass of zeros is zero).
+void FilterColumn(const ColumnBank& b, std::vector<double>& x) {
+  if (!b.filter) return;
+  for (double v : x)
+    if (v != 0.0) {
+      b.filter(x);
+      return;
+    }
+}
+
+// Column c from the values x_j of its joint-j rows on the fit rows (the other joint's rows zero),
+// weighted by w as SetColumn stores them.
+void SetJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vector<double>& x_j) {
+  const size_t m = b.sample.size();
+  for (size_t k = 0; k < m; ++k) {
+    b.X(j * m + k, c) = w[j] * x_j[k];
+    b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
+  }
+}
+
+// Column c as SetColumn stores per-sample values x[i] on joint j's rows (0 on the other's); returns
+// x, filtered as the column's rows are, on the fit rows (before the weight).
+std::vector<double> SetJointColumn(ColumnBank& b, int c, const double w[2], int j, std::vector<double> x) {
+  FilterColumn(b, x);
+  std::vector<double> rows(b.sample.size());
+  for (size_t k = 0; k < rows.size(); ++k) rows[k] = x[b.sample[k]];
+  SetJointRows(b, c, w, j, rows);
+  return rows;
+}
+
+// Appends a column of joint j alone: g(i) on its joint-j rows, zero on the other joint's (the column
+// AddColumn gives for (g(i), 0) or (0, g(i)), with one record-long temporary instead of two).
+template <class G>
+int AddJointColumn(ColumnBank& b, const double w[2], int j, G g) {
+  const int c = NewColumn(b);
+  if (b.filter) {
+    std::vector<double> x(b.n);
+    for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
+    SetJointColumn(b, c, w, j, std::move(x));
+    return c;
+  }
+  const size_t m = b.sample.size();
+  for (size_t k = 0; k < m; ++k) {
+    b.X(j * m + k, c) = w[j] * g(b.sample[k]);
+    b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
+  }
+  return c;
+}
+
+// Appends a column whose hip and knee rows hold the same g(i) (the column AddColumn gives for
+// (g(i), g(i)): both rows filtered alike, from one record-long temporary).
+template <class G>
+int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
+  const int c = NewColumn(b);
+  const size_t m = b.sample.size();
+  if (b.filter) {
+    std::vector<double> x(b.n);
+    for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
+    FilterColumn(b, x);
+    for (int j = 0; j < 2; ++j)
+      for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * x[b.sample[k]];
+    return c;
+  }
+  for (size_t k = 0; k < m; ++k) {
+    const double v = g(b.sample[k]);
+    b.X(k, c) = w[0] * v;
+    b.X(m + k, c) = w[1] * v;
+  }
+  return c;
+}
+
+}  // namespace
+
+void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]) {
+  const size_t m = b.sample.size();
+  for (int j = 0; j < 2; ++j) {
+    FilterColumn(b, v[j]);
+    for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * v[j][b.sample[k]];
+  }
+}
+
+ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
+                        const std::vector<double> tau_S[2],
+                        std::vector<double> resid[2], const double w[2], size_t split,
+                        size_t max_rows, std::function<void(std::vector<double>&)> filter) {
+  ColumnBank b;
+  const size_t n = kin.t.size();
+  b.filter = std::move(filter);
+  b.n = n;
+  const size_t stride = std::max<size_t>(1, (n + max_rows - 1) / max_rows);
+  for (size_t i = 0; i < n; i += stride) {
+    b.sample.push_back(i);
+    b.train.push_back(i < split);
+  }
+  const size_t m = b.sample.size();
+  b.X.resize(2 * m, 0);
+  b.r.resize(2 * m);
+  for (size_t k = 0; k < m; ++k) {
+    b.r[k] = w[0] * resid[0][b.sample[k]];
+    b.r[m + k] = w[1] * resid[1][b.sample[k]];
+  }
+  for (int j = 0; j < 2; ++j) std::vector<double>().swap(resid[j]);
+  LegParams rigid = params;
+  rigid.effects.clear();
+  auto Q = [&](size_t i) { return Eigen::Vector2d(kin.q[0][i], kin.q[1][i]); };
+  auto QD = [&](size_t i) { return Eigen::Vector2d(kin.qd[0][i], kin.qd[1][i]); };
+  auto QDD = [&](size_t i) { return Eigen::Vector2d(kin.qdd[0][i], kin.qdd[1][i]); };
+  const double g = params.g;
+  // The envelope columns are the same at both joints but for the rows they fill: the hip's are kept
+  // on the fit rows (filtered, unweighted) for the knee's.
+  std::vector<std::vector<double>> envelope_rows;
+  b.X.resize(2 * m, 40);
+  for (int j = 0; j < 2; ++j) {
+    auto add = [&](const std::string& name, std::vector<int> cols, const std::string& axis = "") {
+      Candidate c;
+      c.name = name, c.joint = j, c.cols = std::move(cols), c.axis = axis;
+      b.candidates.push_back(c);
+      return &b.candidates.back();
+    };
+    const int off = AddJointColumn(b, w, j, [&](size_t) { return 1.0; });
+    add("coulomb_friction", {AddJointColumn(b, w, j, [&](size_t i) { return -Sign(kin.qd[j][i]); })});
+    add("viscous_friction", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.qd[j][i]; })});
+    add("inertia_error", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.qdd[j][i]; })});
+    for (const char* axis : {"X", "Y"}) {
+      const bool is_x = axis[0] == 'X';
+      // The hip's angle moves the hip rows only; the thigh + shank angle both joints' rows alike.
+      auto G = [&](size_t i) {
+        const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
+        return -g * (is_x ? std::sin(ang) : std::cos(ang));
+      };
+      add("gravity_error", {j == 0 ? AddJointColumn(b, w, 0, G) : AddBothJointsColumn(b, w, G)}, axis);
+    }
+    add("joint_stiffness", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.q[j][i]; }), off});
+    // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b).
+    add("backlash", {AddColumn(b, w, [&](size_t i) {
+          Eigen::Vector2d qa = Q(i), qb = Q(i);
+          qa[j] += 1e-5, qb[j] -= 1e-5;
+          const Eigen::Vector2d d = (ActuatorTorque(rigid, qa, QD(i), QDD(i)) -
+                                     ActuatorTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
+          const double tau_R = ActuatorTorque(rigid, Q(i), QD(i), QDD(i))[j];
+          return Eigen::Vector2d(0.5 * std::tanh(tau_R / kBacklashTorqueWidth) * d);
+        })});
+    // Straps: Delta tau_S = (1/k) dtau_C/dq_j tau_C,j (first order in 1/k).
+    add("series_compliance", {AddColumn(b, w, [&](size_t i) {
+          Eigen::Vector2d qa = Q(i), qb = Q(i);
+          qa[j] += 1e-5, qb[j] -= 1e-5;
+          const Eigen::Vector2d d = (CompliantPartTorque(rigid, qa, QD(i), QDD(i)) -
+                                     CompliantPartTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
+          return Eigen::Vector2d(d * CompliantPartTorque(rigid, Q(i), QD(i), QDD(i))[j]);
+        })});
+    add("sensor_offset", {off});
+    add("sensor_gain", {AddJointColumn(b, w, j, [&](size_t i) { return tau_S[j][i]; })});
+    // Time derivative of the predicted reading (for the delay), central differences on the record.
+    add("sensor_delay", {AddJointColumn(b, w, j, [&](size_t i) {
+          const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
+          return -((tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]));
+        })});
+    if (!kin.emg.empty()) {
+      std::vector<int> cols;
+      std::vector<std::string> chans;
+      for (const auto& ch : kin.emg) {
+        if (j == 0) {
+          std::vector<double> x = EmgEnvelope(kin.t, ch.second);
+          for (double& v : x) v = -v;
+          cols.push_back(NewColumn(b));
+          envelope_rows.push_back(SetJointColumn(b, cols.back(), w, 0, std::move(x)));
+        } else {
+          const int c = NewColumn(b);
+          SetJointRows(b, c, w, j, envelope_rows[chans.size()]);
+          cols.push_back(c);
+        }
+        chans.push_back(ch.first);
+      }
+      add("muscle_activity", cols)->channels = chans;
+    }
+  }
+  b.X.conservativeResize(Eigen::NoChange, b.used);
+  return b;
+}
+
+void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
+                         const std::vector<Eigen::VectorXd>& targets) {
+  for (int j = 0; j < 2; ++j) {
+    auto sse = [&](double f) {
+      double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
+      for (size_t r = 0; r < banks.size(); ++r) {
+        const ColumnBank& b = banks[r];
+        const size_t m = b.sample.size();
+        // The search uses at most ~8000 fitting rows per record (every step-th).
+        const size_t step = std::max<size_t>(1, m / 8000);
+        for (size_t k = 0; k < m; k += step) {
+          if (!b.train[k]) continue;
+          const double x = 2 * M_PI * f * kins[r]->q[j][b.sample[k]];
+          const double s = std::sin(x), c = std::cos(x), y = targets[r][j * m + k];
+          ss += s * s, sc += s * c, cc += c * c, ys += y * s, yc += y * c, yy += y * y;
+        }
+      }
+      const double det = ss * cc - sc * sc;
+      if (det <= 1e-12 * (ss * cc + 1e-300)) return yy;
+      const double a = (ys * cc - yc * sc) / det, c2 = (yc * ss - ys * sc) / det;
+      return yy - a * ys - c2 * yc;
+    };
+    double best_f = 1.0, best = sse(1.0);
+    for (double f = 1.0; f <= 10.0 + 1e-9; f += 0.1) {
+      const double v = sse(f);
+      if (v < best) best = v, best_f = f;
+    }
+    double lo = best_f - 0.1, hi = best_f + 0.1;
+    const double gr = 0.5 * (std::sqrt(5.0) - 1);
+    for (int it = 0; it < 24; ++it) {
+      const double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo);
+      if (sse(x1) < sse(x2)) hi = x2; else lo = x1;
+    }
+    const double f = 0.5 * (lo + hi);
+    for (size_t r = 0; r < banks.size(); ++r) {
+      ColumnBank& b = banks[r];
+      const size_t m = b.sample.size();
+      // Weight of joint j rows: the offset column of joint j holds exactly w_j there.
+      const int off = [&] {
+        for (const auto& c : b.candidates)
+          if (c.name == "sensor_offset" && c.joint == j) return c.cols[0];
+        return -1;
+      }();
+      const double w = b.X(j * m, off);
+      const int c0 = static_cast<int>(b.X.cols());
+      b.X.conservativeResize(Eigen::NoChange, c0 + 2);
+      b.used = c0 + 2;
+      b.X.col(c0).setZero();
+      b.X.col(c0 + 1).setZero();
+      const size_t n = kins[r]->t.size();
+      const double ww[2] = {j == 0 ? w : 0.0, j == 1 ? w : 0.0};
+      for (int k = 0; k < 2; ++k) {  // -sin, then -cos: joint j's rows (the other joint's are zero)
+        std::vector<double> v(n);
+        for (size_t i = 0; i < n; ++i) {
+          const double x = 2 * M_PI * f * kins[r]->q[j][i];
+          v[i] = k == 0 ? -std::sin(x) : -std::cos(x);
+        }
+        SetJointColumn(b, c0 + k, ww, j, std::move(v));
+      }
+      Candidate c;
+      c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
+      b.candidates.push_back(c);
+    }
+  }
+}
+
+}  // namespace exotwin

@@ -1,0 +1,59 @@
+// Candidate explanations of a twin residual as columns of a linear model (first order in each
+// effect of DESIGN.md "Effects"); used by Diagnose (diagnose.h).
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "formats/measured_data.h"
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// One candidate effect: the columns (indices into ColumnBank::X) whose coefficients give its value.
+struct Candidate {
+  std::string name, axis;  // axis: gravity_error only
+  int joint = 0;           // 0 hip, 1 knee
+  std::vector<int> cols;
+  double ripple_f = 0;                // torque_ripple: cycles per rad found by search
+  std::vector<std::string> channels;  // muscle_activity: EMG channel of each column
+  std::string Label() const;          // e.g. "gravity_error.Y(knee)"
+};
+
+// Columns on the fit rows. Row layout: X has 2 m rows, hip rows 0..m-1 then knee rows m..2m-1;
+// rows are weighted by 1/noise of their joint (so the stacked least squares are balanced).
+struct ColumnBank {
+  std::vector<size_t> sample;  // m sample indices of the fit rows
+  std::vector<bool> train;     // m flags: row in the fitting part
+  Eigen::MatrixXd X;           // 2m x columns (weighted)
+  Eigen::VectorXd r;           // 2m weighted residual
+  std::vector<Candidate> candidates;
+  int used = 0;                // columns in use (X may be over-allocated while building)
+  // The residual's low-pass (parallel filtering): every column is evaluated on all n samples and
+  // filtered by it before its fit rows are taken. Empty: no filter.
+  std::function<void(std::vector<double>&)> filter;  // in place
+  size_t n = 0;                // samples of the record
+};
+
+// Builds every candidate for both joints. tau_S: the twin's prediction (N m) on all samples (its rigid
+// tau_R, ActuatorTorque, is evaluated where a column needs it); resid[j]: measured - predicted
+// tau_S, released (left empty) once the fit rows' values are taken; w[j]: row weights (1/N m);
+// split: first held-out sample.
+ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin, const std::vector<double> tau_S[2],
+                        std::vector<double> resid[2], const double w[2], size_t split,
+                        size_t max_rows,
+                        std::function<void(std::vector<double>&)> filter = {});
+
+// Stores column c of the bank from per-sample values v[0] (hip rows), v[1] (knee rows), n each,
+// filtered by bank.filter when set and weighted by w.
+void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]);
+
+// Adds the torque_ripple candidates (sin/cos of 2 pi f q_j) to every bank (one per record of one
+// device, same columns), with f (1 .. 10 cycles/rad) found by grid + golden search on the train rows
+// of `targets` pooled (per bank 2m weighted rows, e.g. the residual of all other columns).
+void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
+                         const std::vector<Eigen::VectorXd>& targets);
+
+}  // namespace exotwin

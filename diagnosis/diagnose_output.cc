@@ -1,0 +1,83 @@
+// diagnosis.json, extended.yaml and the report of a Diagnosis (DESIGN.md "diagnose").
+#include <nlohmann/json.hpp>
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "formats/csv_table.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/diagnose_report.h"
+#include "formats/model_file.h"
+#include "core/error.h"
+
+namespace exotwin {
+
+std::string DiagnosisJson(const Diagnosis& d) {
+  using nlohmann::json;
+  json j;
+  j["effects"] = json::array();
+  for (const auto& e : d.effects) {
+    json x = {{"name", e.effect.name}, {"joint", e.effect.joint}, {"value", e.effect.value},
+              {"unit", e.effect.unit}, {"ci95", {e.ci_lo, e.ci_hi}}, {"explained_pct", e.explained_pct}};
+    if (!e.effect.axis.empty()) x["axis"] = e.effect.axis;
+    for (const auto& f : e.effect.fields) {
+      if (f.first.rfind("w_", 0) == 0) x["weights"][f.first.substr(2)] = f.second;
+      else x[f.first] = f.second;
+    }
+    j["effects"].push_back(x);
+  }
+  j["unexplained"] = json::array();
+  for (const auto& u : d.unexplained)
+    j["unexplained"].push_back({{"joint", u.joint}, {"rms", u.rms},
+                                {"signature", {{"dominant_hz", u.dominant_hz}, {"corr_angle", u.corr_q},
+                                               {"corr_velocity", u.corr_qd}, {"corr_acceleration", u.corr_qdd},
+                                               {"corr_time", u.corr_t}}},
+                                {"hint", u.hint}});
+  const char* names[2] = {"hip", "knee"};
+  auto score = [](const JointScore& s) {
+    return json{{"rmse_before", s.rmse_before}, {"rmse_after", s.rmse_after}, {"gain_pct", s.gain_pct}};
+  };
+  for (int k = 0; k < 2; ++k) j["joints"][names[k]] = score(d.joints[k]);
+  j["validation"] = {{"method", d.method}, {"holdout_fraction", d.holdout_fraction},
+                     {"leave_one_record_out", d.leave_one_out}};
+  j["noise"] = {{"hip", d.noise[0]}, {"knee", d.noise[1]}, {"autocorrelation_rows", d.tau_eff}};
+  j["collinear"] = d.collinear;
+  j["cutoff"] = {{"hz", d.cutoff.from_columns ? 0.0 : d.cutoff.hz},
+                 {"source", d.cutoff.from_columns ? "measured qd/qdd columns" : "butterworth"},
+                 {"why", d.cutoff.why},
+                 {"candidates_hz", d.cutoff.candidates_hz},
+                 {"heldout_rmse_hip", d.cutoff.heldout_rmse[0]},
+                 {"heldout_rmse_knee", d.cutoff.heldout_rmse[1]}};
+  j["selection"] = d.selection;
+  j["implausible"] = d.implausible;
+  j["records"] = json::array();
+  for (const auto& r : d.records) {
+    json x = {{"source", r.source}, {"samples", r.samples}};
+    for (int k = 0; k < 2; ++k) {
+      x["split"][names[k]] = score(r.split[k]);
+      if (d.leave_one_out) x["left_out"][names[k]] = score(r.left_out[k]);
+    }
+    j["records"].push_back(x);
+  }
+  if (d.leave_one_out)
+    for (int k = 0; k < 2; ++k) j["left_out"][names[k]] = score(d.left_out[k]);
+  return j.dump(2) + "\n";
+}
+
+void WriteDiagnosis(const Diagnosis& d, const std::string& dir, const std::string& params_path,
+                    const std::string& measured_path) {
+  if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
+    throw InputError(dir + ": cannot create the output folder: " + std::strerror(errno));
+  WriteFileAtomic(dir + "/diagnosis.json", DiagnosisJson(d));
+  std::string header = "exotwin diagnose: " + params_path + " extended with the effects found in " +
+                       measured_path;
+  for (const auto& e : d.effects)
+    header += "\n" + e.effect.name + " (" + e.effect.joint + "): 95 % interval " +
+              std::to_string(e.ci_lo) + " .. " + std::to_string(e.ci_hi) + " " + e.effect.unit;
+  WriteFileAtomic(dir + "/extended.yaml", ModelToYaml(d.extended, header));
+  WriteFileAtomic(dir + "/report.html", DiagnosisReportHtml(d, params_path, measured_path));
+}
+
+}  // namespace exotwin

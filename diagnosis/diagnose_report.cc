@@ -1,0 +1,169 @@
+#include "diagnosis/diagnose_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "formats/number_text.h"
+#include "formats/svg_chart.h"
+#include "core/units.h"
+
+namespace exotwin {
+namespace {
+
+
+
+
+
+// Amplitude spectrum (N m) of x[a, b) by a direct DFT of a strided copy, f in (0, fmax].
+SvgSeries Spectrum(const std::vector<double>& t, const std::vector<double>& x, size_t a, size_t b,
+                const std::string& color, const std::string& label) {
+  SvgSeries s;
+  s.color = color, s.label = label;
+  const size_t stride = std::max<size_t>(1, (b - a) / 4000);
+  std::vector<double> tt, xx;
+  double mean = 0;
+  for (size_t i = a; i < b; i += stride) tt.push_back(t[i]), xx.push_back(x[i]), mean += x[i];
+  mean /= static_cast<double>(xx.size());
+  const double T = std::max(tt.back() - tt.front(), 1e-6);
+  const double fmax = std::min(20.0, 0.5 * static_cast<double>(xx.size()) / T);
+  for (double f = 1.0 / T; f <= fmax; f += std::max(1.0 / T, fmax / 400)) {
+    double re = 0, im = 0;
+    for (size_t i = 0; i < xx.size(); ++i) {
+      const double ph = 2 * M_PI * f * tt[i];
+      re += (xx[i] - mean) * std::cos(ph), im += (xx[i] - mean) * std::sin(ph);
+    }
+    s.x.push_back(f);
+    s.y.push_back(2 * std::hypot(re, im) / static_cast<double>(xx.size()));
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_path,
+                                const std::string& measured_path) {
+  const auto& k = d.kin;
+  const size_t n = k.t.size();
+  const char* jn[2] = {"hip", "knee"};
+  std::ostringstream o;
+  o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>exotwin diagnosis</title>"
+       "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
+       "td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}</style></head><body>\n";
+  o << "<h1>exotwin diagnosis</h1><p>Twin: <code>" << HtmlEscape(params_path) << "</code>, measured: <code>"
+    << HtmlEscape(measured_path) << "</code>, " << n << " samples, " << NumberText(k.t.back() - k.t.front(), 4)
+    << " s; derivatives: " << HtmlEscape(k.derivative_source) << ".</p>\n";
+  o << "<h2>Filtering</h2><p>Measured and predicted torque are low-passed alike before residuals are "
+       "formed (parallel filtering), the angles differentiated below that filter's cutoff: "
+    << HtmlEscape(d.cutoff.why) << ".</p>";
+  if (!d.cutoff.candidates_hz.empty()) {
+    o << "<table><tr><th>cutoff (Hz)</th><th>generic fit, held-out rmse hip (N m)</th>"
+         "<th>generic fit, held-out rmse knee (N m)</th></tr>";
+    for (size_t i = 0; i < d.cutoff.candidates_hz.size(); ++i)
+      o << "<tr><td>" << (d.cutoff.candidates_hz[i] == d.cutoff.hz ? "<b>" : "") << NumberText(d.cutoff.candidates_hz[i], 3)
+        << (d.cutoff.candidates_hz[i] == d.cutoff.hz ? "</b>" : "") << "</td><td>" << NumberText(d.cutoff.heldout_rmse[0][i], 4)
+        << "</td><td>" << NumberText(d.cutoff.heldout_rmse[1][i], 4) << "</td></tr>";
+    o << "</table>";
+  }
+  o << "<h2>What the twin gets wrong, and why</h2>";
+  if (d.effects.empty()) {
+    o << "<p><b>No effect named</b>: no candidate explanation is supported by the data (information "
+         "criterion and held-out error).</p>";
+  } else {
+    o << "<table><tr><th>effect</th><th>joint</th><th>value</th><th>95 % interval</th><th>extra</th>"
+         "<th>explains (held-out residual)</th></tr>";
+    for (const auto& e : d.effects) {
+      std::string extra = e.effect.axis.empty() ? "" : "axis " + e.effect.axis + " ";
+      for (const auto& f : e.effect.fields) extra += f.first + " = " + NumberText(f.second, 4) + " ";
+      o << "<tr><td>" << e.effect.name << "</td><td>" << e.effect.joint << "</td><td>"
+        << NumberText(e.effect.value, 4) << " " << HtmlEscape(e.effect.unit) << "</td><td>" << NumberText(e.ci_lo, 4) << " .. "
+        << NumberText(e.ci_hi, 4) << "</td><td>" << HtmlEscape(extra) << "</td><td>" << NumberText(e.explained_pct, 3)
+        << " %</td></tr>";
+    }
+    o << "</table>";
+  }
+  o << "<h2>Gain of the extended twin (held-out " << NumberText(100 * d.holdout_fraction, 3) << " %)</h2>"
+    << "<table><tr><th>joint</th><th>rmse before (N m)</th><th>rmse after (N m)</th><th>gain</th>"
+       "<th>noise (N m)</th></tr>";
+  for (int j = 0; j < 2; ++j)
+    o << "<tr><td>" << jn[j] << "</td><td>" << NumberText(d.joints[j].rmse_before, 4) << "</td><td>"
+      << NumberText(d.joints[j].rmse_after, 4) << "</td><td>" << NumberText(d.joints[j].gain_pct, 3) << " %</td><td>"
+      << NumberText(d.noise[j], 3) << "</td></tr>";
+  o << "</table>";
+  if (d.records.size() > 1) {
+    o << "<h2>Records</h2><table><tr><th>record</th><th>samples</th><th>hip: held-out 30 % before / after (N m)</th>"
+         "<th>knee: held-out 30 %</th><th>hip: whole record left out</th><th>knee: whole record left out</th></tr>";
+    auto cell = [&](const JointScore& s) {
+      return NumberText(s.rmse_before, 4) + " / " + NumberText(s.rmse_after, 4) + " (" + NumberText(s.gain_pct, 3) + " %)";
+    };
+    for (const auto& r : d.records)
+      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << r.samples << "</td><td>" << cell(r.split[0]) << "</td><td>"
+        << cell(r.split[1]) << "</td><td>" << cell(r.left_out[0]) << "</td><td>" << cell(r.left_out[1]) << "</td></tr>";
+    o << "<tr><th>all</th><td></td><td>" << cell(d.joints[0]) << "</td><td>" << cell(d.joints[1]) << "</td><td>"
+      << cell(d.left_out[0]) << "</td><td>" << cell(d.left_out[1]) << "</td></tr></table>"
+      << "<p>Plots below: the first record.</p>";
+  }
+  o << "<p><small>" << HtmlEscape(d.method) << "</small></p>";
+  o << "<h2>Selection</h2><ol>";
+  for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
+  o << "</ol>";
+  if (!d.implausible.empty()) {
+    o << "<p>Fitted alone but outside their physical range, so not named:</p><ul>";
+    for (const auto& s : d.implausible) o << "<li>" << HtmlEscape(s) << "</li>";
+    o << "</ul>";
+  }
+  o << "<h2>Unexplained structure</h2>";
+  if (d.unexplained.empty()) o << "<p>None above the noise.</p>";
+  for (const auto& u : d.unexplained)
+    o << "<p><b>" << u.joint << "</b>: rms " << NumberText(u.rms, 3) << " N m (below 5 Hz), dominant "
+      << NumberText(u.dominant_hz, 3) << " Hz; correlation with angle " << NumberText(u.corr_q, 2) << ", velocity "
+      << NumberText(u.corr_qd, 2) << ", acceleration " << NumberText(u.corr_qdd, 2) << ", time " << NumberText(u.corr_t, 2)
+      << " &mdash; " << HtmlEscape(u.hint) << ".</p>";
+  o << "<h2>Candidates</h2><table><tr><th>candidate</th><th>&Delta;BIC</th><th>held-out gain</th>"
+       "<th>chosen</th></tr>";
+  for (const auto& s : d.scores)
+    o << "<tr><td>" << HtmlEscape(s.label) << "</td><td>" << NumberText(s.delta_bic, 4) << "</td><td>"
+      << NumberText(s.heldout_gain_pct, 3) << " %</td><td>" << (s.selected ? "yes" : "") << "</td></tr>";
+  o << "</table>";
+  if (!d.collinear.empty()) {
+    o << "<p>Nearly collinear on this record (told apart only by the small differences in shape, "
+         "the coupling between joints and the held-out data; their intervals are wide when both are "
+         "plausible):</p><ul>";
+    for (const auto& c : d.collinear) o << "<li>" << HtmlEscape(c) << "</li>";
+    o << "</ul>";
+  }
+  // Plots per joint.
+  const size_t a0 = d.split, win = std::min(n - d.split, static_cast<size_t>(std::max<size_t>(
+                                                     1, static_cast<size_t>(10.0 * n / std::max(k.t.back() - k.t.front(), 1e-9)))));
+  const size_t st_line = std::max<size_t>(1, win / 1500), st_dot = std::max<size_t>(1, n / 1500);
+  for (int j = 0; j < 2; ++j) {
+    o << "<h2>" << jn[j] << "</h2>\n";
+    SvgSeries m{{}, {}, "#000", "measured (filtered alike)"}, b{{}, {}, "#d62728", "twin before"}, a{{}, {}, "#1f77b4", "extended twin"};
+    for (size_t i = a0; i < a0 + win; i += st_line) {
+      m.x.push_back(k.t[i]), m.y.push_back(d.measured[j][i]);
+      b.x.push_back(k.t[i]), b.y.push_back(d.before[j][i]);
+      a.x.push_back(k.t[i]), a.y.push_back(d.after[j][i]);
+    }
+    o << SvgChart("measured vs predicted torque (held-out)", "t (s)", "tau_S (N m)", {m, b, a});
+    std::vector<double> rb(n), ra(n);
+    for (size_t i = 0; i < n; ++i) rb[i] = d.measured[j][i] - d.before[j][i], ra[i] = d.measured[j][i] - d.after[j][i];
+    const std::vector<double> qdeg = [&] { std::vector<double> v(n); for (size_t i = 0; i < n; ++i) v[i] = k.q[j][i] * kDegPerRad; return v; }();
+    struct Axis { const std::vector<double>* x; const char* label; } axes[4] = {
+        {&qdeg, "angle (deg)"}, {&k.qd[j], "velocity (rad/s)"}, {&k.qdd[j], "acceleration (rad/s^2)"}, {&k.t, "t (s)"}};
+    for (const auto& ax : axes) {
+      SvgSeries sb{{}, {}, "#d62728", "residual before", true}, sa{{}, {}, "#1f77b4", "residual after (held-out)", true};
+      for (size_t i = 0; i < n; i += st_dot) {
+        sb.x.push_back((*ax.x)[i]), sb.y.push_back(rb[i]);
+        sa.x.push_back((*ax.x)[i]), sa.y.push_back(ra[i]);
+      }
+      o << SvgChart(std::string("residual vs ") + ax.label, ax.label, "N m", {sb, sa});
+    }
+    o << SvgChart("residual amplitude spectrum", "f (Hz)", "N m",
+               {Spectrum(k.t, rb, 0, n, "#d62728", "before"), Spectrum(k.t, ra, d.split, n, "#1f77b4", "after (held-out)")}, true);
+  }
+  o << "</body></html>\n";
+  return o.str();
+}
+
+}  // namespace exotwin

@@ -1,0 +1,382 @@
+#include "diagnosis/diagnose_select.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include <Eigen/Eigenvalues>
+
+#include "formats/number_text.h"
+
+namespace exotwin {
+namespace {
+
+const char* kJoint[2] = {"hip", "knee"};
+constexpr double kStrapDynamics = 0.25;  // (motion frequency / strap resonance)^2: resonance >= 2x
+
+std::string Num(double v) { return NumberText(v, 4); }
+
+// Solves the normalized normal equations of `cols`; false when nearly singular.
+bool Solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd* x, Eigen::MatrixXd* Ainv) {
+  const Eigen::Index p = A.rows();
+  Eigen::VectorXd d = A.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd An = d.asDiagonal() * A * d.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(An);
+  if (!(es.eigenvalues()[0] > 1e-8 * es.eigenvalues()[p - 1])) return false;
+  const Eigen::MatrixXd inv = d.asDiagonal() *
+                              (es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
+                               es.eigenvectors().transpose()) *
+                              d.asDiagonal();
+  *x = inv * b;
+  if (Ainv) *Ainv = inv;
+  return true;
+}
+
+Eigen::MatrixXd Sub(const Eigen::MatrixXd& G, const std::vector<int>& c) {
+  Eigen::MatrixXd A(c.size(), c.size());
+  for (size_t a = 0; a < c.size(); ++a)
+    for (size_t b = 0; b < c.size(); ++b) A(a, b) = G(c[a], c[b]);
+  return A;
+}
+Eigen::VectorXd Sub(const Eigen::VectorXd& v, const std::vector<int>& c) {
+  Eigen::VectorXd o(c.size());
+  for (size_t a = 0; a < c.size(); ++a) o[a] = v[c[a]];
+  return o;
+}
+
+double Sse(const Eigen::MatrixXd& G, const Eigen::VectorXd& b, double rr, const Eigen::VectorXd& x) {
+  return std::max(0.0, rr - 2 * x.dot(b) + x.dot(G * x));
+}
+
+}  // namespace
+
+Grams MakeGrams(const std::vector<ColumnBank>& banks) {
+  const Eigen::Index C = banks.at(0).X.cols();
+  Grams g;
+  g.Gtr = Eigen::MatrixXd::Zero(C, C);
+  g.btr = Eigen::VectorXd::Zero(C);
+  for (int j = 0; j < 2; ++j) g.Gte[j] = Eigen::MatrixXd::Zero(C, C), g.bte[j] = Eigen::VectorXd::Zero(C);
+  for (const ColumnBank& b : banks) {
+    const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
+    const Eigen::Index mtr = static_cast<Eigen::Index>(std::count(b.train.begin(), b.train.end(), true));
+    for (Eigen::Index j = 0; j < 2; ++j) {  // train rows come first in each joint block
+      const auto tr = b.X.middleRows(j * m, mtr);
+      const auto te = b.X.middleRows(j * m + mtr, m - mtr);
+      Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(C, C), Ge = Eigen::MatrixXd::Zero(C, C);
+      Gt.selfadjointView<Eigen::Lower>().rankUpdate(tr.transpose());
+      Ge.selfadjointView<Eigen::Lower>().rankUpdate(te.transpose());
+      Gt = Gt.selfadjointView<Eigen::Lower>();
+      Ge = Ge.selfadjointView<Eigen::Lower>();
+      const Eigen::VectorXd bt = tr.transpose() * b.r.segment(j * m, mtr);
+      const Eigen::VectorXd be = te.transpose() * b.r.segment(j * m + mtr, m - mtr);
+      const double rt = b.r.segment(j * m, mtr).squaredNorm(), re = b.r.segment(j * m + mtr, m - mtr).squaredNorm();
+      g.Gtr += Gt, g.btr += bt, g.rrtr += rt;
+      g.Gte[j] += Ge, g.bte[j] += be, g.rrte[j] += re;
+      g.Grec[j].push_back(Gt + Ge);
+      g.brec[j].push_back(bt + be);
+      g.rrrec[j].push_back(rt + re);
+    }
+    g.n_tr += static_cast<double>(2 * mtr);
+  }
+  g.n_eff = g.n_tr;
+  return g;
+}
+
+Fit FitCols(const Grams& g, std::vector<int> cols) {
+  std::sort(cols.begin(), cols.end());
+  cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+  Fit f;
+  f.cols = cols;
+  const size_t R = g.records();
+  const int p = static_cast<int>(cols.size());
+  auto totals = [&] {
+    f.sse_te = f.sse_te_j[0] + f.sse_te_j[1];
+    f.sse_loo = f.sse_loo_j[0] + f.sse_loo_j[1];
+  };
+  if (p == 0) {
+    f.ok = true;
+    f.sse_tr = g.rrtr;
+    f.bic = g.n_eff * std::log(g.rrtr / g.n_tr);
+    for (int j = 0; j < 2; ++j) {
+      f.sse_te_j[j] = g.rrte[j];
+      if (R >= 2)
+        for (double rr : g.rrrec[j]) f.sse_loo_j[j] += rr;
+    }
+    totals();
+    return f;
+  }
+  const Eigen::MatrixXd A = Sub(g.Gtr, cols);
+  const Eigen::VectorXd bb = Sub(g.btr, cols);
+  Eigen::MatrixXd Ainv;
+  if (!Solve(A, bb, &f.coef, &Ainv)) return f;
+  f.sse_tr = std::max(1e-300, Sse(A, bb, g.rrtr, f.coef));
+  for (int j = 0; j < 2; ++j) f.sse_te_j[j] = Sse(Sub(g.Gte[j], cols), Sub(g.bte[j], cols), g.rrte[j], f.coef);
+  // Covariance with the residual variance and the autocorrelation length n_tr / n_eff.
+  const double s2 = f.sse_tr / (g.n_tr - p) * (g.n_tr / g.n_eff);
+  f.se = (Ainv.diagonal() * s2).cwiseMax(0).cwiseSqrt();
+  f.bic = g.n_eff * std::log(f.sse_tr / g.n_tr) + p * std::log(g.n_eff);
+  if (R >= 2) {
+    for (size_t k = 0; k < R; ++k) {
+      const Eigen::VectorXd x = FitLeavingOut(g, cols, k);
+      if (x.size() == 0) return f;  // not ok: a record's absence makes the set unidentifiable
+      for (int j = 0; j < 2; ++j)
+        f.sse_loo_j[j] += Sse(Sub(g.Grec[j][k], cols), Sub(g.brec[j][k], cols), g.rrrec[j][k], x);
+    }
+  }
+  totals();
+  f.ok = true;
+  return f;
+}
+
+Eigen::VectorXd FitLeavingOut(const Grams& g, const std::vector<int>& cols, size_t left_out) {
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(cols.size(), cols.size());
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(cols.size());
+  for (size_t k = 0; k < g.records(); ++k)
+    for (int j = 0; j < 2; ++j)
+      if (k != left_out) A += Sub(g.Grec[j][k], cols), b += Sub(g.brec[j][k], cols);
+  Eigen::VectorXd x;
+  if (!Solve(A, b, &x, nullptr)) return {};
+  return x;
+}
+
+std::vector<int> ColumnsOf(const ColumnBank& bank, const std::vector<int>& set) {
+  std::vector<int> cols;
+  for (int c : set) cols.insert(cols.end(), bank.candidates[c].cols.begin(), bank.candidates[c].cols.end());
+  std::sort(cols.begin(), cols.end());
+  cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+  return cols;
+}
+
+double CoefOf(const Fit& f, int col) {
+  for (size_t i = 0; i < f.cols.size(); ++i)
+    if (f.cols[i] == col) return f.coef[i];
+  return 0;
+}
+double SeOf(const Fit& f, int col) {
+  for (size_t i = 0; i < f.cols.size(); ++i)
+    if (f.cols[i] == col) return f.se[i];
+  return 0;
+}
+
+DiagnosedEffect ToEffect(const Candidate& c, const Eigen::VectorXd& coef, const std::vector<int>& cols) {
+  Fit f;
+  f.cols = cols, f.coef = coef, f.se = Eigen::VectorXd::Zero(coef.size());
+  return ToEffect(c, f);
+}
+
+DiagnosedEffect ToEffect(const Candidate& c, const Fit& f) {
+  DiagnosedEffect d;
+  Effect& e = d.effect;
+  e.name = c.name, e.joint = kJoint[c.joint], e.axis = c.axis;
+  const double v = CoefOf(f, c.cols[0]), se = SeOf(f, c.cols[0]);
+  d.ci_lo = v - 1.96 * se, d.ci_hi = v + 1.96 * se;
+  e.value = v;
+  static const std::map<std::string, std::string> units = {
+      {"coulomb_friction", "N m"}, {"viscous_friction", "N m s/rad"}, {"inertia_error", "kg m^2"},
+      {"gravity_error", "kg m"}, {"joint_stiffness", "N m/rad"}, {"backlash", "rad"},
+      {"series_compliance", "N m/rad"}, {"torque_ripple", "N m"}, {"sensor_offset", "N m"},
+      {"sensor_gain", "relative"}, {"sensor_delay", "s"}, {"muscle_activity", "-"}};
+  e.unit = units.at(c.name);
+  if (c.name == "joint_stiffness") {
+    e.fields["q0"] = std::abs(v) > 0 ? CoefOf(f, c.cols[1]) / v : 0.0;
+  } else if (c.name == "series_compliance") {
+    e.value = v > 0 ? 1.0 / v : -1.0;  // compliance 1/k was fitted; a negative one is no spring
+    d.ci_lo = v + 1.96 * se > 0 ? 1.0 / (v + 1.96 * se) : 1.0;
+    d.ci_hi = v - 1.96 * se > 0 ? 1.0 / (v - 1.96 * se) : 1e6;
+  } else if (c.name == "torque_ripple") {
+    const double b = CoefOf(f, c.cols[1]), sb = SeOf(f, c.cols[1]);
+    e.value = std::hypot(v, b);
+    const double sA = e.value > 0 ? std::sqrt(std::pow(v * se, 2) + std::pow(b * sb, 2)) / e.value : 0;
+    d.ci_lo = e.value - 1.96 * sA, d.ci_hi = e.value + 1.96 * sA;
+    e.fields["cycles_per_rad"] = c.ripple_f;
+    e.fields["phase"] = std::atan2(b, v);
+  } else if (c.name == "muscle_activity") {
+    e.value = 1.0, d.ci_lo = d.ci_hi = 1.0;
+    for (size_t k = 0; k < c.cols.size(); ++k)
+      if (std::abs(CoefOf(f, c.cols[k])) > 2.0 * SeOf(f, c.cols[k]))
+        e.fields["w_" + c.channels[k]] = CoefOf(f, c.cols[k]);
+    if (e.fields.empty()) e.fields["w_" + c.channels[0]] = CoefOf(f, c.cols[0]);
+  }
+  return d;
+}
+
+bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* why) {
+  const Effect& e = d.effect;
+  const int j = e.joint == "hip" ? 0 : 1;
+  const double v = e.value;
+  std::string no;
+  const double range = s.q_max[j] - s.q_min[j];
+  if (e.name == "coulomb_friction" && !(v > 0 && v <= 0.5 * s.tau_max[j]))
+    no = "Coulomb friction outside (0, half the largest torque " + Num(0.5 * s.tau_max[j]) + "] N m";
+  if (e.name == "viscous_friction" && !(v > 0)) no = "negative viscous friction";
+  if (e.name == "inertia_error" && !(v > -0.5 * s.M_jj[j] && v < s.M_jj[j]))
+    no = "inertia change outside -50 % .. +100 % of the joint's inertia " + Num(s.M_jj[j]) + " kg m^2";
+  if (e.name == "gravity_error" && !(std::abs(v) <= 0.5 * s.distal_moment[j] + 0.05))
+    no = "gravity moment change beyond half the distal segments' " + Num(s.distal_moment[j]) + " kg m";
+  if (e.name == "joint_stiffness") {
+    const double q0 = e.fields.count("q0") ? e.fields.at("q0") : 0.0;
+    if (!(v > 0)) no = "negative stiffness";
+    else if (!(q0 >= s.q_min[j] - 0.5 && q0 <= s.q_max[j] + 0.5))
+      no = "rest angle q0 " + Num(q0) + " rad outside the recorded range widened by 0.5 rad";
+  }
+  if (e.name == "backlash" && !(v > 0 && v <= 0.1)) no = "dead band outside (0, 0.1] rad";
+  if (e.name == "series_compliance" && !(v > 0 && s.tau_C_max[j] / v <= 0.5 * range))
+    no = "strap deflection " + Num(v > 0 ? s.tau_C_max[j] / v : 0) + " rad beyond half the motion range";
+  else if (e.name == "series_compliance" && !(s.strap_dynamics[j] / v <= kStrapDynamics))
+    no = "strap resonance sqrt(k / J) at " + Num(std::sqrt(v / s.strap_dynamics[j])) +
+         " times the motion's frequency, expected above " + Num(1 / std::sqrt(kStrapDynamics)) +
+         " (the quasi-static strap model)";
+  if (e.name == "torque_ripple" && !(v <= 0.5 * s.tau_max[j])) no = "ripple beyond half the largest torque";
+  if (e.name == "sensor_offset" && !(std::abs(v) <= 0.5 * s.tau_max[j])) no = "offset beyond half the largest torque";
+  if (e.name == "sensor_gain" && !(v >= -0.25 && v <= 0.25)) no = "gain error outside -25 % .. +25 %";
+  if (e.name == "sensor_delay" && !(v > 0 && v <= 0.05)) no = "delay outside (0, 50] ms";
+  if (why) *why = no;
+  return no.empty();
+}
+
+namespace {
+
+// Significant and plausible inside fit `f`?
+bool Admissible(const Candidate& c, const Fit& f, const PhysicalScale& s) {
+  if (!f.ok) return false;
+  const double v = CoefOf(f, c.cols[0]), se = SeOf(f, c.cols[0]);
+  bool significant = std::abs(v) > kMinT * se;
+  if (c.name == "torque_ripple") {
+    const double b = CoefOf(f, c.cols[1]), sb = SeOf(f, c.cols[1]);
+    significant = std::hypot(v, b) > kMinT * std::max(se, sb);
+  }
+  if (c.name == "muscle_activity") {
+    significant = false;
+    for (int col : c.cols) significant |= std::abs(CoefOf(f, col)) > kMinT * SeOf(f, col);
+  }
+  return significant && Plausible(ToEffect(c, f), s);
+}
+
+bool Conflicts(const Candidate& a, const Candidate& b) {
+  if (a.name == b.name && a.joint == b.joint) return true;  // gravity X and Y: one at a time
+  for (int x : a.cols)
+    if (std::find(b.cols.begin(), b.cols.end(), x) != b.cols.end()) return true;  // nested (offset)
+  return false;
+}
+
+bool AllAdmissible(const ColumnBank& bank, const std::vector<int>& set, const Fit& f, const PhysicalScale& s) {
+  if (!f.ok) return false;
+  for (int c : set)
+    if (!Admissible(bank.candidates[c], f, s)) return false;
+  return true;
+}
+
+std::string Label(const ColumnBank& bank, const std::vector<int>& set) {
+  std::string o;
+  for (int c : set) o += (o.empty() ? "" : " + ") + bank.candidates[c].Label();
+  return o.empty() ? "rigid twin" : o;
+}
+
+}  // namespace
+
+std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale,
+                               int max_effects, bool loo, Fit* fit, SelectionTrace* trace) {
+  std::vector<int> set;
+  const Fit rigid = FitCols(g, {});
+  Fit cur = rigid;
+  std::set<std::vector<int>> seen{{}};
+  // The held-out error at joint j drops by at least `frac` of its value under `ref`.
+  auto held_ok = [&](const Fit& f, const Fit& ref, int j, double frac) {
+    return f.sse_te_j[j] <= (1 - frac) * ref.sse_te_j[j] &&
+           (!loo || f.sse_loo_j[j] <= (1 - frac) * ref.sse_loo_j[j]);
+  };
+  // Material: the drop is at least (kMinTorqueShare of the measured torque's RMS)^2 there.
+  auto material = [&](const Fit& f, const Fit& ref, int j) {
+    return ref.sse_te_j[j] - f.sse_te_j[j] >= kMinTorqueShare * kMinTorqueShare * g.tt_te[j];
+  };
+  std::string last_rejected;
+  auto score = [&](const Fit& f) {
+    std::string s = "BIC " + Num(f.bic - rigid.bic) + ", held-out SSE " + Num(f.sse_te);
+    if (loo) s += ", left-out records SSE " + Num(f.sse_loo);
+    return s;
+  };
+  while (static_cast<int>(set.size()) < max_effects) {
+    struct Option {
+      int c;
+      Fit f;
+    };
+    std::vector<Option> ok;
+    double best_rejected_bic = 1e300;
+    last_rejected.clear();
+    for (int c = 0; c < static_cast<int>(bank.candidates.size()); ++c) {
+      if (std::find(set.begin(), set.end(), c) != set.end()) continue;
+      if (std::any_of(set.begin(), set.end(),
+                      [&](int s) { return Conflicts(bank.candidates[s], bank.candidates[c]); }))
+        continue;
+      std::vector<int> next = set;
+      next.push_back(c);
+      Fit f = FitCols(g, ColumnsOf(bank, next));
+      if (!f.ok || !(f.bic < cur.bic - kBicMargin)) continue;
+      const int j = bank.candidates[c].joint;
+      if (!held_ok(f, cur, j, kMinHeldoutGain) || !material(f, cur, j)) {
+        if (f.bic < best_rejected_bic)
+          best_rejected_bic = f.bic,
+          last_rejected = bank.candidates[c].Label() + " (BIC " + Num(f.bic - cur.bic) + ") lowers the held-out " +
+                          "error at the " + kJoint[j] + " by " + Num(100 * (1 - f.sse_te_j[j] / cur.sse_te_j[j])) +
+                          " %" + (loo ? " and on left-out records by " + Num(100 * (1 - f.sse_loo_j[j] / cur.sse_loo_j[j])) + " %" : "") +
+                          " (needed: " + Num(100 * kMinHeldoutGain) + " % and (" + Num(100 * kMinTorqueShare) +
+                          " % of the torque RMS)^2)";
+        continue;
+      }
+      if (!AllAdmissible(bank, next, f, scale)) continue;
+      ok.push_back({c, std::move(f)});
+    }
+    if (ok.empty()) {
+      if (trace && !last_rejected.empty()) trace->steps.push_back("stop: the best remaining, " + last_rejected);
+      break;
+    }
+    std::sort(ok.begin(), ok.end(), [](const Option& a, const Option& b) { return a.f.bic < b.f.bic; });
+    const Option* best = &ok[0];
+    // The simplest explanation: fewer parameters win unless the richer one lowers the held-out
+    // error by more than kParsimony of it.
+    const int bj = bank.candidates[best->c].joint;
+    for (const Option& o : ok)
+      if (bank.candidates[o.c].joint == bj &&
+          bank.candidates[o.c].cols.size() < bank.candidates[best->c].cols.size() &&
+          !held_ok(best->f, o.f, bj, kParsimony)) {
+        if (trace)
+          trace->steps.push_back(bank.candidates[o.c].Label() + " preferred to " +
+                                 bank.candidates[best->c].Label() + " (fewer parameters, held-out within " +
+                                 Num(100 * kParsimony) + " %)");
+        best = &o;
+        break;
+      }
+    set.push_back(best->c);
+    cur = best->f;
+    if (trace) trace->steps.push_back("add " + bank.candidates[best->c].Label() + ": " + score(cur));
+    // Backward elimination: drop an effect that no longer earns its margin in the joint fit.
+    for (bool removed = true; removed && set.size() > 1;) {
+      removed = false;
+      int worst = -1;
+      Fit worst_fit;
+      for (size_t k = 0; k < set.size(); ++k) {
+        std::vector<int> less = set;
+        less.erase(less.begin() + static_cast<long>(k));
+        Fit f = FitCols(g, ColumnsOf(bank, less));
+        if (!AllAdmissible(bank, less, f, scale)) continue;
+        if (f.bic < cur.bic + kBicMargin && (worst < 0 || f.bic < worst_fit.bic)) worst = static_cast<int>(k), worst_fit = f;
+      }
+      if (worst >= 0) {
+        if (trace) trace->steps.push_back("remove " + bank.candidates[set[worst]].Label() + ": " + score(worst_fit));
+        set.erase(set.begin() + worst);
+        cur = worst_fit;
+        removed = true;
+      }
+    }
+    std::vector<int> key = set;
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) break;
+  }
+  if (trace) trace->steps.push_back("chosen: " + Label(bank, set));
+  *fit = cur;
+  return set;
+}
+
+}  // namespace exotwin

@@ -1,0 +1,58 @@
+// Model extensions (DESIGN.md "Effects") applied on top of the rigid twin's torques.
+//
+// Physical models (the same code is the truth in `generate` and the extended twin in `predict`):
+//  - coulomb/viscous friction, inertia_error, joint_stiffness, torque_ripple: the DESIGN formulas
+//    added to tau_R of that joint (MuJoCo frictionloss / damping / armature / stiffness analogues).
+//  - gravity_error: HJ15 eq. 7 with the distal segment's lumped X (or Y) changed by value.
+//  - backlash (dead band of total width b): the encoder sits on the motor side; under load the link
+//    rests against one flank, lagging the motor by b/2 in the direction of the transmitted torque:
+//    q_link,j = q_j - (b/2) s(tau_R,j), s(x) = tanh(x / kBacklashTorqueWidth). The link's dynamics
+//    are evaluated at q_link (closed form, HJ15 eq. 5-7 + P): tau_R += tau(q_link) - tau(q).
+//  - series_compliance (strap stiffness k): the compliant part (the human limb when the model has
+//    one, else the whole chain behind the transmission) follows the measured exoskeleton angle
+//    through a spring: q_c,j = q_j - tau_C,j(q_c)/k, solved per sample by Newton's method. Quasi-static:
+//    the deflection's own rates are neglected (valid well below the strap resonance sqrt(k/J), a few
+//    Hz for k >= 100 N m/rad, above the 0.3-1.5 Hz of the motions). tau_R += tau_C(q_c) - tau_C(q).
+//  - muscle_activity: tau_R += value * sum_ch w_ch env_ch(t), env = EmgEnvelope of column emg_<ch>
+//    (fields "w_<ch>", N m per V); value is a dimensionless scale (1 as written by diagnose).
+//  - sensor_offset, sensor_gain, sensor_delay act on tau_S = -tau_R, in the order listed.
+#pragma once
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "formats/measured_data.h"
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// Transition width of the backlash flank selection s(tau) = tanh(tau / width), N m.
+constexpr double kBacklashTorqueWidth = 0.1;
+
+// Joint index of an effect ("hip" -> 0, "knee" -> 1).
+int EffectJoint(const Effect& e);
+
+// Adds the link-side effects to tau_R[j] (actuator torque, N m) for the kinematics `kin`, then forms
+// the sensor reading tau_S = -tau_R and applies the sensor effects (offset, gain, delay). `params`
+// gives L1, g and the lumped parameters for the closed-form terms. tau_R[j] must have kin.t.size()
+// samples. Throws InputError for an effect it cannot apply (e.g. muscle_activity without the EMG
+// column of a weighted channel).
+void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
+                  std::vector<double> tau_S[2]);
+
+// EMG envelope (V) of a measured column: dsp::ZeroPhaseEnvelope with a 2nd-order 20 Hz high-pass
+// (not the 20-450 Hz band-pass: a measured record may be sampled below 900 Hz) and the 4th-order 2 Hz
+// envelope low-pass, padded by up to 1 s at both ends. t strictly increasing with a sample rate above
+// 40 Hz (median step). Throws InputError otherwise.
+std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg);
+
+// Torque (N m) the series-compliant part needs: human rigid dynamics + P(q) when params.human,
+// else the whole chain's actuator torque (HJ15 eq. 5-7).
+Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
+                                    const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
+
+// Link angle of joint j under a strap of stiffness k (N m/rad): solves q_c,j = q_j - tau_C,j(q_c)/k.
+Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
+                               const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
+
+}  // namespace exotwin

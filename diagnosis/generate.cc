@@ -1,0 +1,189 @@
+#include "diagnosis/generate.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "formats/csv_table.h"
+#include "diagnosis/effects.h"
+#include "diagnosis/predict.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "core/units.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+
+const std::vector<std::string>& AllEffectNames() {
+  static const std::vector<std::string> k = {
+      "coulomb_friction", "viscous_friction", "inertia_error",  "gravity_error",
+      "joint_stiffness",  "backlash",         "series_compliance", "torque_ripple",
+      "sensor_offset",    "sensor_gain",      "sensor_delay",   "muscle_activity"};
+  return k;
+}
+
+namespace {
+
+const char* kEmgChannels[] = {"GMAX", "RF", "VM", "ST", "GAS"};
+constexpr double kJointLo[2] = {5 * kRadPerDeg, -70 * kRadPerDeg}, kJointHi[2] = {40 * kRadPerDeg, -5 * kRadPerDeg};
+
+struct Harmonic {
+  double amp, omega, phase;
+};
+
+}  // namespace
+
+Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
+  Effect e;
+  e.name = name;
+  e.joint = joint == 0 ? "hip" : "knee";
+  if (name == "coulomb_friction") {
+    e.value = rng.Uniform(0.3, 1.5), e.unit = "N m";
+  } else if (name == "viscous_friction") {
+    e.value = rng.Uniform(0.3, 2.0), e.unit = "N m s/rad";
+  } else if (name == "inertia_error") {
+    e.value = rng.Sign() * rng.Uniform(0.05, 0.3), e.unit = "kg m^2";
+  } else if (name == "gravity_error") {
+    e.value = rng.Sign() * rng.Uniform(0.05, 0.3), e.unit = "kg m";
+    e.axis = rng.Uniform() < 0.5 ? "X" : "Y";
+  } else if (name == "joint_stiffness") {
+    e.value = rng.Uniform(3.0, 15.0), e.unit = "N m/rad";
+    e.fields["q0"] = rng.Uniform(kJointLo[joint], kJointHi[joint]);
+  } else if (name == "backlash") {
+    e.value = rng.Uniform(0.3, 1.7) * kRadPerDeg, e.unit = "rad";
+  } else if (name == "series_compliance") {
+    // The quasi-static strap model holds well below the strap's resonance sqrt(k / J_c): at the
+    // hip J_c is the whole leg's (~2.5 kg m^2 against ~0.4 at the knee), so for the same margin
+    // above the gait's frequencies the hip's straps are drawn stiffer (effects.h).
+    e.value = joint == 0 ? rng.Uniform(800.0, 3000.0) : rng.Uniform(150.0, 800.0), e.unit = "N m/rad";
+  } else if (name == "torque_ripple") {
+    e.value = rng.Uniform(0.2, 1.0), e.unit = "N m";
+    e.fields["cycles_per_rad"] = rng.Uniform(2.0, 8.0);
+    e.fields["phase"] = rng.Uniform(-M_PI, M_PI);
+  } else if (name == "sensor_offset") {
+    e.value = rng.Sign() * rng.Uniform(0.2, 2.0), e.unit = "N m";
+  } else if (name == "sensor_gain") {
+    e.value = rng.Sign() * rng.Uniform(0.02, 0.10), e.unit = "relative";
+  } else if (name == "sensor_delay") {
+    e.value = rng.Uniform(0.005, 0.030), e.unit = "s";
+  } else if (name == "muscle_activity") {
+    e.value = 1.0, e.unit = "-";
+    const char* ch[2][2] = {{"GMAX", "RF"}, {"VM", "ST"}};
+    for (const char* c : ch[joint]) e.fields[std::string("w_") + c] = rng.Sign() * rng.Uniform(3.0, 10.0);
+  } else {
+    throw InputError("generate: unknown effect '" + name + "'");
+  }
+  return e;
+}
+
+GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& opt) {
+  if (!(opt.duration > 2.0 && opt.duration <= 7200.0))
+    throw InputError("--duration: " + std::to_string(opt.duration) + " s, expected 2 .. 7200 s");
+  if (!(opt.rate >= 100.0 && opt.rate <= 10000.0))
+    throw InputError("--rate: " + std::to_string(opt.rate) + " Hz, expected 100 .. 10000 Hz");
+  if (opt.effects < 0 || opt.effects > 3)
+    throw InputError("--effects: " + std::to_string(opt.effects) + ", expected 0 .. 3");
+  if (!opt.joint.empty() && opt.joint != "hip" && opt.joint != "knee")
+    throw InputError("--joint: '" + opt.joint + "', expected hip or knee");
+  std::vector<std::string> pool = opt.allowed.empty() ? AllEffectNames() : opt.allowed;
+  for (const auto& n : pool)
+    if (std::find(AllEffectNames().begin(), AllEffectNames().end(), n) == AllEffectNames().end())
+      throw InputError("--effect: unknown effect '" + n + "'");
+  if (static_cast<int>(pool.size()) < opt.effects)
+    throw InputError("--effects: " + std::to_string(opt.effects) + " distinct effects from " +
+                     std::to_string(pool.size()) + " allowed names");
+
+  NormalRng<NormalBoxMuller<BoxMullerU1::kOneMinusUniform>> rng(opt.seed);
+  GeneratedData g;
+  g.truth = params;
+  // Trajectory: three harmonics per joint, amplitudes summing to 70-100 % of the half range.
+  Harmonic h[2][3];
+  double centre[2], scale[2];
+  for (int j = 0; j < 2; ++j) {
+    centre[j] = 0.5 * (kJointLo[j] + kJointHi[j]);
+    const double half = 0.5 * (kJointHi[j] - kJointLo[j]) * rng.Uniform(0.7, 1.0);
+    double sum = 0;
+    for (auto& k : h[j]) {
+      k.amp = rng.Uniform(0.3, 1.0);
+      k.omega = 2 * M_PI * rng.Uniform(0.3, 1.5);
+      k.phase = rng.Uniform(-M_PI, M_PI);
+      sum += k.amp;
+    }
+    scale[j] = half / sum;
+  }
+  // Effects.
+  for (int k = 0; k < opt.effects; ++k) {
+    const int pick = rng.Index(static_cast<int>(pool.size()));
+    const std::string name = pool[pick];
+    pool.erase(pool.begin() + pick);
+    const int joint = opt.joint.empty() ? rng.Index(2) : (opt.joint == "hip" ? 0 : 1);
+    g.truth.effects.push_back(DrawEffect(rng, name, joint));
+  }
+  // EMG activations: 0.02 + a (0.5 + 0.5 sin(w t + p))^2 V, a in 0.05-0.3 V, w in 0.1-0.8 Hz.
+  struct Act { double a, w, p; } act[5];
+  for (auto& a : act) a = {rng.Uniform(0.05, 0.3), 2 * M_PI * rng.Uniform(0.1, 0.8), rng.Uniform(-M_PI, M_PI)};
+  g.torque_noise = rng.Uniform(0.02, 0.04);
+
+  const size_t n = static_cast<size_t>(std::floor(opt.duration * opt.rate)) + 1;
+  Kinematics kin;
+  kin.t.resize(n);
+  for (int j = 0; j < 2; ++j) kin.q[j].resize(n), kin.qd[j].resize(n), kin.qdd[j].resize(n);
+  std::vector<double> emg[5];
+  for (int c = 0; c < 5; ++c) emg[c].resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / opt.rate;
+    kin.t[i] = t;
+    for (int j = 0; j < 2; ++j) {
+      double q = centre[j], qd = 0, qdd = 0;
+      for (const auto& k : h[j]) {
+        const double s = std::sin(k.omega * t + k.phase), c = std::cos(k.omega * t + k.phase);
+        q += scale[j] * k.amp * s;
+        qd += scale[j] * k.amp * k.omega * c;
+        qdd -= scale[j] * k.amp * k.omega * k.omega * s;
+      }
+      kin.q[j][i] = q, kin.qd[j][i] = qd, kin.qdd[j][i] = qdd;
+    }
+    for (int c = 0; c < 5; ++c) {
+      const double m = 0.5 + 0.5 * std::sin(act[c].w * t + act[c].p);
+      emg[c][i] = (0.02 + act[c].a * m * m) * rng.Normal();
+    }
+  }
+  for (int c = 0; c < 5; ++c) kin.emg[kEmgChannels[c]] = emg[c];
+  kin.derivative_source = "analytic";
+
+  Plant plant(ExowheelMjcfPath(g.truth.human.has_value()));
+  plant.SetParams(g.truth);
+  const Prediction truth = PredictTorque(plant, kin);
+
+  // Measurement: encoder quantization, sensor noise and resolution.
+  const double enc = 2 * M_PI / 524288.0, res = 0.005;
+  MeasuredData& d = g.data;
+  d.source = "generated(seed " + std::to_string(opt.seed) + ")";
+  d.table.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+  d.table.columns.assign(5, std::vector<double>(n));
+  d.table.columns[0] = kin.t;
+  std::vector<double>* col = d.table.columns.data();
+  for (size_t i = 0; i < n; ++i) {
+    col[1][i] = enc * std::round(kin.q[0][i] / enc);
+    col[2][i] = enc * std::round(kin.q[1][i] / enc);
+    col[3][i] = res * std::round((truth.tau_S[0][i] + g.torque_noise * rng.Normal()) / res);
+    col[4][i] = res * std::round((truth.tau_S[1][i] + g.torque_noise * rng.Normal()) / res);
+  }
+  for (int c = 0; c < 5; ++c) {
+    d.table.names.push_back(std::string("emg_") + kEmgChannels[c]);
+    d.table.columns.push_back(emg[c]);
+  }
+  d.table.line_of_row.resize(n);
+  for (size_t i = 0; i < n; ++i) d.table.line_of_row[i] = static_cast<int>(i) + 2;
+  d.BindRequired();
+  return g;
+}
+
+void WriteGeneratedCsv(const GeneratedData& g, const std::string& path, uint64_t seed) {
+  std::vector<const std::vector<double>*> cols;
+  for (const auto& c : g.data.table.columns) cols.push_back(&c);
+  WriteCsv(path, g.data.table.names, cols,
+           {"exotwin generate: synthetic measurement, seed " + std::to_string(seed) +
+            " (the hidden effects are in the --truth file, not here)"});
+}
+
+}  // namespace exotwin

@@ -1,0 +1,73 @@
+// The discrepancy loop of the EMG-driven joint-torque model (issue 19; emg-fit --report): starting
+// from the linear form of HJ15 eq. 26-27, candidate causes of what it misses are added one at a time,
+// only when they pay on held-out data, with the gates of diagnose's selection (diagnose_select.h):
+//  - the Bayesian information criterion (effective sample size from the residual autocorrelation,
+//    every searched parameter counted) drops by more than kBicMargin;
+//  - the held-out error drops by at least kMinHeldoutGain at a joint the cause acts on, and in sum
+//    over both joints (the last 30 % of every recording, samples within kSpikeMads of the median
+//    moment; with several recordings, also every whole recording left out in turn);
+//  - the cause's parameter is significant (|t| > kMinT: coefficients by least squares, searched
+//    parameters by the profile of the sum of squares) and inside its physiological range.
+// Among the admissible causes the one with the lowest BIC is added; the searched parameters are then
+// refined together. Searched parameters are chosen on the fit rows only (never on held-out rows).
+// Candidates (emg_torque_model.h): electromechanical delay per twin muscle (0-200 ms), the A-shape
+// activation nonlinearity (-3 <= A < 0), angle-dependent moment arms per joint, the passive moment
+// per joint, the vasti standing in for a missing gluteus maximus at the hip. The robust handling of
+// contact spikes (fit rows beyond kSpikeMads left out) is decided first, because it changes the rows
+// every other cause is fitted on; it must pay on held-out data like the others.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "emg/emg_torque_model.h"
+
+namespace exotwin {
+
+struct EmgStep {
+  std::string added;  // "linear form (HJ15 eq. 26)" for the first step
+  std::string why;    // the gates' figures, in words
+  EmgTorqueModel model;  // fitted on the first 70 % (figures, held-out scores)
+};
+
+struct EmgCandidateScore {
+  int round = 0;
+  std::string label;
+  double delta_bic = 0;
+  double gain_pct[2] = {0, 0};           // held-out SSE drop per joint, %
+  double left_out_gain_pct[2] = {0, 0};  // with several recordings
+  bool added = false;
+  std::string verdict;  // why it was or was not added
+};
+
+struct EmgDiagnosis {
+  std::vector<EmgStep> steps;              // [0] the linear form, then one per added cause
+  std::vector<EmgCandidateScore> scores;   // every candidate of every round
+  std::vector<std::string> selection;      // the loop's steps in words
+  EmgTorqueModel calibration;              // the final structure fitted on every sample of every recording
+  double holdout_fraction = 0.3;
+  bool leave_one_out = false;
+  std::vector<std::string> sources, notes, missing;
+  // First recording, for plots: time, measured and estimated moments (linear, final) on all samples
+  // (the held-out part starts at `split`), estimated by the fits on the first 70 %.
+  std::vector<double> t, measured[2], linear[2], final_[2];
+  size_t split = 0;
+};
+
+struct EmgDiagnoseOptions {
+  double holdout_fraction = 0.3;
+  int max_steps = 10;
+  bool robust_candidate = true;  // consider the robust fit
+};
+
+// Runs the loop on recordings with moments (same mapped channels). Throws InputError on unusable input.
+EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const EmgDiagnoseOptions& opt = {});
+
+// diagnosis.json text (the format of `exotwin diagnose` where the concepts match: effects with value,
+// unit, ci95; joints with rmse_before / rmse_after / gain_pct; validation; selection), plus steps.
+std::string EmgDiagnosisJson(const EmgDiagnosis& d);
+// Self-contained HTML report: steps table, candidates, plots of the held-out part.
+std::string EmgDiagnosisHtml(const EmgDiagnosis& d);
+// Writes DIR/diagnosis.json and DIR/report.html (creates DIR).
+void WriteEmgDiagnosis(const EmgDiagnosis& d, const std::string& dir);
+
+}  // namespace exotwin

@@ -1,0 +1,186 @@
+// diagnosis.json and report.html of the EMG model's discrepancy loop (emg_diagnose.h), in the format
+// of `exotwin diagnose` (diagnose_output.cc) where the concepts match.
+#include <nlohmann/json.hpp>
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "formats/csv_table.h"
+#include "emg/emg_diagnose.h"
+#include "formats/number_text.h"
+#include "formats/svg_chart.h"
+#include "core/error.h"
+
+namespace exotwin {
+namespace {
+
+const char* kJoint[2] = {"hip", "knee"};
+
+
+std::string Joints(Muscle m) {
+  std::string o;
+  for (int j = 0; j < 2; ++j)
+    if (ActionSign(m, j) != 0) o += std::string(o.empty() ? "" : "+") + kJoint[j];
+  return o;
+}
+
+// The named causes of the final model in diagnose's effect format.
+nlohmann::json Effects(const EmgDiagnosis& d) {
+  using nlohmann::json;
+  json a = json::array();
+  const EmgTorqueModel& m = d.calibration;
+  for (const auto& dl : m.spec.delay_s) {
+    const double se = m.spec.delay_se.count(dl.first) ? m.spec.delay_se.at(dl.first) : 0.0;
+    a.push_back({{"name", "electromechanical_delay"}, {"muscle", MuscleName(dl.first)}, {"joint", Joints(dl.first)},
+                 {"value", dl.second}, {"unit", "s"}, {"ci95", {dl.second - 1.96 * se, dl.second + 1.96 * se}}});
+  }
+  if (m.spec.a_shape != 0)
+    a.push_back({{"name", "activation_nonlinearity"}, {"joint", "hip+knee"}, {"value", m.spec.a_shape}, {"unit", "1"},
+                 {"ci95", {m.spec.a_shape - 1.96 * m.spec.a_shape_se, m.spec.a_shape + 1.96 * m.spec.a_shape_se}}});
+  for (const EmgTerm& t : m.terms) {
+    std::string name;
+    if (t.kind == TermKind::kPassive) name = "passive_moment";
+    if (t.kind == TermKind::kAlphaQ) name = "moment_arm_angle";
+    if (t.kind == TermKind::kAlpha && t.proxy) name = "missing_channel";
+    if (name.empty()) continue;
+    json e = {{"name", name}, {"joint", kJoint[t.joint]}, {"value", t.value}, {"unit", t.Unit()},
+              {"ci95", {t.value - 1.96 * t.se, t.value + 1.96 * t.se}}, {"parameter", t.Name()}};
+    if (!t.channel.empty()) e["channel"] = t.channel;
+    a.push_back(e);
+  }
+  if (m.spec.robust) a.push_back({{"name", "robust_fit"}, {"joint", "hip+knee"}, {"value", kSpikeMads}, {"unit", "scaled MAD"}});
+  return a;
+}
+
+
+}  // namespace
+
+std::string EmgDiagnosisJson(const EmgDiagnosis& d) {
+  using nlohmann::json;
+  json j;
+  j["effects"] = Effects(d);
+  const EmgTorqueModel& first = d.steps.front().model;
+  const EmgTorqueModel& last = d.steps.back().model;
+  for (int k = 0; k < 2; ++k) {
+    const double b = first.figures[k].rms_heldout_trim, a = last.figures[k].rms_heldout_trim;
+    j["joints"][kJoint[k]] = {{"rmse_before", b}, {"rmse_after", a}, {"gain_pct", b > 0 ? 100 * (1 - a / b) : 0.0},
+                              {"r2_before", first.figures[k].r2_heldout_trim},
+                              {"r2_after", last.figures[k].r2_heldout_trim},
+                              {"r2_before_all_samples", first.figures[k].r2_heldout},
+                              {"r2_after_all_samples", last.figures[k].r2_heldout}};
+  }
+  j["validation"] = {{"method", "fit on the first " + NumberText(100 * (1 - d.holdout_fraction)) +
+                                    " % of every recording, scored on the rest" +
+                                    (d.leave_one_out ? " and on every recording left out in turn" : "") +
+                                    "; scores over samples within " + NumberText(kSpikeMads) +
+                                    " scaled MADs of the median moment"},
+                     {"holdout_fraction", d.holdout_fraction},
+                     {"leave_one_record_out", d.leave_one_out}};
+  j["selection"] = d.selection;
+  j["steps"] = json::array();
+  for (const EmgStep& s : d.steps) {
+    json x = {{"added", s.added}, {"why", s.why}, {"bic", s.model.bic}};
+    for (int k = 0; k < 2; ++k) {
+      const EmgJointFigures& F = s.model.figures[k];
+      x[kJoint[k]] = {{"r2_fit", F.r2_fit}, {"r2_heldout", F.r2_heldout_trim}, {"rms_heldout", F.rms_heldout_trim},
+                      {"r2_heldout_all_samples", F.r2_heldout}, {"rms_heldout_all_samples", F.rms_heldout}};
+    }
+    j["steps"].push_back(x);
+  }
+  j["candidates"] = json::array();
+  for (const EmgCandidateScore& c : d.scores) {
+    json x = {{"round", c.round}, {"label", c.label}, {"delta_bic", c.delta_bic},
+              {"heldout_gain_pct", {{"hip", c.gain_pct[0]}, {"knee", c.gain_pct[1]}}}, {"selected", c.added},
+              {"verdict", c.verdict}};
+    if (d.leave_one_out) x["left_out_gain_pct"] = {{"hip", c.left_out_gain_pct[0]}, {"knee", c.left_out_gain_pct[1]}};
+    j["candidates"].push_back(x);
+  }
+  j["missing_channels"] = d.missing;
+  j["notes"] = d.notes;
+  j["records"] = d.sources;
+  return j.dump(2) + "\n";
+}
+
+std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
+  std::ostringstream o;
+  o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>exotwin EMG model diagnosis</title>"
+       "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
+       "td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}</style></head><body>\n"
+       "<h1>exotwin EMG model diagnosis</h1><p>Recordings: ";
+  for (size_t i = 0; i < d.sources.size(); ++i) o << (i ? ", " : "") << "<code>" << HtmlEscape(d.sources[i]) << "</code>";
+  o << ". Fit on the first " << NumberText(100 * (1 - d.holdout_fraction)) << " % of every recording, scored on the rest"
+    << (d.leave_one_out ? " and on each recording left out in turn" : "") << "; held-out scores over the samples within "
+    << NumberText(kSpikeMads) << " scaled MADs of the median moment (contact spikes of inverse dynamics left out "
+                                 "for every model alike).</p>";
+  if (!d.notes.empty()) {
+    o << "<ul>";
+    for (const auto& n : d.notes) o << "<li>" << HtmlEscape(n) << "</li>";
+    o << "</ul>";
+  }
+  o << "<h2>Steps from the linear form to the final model</h2><table><tr><th>step</th><th>added</th><th>why</th>"
+       "<th>hip R&sup2; held-out</th><th>hip rms (N m)</th><th>knee R&sup2; held-out</th><th>knee rms (N m)</th>"
+       "<th>hip / knee R&sup2; all held-out samples</th></tr>";
+  for (size_t i = 0; i < d.steps.size(); ++i) {
+    const auto& F = d.steps[i].model.figures;
+    o << "<tr><td>" << i << "</td><td>" << HtmlEscape(d.steps[i].added) << "</td><td>" << HtmlEscape(d.steps[i].why) << "</td><td>"
+      << NumberText(F[0].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[0].rms_heldout_trim, 3) << "</td><td>"
+      << NumberText(F[1].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[1].rms_heldout_trim, 3) << "</td><td>"
+      << NumberText(F[0].r2_heldout, 3) << " / " << NumberText(F[1].r2_heldout, 3) << "</td></tr>";
+  }
+  o << "</table><h2>Named causes (fitted on every sample)</h2><table><tr><th>cause</th><th>joint</th><th>value</th>"
+       "<th>95 % interval</th></tr>";
+  for (const auto& e : Effects(d)) {
+    o << "<tr><td>" << HtmlEscape(e["name"].get<std::string>()) << (e.contains("muscle") ? " " + e["muscle"].get<std::string>() : "")
+      << (e.contains("parameter") ? " " + HtmlEscape(e["parameter"].get<std::string>()) : "") << "</td><td>"
+      << e["joint"].get<std::string>() << "</td><td>" << NumberText(e["value"].get<double>(), 4) << " "
+      << HtmlEscape(e["unit"].get<std::string>()) << "</td><td>";
+    if (e.contains("ci95")) o << NumberText(e["ci95"][0].get<double>(), 4) << " .. " << NumberText(e["ci95"][1].get<double>(), 4);
+    o << "</td></tr>";
+  }
+  o << "</table>";
+  if (!d.missing.empty()) {
+    o << "<p>Muscles without a channel: ";
+    for (const auto& m : d.missing) o << m << " ";
+    o << "</p>";
+  }
+  o << "<h2>Selection</h2><ol>";
+  for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
+  o << "</ol><h2>Candidates</h2><table><tr><th>round</th><th>candidate</th><th>&Delta;BIC</th><th>held-out gain hip</th>"
+       "<th>knee</th>"
+    << (d.leave_one_out ? "<th>left-out hip</th><th>left-out knee</th>" : "") << "<th>verdict</th></tr>";
+  for (const auto& c : d.scores) {
+    o << "<tr><td>" << c.round << "</td><td>" << HtmlEscape(c.label) << "</td><td>" << NumberText(c.delta_bic, 4) << "</td><td>"
+      << NumberText(c.gain_pct[0], 3) << " %</td><td>" << NumberText(c.gain_pct[1], 3) << " %</td>";
+    if (d.leave_one_out)
+      o << "<td>" << NumberText(c.left_out_gain_pct[0], 3) << " %</td><td>" << NumberText(c.left_out_gain_pct[1], 3) << " %</td>";
+    o << "<td>" << (c.added ? "<b>" : "") << HtmlEscape(c.verdict) << (c.added ? "</b>" : "") << "</td></tr>";
+  }
+  o << "</table>";
+  if (d.t.size() > d.split + 2) {
+    const size_t a = d.split, b = std::min(d.t.size(), a + static_cast<size_t>(10.0 / std::max(1e-6, d.t[1] - d.t[0])));
+    const std::vector<double> t(d.t.begin() + a, d.t.begin() + b);
+    auto part = [&](const std::vector<double>& y) { return std::vector<double>(y.begin() + a, y.begin() + b); };
+    for (int j = 0; j < 2; ++j)
+      o << "<h2>" << kJoint[j] << " (held-out, first 10 s)</h2>"
+        << SvgChart(std::string(kJoint[j]) + " moment", "t (s)", "N m",
+                    {{t, part(d.measured[j]), "#000", "inverse dynamics"},
+                     {t, part(d.linear[j]), "#d62728", "linear form"},
+                     {t, part(d.final_[j]), "#1f77b4", "final model"}});
+  }
+  o << "</body></html>\n";
+  return o.str();
+}
+
+void WriteEmgDiagnosis(const EmgDiagnosis& d, const std::string& dir) {
+  if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
+    throw InputError(dir + ": cannot create the report folder: " + std::strerror(errno));
+  WriteFileAtomic(dir + "/diagnosis.json", EmgDiagnosisJson(d));
+  WriteFileAtomic(dir + "/report.html", EmgDiagnosisHtml(d));
+}
+
+}  // namespace exotwin

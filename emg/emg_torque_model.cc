@@ -1,0 +1,429 @@
+#include "emg/emg_torque_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "diagnosis/diagnose_columns.h"
+#include "diagnosis/diagnose_select.h"
+#include "formats/measured_data.h"
+#include "formats/number_text.h"
+#include "dsp/statistics.h"
+#include "core/yaml_fields.h"
+#include "core/error.h"
+#include "model/passive_torque.h"
+
+namespace exotwin {
+namespace {
+
+const char* kJointName[2] = {"hip", "knee"};
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return Percentile(v, 0.5);
+}
+
+int ChannelIndex(const EmgRecording& rec, const std::string& ch) {
+  for (size_t i = 0; i < rec.channels.size(); ++i)
+    if (rec.channels[i] == ch) return static_cast<int>(i);
+  return -1;
+}
+
+bool MuscleByName(const std::string& s, Muscle* m) {
+  for (int i = 0; i < kNumMuscles; ++i)
+    if (s == MuscleName(MuscleAt(i))) return *m = MuscleAt(i), true;
+  return false;
+}
+
+}  // namespace
+
+double EmgModelSpec::Delay(Muscle m) const {
+  const auto it = delay_s.find(m);
+  return it == delay_s.end() ? 0.0 : it->second;
+}
+
+int EmgTorqueModel::nonlinear_parameters() const {
+  int n = spec.a_shape != 0 ? 1 : 0;
+  for (const auto& d : spec.delay_s) n += d.second != 0 ? 1 : 0;
+  return n;
+}
+
+std::string EmgTerm::Kind() const {
+  switch (kind) {
+    case TermKind::kAlpha: return "alpha";
+    case TermKind::kAlphaQ: return "alpha_q";
+    case TermKind::kBeta: return "beta";
+    case TermKind::kGamma: return "gamma";
+    case TermKind::kOffset: return "offset";
+    case TermKind::kPassive: return "passive_scale";
+  }
+  return "";
+}
+
+std::string EmgTerm::Name() const {
+  if (kind == TermKind::kAlpha || kind == TermKind::kAlphaQ)
+    return Kind() + "[" + channel + (proxy ? " as GMAX" : "") + "]";
+  return Kind();
+}
+
+std::string EmgTerm::Unit() const {
+  switch (kind) {
+    case TermKind::kAlpha: return "N m";  // per unit envelope (fraction of the muscle's maximum)
+    case TermKind::kAlphaQ: return "N m/rad";
+    case TermKind::kBeta: return "N m/rad";
+    case TermKind::kGamma: return "N m s/rad";
+    case TermKind::kOffset: return "N m";
+    case TermKind::kPassive: return "1";
+  }
+  return "";
+}
+
+std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec) {
+  std::vector<EmgTerm> out;
+  const bool gmax_missing = std::find(rec.missing.begin(), rec.missing.end(), "GMAX") != rec.missing.end();
+  for (int j = 0; j < 2; ++j) {
+    std::vector<EmgTerm> alphas;
+    for (size_t c = 0; c < rec.channels.size(); ++c) {
+      EmgTerm t;
+      t.joint = j, t.kind = TermKind::kAlpha, t.channel = rec.channels[c], t.muscle = rec.muscle[c];
+      if (ActionSign(rec.muscle[c], j) != 0) alphas.push_back(t);
+      else if (j == 0 && spec.gmax_proxy && gmax_missing && rec.muscle[c] == Muscle::kVM)
+        t.proxy = true, alphas.push_back(t);
+    }
+    out.insert(out.end(), alphas.begin(), alphas.end());
+    if (spec.moment_arm[j])
+      for (EmgTerm t : alphas) t.kind = TermKind::kAlphaQ, out.push_back(t);
+    for (TermKind k : {TermKind::kBeta, TermKind::kGamma, TermKind::kOffset}) {
+      EmgTerm t;
+      t.joint = j, t.kind = k;
+      out.push_back(t);
+    }
+    if (spec.passive[j]) {
+      EmgTerm t;
+      t.joint = j, t.kind = TermKind::kPassive;
+      out.push_back(t);
+    }
+  }
+  return out;
+}
+
+double ActivationShape(double u, double A) {
+  if (A == 0) return u;
+  return std::expm1(A * u) / std::expm1(A);
+}
+
+std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, const EmgRecording& rec) {
+  const size_t n = rec.size();
+  const int j = term.joint;
+  std::vector<double> v(n);
+  if (term.kind == TermKind::kAlpha || term.kind == TermKind::kAlphaQ) {
+    const int c = ChannelIndex(rec, term.channel);
+    if (c < 0) throw InputError(rec.source + ": no EMG channel '" + term.channel + "' (the model uses it)");
+    const double d = spec.Delay(term.muscle);
+    std::vector<double> u = rec.e[c];
+    if (d != 0) {
+      std::vector<double> tq(n);
+      for (size_t i = 0; i < n; ++i) tq[i] = rec.t[i] - d;
+      u = Interpolate(rec.t, rec.e[c], tq);
+    }
+    for (size_t i = 0; i < n; ++i)
+      v[i] = ActivationShape(u[i], spec.a_shape) * (term.kind == TermKind::kAlphaQ ? rec.q[j][i] : 1.0);
+    return v;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    switch (term.kind) {
+      case TermKind::kBeta: v[i] = rec.q[j][i]; break;
+      case TermKind::kGamma: v[i] = rec.qd[j][i]; break;
+      case TermKind::kOffset: v[i] = 1.0; break;
+      case TermKind::kPassive:  // P of HJ15 eq. 1 is minus the passive moment along the coordinate
+        v[i] = -PassiveElasticTorque(PassiveModel::kRiener1999, Eigen::Vector2d(rec.q[0][i], rec.q[1][i]))[j];
+        break;
+      default: break;
+    }
+  }
+  return v;
+}
+
+std::vector<double> PredictMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint) {
+  std::vector<double> tau(rec.size(), 0.0);
+  for (const EmgTerm& t : model.terms) {
+    if (t.joint != joint) continue;
+    const std::vector<double> col = TermColumn(t, model.spec, rec);
+    for (size_t i = 0; i < tau.size(); ++i) tau[i] += t.value * col[i];
+  }
+  return tau;
+}
+
+std::vector<size_t> WithinSpikeLimit(const std::vector<double>& x, size_t a, size_t b) {
+  std::vector<size_t> idx;
+  if (b <= a) return idx;
+  const std::vector<double> part(x.begin() + static_cast<long>(a), x.begin() + static_cast<long>(b));
+  const double med = Median(part);
+  std::vector<double> dev(part.size());
+  for (size_t i = 0; i < part.size(); ++i) dev[i] = std::abs(part[i] - med);
+  const double limit = kSpikeMads * 1.4826 * Median(dev);
+  for (size_t i = a; i < b; ++i)
+    if (std::abs(x[i] - med) <= limit) idx.push_back(i);
+  return idx;
+}
+
+void ScoreSamples(const std::vector<double>& measured, const std::vector<double>& predicted,
+                  const std::vector<size_t>& idx, double* r2, double* rms) {
+  double mean = 0, ss_res = 0, ss_tot = 0;
+  for (size_t i : idx) mean += measured[i];
+  mean /= std::max<size_t>(1, idx.size());
+  for (size_t i : idx) ss_res += std::pow(measured[i] - predicted[i], 2), ss_tot += std::pow(measured[i] - mean, 2);
+  *r2 = ss_tot > 0 ? 1 - ss_res / ss_tot : 0;
+  *rms = idx.empty() ? 0 : std::sqrt(ss_res / static_cast<double>(idx.size()));
+}
+
+EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const EmgRecording*>& recs,
+                           const EmgFitOptions& opt) {
+  if (recs.empty()) throw InputError("emg fit: no recording");
+  EmgTorqueModel model;
+  model.spec = spec;
+  model.missing = recs[0]->missing;
+  model.terms = TermsOf(spec, *recs[0]);
+  for (const EmgRecording* r : recs) {
+    if (!r->has_moments()) throw InputError(r->source + ": no joint moments to fit (--moments)");
+    if (r->channels != recs[0]->channels)
+      throw InputError(r->source + ": its EMG channels differ from those of " + recs[0]->source +
+                       " (every recording of one fit needs the same mapped channels)");
+  }
+  const size_t T = model.terms.size();
+  auto n_train = [&](const EmgRecording& r) {
+    return std::min(r.size(), static_cast<size_t>(std::floor(opt.train_fraction * static_cast<double>(r.size()))));
+  };
+  // Rows kept per recording and joint: fit rows (all, or within the spike limit when robust) and
+  // held-out rows within the spike limit.
+  std::vector<std::vector<char>> keep[2];
+  for (int j = 0; j < 2; ++j)
+    for (const EmgRecording* r : recs) {
+      const size_t m = r->size(), mtr = n_train(*r);
+      std::vector<char> k(m, 0);
+      if (spec.robust) for (size_t i : WithinSpikeLimit(r->tau[j], 0, mtr)) k[i] = 1;
+      else std::fill(k.begin(), k.begin() + static_cast<long>(mtr), 1);
+      for (size_t i : WithinSpikeLimit(r->tau[j], mtr, m)) k[i] = 1;
+      keep[j].push_back(std::move(k));
+    }
+  double w[2] = {opt.weight[0], opt.weight[1]};
+  for (int j = 0; j < 2; ++j) {
+    if (w[j] > 0) continue;
+    double s = 0, ss = 0, n = 0;
+    for (size_t k = 0; k < recs.size(); ++k)
+      for (size_t i = 0; i < n_train(*recs[k]); ++i)
+        if (keep[j][k][i]) s += recs[k]->tau[j][i], ss += recs[k]->tau[j][i] * recs[k]->tau[j][i], n += 1;
+    const double var = n > 1 ? (ss - s * s / n) / (n - 1) : 0;
+    if (!(var > 0)) throw InputError(recs[0]->source + ": the " + kJointName[j] + " moment is constant");
+    w[j] = 1 / std::sqrt(var);
+  }
+  // Unweighted columns per recording (for predictions) and the weighted banks.
+  std::vector<std::vector<std::vector<double>>> cols(recs.size());
+  std::vector<ColumnBank> banks;
+  for (size_t k = 0; k < recs.size(); ++k) {
+    const EmgRecording& r = *recs[k];
+    const size_t m = r.size(), mtr = n_train(r);
+    for (const EmgTerm& t : model.terms) cols[k].push_back(TermColumn(t, spec, r));
+    ColumnBank b;
+    b.n = m;
+    for (size_t i = 0; i < m; ++i) b.sample.push_back(i), b.train.push_back(i < mtr);
+    b.X = Eigen::MatrixXd::Zero(2 * static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(T));
+    b.r = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(m));
+    for (int j = 0; j < 2; ++j)
+      for (size_t i = 0; i < m; ++i) {
+        if (!keep[j][k][i]) continue;
+        const Eigen::Index row = j * static_cast<Eigen::Index>(m) + static_cast<Eigen::Index>(i);
+        b.r[row] = w[j] * r.tau[j][i];
+        for (size_t c = 0; c < T; ++c)
+          if (model.terms[c].joint == j) b.X(row, static_cast<Eigen::Index>(c)) = w[j] * cols[k][c][i];
+      }
+    b.used = static_cast<int>(T);
+    banks.push_back(std::move(b));
+  }
+  Grams g = MakeGrams(banks);
+  // Fit rows actually used (zero-weight rows do not count).
+  double rows = 0;
+  for (int j = 0; j < 2; ++j)
+    for (size_t k = 0; k < recs.size(); ++k)
+      for (size_t i = 0; i < n_train(*recs[k]); ++i) rows += keep[j][k][i];
+  g.n_tr = rows;
+  std::vector<int> all(T);
+  for (size_t c = 0; c < T; ++c) all[c] = static_cast<int>(c);
+  auto predict = [&](const Eigen::VectorXd& coef, size_t k, int j) {
+    std::vector<double> p(recs[k]->size(), 0.0);
+    for (size_t c = 0; c < T; ++c)
+      if (model.terms[c].joint == j)
+        for (size_t i = 0; i < p.size(); ++i) p[i] += coef[static_cast<Eigen::Index>(c)] * cols[k][c][i];
+    return p;
+  };
+  double L = opt.autocorr_rows;
+  g.n_eff = g.n_tr / std::max(1.0, L);
+  Fit f = FitCols(g, all);
+  if (!f.ok)
+    throw InputError(recs[0]->source + ": the model's regressors are nearly collinear (a channel that "
+                     "is constant or copies another?)");
+  if (!(L > 0)) {  // autocorrelation length of the fit residual, longest over joints and recordings
+    L = 1;
+    for (size_t k = 0; k < recs.size(); ++k)
+      for (int j = 0; j < 2; ++j) {
+        const std::vector<double> p = predict(f.coef, k, j);
+        std::vector<double> res;
+        for (size_t i = 0; i < n_train(*recs[k]); ++i)
+          if (keep[j][k][i]) res.push_back(recs[k]->tau[j][i] - p[i]);
+        if (res.size() > 8) L = std::max(L, AutocorrelationLength(res.data(), res.size()));
+      }
+    g.n_eff = g.n_tr / L;
+    f = FitCols(g, all);
+  }
+  model.autocorr_rows = L;
+  model.weight[0] = w[0], model.weight[1] = w[1];
+  for (size_t c = 0; c < T; ++c) model.terms[c].value = f.coef[static_cast<Eigen::Index>(c)], model.terms[c].se = f.se[static_cast<Eigen::Index>(c)];
+  model.bic = f.bic + model.nonlinear_parameters() * std::log(g.n_eff);
+  model.sse_fit = f.sse_tr, model.n_fit = g.n_tr;
+  for (int j = 0; j < 2; ++j) model.sse_heldout[j] = f.sse_te_j[j], model.sse_left_out[j] = f.sse_loo_j[j];
+  // Figures pooled over recordings.
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> mf, pf, mh, ph, mt, pt;
+    EmgJointFigures& F = model.figures[j];
+    for (size_t k = 0; k < recs.size(); ++k) {
+      const std::vector<double> p = predict(f.coef, k, j);
+      const std::vector<double>& tau = recs[k]->tau[j];
+      const size_t m = tau.size(), mtr = n_train(*recs[k]);
+      for (size_t i = 0; i < m; ++i) {
+        if (i < mtr && keep[j][k][i]) mf.push_back(tau[i]), pf.push_back(p[i]);
+        if (i >= mtr) {
+          mh.push_back(tau[i]), ph.push_back(p[i]);
+          if (keep[j][k][i]) mt.push_back(tau[i]), pt.push_back(p[i]);
+        }
+      }
+    }
+    auto score = [](const std::vector<double>& a, const std::vector<double>& b, double* r2, double* rms) {
+      std::vector<size_t> idx(a.size());
+      for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+      ScoreSamples(a, b, idx, r2, rms);
+    };
+    double rms_fit = 0;
+    score(mf, pf, &F.r2_fit, &rms_fit);
+    score(mh, ph, &F.r2_heldout, &F.rms_heldout);
+    score(mt, pt, &F.r2_heldout_trim, &F.rms_heldout_trim);
+    F.heldout = mh.size(), F.trimmed = mh.size() - mt.size();
+  }
+  return model;
+}
+
+// ---- EMGMODEL.yaml ----
+
+std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>& header) {
+  std::ostringstream o;
+  for (const std::string& h : header) o << "# " << h << "\n";
+  o << "# EMG-driven joint moment per joint (N m, along the coordinate: hip flexion +, knee extension +):\n"
+       "#   tau = sum (alpha + alpha_q q) a(e(t - delay)) + beta q + gamma qd + offset + passive_scale M_P(q)\n"
+       "#   a(u) = (exp(A u) - 1) / (exp(A) - 1) (Lloyd & Besier 2003; A = 0: a = u), M_P: Riener & Edrich 1999\n"
+       "# se: standard error (residual autocorrelation taken into account); alpha per unit envelope.\n";
+  o << "model: emg_torque_hj15\n";
+  o << "activation: {A_shape: " << NumberText(m.spec.a_shape, 10) << ", se: " << NumberText(m.spec.a_shape_se, 4)
+    << ", unit: \"1\"}\n";
+  o << "delays:";
+  if (m.spec.delay_s.empty()) o << " {}";
+  o << "\n";
+  for (const auto& d : m.spec.delay_s)
+    o << "  " << MuscleName(d.first) << ": {value: " << NumberText(d.second, 10) << ", se: "
+      << NumberText(m.spec.delay_se.count(d.first) ? m.spec.delay_se.at(d.first) : 0.0, 4) << ", unit: s}\n";
+  auto yn = [](bool b) { return b ? "true" : "false"; };
+  o << "structure:\n  moment_arm: {hip: " << yn(m.spec.moment_arm[0]) << ", knee: " << yn(m.spec.moment_arm[1])
+    << "}\n  passive: {hip: " << yn(m.spec.passive[0]) << ", knee: " << yn(m.spec.passive[1])
+    << "}\n  gmax_proxy: " << yn(m.spec.gmax_proxy) << "\n  robust_fit: " << yn(m.spec.robust) << "\n";
+  o << "missing_channels: [";
+  for (size_t i = 0; i < m.missing.size(); ++i) o << (i ? ", " : "") << m.missing[i];
+  o << "]\nautocorrelation_rows: " << NumberText(m.autocorr_rows, 6) << "\n";
+  o << "parameters:\n";
+  for (int j = 0; j < 2; ++j) {
+    o << "  " << kJointName[j] << ":\n";
+    for (const EmgTerm& t : m.terms) {
+      if (t.joint != j) continue;
+      o << "    - {term: " << t.Kind();
+      if (!t.channel.empty())
+        o << ", channel: " << t.channel << ", muscle: " << MuscleName(t.muscle)
+          << (t.proxy ? ", proxy_for: GMAX" : "")
+          << ", expected_sign: " << (t.proxy ? ActionSign(Muscle::kGMAX, j) : ActionSign(t.muscle, j));
+      o << ", value: " << NumberText(t.value, 10) << ", se: " << NumberText(t.se, 4) << ", unit: \"" << t.Unit()
+        << "\"}\n";
+    }
+  }
+  o << "fit:\n";
+  for (int j = 0; j < 2; ++j) {
+    const EmgJointFigures& F = m.figures[j];
+    o << "  " << kJointName[j] << ": {r2_fit: " << NumberText(F.r2_fit, 4) << ", r2_heldout: " << NumberText(F.r2_heldout, 4)
+      << ", rms_heldout: " << NumberText(F.rms_heldout, 4) << ", r2_heldout_within_6mad: "
+      << NumberText(F.r2_heldout_trim, 4) << ", rms_heldout_within_6mad: " << NumberText(F.rms_heldout_trim, 4)
+      << ", heldout_samples: " << F.heldout << "}\n";
+  }
+  return o.str();
+}
+
+EmgTorqueModel ReadEmgModel(const std::string& path) {
+  const YamlContext c{path};
+  const YAML::Node root = ParseYaml(ReadYamlText(path, "EMG model"), path);
+  YamlCheckKeys(c, root, "",
+                {"model", "activation", "delays", "structure", "missing_channels", "autocorrelation_rows",
+                 "parameters", "fit"});
+  if (!root["model"] || !root["model"].IsScalar() || root["model"].as<std::string>() != "emg_torque_hj15")
+    c.Fail("model", "expected 'emg_torque_hj15' (a file written by exotwin emg-fit)" + YamlLine(root["model"]));
+  EmgTorqueModel m;
+  if (const YAML::Node a = root["activation"]) m.spec.a_shape = YamlNumber(c, a["A_shape"], "activation.A_shape", -10, 10, "");
+  if (const YAML::Node d = root["delays"]) {
+    if (!d.IsMap()) c.Fail("delays", "expected a mapping of muscles to delays" + YamlLine(d));
+    for (const auto& kv : d) {
+      Muscle mu;
+      const std::string k = kv.first.as<std::string>();
+      if (!MuscleByName(k, &mu)) c.Fail("delays." + k, "expected GMAX, VM, RF, ST or GAS" + YamlLine(kv.first));
+      m.spec.delay_s[mu] = YamlNumber(c, kv.second["value"], "delays." + k + ".value", -1, 1, "s");
+    }
+  }
+  if (const YAML::Node s = root["structure"]) {
+    auto flag = [&](const YAML::Node& n, const std::string& key) {
+      if (!n || !n.IsScalar() || (n.as<std::string>() != "true" && n.as<std::string>() != "false"))
+        c.Fail(key, "expected true or false" + YamlLine(n));
+      return n.as<std::string>() == "true";
+    };
+    for (int j = 0; j < 2; ++j) {
+      m.spec.moment_arm[j] = flag(s["moment_arm"][kJointName[j]], std::string("structure.moment_arm.") + kJointName[j]);
+      m.spec.passive[j] = flag(s["passive"][kJointName[j]], std::string("structure.passive.") + kJointName[j]);
+    }
+    m.spec.gmax_proxy = flag(s["gmax_proxy"], "structure.gmax_proxy");
+    m.spec.robust = flag(s["robust_fit"], "structure.robust_fit");
+  }
+  if (const YAML::Node mc = root["missing_channels"])
+    for (const auto& x : mc) m.missing.push_back(x.as<std::string>());
+  const YAML::Node p = root["parameters"];
+  if (!p || !p.IsMap()) c.Fail("parameters", "expected hip: and knee: lists of parameters");
+  const std::map<std::string, TermKind> kinds = {{"alpha", TermKind::kAlpha},   {"alpha_q", TermKind::kAlphaQ},
+                                                 {"beta", TermKind::kBeta},     {"gamma", TermKind::kGamma},
+                                                 {"offset", TermKind::kOffset}, {"passive_scale", TermKind::kPassive}};
+  for (int j = 0; j < 2; ++j) {
+    const YAML::Node list = p[kJointName[j]];
+    const std::string key = std::string("parameters.") + kJointName[j];
+    if (!list || !list.IsSequence()) c.Fail(key, "expected a list of parameters" + YamlLine(list));
+    for (size_t i = 0; i < list.size(); ++i) {
+      const YAML::Node e = list[i];
+      const std::string ek = key + "[" + std::to_string(i) + "]";
+      EmgTerm t;
+      t.joint = j;
+      if (!e["term"] || !kinds.count(e["term"].as<std::string>()))
+        c.Fail(ek + ".term", "expected alpha, alpha_q, beta, gamma, offset or passive_scale" + YamlLine(e));
+      t.kind = kinds.at(e["term"].as<std::string>());
+      if (t.kind == TermKind::kAlpha || t.kind == TermKind::kAlphaQ) {
+        if (!e["channel"] || !e["muscle"] || !MuscleByName(e["muscle"].as<std::string>(), &t.muscle))
+          c.Fail(ek, "expected channel: and muscle: (GMAX, VM, RF, ST, GAS)" + YamlLine(e));
+        t.channel = e["channel"].as<std::string>();
+        t.proxy = static_cast<bool>(e["proxy_for"]);
+      }
+      t.value = YamlNumber(c, e["value"], ek + ".value", -1e6, 1e6, t.Unit());
+      if (e["se"]) t.se = YamlNumber(c, e["se"], ek + ".se", 0, 1e12, t.Unit());
+      m.terms.push_back(t);
+    }
+  }
+  return m;
+}
+
+}  // namespace exotwin

@@ -1,0 +1,124 @@
+// EMG-driven joint torque of the hip and the knee: the linear form of Hwang & Jeon 2015 (HJ15
+// HJ15 eq. 26-27, after Olney & Winter 1985) and the extensions the discrepancy loop may add
+// (emg/emg_diagnose.h). Per joint j:
+//
+//   tau_j(t) = sum_i (alpha_i + alpha_q,i q_j) a_i(t) + beta q_j + gamma qd_j + offset + s_P M_P,j(q)
+//   a_i(t)   = ((e^{A u} - 1) / (e^A - 1))  with u = e_i(t - d_m)       (A = 0: a = u)
+//
+// HJ15 eq. 26: tau = sum alpha_i e_i + beta q + gamma qd + offset, the form the linear model keeps
+// (beta, gamma additive, as the README of shared/data/real_human measures it); the extensions:
+//  - d_m: electromechanical delay of the twin muscle m the channel stands for (s; Cavanagh & Komi
+//    1979: 30-100 ms between EMG and force);
+//  - A: activation nonlinearity, LB03 eq. 2 (Lloyd & Besier 2003) (A-shape factor, -3 < A < 0);
+//  - alpha_q,i: moment arm changing with the joint angle, alpha_i (1 + c_i q) = alpha_i + alpha_q,i q;
+//  - M_P,j: the passive moment of Riener & Edrich 1999 (model/passive_torque.h) along the
+//    coordinate, with a fitted scale s_P (1 = as published);
+//  - a missing gluteus maximus (no GMAX channel): the vasti channels at the hip, GMAX's synergists of
+//    the weight-acceptance module (Neptune, Kautz & Zajac 2004; Ivanenko et al. 2004);
+//  - robust fit: rows whose moment lies beyond kSpikeMads scaled MADs of the median left out of the
+//    fit (the contact spikes of inverse dynamics).
+// Channels act at the joints their muscle spans (sim/muscles.h ActionSign); alpha is fitted free of
+// sign (its expected sign is reported). Least squares on rows weighted by 1/SD of each joint's
+// moment, both joints in one stack (diagnosis/diagnose_select.h FitCols), standard errors corrected
+// for the residual's autocorrelation.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "emg/emg_recording.h"
+
+namespace exotwin {
+
+// Samples beyond this many scaled MADs (1.4826 MAD) of the median moment are contact spikes: left
+// out of every held-out score (issue 19) and, with spec.robust, of the fit.
+constexpr double kSpikeMads = 6.0;
+
+// The structure of the model: which extensions are on.
+struct EmgModelSpec {
+  std::map<Muscle, double> delay_s;        // electromechanical delay per twin muscle, s (absent: 0)
+  double a_shape = 0;                      // Lloyd & Besier A; 0 = linear activation
+  bool moment_arm[2] = {false, false};     // alpha_q terms at the hip / knee
+  bool passive[2] = {false, false};        // Riener & Edrich passive moment at the hip / knee
+  bool gmax_proxy = false;                 // vasti channels at the hip when GMAX is missing
+  bool robust = false;                     // spikes left out of the fit rows
+  // Standard errors of the searched parameters (profile of the fit's sum of squares), 0 if unknown.
+  std::map<Muscle, double> delay_se;       // s
+  double a_shape_se = 0;
+  double Delay(Muscle m) const;
+};
+
+enum class TermKind { kAlpha, kAlphaQ, kBeta, kGamma, kOffset, kPassive };
+
+// One fitted parameter.
+struct EmgTerm {
+  int joint = 0;  // 0 hip, 1 knee
+  TermKind kind = TermKind::kOffset;
+  std::string channel;            // alpha / alpha_q
+  Muscle muscle = Muscle::kGMAX;  // the twin muscle of the channel
+  bool proxy = false;             // a vasti channel standing in for the missing GMAX at the hip
+  double value = 0, se = 0;
+  std::string Name() const;       // e.g. "alpha[rect_fem_r]", "alpha_q[vas_lat_r as GMAX]", "beta"
+  std::string Unit() const;       // e.g. "N m", "N m/rad", "N m s/rad", "1"
+  std::string Kind() const;       // "alpha", "alpha_q", "beta", "gamma", "offset", "passive_scale"
+};
+
+struct EmgJointFigures {
+  double r2_fit = 0;         // fit rows
+  double r2_heldout = 0;     // all held-out samples
+  double rms_heldout = 0;    // N m
+  double r2_heldout_trim = 0, rms_heldout_trim = 0;  // held-out samples within kSpikeMads of the median
+  size_t heldout = 0, trimmed = 0;                    // held-out samples, and those left out as spikes
+};
+
+struct EmgTorqueModel {
+  EmgModelSpec spec;
+  std::vector<EmgTerm> terms;
+  std::vector<std::string> missing;  // twin muscles without a channel
+  double autocorr_rows = 1;          // residual autocorrelation length the standard errors use
+  EmgJointFigures figures[2];        // of the fit that produced the coefficients
+  double bic = 0;                    // of that fit (columns + nonlinear parameters)
+  double weight[2] = {0, 0};         // row weights of the fit, 1/N m
+  double sse_fit = 0, n_fit = 0;     // weighted SSE and row count of the fit rows
+  double sse_heldout[2] = {0, 0};    // weighted held-out SSE per joint (time split), for the loop
+  double sse_left_out[2] = {0, 0};   // weighted, each recording left out in turn (>= 2 recordings)
+  int nonlinear_parameters() const;  // delays and A
+};
+
+// The terms of `spec` for the channels of `rec` (coefficients zero).
+std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec);
+
+// Activation a(u) of LB03 eq. 2 (Lloyd & Besier 2003) with shape factor A (A = 0: u).
+double ActivationShape(double u, double A);
+
+// The regressor of `term` on every sample of `rec` (N m per unit of the term's coefficient).
+// Throws InputError when the recording lacks the term's channel.
+std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, const EmgRecording& rec);
+
+// Estimated joint moment (N m) at joint j on every sample of `rec`.
+std::vector<double> PredictMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint);
+
+// Indices of the samples [a, b) of x within kSpikeMads scaled MADs of their median.
+std::vector<size_t> WithinSpikeLimit(const std::vector<double>& x, size_t a, size_t b);
+
+// R^2 = 1 - SS_res / SS_tot (about the measured mean) and RMS error over the samples `idx`.
+void ScoreSamples(const std::vector<double>& measured, const std::vector<double>& predicted,
+                  const std::vector<size_t>& idx, double* r2, double* rms);
+
+struct EmgFitOptions {
+  double train_fraction = 0.7;  // first part of every recording fitted, the rest held out; 1 = all
+  double weight[2] = {0, 0};    // row weights per joint (1/N m); 0: 1/SD of the moment's fit rows
+  double autocorr_rows = 0;     // 0: from this fit's residual
+};
+
+// Least-squares fit of `spec` on recordings with moments (>= 1). Fills coefficients, standard
+// errors, the figures (pooled over recordings) and the loop's scores.
+EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const EmgRecording*>& recs,
+                           const EmgFitOptions& opt = {});
+
+// EMGMODEL.yaml: every parameter with its unit and standard error (DESIGN.md "EMG model file").
+std::string EmgModelYaml(const EmgTorqueModel& model, const std::vector<std::string>& header_comments);
+// Reads EMGMODEL.yaml; throws InputError naming the file and key.
+EmgTorqueModel ReadEmgModel(const std::string& path);
+
+}  // namespace exotwin

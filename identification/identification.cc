@@ -1,0 +1,306 @@
+#include "identification/identification.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "core/error.h"
+#include "core/units.h"
+#include "model/passive_torque.h"
+#include "model/regressors.h"
+
+namespace exotwin {
+
+namespace {
+
+
+std::string Fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof(b), f, v);
+  return b;
+}
+
+std::string RangeText(const JointRanges& r, int j) {
+  return Fmt("%.1f", r.min[j] * kDegPerRad) + ".." + Fmt("%.1f", r.max[j] * kDegPerRad) + " deg (range " +
+         Fmt("%.1f", (r.max[j] - r.min[j]) * kDegPerRad) + ", mean " + Fmt("%.1f", r.mean[j] * kDegPerRad) + ")";
+}
+
+}  // namespace
+
+const char* ConfigurationName(IdConfiguration c) {
+  return c == IdConfiguration::kKneeSwing ? "knee swing (hip held)" : "hip swing (knee held)";
+}
+
+JointRanges ComputeJointRanges(const MeasuredData& data) {
+  JointRanges r{};
+  const std::vector<double>* q[2] = {&data.q_hip(), &data.q_knee()};
+  for (int j = 0; j < 2; ++j) {
+    const auto mm = std::minmax_element(q[j]->begin(), q[j]->end());
+    r.min[j] = *mm.first;
+    r.max[j] = *mm.second;
+    double s = 0;
+    for (double v : *q[j]) s += v;
+    r.mean[j] = s / static_cast<double>(q[j]->size());
+  }
+  return r;
+}
+
+IdConfiguration ClassifyConfiguration(const MeasuredData& data, const IdentificationOptions& opt) {
+  const JointRanges r = ComputeJointRanges(data);
+  const double span[2] = {r.max[0] - r.min[0], r.max[1] - r.min[1]};
+  if (span[1] >= opt.moving_min_range && span[0] <= opt.held_max_range)
+    return IdConfiguration::kKneeSwing;
+  if (span[0] >= opt.moving_min_range && span[1] <= opt.held_max_range)
+    return IdConfiguration::kHipSwing;
+  throw InputError(data.source + ": fits neither identification configuration: hip " +
+                   RangeText(r, 0) + ", knee " + RangeText(r, 1) +
+                   "; expected one joint moving over at least " + Fmt("%.1f", opt.moving_min_range * kDegPerRad) +
+                   " deg while the other is held within " + Fmt("%.1f", opt.held_max_range * kDegPerRad) +
+                   " deg (knee swing with the hip at 90 deg, or hip swing with the knee at -90 deg)");
+}
+
+void AppendSamples(const MeasuredData& data, bool select_passive, const IdentificationOptions& opt,
+                   IdentificationSamples* into) {
+  const Kinematics kin = DeriveKinematics(data, opt.cutoff_hz);
+  std::vector<char> keep(data.size(), 1);
+  if (select_passive) keep = SelectPassiveSamples(data, opt.selection).passive;
+  const double t0 = data.t().front() + opt.trim_s, t1 = data.t().back() - opt.trim_s;
+  const size_t before = into->size();
+  for (int j = 0; j < 2; ++j)
+    for (auto* v : {&into->q[j], &into->qd[j], &into->qdd[j], &into->u[j]}) v->reserve(before + data.size());
+  for (size_t i = 0; i < data.size(); ++i) {
+    if (!keep[i] || data.t()[i] < t0 || data.t()[i] > t1) continue;
+    for (int j = 0; j < 2; ++j) {
+      into->q[j].push_back(kin.q[j][i]);
+      into->qd[j].push_back(kin.qd[j][i]);
+      into->qdd[j].push_back(kin.qdd[j][i]);
+    }
+    into->u[0].push_back(-data.tau_hip()[i]);  // tau_R = -tau_S, HJ15 eq. 8
+    into->u[1].push_back(-data.tau_knee()[i]);
+  }
+  if (into->size() == before)
+    throw InputError(data.source + ": no usable sample after trimming " + Fmt("%g", opt.trim_s) +
+                     " s at both ends" + (select_passive ? " and the EMG selection of eq. (13)" : "") +
+                     ", expected a longer recording of a relaxed subject");
+  into->total += data.size();
+  into->sources.push_back(data.source);
+}
+
+namespace {
+
+// GeneralStepRow on a precomputed full regressor Y(q, qd, qdd).
+StepRow RowFromRegressor(int step, const Matrix26& Y, const Vector6& known, PassiveModel passive,
+                         const Eigen::Vector2d& q, double u) {
+  const bool knee_row = step == 1 || step == 3;
+  const int row = knee_row ? 1 : 0;
+  const int c0 = knee_row ? 1 : 0;  // unknown columns c0, c0 + 2, c0 + 4
+  StepRow r;
+  r.u_star = u - Y.row(row).dot(known);  // known parameters to the left side
+  if (step >= 3 && passive != PassiveModel::kNone) r.u_star -= PassiveElasticTorque(passive, q)[row];
+  r.w << Y(row, c0), Y(row, c0 + 2), Y(row, c0 + 4);
+  return r;
+}
+
+}  // namespace
+
+StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, PassiveModel passive,
+                       const Eigen::Vector2d& q, const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd,
+                       double u) {
+  return RowFromRegressor(step, FullRegressor(L1, g, q, qd, qdd), known, passive, q, u);
+}
+
+StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, double g,
+                       const Vector6& known, PassiveModel passive, const Eigen::Matrix3d* known_cov) {
+  const bool knee_row = step == 1 || step == 3;
+  const int row = knee_row ? 1 : 0;
+  const int held = knee_row ? 0 : 1;
+  const bool human = step >= 3;
+  const size_t n = s.size();
+  StepEstimate e;
+  e.step = step;
+  e.segment = std::string(human ? "H" : "R") + (knee_row ? "2" : "1");
+  e.samples_used = n;
+  e.samples_total = s.total;
+  e.sources = s.sources;
+  if (n < 3) throw InputError("step " + std::to_string(step) + ": fewer than 3 samples");
+
+  // Rows (u*, w) are kept for an exact residual pass (the shortcut u'u - 2 phi'W'u + phi'W'W phi
+  // cancels down to ~1e-6 N m RMS). W'A (A = the known distal columns) for the propagated covariance.
+  Eigen::Matrix<double, Eigen::Dynamic, 4> rows(n, 4);  // [w' u*]
+  Eigen::Matrix3d WtW = Eigen::Matrix3d::Zero(), WtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Wtu = Eigen::Vector3d::Zero();
+  double held_sum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d q(s.q[0][i], s.q[1][i]), qd(s.qd[0][i], s.qd[1][i]),
+        qdd(s.qdd[0][i], s.qdd[1][i]);
+    const Matrix26 Y = FullRegressor(L1, g, q, qd, qdd);
+    const StepRow sr = RowFromRegressor(step, Y, known, passive, q, s.u[row][i]);
+    rows.row(i) << sr.w.transpose(), sr.u_star;
+    WtW.selfadjointView<Eigen::Lower>().rankUpdate(sr.w);
+    Wtu += sr.w * sr.u_star;
+    if (known_cov) WtA += sr.w * Eigen::RowVector3d(Y(row, 1), Y(row, 3), Y(row, 5));
+    held_sum += q[held];
+  }
+  WtW = WtW.selfadjointView<Eigen::Lower>();
+  e.held_mean = held_sum / static_cast<double>(n);
+
+  Eigen::Vector3d d;
+  for (int c = 0; c < 3; ++c) d[c] = WtW(c, c) > 0 ? 1.0 / std::sqrt(WtW(c, c)) : 0.0;
+  const Eigen::Matrix3d S = d.asDiagonal() * WtW * d.asDiagonal();  // (W D)'(W D)
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(S, Eigen::EigenvaluesOnly);
+  const double lmin = eig.eigenvalues()[0], lmax = eig.eigenvalues()[2];
+  if (!(lmin > 1e-14 * lmax) || d.minCoeff() == 0.0)
+    throw InputError("step " + std::to_string(step) + " (" + e.segment +
+                     "): the regressor is rank deficient, expected an exciting motion (several "
+                     "harmonics over a wide range) of the moving joint");
+  e.condition_number = std::sqrt(lmax / lmin);
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);
+  e.phi = d.asDiagonal() * ldlt.solve(d.asDiagonal() * Wtu);  // HJ15 eq. 21
+
+  const double rss = (rows.col(3) - rows.leftCols<3>() * e.phi).squaredNorm();
+  e.residual_rms = std::sqrt(rss / static_cast<double>(n));
+  const double sigma2 = n > 3 ? rss / static_cast<double>(n - 3) : 0.0;
+  const Eigen::Matrix3d Sinv = ldlt.solve(Eigen::Matrix3d::Identity());
+  const Eigen::Matrix3d WtWinv = d.asDiagonal() * Sinv * d.asDiagonal();
+  e.cov = sigma2 * WtWinv;
+  if (known_cov) {
+    const Eigen::Matrix3d G = WtWinv * WtA;
+    e.cov += G * (*known_cov) * G.transpose();
+  }
+  for (int c = 0; c < 3; ++c) e.se[c] = std::sqrt(std::max(0.0, e.cov(c, c)));
+  return e;
+}
+
+IdentificationResult IdentifyExo(const IdentificationSamples& knee, const IdentificationSamples& hip,
+                                 double L1, double g) {
+  IdentificationResult r;
+  r.params.L1 = L1;
+  r.params.g = g;
+  const StepEstimate s1 = SolveStep(1, knee, L1, g, Vector6::Zero(), PassiveModel::kNone);
+  LumpedParams& exo = r.params.exo;
+  exo.J2 = s1.phi[0];
+  exo.X2 = s1.phi[1];
+  exo.Y2 = s1.phi[2];
+  const StepEstimate s2 = SolveStep(2, hip, L1, g, ToVector(exo), PassiveModel::kNone, &s1.cov);
+  exo.J1 = s2.phi[0];
+  exo.X1 = s2.phi[1];
+  exo.Y1 = s2.phi[2];
+  r.steps = {s1, s2};
+  return r;
+}
+
+IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
+                                   const LegParams& known, PassiveModel passive) {
+  IdentificationResult r;
+  r.params = known;
+  r.params.human.reset();
+  r.params.effects.clear();
+  const StepEstimate s3 = SolveStep(3, knee, known.L1, known.g, ToVector(known.exo), passive);
+  LumpedParams h;
+  h.J2 = s3.phi[0];
+  h.X2 = s3.phi[1];
+  h.Y2 = s3.phi[2];
+  const StepEstimate s4 =
+      SolveStep(4, hip, known.L1, known.g, ToVector(known.exo) + ToVector(h), passive, &s3.cov);
+  h.J1 = s4.phi[0];
+  h.X1 = s4.phi[1];
+  h.Y1 = s4.phi[2];
+  r.params.human = h;
+  r.params.passive = passive;
+  r.steps = {s3, s4};
+  return r;
+}
+
+IdentificationResult Identify(const std::vector<MeasuredData>& files, const LegParams* known,
+                              double L1, const IdentificationOptions& opt) {
+  IdentificationSamples knee, hip;
+  knee.config = IdConfiguration::kKneeSwing;
+  hip.config = IdConfiguration::kHipSwing;
+  const bool human = known != nullptr;
+  for (const MeasuredData& f : files) {
+    const IdConfiguration c = ClassifyConfiguration(f, opt);
+    AppendSamples(f, human, opt, c == IdConfiguration::kKneeSwing ? &knee : &hip);
+  }
+  auto missing = [&](IdConfiguration c) {
+    std::string got;
+    for (const MeasuredData& f : files) got += (got.empty() ? "" : ", ") + f.source;
+    throw InputError(std::string("identify: no ") + ConfigurationName(c) + " recording among [" + got +
+                     "]; expected one knee swing with the hip held at 90 deg and one hip swing with "
+                     "the knee held at -90 deg");
+  };
+  if (knee.size() == 0) missing(IdConfiguration::kKneeSwing);
+  if (hip.size() == 0) missing(IdConfiguration::kHipSwing);
+  if (human) return IdentifyHuman(knee, hip, *known, opt.passive);
+  return IdentifyExo(knee, hip, L1, 9.81);
+}
+
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(8);
+  os << v;
+  return os.str();
+}
+
+std::string List(const Eigen::Vector3d& v) {
+  return "[" + Num(v[0]) + ", " + Num(v[1]) + ", " + Num(v[2]) + "]";
+}
+
+std::string Quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::string IdentificationYaml(const IdentificationResult& r, const IdentificationOptions& opt) {
+  std::ostringstream os;
+  const bool human = !r.steps.empty() && r.steps[0].step >= 3;
+  os << "identification:\n";
+  os << "  method: \"least squares, Hwang & Jeon 2015 eq. (18)-(21); full regressor restricted to "
+        "the unknown columns, known parameters on the left (re-derived signs)\"\n";
+  os << "  derivatives: \"zero-phase 2nd-order Butterworth " << Num(opt.cutoff_hz)
+     << " Hz, central differences; " << Num(opt.trim_s) << " s trimmed at both ends of each file\"\n";
+  if (human) {
+    os << "  passive_model: " << PassiveModelName(opt.passive) << "\n";
+    if (opt.selection.thresholds.empty())
+      os << "  passive_selection: \"eq. (13): every |emg_*| below mean + " << Num(opt.selection.n_sd)
+         << " SD of the first " << Num(opt.selection.reference_s) << " s of each file";
+    else
+      os << "  passive_selection: \"eq. (13): every |emg_*| below the given thresholds";
+    if (opt.selection.envelope_s > 0)
+      os << " (moving average " << Num(opt.selection.envelope_s) << " s)";
+    os << "; all samples when a file has no emg_* column\"\n";
+  }
+  os << "  condition_number: \"2-norm condition number of the column-scaled regressor W D\"\n";
+  os << "  std_error: \"sqrt(diag(sigma^2 (W'W)^-1)) (+ propagated step-1/3 uncertainty in steps 2/4); "
+        "white-residual assumption\"\n";
+  os << "  steps:\n";
+  for (const StepEstimate& s : r.steps) {
+    const bool knee = s.step == 1 || s.step == 3;
+    os << "    - step: " << s.step << "\n";
+    os << "      segment: " << s.segment << "\n";
+    os << "      parameters: " << (knee ? "[J2, X2, Y2]" : "[J1, X1, Y1]") << "\n";
+    os << "      estimate: " << List(s.phi) << "\n";
+    os << "      std_error: " << List(s.se) << "\n";
+    os << "      condition_number: " << Num(s.condition_number) << "\n";
+    os << "      residual_rms: " << Num(s.residual_rms) << "   # N m\n";
+    os << "      held_joint_mean_deg: " << Num(s.held_mean * kDegPerRad) << "   # "
+       << (knee ? "hip" : "knee") << "\n";
+    os << "      samples_used: " << s.samples_used << "\n";
+    os << "      samples_total: " << s.samples_total << "\n";
+    os << "      files: [";
+    for (size_t i = 0; i < s.sources.size(); ++i) os << (i ? ", " : "") << Quote(s.sources[i]);
+    os << "]\n";
+  }
+  return os.str();
+}
+
+}  // namespace exotwin

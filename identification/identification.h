@@ -1,0 +1,133 @@
+// Off-line least-squares identification of the lumped parameters (HJ15 eq. 4), the four steps of Hwang &
+// Jeon 2015 sec. 3.2 (HJ15 eq. 14-21, Appendix A1-A4) with the re-derived signs of model/regressors.cc.
+//
+// Configurations (DESIGN.md `identify`): knee swing = the knee moves, the hip is held near 90 deg
+// (steps 1 and 3); hip swing = the hip moves, the knee is held near -90 deg (steps 2 and 4). A file's
+// configuration is told by which joint moves.
+//
+// Regressor: the held joint is held by a PD controller, so it is near but not exactly at 90 / -90 deg.
+// Instead of the paper's step rows (exact only when the held joint is exactly still) each step uses
+// the moving joint's row of the full regressor, tau_R = Y(q, qd, qdd) theta + P(q) (HJ15 eq. 3, 8 with
+// tau_M = 0), restricted to the three unknown columns, with every known parameter moved to the left:
+//   step 1 (R2): knee row, unknown [J2 X2 Y2]_R, nothing known (exo alone)
+//   step 2 (R1): hip row,  unknown [J1 X1 Y1]_R, known [J2 X2 Y2]_R from step 1
+//   step 3 (H2): knee row, unknown [J2 X2 Y2]_H, known exo, minus P2 (passive model)
+//   step 4 (H1): hip row,  unknown [J1 X1 Y1]_H, known exo and [J2 X2 Y2]_H from step 3, minus P1
+// This is exact for any state and equals Step1Row..Step4Row (HJ15 eq. 18, A1-A4) when the held joint is
+// exactly still at 90 / -90 deg (tests/identification/identification_test.cc).
+//
+// Solver: HJ15 eq. 21 through the normal equations of the column-scaled regressor W D (D = diag of
+// 1/||column||), LDLT in Eigen. Outputs per step: estimate phi, standard errors sqrt(diag(
+// sigma^2 (W'W)^-1)) with sigma^2 = |r|^2 / (N - 3), plus, for steps 2 and 4, the propagated
+// uncertainty of the step-1/3 values they use (G Sigma G', G = (W'W)^-1 W'A, A the known columns).
+// The standard errors assume white residuals; the 20 Hz-filtered derivatives make the residual
+// correlated over a few ms, so they can be optimistic (on the synthetic protocol they match the
+// observed errors in order of magnitude).
+// Condition number: sigma_max / sigma_min of W D (2-norm), invariant to the units of J, X, Y.
+#pragma once
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "formats/measured_data.h"
+#include "identification/passive_selection.h"
+#include "core/units.h"
+#include "model/lumped_params.h"
+#include "model/regressors.h"
+
+namespace exotwin {
+
+enum class IdConfiguration { kKneeSwing, kHipSwing };
+// "knee swing (hip held)" / "hip swing (knee held)".
+const char* ConfigurationName(IdConfiguration c);
+
+struct IdentificationOptions {
+  double moving_min_range = 10.0 * kRadPerDeg;  // rad, least range (max - min) of the moving joint
+  double held_max_range = 5.0 * kRadPerDeg;     // rad, largest range of the held joint
+  double trim_s = 0.1;          // s dropped at both ends of every file (derivative-filter edges)
+  double cutoff_hz = 20.0;      // Hz, zero-phase Butterworth of the derivatives (sec. 3.2)
+  PassiveModel passive = PassiveModel::kRiener1999;  // P^ subtracted in steps 3-4 (HJ15 eq. 16-17)
+  PassiveSelectionOptions selection;                 // HJ15 eq. 13, human steps only
+};
+
+// Range (min, max, mean; rad) of both joints of a file.
+struct JointRanges {
+  double min[2], max[2], mean[2];  // [0] hip, [1] knee
+};
+JointRanges ComputeJointRanges(const MeasuredData& data);
+
+// Which configuration a file is. Throws InputError naming data.source, both joints' ranges (deg) and
+// what was expected when the file fits neither.
+IdConfiguration ClassifyConfiguration(const MeasuredData& data, const IdentificationOptions& opt = {});
+
+// Samples of one configuration ready for the regressor: state (rad, rad/s, rad/s^2) and actuator
+// torque u = tau_R = -tau_S (N m, HJ15 eq. 8), after derivative estimation, trimming and EMG selection.
+struct IdentificationSamples {
+  IdConfiguration config = IdConfiguration::kKneeSwing;
+  std::vector<std::string> sources;
+  std::vector<double> q[2], qd[2], qdd[2], u[2];
+  size_t total = 0;  // samples in the files before trimming and selection
+  size_t size() const { return u[0].size(); }
+};
+
+// Appends the samples of one file (derivatives by DeriveKinematics with opt.cutoff_hz, trim at both
+// ends; with select_passive, only samples passing HJ15 eq. 13). Precondition: data is of configuration
+// into->config (use ClassifyConfiguration). Throws InputError if the trim leaves nothing.
+void AppendSamples(const MeasuredData& data, bool select_passive, const IdentificationOptions& opt,
+                   IdentificationSamples* into);
+
+// One row u* = w' phi (HJ15 eq. 18) of step 1..4 from the full regressor at any state (q, qd, qdd) with
+// actuator torque u (N m, the moving joint's tau_R): w = the moving joint's row of FullRegressor at
+// the unknown columns, u* = u - (that row) . known - P_row(q) (P only in steps 3-4, model `passive`).
+// `known` as in SolveStep. Equals Step1Row..Step4Row when the held joint is exactly still at 90 / -90.
+StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, PassiveModel passive,
+                       const Eigen::Vector2d& q, const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd,
+                       double u);
+
+// Result of one step (HJ15 eq. 18-21).
+struct StepEstimate {
+  int step = 0;                                  // 1..4 (HJ15 eq. 14-17)
+  std::string segment;                           // "R2", "R1", "H2", "H1"
+  Eigen::Vector3d phi = Eigen::Vector3d::Zero();  // [J, X, Y]: kg m^2, kg m, kg m
+  Eigen::Vector3d se = Eigen::Vector3d::Zero();   // standard errors, same units
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  // covariance of phi
+  double condition_number = 0;                   // of the column-scaled regressor
+  double residual_rms = 0;                       // N m
+  double held_mean = 0;                          // rad, mean angle of the held joint
+  size_t samples_used = 0, samples_total = 0;
+  std::vector<std::string> sources;
+};
+
+// One step on prepared samples. `known` holds every parameter already known in the layout of
+// model/regressors.h ([J1 J2 X1 X2 Y1 Y2] of the combined system, the unknown entries zero);
+// `known_cov` (may be null) the covariance of the known distal [J2 X2 Y2] (steps 2 and 4).
+// Precondition: samples.size() >= 3; throws InputError if the regressor is rank deficient.
+StepEstimate SolveStep(int step, const IdentificationSamples& samples, double L1, double g,
+                       const Vector6& known, PassiveModel passive,
+                       const Eigen::Matrix3d* known_cov = nullptr);
+
+struct IdentificationResult {
+  LegParams params;                // exo (+ human, passive) identified; L1, g as used
+  std::vector<StepEstimate> steps;  // steps 1-2 or 3-4
+};
+
+// Steps 1-2: the exoskeleton alone from the knee-swing and hip-swing samples. L1 (m), g (m/s^2).
+IdentificationResult IdentifyExo(const IdentificationSamples& knee, const IdentificationSamples& hip,
+                                 double L1, double g);
+
+// Steps 3-4: the human with known.exo, known.L1, known.g; P^ = `passive`.
+IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
+                                   const LegParams& known, PassiveModel passive);
+
+// Whole pipeline on files (any order, one or more per configuration): classifies, prepares, solves.
+// known == nullptr: steps 1-2 with thigh length L1; else steps 3-4 with known->exo (L1 from known).
+// Throws InputError when a configuration is missing or a file fits neither.
+IdentificationResult Identify(const std::vector<MeasuredData>& files, const LegParams* known,
+                              double L1, const IdentificationOptions& opt = {});
+
+// The `identification:` block of MODEL.yaml (top-level YAML text, ends with a newline).
+std::string IdentificationYaml(const IdentificationResult& r, const IdentificationOptions& opt);
+
+}  // namespace exotwin

@@ -1,0 +1,50 @@
+// The EMG model on a real subject (shared/data/real_human/ceinms_lowerlimb_walk36, README there):
+// the linear form of HJ15 eq. 26 reproduces the README's held-out figures (first 70 % fitted, last
+// 30 % held out: knee R^2 0.60, hip 0.65 over all samples), and the discrepancy loop's final model
+// beats it on the held-out part and reaches issue 19's knee R^2 >= 0.70 and hip >= 0.80 (R^2 over the samples within 6 scaled MADs of the median moment, the
+// contact spikes left out for every model alike). Skipped when shared/data is not beside the project.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "emg/emg_diagnose.h"
+#include "emg/emg_recording.h"
+
+namespace exotwin {
+namespace {
+
+const std::string kDir = std::string(EXOTWIN_SOURCE_DIR) + "/../shared/data/real_human/ceinms_lowerlimb_walk36";
+
+TEST(EmgRealHuman, LinearFormReproducesTheReadmeAndTheLoopGains) {
+  if (!std::ifstream(kDir + "/emgFilt.sto")) GTEST_SKIP() << "shared/data not beside the project";
+  const EmgRecording r = ReadEmgRecording(kDir + "/emgFilt.sto", kDir + "/ik.sto", kDir + "/id.sto", DefaultMuscleMap());
+  ASSERT_EQ(r.size(), 6097u);
+  EXPECT_EQ(r.missing, std::vector<std::string>{"GMAX"});
+  const EmgDiagnosis d = DiagnoseEmg({&r});
+  const EmgJointFigures* lin = d.steps.front().model.figures;
+  const EmgJointFigures* fin = d.steps.back().model.figures;
+  std::printf("%-48s %8s %8s %8s %8s\n", "step", "hip R2", "hip rms", "knee R2", "knee rms");
+  for (const auto& s : d.steps)
+    std::printf("%-48s %8.3f %8.2f %8.3f %8.2f\n", s.added.c_str(), s.model.figures[0].r2_heldout_trim,
+                s.model.figures[0].rms_heldout_trim, s.model.figures[1].r2_heldout_trim, s.model.figures[1].rms_heldout_trim);
+  for (const auto& s : d.selection) std::printf("  %s\n", s.c_str());
+  // README: linear form, all held-out samples.
+  EXPECT_NEAR(lin[1].r2_heldout, 0.60, 0.02);
+  EXPECT_NEAR(lin[0].r2_heldout, 0.65, 0.02);
+  EXPECT_NEAR(lin[1].rms_heldout, 6.0, 0.3);
+  EXPECT_NEAR(lin[0].rms_heldout, 13.9, 0.5);
+  // Issue 19: 0.60 / 0.73 by the spike rule.
+  EXPECT_NEAR(lin[1].r2_heldout_trim, 0.60, 0.02);
+  EXPECT_NEAR(lin[0].r2_heldout_trim, 0.73, 0.02);
+  // The loop pays on held-out data at both joints.
+  EXPECT_GT(d.steps.size(), 1u);
+  EXPECT_GT(fin[0].r2_heldout_trim, lin[0].r2_heldout_trim + 0.02);
+  EXPECT_GT(fin[1].r2_heldout_trim, lin[1].r2_heldout_trim + 0.02);
+  // Issue 19's targets on the development trial (held-out, spike rule).
+  EXPECT_GE(fin[1].r2_heldout_trim, 0.70);
+  EXPECT_GE(fin[0].r2_heldout_trim, 0.80);
+}
+
+}  // namespace
+}  // namespace exotwin

@@ -1,0 +1,166 @@
+// Measured-data angles: a record may turn a joint through several revolutions (up to the sanity
+// bound kMaxRecordedAngle); a human joint's range (2 pi) is a separate check naming file, line, column.
+#include "formats/measured_data.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/error.h"
+#include "dsp/butterworth.h"
+
+namespace exotwin {
+namespace {
+
+// 30 rows at 1 kHz, data row i on line i + 2; q_knee of row `row` set to `q`.
+CsvTable Table(int row, double q) {
+  CsvTable t;
+  t.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"};
+  t.columns.assign(5, {});
+  for (int i = 0; i < 30; ++i) {
+    const double v[5] = {1e-3 * i, 0.1, i == row ? q : -0.5, 1.0, 2.0};
+    for (int c = 0; c < 5; ++c) t.columns[c].push_back(v[c]);
+    t.line_of_row.push_back(i + 2);
+  }
+  return t;
+}
+
+TEST(MeasuredAngles, ARecordMayTurnThroughSeveralRevolutions) {
+  const MeasuredData d = MeasuredFromTable(Table(7, 11.0), "rig.csv");
+  EXPECT_DOUBLE_EQ(d.q_knee()[7], 11.0);
+  EXPECT_NO_THROW(MeasuredFromTable(Table(7, -kMaxRecordedAngle), "rig.csv"));
+}
+
+TEST(MeasuredAngles, BeyondTheSanityBoundIsBadInput) {
+  try {
+    MeasuredFromTable(Table(7, 2e4), "rig.csv");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("rig.csv:9: column 'q_knee': value 20000 out of range, expected |x| <= 10000"),
+              std::string::npos) << m;
+  }
+}
+
+TEST(MeasuredAngles, HumanJointRangeIsASeparateCheck) {
+  EXPECT_NO_THROW(CheckHumanJointRange(MeasuredFromTable(Table(7, -6.28), "leg.csv")));
+  try {
+    CheckHumanJointRange(MeasuredFromTable(Table(12, -7.5), "leg.csv"));
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("leg.csv:14: column 'q_knee': angle -7.5 rad is beyond a human joint's range, "
+                     "expected |q| <= 6.28"), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// A 2 s record at 1 kHz with EMG, optionally non-uniform and with a measured qd_knee column.
+MeasuredData Record(bool uniform, bool qd_column) {
+  CsvTable t;
+  t.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "emg_VM"};
+  if (qd_column) t.names.push_back("qd_knee");
+  t.columns.assign(t.names.size(), {});
+  for (int i = 0; i < 2000; ++i) {
+    const double ti = 1e-3 * i + (uniform ? 0.0 : 3e-4 * (i % 3));
+    const double v[7] = {ti, 0.3 * std::sin(3 * ti), -0.6 + 0.4 * std::cos(5 * ti), 1.0, 2.0, 0.01 * std::sin(90 * ti),
+                         -2.0 * std::sin(5 * ti)};
+    for (size_t c = 0; c < t.names.size(); ++c) t.columns[c].push_back(v[c]);
+    t.line_of_row.push_back(i + 2);
+  }
+  return MeasuredFromTable(t, "record.csv");
+}
+
+// The required columns are views of the table (one copy of a record's data): a copy of the record
+// views its own table, writes through column_at show in the table, an empty record has empty views.
+TEST(MeasuredData, RequiredColumnsAreViewsOfTheTable) {
+  const MeasuredData d = Record(true, true);
+  EXPECT_EQ(&d.t(), &d.table.columns[0]);
+  EXPECT_EQ(&d.tau_knee(), &d.table.columns[4]);
+  EXPECT_EQ(d.size(), 2000u);
+  MeasuredData c = d;
+  EXPECT_EQ(&c.q_hip(), &c.table.columns[1]);
+  c.column_at(kColQKnee)[7] = 1.25;
+  EXPECT_EQ(c.table.columns[2][7], 1.25);
+  EXPECT_NE(d.q_knee()[7], 1.25);
+  const MeasuredData none;
+  EXPECT_EQ(none.size(), 0u);
+  EXPECT_TRUE(none.tau_hip().empty());
+  CsvTable t = d.table;
+  t.names[3] = "torque_hip";
+  try {
+    MakeMeasuredData(t, "rig.csv");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rig.csv: missing required column 'tau_hip'"), std::string::npos) << e.what();
+  }
+}
+
+// DeriveKinematics taking the record's columns gives what the copying one gives, to the bit.
+TEST(DeriveKinematics, TakingTheColumnsEqualsCopyingThem) {
+  for (bool uniform : {true, false})
+    for (bool qd_column : {false, true}) {
+      SCOPED_TRACE(std::to_string(uniform) + std::to_string(qd_column));
+      const MeasuredData d = Record(uniform, qd_column);
+      const Kinematics a = DeriveKinematics(d, 15.0);
+      MeasuredData taken = d;
+      const Kinematics b = DeriveKinematics(std::move(taken), 15.0);
+      EXPECT_EQ(taken.size(), 0u);
+      EXPECT_TRUE(taken.table.columns.empty());
+      EXPECT_EQ(a.t, b.t);
+      for (int j = 0; j < 2; ++j) {
+        EXPECT_EQ(a.q[j], b.q[j]);
+        EXPECT_EQ(a.qd[j], b.qd[j]);
+        EXPECT_EQ(a.qdd[j], b.qdd[j]);
+      }
+      EXPECT_EQ(a.emg, b.emg);
+      EXPECT_EQ(a.resampled, b.resampled);
+      EXPECT_EQ(a.derivative_source, b.derivative_source);
+    }
+}
+
+
+// TimeBaseLowPass (the sampling examined once, the filter designed once, several signals at a
+// time) gives LowPassOnTimeBase's composition bit for bit: FiltFilt on a uniform record, through
+// the median-step grid and back on a non-uniform one; DeriveAngleRates gives DeriveKinematics' rates.
+TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
+  for (bool uniform : {true, false}) {
+    SCOPED_TRACE(uniform ? "uniform" : "non-uniform");
+    const MeasuredData d = Record(uniform, false);
+    const Sampling s = ExamineSampling(d.t(), d.source);
+    EXPECT_EQ(s.uniform, uniform);
+    EXPECT_EQ(s.dt, MedianStep(d.t()));
+    const auto sos = dsp::DesignButterworth(2, dsp::BandType::kLowPass, 1.0 / s.dt, 7.0);
+    const TimeBaseLowPass low(s, d.t(), 7.0, d.source);
+    std::vector<double> xs[5] = {d.q_hip(), d.q_knee(), d.tau_hip(), *d.Column("emg_VM"), d.t()};
+    std::vector<double> batched[5] = {xs[0], xs[1], xs[2], xs[3], xs[4]};
+    std::vector<double>* bptr[5];
+    for (int k = 0; k < 5; ++k) bptr[k] = &batched[k];
+    low.Apply(bptr, 5);
+    for (int k = 0; k < 5; ++k) {
+      const std::vector<double> ref =
+          uniform ? dsp::FiltFilt(sos, xs[k]) : Interpolate(s.grid, dsp::FiltFilt(sos, Interpolate(d.t(), xs[k], s.grid)), d.t());
+      EXPECT_EQ(low(xs[k]), ref);
+      EXPECT_EQ(TimeBaseLowPass(d.t(), 7.0, d.source)(xs[k]), ref);
+      EXPECT_EQ(LowPassOnTimeBase(d.t(), xs[k], 7.0, d.source), ref);
+      EXPECT_EQ(batched[k], ref);
+    }
+    const Kinematics k = DeriveKinematics(d, 15.0);
+    for (int j = 0; j < 2; ++j) {
+      const AngleRates r = DeriveAngleRates(s, d.t(), j == 0 ? d.q_hip() : d.q_knee(), 15.0, d.source);
+      EXPECT_EQ(r.qd, k.qd[j]);
+      EXPECT_EQ(r.qdd, k.qdd[j]);
+    }
+    EXPECT_THROW(TimeBaseLowPass(s, d.t(), 600.0, d.source), InputError);  // above half the sample rate
+  }
+}
+
+}  // namespace
+}  // namespace exotwin
