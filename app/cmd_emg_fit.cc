@@ -21,6 +21,7 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
     std::vector<std::string> emg, kin, mom;
     std::string map, out, report;
     bool linear = false;
+    int blocks = 5;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
@@ -33,6 +34,9 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
   sub->add_option("--out", o->out, "calibration output, EMGMODEL.yaml")->required();
   sub->add_option("--report", o->report, "folder for diagnosis.json and report.html of the discrepancy loop");
   sub->add_flag("--linear", o->linear, "fit the linear form of HJ15 eq. 26 only (no discrepancy loop)");
+  sub->add_option("--blocks", o->blocks,
+                  "one recording: contiguous cross-validation blocks, each left out in turn (default 5; several "
+                  "recordings: each recording is left out instead)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     const auto start = std::chrono::steady_clock::now();
@@ -48,6 +52,7 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
     std::vector<const EmgRecording*> ptrs;
     for (const auto& r : recs) ptrs.push_back(&r);
     EmgDiagnoseOptions opt;
+    opt.blocks = o->blocks;
     if (o->linear) opt.max_steps = 0, opt.robust_candidate = false;
     const EmgDiagnosis d = DiagnoseEmg(ptrs, opt);
     std::vector<std::string> header = {"exotwin emg-fit: EMG-driven joint moment model (HJ15 eq. 26-27 + discrepancy loop)"};
@@ -56,20 +61,30 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
       files += (i ? "; " : "") + o->emg[i] + ", " + o->kin[i] + ", " + o->mom[i];
     header.push_back("recordings: " + files + "; map: " + map.source);
     for (const auto& s : d.selection) header.push_back(s);
-    header.push_back("fit: the final structure on every sample; held-out figures in 'fit' are of the same structure "
-                     "fitted on the first 70 % of every recording");
+    header.push_back("fit: the final structure on every sample; in 'fit', r2_cv / rms_cv are its cross-validation, the "
+                     "heldout figures of the same structure fitted on the first 70 % of every recording");
     EmgTorqueModel out = d.calibration;
-    for (int j = 0; j < 2; ++j) out.figures[j] = d.steps.back().model.figures[j];
+    for (int j = 0; j < 2; ++j) {
+      const EmgJointFigures cv = out.figures[j];
+      out.figures[j] = d.steps.back().model.figures[j];
+      out.figures[j].r2_cv = cv.r2_cv, out.figures[j].rms_cv = cv.rms_cv;
+    }
     WriteFileAtomic(o->out, EmgModelYaml(out, header));
     if (!o->report.empty()) WriteEmgDiagnosis(d, o->report);
     const char* jn[2] = {"hip", "knee"};
-    std::printf("%-44s %8s %8s %8s %8s\n", "step (held-out, within 6 MAD)", "hip R^2", "hip rms", "knee R^2", "knee rms");
+    std::printf("R^2 within 6 MAD: cv = %s left out in turn; last 30 %% = fit on the first 70 %%\n",
+                d.folds_are_recordings ? (std::to_string(d.folds) + " recordings").c_str()
+                                       : (std::to_string(d.folds) + " contiguous blocks").c_str());
+    std::printf("%-44s %8s %8s %9s %9s %8s %8s\n", "step", "hip cv", "knee cv", "hip 30%", "knee 30%", "hip rms",
+                "knee rms");
     for (const auto& s : d.steps)
-      std::printf("%-44s %8.3f %8.2f %8.3f %8.2f\n", s.added.substr(0, 44).c_str(), s.model.figures[0].r2_heldout_trim,
-                  s.model.figures[0].rms_heldout_trim, s.model.figures[1].r2_heldout_trim,
-                  s.model.figures[1].rms_heldout_trim);
+      std::printf("%-44s %8.3f %8.3f %9.3f %9.3f %8.2f %8.2f\n", s.added.substr(0, 44).c_str(), s.model.figures[0].r2_cv,
+                  s.model.figures[1].r2_cv, s.model.figures[0].r2_heldout_trim, s.model.figures[1].r2_heldout_trim,
+                  s.model.figures[0].rms_heldout_trim, s.model.figures[1].rms_heldout_trim);
     for (int j = 0; j < 2; ++j)
-      std::printf("%s: held-out R^2 %.3f (all samples %.3f), linear form %.3f (all samples %.3f)\n", jn[j],
+      std::printf("%s: cross-validated R^2 %.3f (linear form %.3f); last 30 %% R^2 %.3f (all samples %.3f), linear "
+                  "form %.3f (all samples %.3f)\n",
+                  jn[j], d.steps.back().model.figures[j].r2_cv, d.steps.front().model.figures[j].r2_cv,
                   d.steps.back().model.figures[j].r2_heldout_trim, d.steps.back().model.figures[j].r2_heldout,
                   d.steps.front().model.figures[j].r2_heldout_trim, d.steps.front().model.figures[j].r2_heldout);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

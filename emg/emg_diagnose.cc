@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 
 #include "diagnosis/diagnose_select.h"
 #include "formats/number_text.h"
@@ -12,14 +13,36 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
-constexpr double kMaxDelay = 0.2;   // s: EMG-to-force delay, activation dynamics included
+// Delays are searched on 0-200 ms and named only inside the physiological range (a delay outside
+// it is listed with its verdict, not named): the electromechanical delay of human muscles, the time
+// from EMG to force, is tens of milliseconds; Cavanagh & Komi 1979 (Eur J Appl Physiol 42:159-163)
+// measured about 50 ms in the elbow flexors, and the values reported for limb muscles span about
+// 10 to 100 ms (Norman & Komi 1979, Acta Physiol Scand 106:241-248; Corcos et al. 1992, J
+// Electromyogr Kinesiol 2:59-68, show how much of the spread is the measuring apparatus). A
+// longer apparent delay between envelope and moment stands for something else (activation and
+// force build-up, another muscle's timing).
+constexpr double kMaxDelaySearch = 0.2;  // s
+constexpr double kMinEmd = 0.010, kMaxEmd = 0.100;  // s, the range a named delay must lie in
 constexpr double kDelayStep = 0.005;
-constexpr double kMinA = -3.0;      // Lloyd & Besier 2003: -3 < A < 0
+// Muscle twitch (emg_torque_model.h T_tau): Winter's critically damped EMG-to-force filter of about
+// 3 Hz (tau = 1 / (2 pi 3 Hz) ~ 53 ms; Winter, Biomechanics and Motor Control of Human Movement, ch.
+// on EMG and force; Olney & Winter 1985), which depends on the muscle: named within 20-100 ms
+// (cut-off 8 down to 1.6 Hz), searched on 10-150 ms.
+constexpr double kMinTwitch = 0.020, kMaxTwitch = 0.100, kMaxTwitchSearch = 0.150, kTwitchStep = 0.005;
+constexpr double kMinA = -3.0;      // Lloyd & Besier 2003 (LB03 eq. 2): -3 < A < 0
 constexpr double kAStep = 0.25;
+// Moment arms: the alpha of a channel times (1 + c q) may change by at most this factor over the
+// calibrated angle range, and keep its sign. Measured moment arms of the knee's extensors and
+// flexors change by up to about a factor 2 over 0-90 deg of flexion (Herzog & Read 1993, J Anat
+// 182:213-230); beyond 3 the term is no moment arm.
+constexpr double kMaxMomentArmRatio = 3.0;
+// Passive moment: Riener & Edrich 1999's population curves scaled by s_P; a subject's passive
+// moment within (0, 3] times theirs (a stated bound: they report a wide spread between subjects).
+constexpr double kMaxPassiveScale = 3.0;
 
 std::string Num(double v) { return NumberText(v, 4); }
 
-enum class Kind { kDelay, kAShape, kMomentArm, kPassive, kGmaxProxy, kRobust };
+enum class Kind { kCommonDelay, kTwitch, kTiming, kDelay, kAShape, kMomentArm, kPassive, kGmaxProxy, kRobust };
 
 struct Cause {
   Kind kind;
@@ -27,6 +50,9 @@ struct Cause {
   int joint = -1;                 // moment arm, passive; -1: both joints
   std::string Label() const {
     switch (kind) {
+      case Kind::kCommonDelay: return "electromechanical_delay(common)";
+      case Kind::kTwitch: return "muscle_twitch(common)";
+      case Kind::kTiming: return "electromechanical_delay(common) + muscle_twitch(common)";
       case Kind::kDelay: return std::string("electromechanical_delay(") + MuscleName(muscle) + ")";
       case Kind::kAShape: return "activation_nonlinearity";
       case Kind::kMomentArm: return std::string("moment_arm_angle(") + kJoint[joint] + ")";
@@ -46,8 +72,9 @@ struct Cause {
 
 class Loop {
  public:
-  Loop(const std::vector<const EmgRecording*>& recs, double train_fraction) : recs_(recs) {
+  Loop(const std::vector<const EmgRecording*>& recs, double train_fraction, int blocks) : recs_(recs) {
     opt_.train_fraction = train_fraction;
+    opt_.blocks = blocks;
   }
   // Fixes the row weights and autocorrelation length from the linear form (comparable scores).
   EmgTorqueModel Baseline(const EmgModelSpec& s) {
@@ -94,14 +121,42 @@ std::function<double&(EmgModelSpec&)> DelayOf(Muscle m) {
   return [m](EmgModelSpec& s) -> double& { return s.delay_s[m]; };
 }
 double& AShapeOf(EmgModelSpec& s) { return s.a_shape; }
+double& CommonDelayOf(EmgModelSpec& s) { return s.common_delay; }
+double& TwitchOf(EmgModelSpec& s) { return s.twitch; }
 
 // The spec with `c` added (searched parameters chosen on the fit rows). False if not applicable.
 bool Apply(const Loop& loop, const Cause& c, EmgModelSpec* s) {
   switch (c.kind) {
-    case Kind::kDelay: {
-      if (s->delay_s.count(c.muscle)) return false;
+    case Kind::kCommonDelay: {
+      if (s->common_delay != 0) return false;
+      loop.Search(s, CommonDelayOf, kDelayStep, kMaxDelaySearch, kDelayStep, kDelayStep, &s->common_delay_se);
+      return true;
+    }
+    case Kind::kTwitch: {
+      if (s->twitch != 0) return false;
+      loop.Search(s, TwitchOf, kTwitchStep, kMaxTwitchSearch, kTwitchStep, kTwitchStep, &s->twitch_se);
+      return true;
+    }
+    case Kind::kTiming: {  // both on the grid of their physiological ranges
+      if (s->twitch != 0 || s->common_delay != 0) return false;
+      double best = 1e300;
+      EmgModelSpec b = *s;
+      for (double tau = kMinTwitch; tau <= kMaxTwitch + 1e-9; tau += 2 * kTwitchStep)
+        for (double dl = kMinEmd; dl <= kMaxEmd + 1e-9; dl += 2 * kDelayStep) {
+          EmgModelSpec t = *s;
+          t.twitch = tau, t.common_delay = dl;
+          const double sse = loop.Fit(t).sse_fit;
+          if (sse < best) best = sse, b = t;
+        }
+      *s = b;
+      loop.Search(s, TwitchOf, kMinTwitch, kMaxTwitch, kTwitchStep, kTwitchStep, &s->twitch_se);
+      loop.Search(s, CommonDelayOf, kMinEmd, kMaxEmd, kDelayStep, kDelayStep, &s->common_delay_se);
+      return true;
+    }
+    case Kind::kDelay: {  // fewer parameters first: a muscle's own delay only after the common one
+      if (s->common_delay == 0 || s->delay_s.count(c.muscle)) return false;
       double se;
-      loop.Search(s, DelayOf(c.muscle), kDelayStep, kMaxDelay, kDelayStep, kDelayStep, &se);
+      loop.Search(s, DelayOf(c.muscle), kDelayStep, kMaxDelaySearch, kDelayStep, kDelayStep, &se);
       s->delay_se[c.muscle] = se;
       return true;
     }
@@ -144,11 +199,34 @@ bool Admissible(const Cause& c, const EmgTorqueModel& m, std::string* why) {
       }
     return std::make_pair(best, sum);
   };
+  auto delay_ok = [&](double d, double se) {
+    if (!(d >= kMinEmd - 1e-9 && d <= kMaxEmd + 1e-9))
+      return *why = "delay " + Num(d) + " s outside the electromechanical delay of human muscles (" + Num(kMinEmd) +
+                    "-" + Num(kMaxEmd) + " s)",
+             false;
+    if (!(d > kMinT * se)) return *why = "delay " + Num(d) + " s, |t| " + Num(d / se) + " <= " + Num(kMinT), false;
+    return true;
+  };
   switch (c.kind) {
+    case Kind::kCommonDelay: return delay_ok(s.common_delay, s.common_delay_se);
+    case Kind::kTiming:
+      if (!delay_ok(s.common_delay, s.common_delay_se)) return false;
+      [[fallthrough]];
+    case Kind::kTwitch:
+      if (!(s.twitch >= kMinTwitch - 1e-9 && s.twitch <= kMaxTwitch + 1e-9))
+        return *why = "twitch time constant " + Num(s.twitch) + " s outside " + Num(kMinTwitch) + "-" + Num(kMaxTwitch) + " s",
+               false;
+      if (!(s.twitch > kMinT * s.twitch_se))
+        return *why = "twitch " + Num(s.twitch) + " s, |t| " + Num(s.twitch / s.twitch_se) + " <= " + Num(kMinT), false;
+      return true;
     case Kind::kDelay: {
       const double d = s.Delay(c.muscle), se = s.delay_se.count(c.muscle) ? s.delay_se.at(c.muscle) : 1e300;
-      if (!(d > 0 && d < kMaxDelay)) return *why = "delay " + Num(d) + " s at the end of (0, " + Num(kMaxDelay) + ") s", false;
-      if (!(d > kMinT * se)) return *why = "delay " + Num(d) + " s, |t| " + Num(d / se) + " <= " + Num(kMinT), false;
+      if (!delay_ok(d, se)) return false;
+      // The muscle's own delay must differ from the common one beyond its uncertainty.
+      if (!(std::abs(d - s.common_delay) > kMinT * se))
+        return *why = "delay " + Num(d) + " s within " + Num(kMinT) + " standard errors of the common " +
+                      Num(s.common_delay) + " s",
+               false;
       return true;
     }
     case Kind::kAShape:
@@ -159,11 +237,27 @@ bool Admissible(const Cause& c, const EmgTorqueModel& m, std::string* why) {
     case Kind::kMomentArm: {
       const auto t = t_of(TermKind::kAlphaQ, c.joint, false);
       if (!(t.first > kMinT)) return *why = "no alpha_q with |t| > " + Num(kMinT), false;
+      // Every channel whose moment arm changes significantly: alpha + alpha_q q over the calibrated
+      // angles keeps its sign and changes by at most kMaxMomentArmRatio.
+      const int j = c.joint;
+      for (const EmgTerm& q : m.terms) {
+        if (q.kind != TermKind::kAlphaQ || q.joint != j || !(std::abs(q.value) > 2 * q.se)) continue;
+        for (const EmgTerm& a : m.terms) {
+          if (a.kind != TermKind::kAlpha || a.joint != j || a.channel != q.channel || a.proxy != q.proxy) continue;
+          const double lo = a.value + q.value * m.range.q_lo[j], hi = a.value + q.value * m.range.q_hi[j];
+          const double r = std::max(std::abs(lo), std::abs(hi)) / std::max(1e-12, std::min(std::abs(lo), std::abs(hi)));
+          if (lo * hi <= 0 || r > kMaxMomentArmRatio)
+            return *why = a.Name() + " goes from " + Num(lo) + " to " + Num(hi) + " N m over the calibrated angles (a moment "
+                          "arm keeps its sign and changes by at most a factor " + Num(kMaxMomentArmRatio) + ")",
+                   false;
+        }
+      }
       return true;
     }
     case Kind::kPassive: {
       const auto t = t_of(TermKind::kPassive, c.joint, false);
-      if (!(t.second > 0)) return *why = "negative passive scale " + Num(t.second), false;
+      if (!(t.second > 0 && t.second <= kMaxPassiveScale))
+        return *why = "passive scale " + Num(t.second) + " outside (0, " + Num(kMaxPassiveScale) + "]", false;
       if (!(t.first > kMinT)) return *why = "passive scale |t| " + Num(t.first) + " <= " + Num(kMinT), false;
       return true;
     }
@@ -185,10 +279,20 @@ constexpr int kMaxRefinePasses = 10;
 void Refine(const Loop& loop, EmgModelSpec* s) {
   for (int pass = 0; pass < kMaxRefinePasses; ++pass) {
     bool moved = false;
+    if (s->common_delay != 0) {
+      const double before = s->common_delay;
+      loop.Search(s, CommonDelayOf, kMinEmd, kMaxEmd, kDelayStep, kDelayStep, &s->common_delay_se);
+      moved |= s->common_delay != before;
+    }
+    if (s->twitch != 0) {
+      const double before = s->twitch;
+      loop.Search(s, TwitchOf, kMinTwitch, kMaxTwitch, kTwitchStep, kTwitchStep, &s->twitch_se);
+      moved |= s->twitch != before;
+    }
     for (auto& d : s->delay_s) {
       const double before = d.second;
       double se;
-      loop.Search(s, DelayOf(d.first), kDelayStep, kMaxDelay, kDelayStep, kDelayStep, &se);
+      loop.Search(s, DelayOf(d.first), kMinEmd, kMaxEmd, kDelayStep, kDelayStep, &se);
       s->delay_se[d.first] = se;
       moved |= s->delay_s[d.first] != before;
     }
@@ -202,6 +306,8 @@ void Refine(const Loop& loop, EmgModelSpec* s) {
 }
 
 void ProfileAll(const Loop& loop, EmgModelSpec* s) {
+  if (s->common_delay != 0) s->common_delay_se = loop.ProfileSe(*s, CommonDelayOf, kDelayStep);
+  if (s->twitch != 0) s->twitch_se = loop.ProfileSe(*s, TwitchOf, kTwitchStep);
   for (auto& d : s->delay_s) s->delay_se[d.first] = loop.ProfileSe(*s, DelayOf(d.first), kDelayStep);
   if (s->a_shape != 0) s->a_shape_se = loop.ProfileSe(*s, AShapeOf, 0.1);
 }
@@ -209,31 +315,94 @@ void ProfileAll(const Loop& loop, EmgModelSpec* s) {
 std::string Scores(const EmgTorqueModel& m) {
   std::string o;
   for (int j = 0; j < 2; ++j)
-    o += std::string(j ? "; " : "") + kJoint[j] + " held-out R^2 " + Num(m.figures[j].r2_heldout_trim) + ", rms " +
-         Num(m.figures[j].rms_heldout_trim) + " N m";
+    o += std::string(j ? "; " : "") + kJoint[j] + " cross-validated R^2 " + Num(m.figures[j].r2_cv) + ", last 30 % R^2 " +
+         Num(m.figures[j].r2_heldout_trim) + ", rms " + Num(m.figures[j].rms_heldout_trim) + " N m";
   return o;
+}
+
+
+// Muscles with several channels (the vasti, the two hamstrings) whose channels' alphas in `m` are
+// not separable: one of them against its muscle's action (HJ15 eq. 23-24 signs) beyond two
+// standard errors. `why` per muscle.
+std::map<Muscle, std::string> WrongSignMuscles(const EmgTorqueModel& m, const EmgRecording& r) {
+  std::map<Muscle, std::string> out;
+  for (const EmgTerm& t : m.terms) {
+    if (t.kind != TermKind::kAlpha || t.proxy || t.channel.find('+') != std::string::npos) continue;
+    if (std::count(r.muscle.begin(), r.muscle.end(), t.muscle) < 2) continue;
+    if (t.value * ActionSign(t.muscle, t.joint) < 0 && std::abs(t.value) > 2 * t.se)
+      out[t.muscle] += std::string(out[t.muscle].empty() ? "" : "; ") + t.Name() + " " + Num(t.value) + " +- " +
+                       Num(t.se) + " N m at the " + kJoint[t.joint];
+  }
+  return out;
+}
+
+// Envelope correlation of the first two channels of muscle `mu`.
+double ChannelCorrelation(const EmgRecording& r, Muscle mu) {
+  std::vector<size_t> ch;
+  for (size_t c = 0; c < r.channels.size(); ++c)
+    if (r.muscle[c] == mu) ch.push_back(c);
+  const std::vector<double>& x = r.e[ch[0]];
+  const std::vector<double>& y = r.e[ch[1]];
+  double mx = 0, my = 0, sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = 0; i < x.size(); ++i) mx += x[i], my += y[i];
+  mx /= static_cast<double>(x.size()), my /= static_cast<double>(y.size());
+  for (size_t i = 0; i < x.size(); ++i)
+    sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx), syy += (y[i] - my) * (y[i] - my);
+  return sxy / std::sqrt(sxx * syy);
 }
 
 }  // namespace
 
 EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const EmgDiagnoseOptions& opt) {
   if (recs.empty()) throw InputError("emg-fit: no recording");
+  if (recs.size() < 2 && opt.blocks < 2)
+    throw InputError("emg-fit: --blocks " + std::to_string(opt.blocks) + ": expected at least 2 cross-validation blocks");
   EmgDiagnosis d;
   d.holdout_fraction = opt.holdout_fraction;
-  d.leave_one_out = recs.size() >= 2;
+  d.folds_are_recordings = recs.size() >= 2;
+  d.folds = d.folds_are_recordings ? static_cast<int>(recs.size()) : opt.blocks;
   d.missing = recs[0]->missing;
   for (const EmgRecording* r : recs) {
     d.sources.push_back(r->source);
     for (const std::string& n : r->notes) d.notes.push_back(r->source + ": " + n);
   }
-  Loop loop(recs, 1 - opt.holdout_fraction);
+  Loop loop(recs, 1 - opt.holdout_fraction, opt.blocks);
   EmgModelSpec spec;
   EmgTorqueModel cur = loop.Baseline(spec);
   d.steps.push_back({"linear form (HJ15 eq. 26)", "the papers' model", cur});
-  d.selection.push_back("start: linear form (HJ15 eq. 26): " + Scores(cur));
-  const bool loo = d.leave_one_out;
+  d.selection.push_back("start: " + d.steps[0].added + ": " + Scores(cur));
+  const bool recs_out = d.folds_are_recordings;
+  const std::string fold_word = recs_out ? "recording" : "block";
   auto gain = [](double now, double before) { return before > 0 ? 100 * (1 - now / before) : 0.0; };
-  std::vector<Cause> causes;
+  // The validation gates of a candidate model `m` against the current one: cross-validated error
+  // (each fold left out in turn) drops by kMinHeldoutGain at a joint the cause acts on and in sum;
+  // with several recordings every recording left out in turn gains (sum over joints).
+  auto validate = [&](const EmgTorqueModel& m, const std::function<bool(int)>& acts, EmgCandidateScore* sc) {
+    bool enough = false;
+    double before = 0, after = 0;
+    for (int j = 0; j < 2; ++j) {
+      sc->gain_pct[j] = gain(m.sse_heldout[j], cur.sse_heldout[j]);
+      sc->cv_gain_pct[j] = gain(m.sse_cv[j], cur.sse_cv[j]);
+      enough |= acts(j) && sc->cv_gain_pct[j] >= 100 * kMinHeldoutGain;
+      before += cur.sse_cv[j], after += m.sse_cv[j];
+    }
+    if (!enough || !(after < before)) {
+      sc->verdict = "cross-validated gain below " + Num(100 * kMinHeldoutGain) + " % where it acts";
+      return false;
+    }
+    if (recs_out)
+      for (size_t k = 0; k < m.sse_fold.size(); ++k)
+        if (!(m.sse_fold[k][0] + m.sse_fold[k][1] < cur.sse_fold[k][0] + cur.sse_fold[k][1])) {
+          sc->verdict = "no gain on recording " + std::to_string(k + 1) + " left out (" + recs[k]->source + ")";
+          return false;
+        }
+    return true;
+  };
+  auto gains_text = [&](const EmgCandidateScore& sc) {
+    return "cross-validated gain (" + fold_word + "s left out) hip " + Num(sc.cv_gain_pct[0]) + " %, knee " +
+           Num(sc.cv_gain_pct[1]) + " %; last 30 % hip " + Num(sc.gain_pct[0]) + " %, knee " + Num(sc.gain_pct[1]) + " %";
+  };
+  std::vector<Cause> causes = {{Kind::kCommonDelay}, {Kind::kTwitch}, {Kind::kTiming}};
   for (int m = 0; m < kNumMuscles; ++m)
     if (std::find(recs[0]->muscle.begin(), recs[0]->muscle.end(), MuscleAt(m)) != recs[0]->muscle.end())
       causes.push_back({Kind::kDelay, MuscleAt(m)});
@@ -251,26 +420,16 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     const EmgTorqueModel m = loop.Fit(s);
     EmgCandidateScore sc;
     sc.label = Cause{Kind::kRobust}.Label();
-    double total_before = 0, total_after = 0;
-    bool enough = false;
-    for (int j = 0; j < 2; ++j) {
-      sc.gain_pct[j] = gain(m.sse_heldout[j], cur.sse_heldout[j]);
-      total_before += cur.sse_heldout[j], total_after += m.sse_heldout[j];
-      enough |= sc.gain_pct[j] >= 100 * kMinHeldoutGain;
-      if (loo) sc.left_out_gain_pct[j] = gain(m.sse_left_out[j], cur.sse_left_out[j]);
-    }
-    const bool loo_ok = !loo || m.sse_left_out[0] + m.sse_left_out[1] < cur.sse_left_out[0] + cur.sse_left_out[1];
-    sc.added = enough && total_after < total_before && loo_ok;
-    sc.verdict = sc.added ? "added: held-out error drops" : "not added: held-out gain below " + Num(100 * kMinHeldoutGain) + " %";
+    sc.added = validate(m, [](int) { return true; }, &sc);
+    if (sc.added) sc.verdict = "added: cross-validated error drops";
     d.scores.push_back(sc);
     if (sc.added) {
       spec = s, cur = m;
-      d.steps.push_back({sc.label, "fit rows beyond " + Num(kSpikeMads) + " scaled MADs of the median moment left out; held-out gain hip " +
-                                       Num(sc.gain_pct[0]) + " %, knee " + Num(sc.gain_pct[1]) + " %", cur});
+      d.steps.push_back({sc.label, "fit rows beyond " + Num(kSpikeMads) + " scaled MADs of the median moment left out; " +
+                                       gains_text(sc), cur});
       d.selection.push_back("add " + sc.label + ": " + Scores(cur));
     } else {
-      d.selection.push_back("robust fit not added: held-out gain hip " + Num(sc.gain_pct[0]) + " %, knee " +
-                            Num(sc.gain_pct[1]) + " % (needed " + Num(100 * kMinHeldoutGain) + " % at one joint)");
+      d.selection.push_back("robust fit not added: " + sc.verdict + " (" + gains_text(sc) + ")");
     }
   }
 
@@ -289,30 +448,23 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
       EmgCandidateScore sc;
       sc.round = round;
       sc.label = c.Label();
+      if (c.kind == Kind::kCommonDelay) sc.label += " " + Num(s.common_delay) + " s";
+      if (c.kind == Kind::kTwitch || c.kind == Kind::kTiming) sc.label += " tau " + Num(s.twitch) + " s";
+      if (c.kind == Kind::kTiming) sc.label += ", delay " + Num(s.common_delay) + " s";
       if (c.kind == Kind::kDelay) sc.label += " " + Num(s.Delay(c.muscle)) + " s";
       if (c.kind == Kind::kAShape) sc.label += " A = " + Num(s.a_shape);
       sc.delta_bic = m.bic - cur.bic;
-      bool enough = false;
-      double total_before = 0, total_after = 0, loo_before = 0, loo_after = 0;
-      bool loo_enough = !loo;
-      for (int j = 0; j < 2; ++j) {
-        sc.gain_pct[j] = gain(m.sse_heldout[j], cur.sse_heldout[j]);
-        if (loo) sc.left_out_gain_pct[j] = gain(m.sse_left_out[j], cur.sse_left_out[j]);
-        if (c.Acts(j) && sc.gain_pct[j] >= 100 * kMinHeldoutGain) {
-          enough = true;
-          if (loo && sc.left_out_gain_pct[j] >= 100 * kMinHeldoutGain) loo_enough = true;
-        }
-        total_before += cur.sse_heldout[j], total_after += m.sse_heldout[j];
-        loo_before += cur.sse_left_out[j], loo_after += m.sse_left_out[j];
-      }
       std::string why;
-      if (!(sc.delta_bic < -kBicMargin)) sc.verdict = "BIC drop " + Num(-sc.delta_bic) + " <= " + Num(kBicMargin);
-      else if (!enough || !(total_after < total_before))
-        sc.verdict = "held-out gain below " + Num(100 * kMinHeldoutGain) + " % where it acts";
-      else if (!loo_enough || (loo && !(loo_after < loo_before)))
-        sc.verdict = "no gain on whole recordings left out";
-      else if (!Admissible(c, m, &why)) sc.verdict = why;
-      else sc.verdict = "admissible";
+      if (!(sc.delta_bic < -kBicMargin)) {
+        sc.verdict = "BIC drop " + Num(-sc.delta_bic) + " <= " + Num(kBicMargin);
+        for (int j = 0; j < 2; ++j)
+          sc.gain_pct[j] = gain(m.sse_heldout[j], cur.sse_heldout[j]), sc.cv_gain_pct[j] = gain(m.sse_cv[j], cur.sse_cv[j]);
+      } else if (!validate(m, [&c](int j) { return c.Acts(j); }, &sc)) {
+      } else if (!Admissible(c, m, &why)) {
+        sc.verdict = "outside its range or not significant: " + why;
+      } else {
+        sc.verdict = "admissible";
+      }
       d.scores.push_back(sc);
       if (sc.verdict == "admissible") ok.push_back({c, s, m, d.scores.size() - 1});
     }
@@ -327,21 +479,55 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     spec = best->s;
     Refine(loop, &spec);
     cur = loop.Fit(spec);
-    const std::string why = "BIC " + Num(sc.delta_bic) + ", held-out gain hip " + Num(sc.gain_pct[0]) + " %, knee " +
-                            Num(sc.gain_pct[1]) + " %" +
-                            (loo ? ", left-out recordings hip " + Num(sc.left_out_gain_pct[0]) + " %, knee " +
-                                       Num(sc.left_out_gain_pct[1]) + " %"
-                                 : "");
+    const std::string why = "BIC " + Num(sc.delta_bic) + ", " + gains_text(sc);
     d.steps.push_back({sc.label, why, cur});
     d.selection.push_back("add " + sc.label + " (" + why + "): " + Scores(cur));
   }
+  // Collinear channels of one muscle (the vasti, the two hamstrings): when the chosen structure
+  // fitted on every sample gives one of them an alpha against the muscle's action, the channels are
+  // pooled (one alpha of their mean envelope) if the pooled alphas keep their expected signs and
+  // the cross-validated error rises by at most kParsimony; otherwise they are reported as not
+  // separable.
+  {
+    Loop all(recs, 1.0, opt.blocks);
+    const EmgTorqueModel full = all.Fit(spec);
+    for (const auto& w : WrongSignMuscles(full, *recs[0])) {
+      EmgModelSpec s = spec;
+      s.pooled.push_back(w.first);
+      const EmgTorqueModel pooled = all.Fit(s);
+      bool signs = true;
+      for (const EmgTerm& t : pooled.terms)
+        if (t.kind == TermKind::kAlpha && t.muscle == w.first && !t.proxy && t.value * ActionSign(w.first, t.joint) < 0 &&
+            std::abs(t.value) > 2 * t.se)
+          signs = false;
+      const double before = full.sse_cv[0] + full.sse_cv[1], after = pooled.sse_cv[0] + pooled.sse_cv[1];
+      const std::string what = std::string(MuscleName(w.first)) + "'s channels (" + w.second + ", against the muscle's action; " +
+                               "envelope correlation " + Num(ChannelCorrelation(*recs[0], w.first)) + ")";
+      if (signs && after <= (1 + kParsimony) * before) {
+        spec = s;
+        cur = loop.Fit(spec);
+        d.steps.push_back({"pooled " + std::string(MuscleName(w.first)) + " channels", what, cur});
+        d.selection.push_back("pool " + what + ": " + Scores(cur));
+        d.notes.push_back(what + ": pooled, one alpha of their mean envelope");
+      } else {
+        d.notes.push_back(what + ": not separable (pooled, " +
+                          (signs ? "the cross-validated error rises by " + Num(100 * (after / before - 1)) + " %"
+                                 : std::string("their alpha is still against the action")) +
+                          "); kept apart, their alphas are not physiological");
+      }
+    }
+  }
   // The calibration: the chosen structure fitted on every sample.
   {
-    Loop all(recs, 1.0);
+    Loop all(recs, 1.0, opt.blocks);
     EmgFitOptions& o = all.options();
     o.autocorr_rows = 0;
     ProfileAll(all, &spec);
     d.calibration = all.Fit(spec);
+    // Outside the calibrated angles the angle-dependent terms continue as emg_torque_model.h says.
+    d.calibration.spec.bounded = true;
+    for (int j = 0; j < 2; ++j)
+      d.calibration.spec.q_lo[j] = d.calibration.range.q_lo[j], d.calibration.spec.q_hi[j] = d.calibration.range.q_hi[j];
   }
   // Channels whose fitted alpha contradicts their muscle's action (HJ15 eq. 23-24 signs): crosstalk,
   // a channel standing for a missing muscle, or collinearity; reported, not constrained.

@@ -1,20 +1,27 @@
 // The discrepancy loop of the EMG-driven joint-torque model (issue 19; emg-fit --report): starting
 // from the linear form of HJ15 eq. 26-27, candidate causes of what it misses are added one at a time,
-// only when they pay on held-out data, with the gates of diagnose's selection (diagnose_select.h):
+// only when they generalize, with the gates of diagnose's selection (diagnose_select.h):
 //  - the Bayesian information criterion (effective sample size from the residual autocorrelation,
 //    every searched parameter counted) drops by more than kBicMargin;
-//  - the held-out error drops by at least kMinHeldoutGain at a joint the cause acts on, and in sum
-//    over both joints (the last 30 % of every recording, samples within kSpikeMads of the median
-//    moment; with several recordings, also every whole recording left out in turn);
+//  - the cross-validated error drops by at least kMinHeldoutGain at a joint the cause acts on, and
+//    in sum over both joints: with several recordings, each recording is left out in turn and
+//    predicted by the fit on the others, and every one of them must gain; with one recording, its
+//    `blocks` contiguous blocks are left out in turn (scores over samples within kSpikeMads of the
+//    median moment). The last 30 % of every recording is scored too, for comparison only;
 //  - the cause's parameter is significant (|t| > kMinT: coefficients by least squares, searched
-//    parameters by the profile of the sum of squares) and inside its physiological range.
+//    parameters by the profile of the sum of squares) and inside its physiological range (a cause
+//    outside it is listed with its verdict, not named).
 // Among the admissible causes the one with the lowest BIC is added; the searched parameters are then
-// refined together. Searched parameters are chosen on the fit rows only (never on held-out rows).
-// Candidates (emg_torque_model.h): electromechanical delay per twin muscle (0-200 ms), the A-shape
-// activation nonlinearity (-3 <= A < 0), angle-dependent moment arms per joint, the passive moment
-// per joint, the vasti standing in for a missing gluteus maximus at the hip. The robust handling of
-// contact spikes (fit rows beyond kSpikeMads left out) is decided first, because it changes the rows
-// every other cause is fitted on; it must pay on held-out data like the others.
+// refined together, on the first 70 % of every recording (the BIC's rows).
+// Candidates (emg_torque_model.h): one electromechanical delay common to every channel, then (fewer
+// parameters first) a muscle's own delay (searched on 0-200 ms, named within 10-100 ms), the A-shape
+// activation nonlinearity (-3 < A < 0), angle-dependent moment arms per joint (keeping their sign,
+// changing by at most a factor 3 over the calibrated angles), the passive moment per joint (scale in
+// (0, 3]), the vasti standing in for a missing gluteus maximus at the hip. Channels of one muscle
+// whose alphas are not separable (one against the muscle's action in the linear form) are pooled
+// before the loop. The robust handling of contact spikes (fit rows beyond kSpikeMads left out) is
+// decided first, because it changes the rows every other cause is fitted on; it must pay on the
+// cross-validation like the others.
 #pragma once
 #include <string>
 #include <vector>
@@ -33,8 +40,8 @@ struct EmgCandidateScore {
   int round = 0;
   std::string label;
   double delta_bic = 0;
-  double gain_pct[2] = {0, 0};           // held-out SSE drop per joint, %
-  double left_out_gain_pct[2] = {0, 0};  // with several recordings
+  double gain_pct[2] = {0, 0};     // last-30 % held-out SSE drop per joint, % (for comparison)
+  double cv_gain_pct[2] = {0, 0};  // cross-validated SSE drop per joint, % (the gate)
   bool added = false;
   std::string verdict;  // why it was or was not added
 };
@@ -45,7 +52,8 @@ struct EmgDiagnosis {
   std::vector<std::string> selection;      // the loop's steps in words
   EmgTorqueModel calibration;              // the final structure fitted on every sample of every recording
   double holdout_fraction = 0.3;
-  bool leave_one_out = false;
+  bool folds_are_recordings = false;  // several recordings: each left out in turn; else blocks
+  int folds = 0;
   std::vector<std::string> sources, notes, missing;
   // First recording, for plots: time, measured and estimated moments (linear, final) on all samples
   // (the held-out part starts at `split`), estimated by the fits on the first 70 %.
@@ -57,6 +65,7 @@ struct EmgDiagnoseOptions {
   double holdout_fraction = 0.3;
   int max_steps = 10;
   bool robust_candidate = true;  // consider the robust fit
+  int blocks = 5;                // one recording: contiguous cross-validation blocks (>= 2)
 };
 
 // Runs the loop on recordings with moments (same mapped channels). Throws InputError on unusable input.

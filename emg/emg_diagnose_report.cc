@@ -34,6 +34,11 @@ nlohmann::json Effects(const EmgDiagnosis& d) {
   using nlohmann::json;
   json a = json::array();
   const EmgTorqueModel& m = d.calibration;
+  if (m.spec.common_delay != 0) {
+    const double v = m.spec.common_delay, se = m.spec.common_delay_se;
+    a.push_back({{"name", "electromechanical_delay"}, {"muscle", "common"}, {"joint", "hip+knee"}, {"value", v},
+                 {"unit", "s"}, {"ci95", {v - 1.96 * se, v + 1.96 * se}}});
+  }
   for (const auto& dl : m.spec.delay_s) {
     const double se = m.spec.delay_se.count(dl.first) ? m.spec.delay_se.at(dl.first) : 0.0;
     a.push_back({{"name", "electromechanical_delay"}, {"muscle", MuscleName(dl.first)}, {"joint", Joints(dl.first)},
@@ -58,6 +63,15 @@ nlohmann::json Effects(const EmgDiagnosis& d) {
 }
 
 
+std::string Validation(const EmgDiagnosis& d) {
+  return std::string("causes chosen by cross-validation: ") +
+         (d.folds_are_recordings ? "each of the " + std::to_string(d.folds) + " recordings left out in turn"
+                                 : std::to_string(d.folds) + " contiguous blocks of the recording left out in turn") +
+         "; also fit on the first " + NumberText(100 * (1 - d.holdout_fraction)) +
+         " % of every recording and scored on the rest, for comparison; scores over samples within " +
+         NumberText(kSpikeMads) + " scaled MADs of the median moment";
+}
+
 }  // namespace
 
 std::string EmgDiagnosisJson(const EmgDiagnosis& d) {
@@ -68,26 +82,28 @@ std::string EmgDiagnosisJson(const EmgDiagnosis& d) {
   const EmgTorqueModel& last = d.steps.back().model;
   for (int k = 0; k < 2; ++k) {
     const double b = first.figures[k].rms_heldout_trim, a = last.figures[k].rms_heldout_trim;
+    const double cb = first.figures[k].rms_cv, ca = last.figures[k].rms_cv;
     j["joints"][kJoint[k]] = {{"rmse_before", b}, {"rmse_after", a}, {"gain_pct", b > 0 ? 100 * (1 - a / b) : 0.0},
+                              {"cv_rmse_before", cb}, {"cv_rmse_after", ca},
+                              {"cv_gain_pct", cb > 0 ? 100 * (1 - ca / cb) : 0.0},
+                              {"cv_r2_before", first.figures[k].r2_cv}, {"cv_r2_after", last.figures[k].r2_cv},
                               {"r2_before", first.figures[k].r2_heldout_trim},
                               {"r2_after", last.figures[k].r2_heldout_trim},
                               {"r2_before_all_samples", first.figures[k].r2_heldout},
                               {"r2_after_all_samples", last.figures[k].r2_heldout}};
   }
-  j["validation"] = {{"method", "fit on the first " + NumberText(100 * (1 - d.holdout_fraction)) +
-                                    " % of every recording, scored on the rest" +
-                                    (d.leave_one_out ? " and on every recording left out in turn" : "") +
-                                    "; scores over samples within " + NumberText(kSpikeMads) +
-                                    " scaled MADs of the median moment"},
+  j["validation"] = {{"method", Validation(d)},
                      {"holdout_fraction", d.holdout_fraction},
-                     {"leave_one_record_out", d.leave_one_out}};
+                     {"folds", d.folds},
+                     {"leave_one_record_out", d.folds_are_recordings}};
   j["selection"] = d.selection;
   j["steps"] = json::array();
   for (const EmgStep& s : d.steps) {
     json x = {{"added", s.added}, {"why", s.why}, {"bic", s.model.bic}};
     for (int k = 0; k < 2; ++k) {
       const EmgJointFigures& F = s.model.figures[k];
-      x[kJoint[k]] = {{"r2_fit", F.r2_fit}, {"r2_heldout", F.r2_heldout_trim}, {"rms_heldout", F.rms_heldout_trim},
+      x[kJoint[k]] = {{"r2_cv", F.r2_cv}, {"rms_cv", F.rms_cv},
+                      {"r2_fit", F.r2_fit}, {"r2_heldout", F.r2_heldout_trim}, {"rms_heldout", F.rms_heldout_trim},
                       {"r2_heldout_all_samples", F.r2_heldout}, {"rms_heldout_all_samples", F.rms_heldout}};
     }
     j["steps"].push_back(x);
@@ -95,9 +111,9 @@ std::string EmgDiagnosisJson(const EmgDiagnosis& d) {
   j["candidates"] = json::array();
   for (const EmgCandidateScore& c : d.scores) {
     json x = {{"round", c.round}, {"label", c.label}, {"delta_bic", c.delta_bic},
-              {"heldout_gain_pct", {{"hip", c.gain_pct[0]}, {"knee", c.gain_pct[1]}}}, {"selected", c.added},
+              {"heldout_gain_pct", {{"hip", c.gain_pct[0]}, {"knee", c.gain_pct[1]}}},
+              {"cv_gain_pct", {{"hip", c.cv_gain_pct[0]}, {"knee", c.cv_gain_pct[1]}}}, {"selected", c.added},
               {"verdict", c.verdict}};
-    if (d.leave_one_out) x["left_out_gain_pct"] = {{"hip", c.left_out_gain_pct[0]}, {"knee", c.left_out_gain_pct[1]}};
     j["candidates"].push_back(x);
   }
   j["missing_channels"] = d.missing;
@@ -113,21 +129,20 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
        "td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}</style></head><body>\n"
        "<h1>exotwin EMG model diagnosis</h1><p>Recordings: ";
   for (size_t i = 0; i < d.sources.size(); ++i) o << (i ? ", " : "") << "<code>" << HtmlEscape(d.sources[i]) << "</code>";
-  o << ". Fit on the first " << NumberText(100 * (1 - d.holdout_fraction)) << " % of every recording, scored on the rest"
-    << (d.leave_one_out ? " and on each recording left out in turn" : "") << "; held-out scores over the samples within "
-    << NumberText(kSpikeMads) << " scaled MADs of the median moment (contact spikes of inverse dynamics left out "
-                                 "for every model alike).</p>";
+  o << ". " << HtmlEscape(Validation(d)) << " (contact spikes of inverse dynamics left out for every model alike).</p>";
   if (!d.notes.empty()) {
     o << "<ul>";
     for (const auto& n : d.notes) o << "<li>" << HtmlEscape(n) << "</li>";
     o << "</ul>";
   }
   o << "<h2>Steps from the linear form to the final model</h2><table><tr><th>step</th><th>added</th><th>why</th>"
-       "<th>hip R&sup2; held-out</th><th>hip rms (N m)</th><th>knee R&sup2; held-out</th><th>knee rms (N m)</th>"
-       "<th>hip / knee R&sup2; all held-out samples</th></tr>";
+       "<th>hip R&sup2; cross-validated</th><th>knee R&sup2; cross-validated</th>"
+       "<th>hip R&sup2; last 30 %</th><th>hip rms (N m)</th><th>knee R&sup2; last 30 %</th><th>knee rms (N m)</th>"
+       "<th>hip / knee R&sup2; all last-30 % samples</th></tr>";
   for (size_t i = 0; i < d.steps.size(); ++i) {
     const auto& F = d.steps[i].model.figures;
     o << "<tr><td>" << i << "</td><td>" << HtmlEscape(d.steps[i].added) << "</td><td>" << HtmlEscape(d.steps[i].why) << "</td><td>"
+      << NumberText(F[0].r2_cv, 3) << "</td><td>" << NumberText(F[1].r2_cv, 3) << "</td><td>"
       << NumberText(F[0].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[0].rms_heldout_trim, 3) << "</td><td>"
       << NumberText(F[1].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[1].rms_heldout_trim, 3) << "</td><td>"
       << NumberText(F[0].r2_heldout, 3) << " / " << NumberText(F[1].r2_heldout, 3) << "</td></tr>";
@@ -150,14 +165,12 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
   }
   o << "<h2>Selection</h2><ol>";
   for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
-  o << "</ol><h2>Candidates</h2><table><tr><th>round</th><th>candidate</th><th>&Delta;BIC</th><th>held-out gain hip</th>"
-       "<th>knee</th>"
-    << (d.leave_one_out ? "<th>left-out hip</th><th>left-out knee</th>" : "") << "<th>verdict</th></tr>";
+  o << "</ol><h2>Candidates</h2><table><tr><th>round</th><th>candidate</th><th>&Delta;BIC</th><th>cross-validated gain hip</th>"
+       "<th>knee</th><th>last-30 % gain hip</th><th>knee</th><th>verdict</th></tr>";
   for (const auto& c : d.scores) {
     o << "<tr><td>" << c.round << "</td><td>" << HtmlEscape(c.label) << "</td><td>" << NumberText(c.delta_bic, 4) << "</td><td>"
+      << NumberText(c.cv_gain_pct[0], 3) << " %</td><td>" << NumberText(c.cv_gain_pct[1], 3) << " %</td><td>"
       << NumberText(c.gain_pct[0], 3) << " %</td><td>" << NumberText(c.gain_pct[1], 3) << " %</td>";
-    if (d.leave_one_out)
-      o << "<td>" << NumberText(c.left_out_gain_pct[0], 3) << " %</td><td>" << NumberText(c.left_out_gain_pct[1], 3) << " %</td>";
     o << "<td>" << (c.added ? "<b>" : "") << HtmlEscape(c.verdict) << (c.added ? "</b>" : "") << "</td></tr>";
   }
   o << "</table>";

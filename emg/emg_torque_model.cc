@@ -39,11 +39,13 @@ bool MuscleByName(const std::string& s, Muscle* m) {
 
 double EmgModelSpec::Delay(Muscle m) const {
   const auto it = delay_s.find(m);
-  return it == delay_s.end() ? 0.0 : it->second;
+  return it == delay_s.end() ? common_delay : it->second;
 }
 
+bool EmgModelSpec::Pooled(Muscle m) const { return std::find(pooled.begin(), pooled.end(), m) != pooled.end(); }
+
 int EmgTorqueModel::nonlinear_parameters() const {
-  int n = spec.a_shape != 0 ? 1 : 0;
+  int n = (spec.a_shape != 0 ? 1 : 0) + (spec.common_delay != 0 ? 1 : 0) + (spec.twitch != 0 ? 1 : 0);
   for (const auto& d : spec.delay_s) n += d.second != 0 ? 1 : 0;
   return n;
 }
@@ -86,6 +88,13 @@ std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec) 
     for (size_t c = 0; c < rec.channels.size(); ++c) {
       EmgTerm t;
       t.joint = j, t.kind = TermKind::kAlpha, t.channel = rec.channels[c], t.muscle = rec.muscle[c];
+      if (spec.Pooled(t.muscle)) {  // one term of the muscle's channels: "a+b"
+        bool first = true;
+        for (size_t k = 0; k < c; ++k) first &= rec.muscle[k] != t.muscle;
+        if (!first) continue;
+        for (size_t k = c + 1; k < rec.channels.size(); ++k)
+          if (rec.muscle[k] == t.muscle) t.channel += "+" + rec.channels[k];
+      }
       if (ActionSign(rec.muscle[c], j) != 0) alphas.push_back(t);
       else if (j == 0 && spec.gmax_proxy && gmax_missing && rec.muscle[c] == Muscle::kVM)
         t.proxy = true, alphas.push_back(t);
@@ -109,25 +118,79 @@ std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec) 
 
 double ActivationShape(double u, double A) {
   if (A == 0) return u;
-  return std::expm1(A * u) / std::expm1(A);
+  const double den = std::expm1(A);
+  if (u < 0) return u * A / den;                                  // a(0) = 0, a'(0) = A / (e^A - 1)
+  if (u > 1) return 1 + (u - 1) * A * std::exp(A) / den;          // a(1) = 1, a'(1) = A e^A / (e^A - 1)
+  return std::expm1(A * u) / den;
 }
+
+std::vector<double> TwitchFilter(const std::vector<double>& t, const std::vector<double>& u, double tau) {
+  if (tau <= 0 || u.empty()) return u;
+  // Two first-order stages x' = (in - x) / tau, each discretized exactly for an input held over
+  // the step: x_i = p x_{i-1} + (1 - p) in_i, p = exp(-dt_i / tau).
+  std::vector<double> y(u.size());
+  double x1 = u[0], x2 = u[0];
+  for (size_t i = 0; i < u.size(); ++i) {
+    const double p = i ? std::exp(-(t[i] - t[i - 1]) / tau) : 1.0;
+    x1 = p * x1 + (1 - p) * u[i];
+    x2 = p * x2 + (1 - p) * x1;
+    y[i] = x2;
+  }
+  return y;
+}
+
+std::vector<double> ChannelEnvelope(const EmgRecording& rec, const std::string& channel) {
+  std::vector<double> sum(rec.size(), 0.0);
+  int n = 0;
+  for (size_t a = 0; a <= channel.size();) {
+    size_t b = channel.find('+', a);
+    if (b == std::string::npos) b = channel.size();
+    const std::string name = channel.substr(a, b - a);
+    const int c = ChannelIndex(rec, name);
+    if (c < 0) throw InputError(rec.source + ": no EMG channel '" + name + "' (the model uses it)");
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += rec.e[c][i];
+    ++n, a = b + 1;
+  }
+  for (double& v : sum) v /= n;
+  return sum;
+}
+
+namespace {
+
+// Riener & Edrich's passive moment along coordinate j (minus P of HJ15 eq. 1) at (q0, q1); with a
+// calibration range, continued along its tangent outside it (header).
+double PassiveAlong(const EmgModelSpec& spec, int j, double q0, double q1) {
+  auto P = [j](double a, double b) {
+    return -PassiveElasticTorque(PassiveModel::kRiener1999, Eigen::Vector2d(a, b))[j];
+  };
+  if (!spec.bounded) return P(q0, q1);
+  const double c0 = std::clamp(q0, spec.q_lo[0], spec.q_hi[0]), c1 = std::clamp(q1, spec.q_lo[1], spec.q_hi[1]);
+  if (c0 == q0 && c1 == q1) return P(q0, q1);
+  constexpr double h = 1e-4;  // rad: central differences of a smooth sum of exponentials
+  return P(c0, c1) + (P(c0 + h, c1) - P(c0 - h, c1)) / (2 * h) * (q0 - c0) +
+         (P(c0, c1 + h) - P(c0, c1 - h)) / (2 * h) * (q1 - c1);
+}
+
+}  // namespace
 
 std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, const EmgRecording& rec) {
   const size_t n = rec.size();
   const int j = term.joint;
   std::vector<double> v(n);
   if (term.kind == TermKind::kAlpha || term.kind == TermKind::kAlphaQ) {
-    const int c = ChannelIndex(rec, term.channel);
-    if (c < 0) throw InputError(rec.source + ": no EMG channel '" + term.channel + "' (the model uses it)");
+    std::vector<double> u = ChannelEnvelope(rec, term.channel);
     const double d = spec.Delay(term.muscle);
-    std::vector<double> u = rec.e[c];
     if (d != 0) {
       std::vector<double> tq(n);
       for (size_t i = 0; i < n; ++i) tq[i] = rec.t[i] - d;
-      u = Interpolate(rec.t, rec.e[c], tq);
+      u = Interpolate(rec.t, u, tq);
     }
-    for (size_t i = 0; i < n; ++i)
-      v[i] = ActivationShape(u[i], spec.a_shape) * (term.kind == TermKind::kAlphaQ ? rec.q[j][i] : 1.0);
+    u = TwitchFilter(rec.t, u, spec.twitch);
+    for (size_t i = 0; i < n; ++i) {
+      double q = rec.q[j][i];
+      if (spec.bounded) q = std::clamp(q, spec.q_lo[j], spec.q_hi[j]);
+      v[i] = ActivationShape(u[i], spec.a_shape) * (term.kind == TermKind::kAlphaQ ? q : 1.0);
+    }
     return v;
   }
   for (size_t i = 0; i < n; ++i) {
@@ -136,7 +199,7 @@ std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, co
       case TermKind::kGamma: v[i] = rec.qd[j][i]; break;
       case TermKind::kOffset: v[i] = 1.0; break;
       case TermKind::kPassive:  // P of HJ15 eq. 1 is minus the passive moment along the coordinate
-        v[i] = -PassiveElasticTorque(PassiveModel::kRiener1999, Eigen::Vector2d(rec.q[0][i], rec.q[1][i]))[j];
+        v[i] = PassiveAlong(spec, j, rec.q[0][i], rec.q[1][i]);
         break;
       default: break;
     }
@@ -217,25 +280,39 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
     if (!(var > 0)) throw InputError(recs[0]->source + ": the " + kJointName[j] + " moment is constant");
     w[j] = 1 / std::sqrt(var);
   }
-  // Unweighted columns per recording (for predictions) and the weighted banks.
+  // Cross-validation folds: the recordings, or contiguous blocks of the one recording.
+  struct Fold {
+    size_t rec, a, b;
+  };
+  std::vector<Fold> folds;
+  model.folds_are_recordings = recs.size() >= 2;
+  if (model.folds_are_recordings) {
+    for (size_t k = 0; k < recs.size(); ++k) folds.push_back({k, 0, recs[k]->size()});
+  } else {
+    const size_t m = recs[0]->size(), K = static_cast<size_t>(std::max(1, opt.blocks));
+    for (size_t f = 0; f < K; ++f) folds.push_back({0, f * m / K, (f + 1) * m / K});
+  }
+  // Unweighted columns per recording (for predictions) and the weighted banks, one per fold (its
+  // fit rows first, as MakeGrams expects).
   std::vector<std::vector<std::vector<double>>> cols(recs.size());
+  for (size_t k = 0; k < recs.size(); ++k)
+    for (const EmgTerm& t : model.terms) cols[k].push_back(TermColumn(t, spec, *recs[k]));
   std::vector<ColumnBank> banks;
-  for (size_t k = 0; k < recs.size(); ++k) {
-    const EmgRecording& r = *recs[k];
-    const size_t m = r.size(), mtr = n_train(r);
-    for (const EmgTerm& t : model.terms) cols[k].push_back(TermColumn(t, spec, r));
+  for (const Fold& fo : folds) {
+    const EmgRecording& r = *recs[fo.rec];
+    const size_t m = fo.b - fo.a, mtr = n_train(r);
     ColumnBank b;
     b.n = m;
-    for (size_t i = 0; i < m; ++i) b.sample.push_back(i), b.train.push_back(i < mtr);
+    for (size_t i = fo.a; i < fo.b; ++i) b.sample.push_back(i), b.train.push_back(i < mtr);
     b.X = Eigen::MatrixXd::Zero(2 * static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(T));
     b.r = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(m));
     for (int j = 0; j < 2; ++j)
-      for (size_t i = 0; i < m; ++i) {
-        if (!keep[j][k][i]) continue;
-        const Eigen::Index row = j * static_cast<Eigen::Index>(m) + static_cast<Eigen::Index>(i);
+      for (size_t i = fo.a; i < fo.b; ++i) {
+        if (!keep[j][fo.rec][i]) continue;
+        const Eigen::Index row = j * static_cast<Eigen::Index>(m) + static_cast<Eigen::Index>(i - fo.a);
         b.r[row] = w[j] * r.tau[j][i];
         for (size_t c = 0; c < T; ++c)
-          if (model.terms[c].joint == j) b.X(row, static_cast<Eigen::Index>(c)) = w[j] * cols[k][c][i];
+          if (model.terms[c].joint == j) b.X(row, static_cast<Eigen::Index>(c)) = w[j] * cols[fo.rec][c][i];
       }
     b.used = static_cast<int>(T);
     banks.push_back(std::move(b));
@@ -280,7 +357,43 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
   for (size_t c = 0; c < T; ++c) model.terms[c].value = f.coef[static_cast<Eigen::Index>(c)], model.terms[c].se = f.se[static_cast<Eigen::Index>(c)];
   model.bic = f.bic + model.nonlinear_parameters() * std::log(g.n_eff);
   model.sse_fit = f.sse_tr, model.n_fit = g.n_tr;
-  for (int j = 0; j < 2; ++j) model.sse_heldout[j] = f.sse_te_j[j], model.sse_left_out[j] = f.sse_loo_j[j];
+  for (int j = 0; j < 2; ++j) model.sse_heldout[j] = f.sse_te_j[j];
+  model.range = RangeOf(recs);
+  // Cross-validation: each fold predicted by the coefficients fitted on the others' rows, scored on
+  // its samples within kSpikeMads of the recording's median moment.
+  {
+    std::vector<std::vector<char>> score[2];
+    for (int j = 0; j < 2; ++j)
+      for (const EmgRecording* r : recs) {
+        std::vector<char> k(r->size(), 0);
+        for (size_t i : WithinSpikeLimit(r->tau[j], 0, r->size())) k[i] = 1;
+        score[j].push_back(std::move(k));
+      }
+    std::vector<double> meas[2], res[2];
+    for (size_t fi = 0; fi < folds.size() && folds.size() >= 2; ++fi) {
+      const Fold& fo = folds[fi];
+      const Eigen::VectorXd x = FitLeavingOut(g, all, fi);
+      std::array<double, 2> sse = {0, 0};
+      for (int j = 0; j < 2; ++j)
+        for (size_t i = fo.a; i < fo.b; ++i) {
+          if (!score[j][fo.rec][i]) continue;
+          double p = 0;
+          for (size_t c = 0; c < T && x.size() > 0; ++c)
+            if (model.terms[c].joint == j) p += x[static_cast<Eigen::Index>(c)] * cols[fo.rec][c][i];
+          const double e = x.size() > 0 ? recs[fo.rec]->tau[j][i] - p : 1e150;  // unidentifiable without it
+          sse[j] += w[j] * w[j] * e * e;
+          meas[j].push_back(recs[fo.rec]->tau[j][i]), res[j].push_back(e);
+        }
+      model.sse_fold.push_back(sse);
+      for (int j = 0; j < 2; ++j) model.sse_cv[j] += sse[j];
+    }
+    for (int j = 0; j < 2; ++j) {
+      std::vector<double> pred(res[j].size());
+      std::vector<size_t> idx(res[j].size());
+      for (size_t i = 0; i < idx.size(); ++i) idx[i] = i, pred[i] = meas[j][i] - res[j][i];
+      ScoreSamples(meas[j], pred, idx, &model.figures[j].r2_cv, &model.figures[j].rms_cv);
+    }
+  }
   // Figures pooled over recordings.
   for (int j = 0; j < 2; ++j) {
     std::vector<double> mf, pf, mh, ph, mt, pt;
@@ -311,6 +424,52 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
   return model;
 }
 
+EmgCalibrationRange RangeOf(const std::vector<const EmgRecording*>& recs) {
+  EmgCalibrationRange g;
+  if (recs.empty()) return g;
+  g.channels = recs[0]->channels;
+  g.e_lo.assign(g.channels.size(), 1e300), g.e_hi.assign(g.channels.size(), -1e300);
+  for (int j = 0; j < 2; ++j) g.q_lo[j] = g.qd_lo[j] = 1e300, g.q_hi[j] = g.qd_hi[j] = -1e300;
+  for (const EmgRecording* r : recs) {
+    for (size_t c = 0; c < g.channels.size(); ++c) {
+      const auto mm = std::minmax_element(r->e[c].begin(), r->e[c].end());
+      g.e_lo[c] = std::min(g.e_lo[c], *mm.first), g.e_hi[c] = std::max(g.e_hi[c], *mm.second);
+    }
+    for (int j = 0; j < 2; ++j) {
+      const auto q = std::minmax_element(r->q[j].begin(), r->q[j].end());
+      const auto qd = std::minmax_element(r->qd[j].begin(), r->qd[j].end());
+      g.q_lo[j] = std::min(g.q_lo[j], *q.first), g.q_hi[j] = std::max(g.q_hi[j], *q.second);
+      g.qd_lo[j] = std::min(g.qd_lo[j], *qd.first), g.qd_hi[j] = std::max(g.qd_hi[j], *qd.second);
+    }
+  }
+  return g;
+}
+
+EmgExtrapolation ExtrapolationOf(const EmgCalibrationRange& g, const EmgRecording& rec) {
+  EmgExtrapolation x;
+  const double n = static_cast<double>(std::max<size_t>(1, rec.size()));
+  auto share = [n](const std::vector<double>& v, double lo, double hi) {
+    double out = 0;
+    for (double y : v) out += (y < lo || y > hi) ? 1 : 0;
+    return out / n;
+  };
+  for (size_t c = 0; c < rec.channels.size(); ++c) {
+    x.channels.push_back(rec.channels[c]);
+    const auto it = std::find(g.channels.begin(), g.channels.end(), rec.channels[c]);
+    if (it == g.channels.end()) {
+      x.envelope_share.push_back(1.0);
+      continue;
+    }
+    const size_t k = static_cast<size_t>(it - g.channels.begin());
+    x.envelope_share.push_back(share(rec.e[c], g.e_lo[k], g.e_hi[k]));
+  }
+  for (int j = 0; j < 2; ++j) {
+    x.angle_share[j] = share(rec.q[j], g.q_lo[j], g.q_hi[j]);
+    x.velocity_share[j] = share(rec.qd[j], g.qd_lo[j], g.qd_hi[j]);
+  }
+  return x;
+}
+
 // ---- EMGMODEL.yaml ----
 
 std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>& header) {
@@ -319,20 +478,27 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
   o << "# EMG-driven joint moment per joint (N m, along the coordinate: hip flexion +, knee extension +):\n"
        "#   tau = sum (alpha + alpha_q q) a(e(t - delay)) + beta q + gamma qd + offset + passive_scale M_P(q)\n"
        "#   a(u) = (exp(A u) - 1) / (exp(A) - 1) (Lloyd & Besier 2003; A = 0: a = u), M_P: Riener & Edrich 1999\n"
+       "#   e filtered by the muscle twitch (critically damped, time constant tau; 0: none) before a(u)\n"
        "# se: standard error (residual autocorrelation taken into account); alpha per unit envelope.\n";
   o << "model: emg_torque_hj15\n";
   o << "activation: {A_shape: " << NumberText(m.spec.a_shape, 10) << ", se: " << NumberText(m.spec.a_shape_se, 4)
     << ", unit: \"1\"}\n";
+  o << "twitch: {tau: " << NumberText(m.spec.twitch, 10) << ", se: " << NumberText(m.spec.twitch_se, 4) << ", unit: s}\n";
   o << "delays:";
-  if (m.spec.delay_s.empty()) o << " {}";
+  if (m.spec.delay_s.empty() && m.spec.common_delay == 0) o << " {}";
   o << "\n";
+  if (m.spec.common_delay != 0)
+    o << "  common: {value: " << NumberText(m.spec.common_delay, 10) << ", se: " << NumberText(m.spec.common_delay_se, 4)
+      << ", unit: s}\n";
   for (const auto& d : m.spec.delay_s)
     o << "  " << MuscleName(d.first) << ": {value: " << NumberText(d.second, 10) << ", se: "
       << NumberText(m.spec.delay_se.count(d.first) ? m.spec.delay_se.at(d.first) : 0.0, 4) << ", unit: s}\n";
   auto yn = [](bool b) { return b ? "true" : "false"; };
   o << "structure:\n  moment_arm: {hip: " << yn(m.spec.moment_arm[0]) << ", knee: " << yn(m.spec.moment_arm[1])
     << "}\n  passive: {hip: " << yn(m.spec.passive[0]) << ", knee: " << yn(m.spec.passive[1])
-    << "}\n  gmax_proxy: " << yn(m.spec.gmax_proxy) << "\n  robust_fit: " << yn(m.spec.robust) << "\n";
+    << "}\n  gmax_proxy: " << yn(m.spec.gmax_proxy) << "\n  robust_fit: " << yn(m.spec.robust) << "\n  pooled: [";
+  for (size_t i = 0; i < m.spec.pooled.size(); ++i) o << (i ? ", " : "") << MuscleName(m.spec.pooled[i]);
+  o << "]\n";
   o << "missing_channels: [";
   for (size_t i = 0; i < m.missing.size(); ++i) o << (i ? ", " : "") << m.missing[i];
   o << "]\nautocorrelation_rows: " << NumberText(m.autocorr_rows, 6) << "\n";
@@ -350,10 +516,21 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
         << "\"}\n";
     }
   }
-  o << "fit:\n";
+  if (!m.range.empty()) {
+    auto pair = [](double a, double b) { return "[" + NumberText(a, 6) + ", " + NumberText(b, 6) + "]"; };
+    o << "calibration_range:\n  envelope: {";
+    for (size_t c = 0; c < m.range.channels.size(); ++c)
+      o << (c ? ", " : "") << m.range.channels[c] << ": " << pair(m.range.e_lo[c], m.range.e_hi[c]);
+    o << "}\n  angle: {hip: " << pair(m.range.q_lo[0], m.range.q_hi[0]) << ", knee: " << pair(m.range.q_lo[1], m.range.q_hi[1])
+      << ", unit: rad}\n  velocity: {hip: " << pair(m.range.qd_lo[0], m.range.qd_hi[0])
+      << ", knee: " << pair(m.range.qd_lo[1], m.range.qd_hi[1]) << ", unit: rad/s}\n";
+  }
+  o << "fit:\n  validation: \"" << (m.folds_are_recordings ? "each recording left out in turn" : "contiguous blocks left out in turn")
+    << "\"\n  folds: " << m.sse_fold.size() << "\n";
   for (int j = 0; j < 2; ++j) {
     const EmgJointFigures& F = m.figures[j];
-    o << "  " << kJointName[j] << ": {r2_fit: " << NumberText(F.r2_fit, 4) << ", r2_heldout: " << NumberText(F.r2_heldout, 4)
+    o << "  " << kJointName[j] << ": {r2_cv: " << NumberText(F.r2_cv, 4) << ", rms_cv: " << NumberText(F.rms_cv, 4)
+      << ", r2_fit: " << NumberText(F.r2_fit, 4) << ", r2_heldout: " << NumberText(F.r2_heldout, 4)
       << ", rms_heldout: " << NumberText(F.rms_heldout, 4) << ", r2_heldout_within_6mad: "
       << NumberText(F.r2_heldout_trim, 4) << ", rms_heldout_within_6mad: " << NumberText(F.rms_heldout_trim, 4)
       << ", heldout_samples: " << F.heldout << "}\n";
@@ -365,19 +542,22 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
   const YamlContext c{path};
   const YAML::Node root = ParseYaml(ReadYamlText(path, "EMG model"), path);
   YamlCheckKeys(c, root, "",
-                {"model", "activation", "delays", "structure", "missing_channels", "autocorrelation_rows",
-                 "parameters", "fit"});
+                {"model", "activation", "twitch", "delays", "structure", "missing_channels", "autocorrelation_rows",
+                 "parameters", "calibration_range", "fit"});
   if (!root["model"] || !root["model"].IsScalar() || root["model"].as<std::string>() != "emg_torque_hj15")
     c.Fail("model", "expected 'emg_torque_hj15' (a file written by exotwin emg-fit)" + YamlLine(root["model"]));
   EmgTorqueModel m;
   if (const YAML::Node a = root["activation"]) m.spec.a_shape = YamlNumber(c, a["A_shape"], "activation.A_shape", -10, 10, "");
+  if (const YAML::Node tw = root["twitch"]) m.spec.twitch = YamlNumber(c, tw["tau"], "twitch.tau", 0, 1, "s");
   if (const YAML::Node d = root["delays"]) {
     if (!d.IsMap()) c.Fail("delays", "expected a mapping of muscles to delays" + YamlLine(d));
     for (const auto& kv : d) {
       Muscle mu;
       const std::string k = kv.first.as<std::string>();
-      if (!MuscleByName(k, &mu)) c.Fail("delays." + k, "expected GMAX, VM, RF, ST or GAS" + YamlLine(kv.first));
-      m.spec.delay_s[mu] = YamlNumber(c, kv.second["value"], "delays." + k + ".value", -1, 1, "s");
+      const double v = YamlNumber(c, kv.second["value"], "delays." + k + ".value", -1, 1, "s");
+      if (k == "common") m.spec.common_delay = v;
+      else if (MuscleByName(k, &mu)) m.spec.delay_s[mu] = v;
+      else c.Fail("delays." + k, "expected common, GMAX, VM, RF, ST or GAS" + YamlLine(kv.first));
     }
   }
   if (const YAML::Node s = root["structure"]) {
@@ -392,6 +572,34 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
     }
     m.spec.gmax_proxy = flag(s["gmax_proxy"], "structure.gmax_proxy");
     m.spec.robust = flag(s["robust_fit"], "structure.robust_fit");
+    if (const YAML::Node pl = s["pooled"]) {
+      if (!pl.IsSequence()) c.Fail("structure.pooled", "expected a list of muscles" + YamlLine(pl));
+      for (const auto& x : pl) {
+        Muscle mu;
+        if (!MuscleByName(x.as<std::string>(), &mu)) c.Fail("structure.pooled", "expected GMAX, VM, RF, ST or GAS" + YamlLine(x));
+        m.spec.pooled.push_back(mu);
+      }
+    }
+  }
+  if (const YAML::Node g = root["calibration_range"]) {
+    auto pair = [&](const YAML::Node& n, const std::string& key, double* lo, double* hi) {
+      if (!n || !n.IsSequence() || n.size() != 2) c.Fail(key, "expected [low, high]" + YamlLine(n));
+      *lo = YamlNumber(c, n[0], key + "[0]", -1e6, 1e6, ""), *hi = YamlNumber(c, n[1], key + "[1]", *lo, 1e6, "");
+    };
+    if (!g["envelope"] || !g["envelope"].IsMap()) c.Fail("calibration_range.envelope", "expected channel: [low, high]" + YamlLine(g));
+    for (const auto& kv : g["envelope"]) {
+      const std::string ch = kv.first.as<std::string>();
+      double lo, hi;
+      pair(kv.second, "calibration_range.envelope." + ch, &lo, &hi);
+      m.range.channels.push_back(ch), m.range.e_lo.push_back(lo), m.range.e_hi.push_back(hi);
+    }
+    for (int j = 0; j < 2; ++j) {
+      pair(g["angle"][kJointName[j]], std::string("calibration_range.angle.") + kJointName[j], &m.range.q_lo[j], &m.range.q_hi[j]);
+      pair(g["velocity"][kJointName[j]], std::string("calibration_range.velocity.") + kJointName[j], &m.range.qd_lo[j],
+           &m.range.qd_hi[j]);
+      m.spec.q_lo[j] = m.range.q_lo[j], m.spec.q_hi[j] = m.range.q_hi[j];
+    }
+    m.spec.bounded = true;
   }
   if (const YAML::Node mc = root["missing_channels"])
     for (const auto& x : mc) m.missing.push_back(x.as<std::string>());

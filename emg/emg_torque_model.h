@@ -3,18 +3,31 @@
 // (emg/emg_diagnose.h). Per joint j:
 //
 //   tau_j(t) = sum_i (alpha_i + alpha_q,i q_j) a_i(t) + beta q_j + gamma qd_j + offset + s_P M_P,j(q)
-//   a_i(t)   = ((e^{A u} - 1) / (e^A - 1))  with u = e_i(t - d_m)       (A = 0: a = u)
+//   a_i(t)   = ((e^{A u} - 1) / (e^A - 1))  with u = T_tau[e_i](t - d_m)  (A = 0: a = u)
+//   T_tau    : the muscle twitch, a critically damped second-order low-pass of unit gain and time
+//              constant tau (impulse response t/tau^2 e^{-t/tau}, peak at t = tau), causal; tau = 0:
+//              none. The twitch filter of Olney & Winter 1985 (the source of HJ15's law) and of
+//              Winter's EMG-to-force processing (about 3 Hz, tau ~ 50 ms); LB03 eq. 1 is its
+//              discrete recursive form.
+//
+// Outside the calibrated range the nonlinear terms continue without exploding (emg-predict on a
+// trial unlike the calibration): a(u) continues along its tangent below u = 0 and above u = 1 (C1,
+// linear in u like the linear form); with a calibration range (spec.bounded), the moment arm's
+// angle q in alpha_q q is held at the nearest end of the calibrated angle range (the moment arm
+// at its last calibrated value), and M_P continues along its tangent at that end.
 //
 // HJ15 eq. 26: tau = sum alpha_i e_i + beta q + gamma qd + offset, the form the linear model keeps
 // (beta, gamma additive, as the README of shared/data/real_human measures it); the extensions:
-//  - d_m: electromechanical delay of the twin muscle m the channel stands for (s; Cavanagh & Komi
-//    1979: 30-100 ms between EMG and force);
+//  - d_m: electromechanical delay (s), one common to every channel (spec.common_delay) or, after
+//    it, of the twin muscle m the channel stands for (spec.delay_s overrides the common one);
 //  - A: activation nonlinearity, LB03 eq. 2 (Lloyd & Besier 2003) (A-shape factor, -3 < A < 0);
 //  - alpha_q,i: moment arm changing with the joint angle, alpha_i (1 + c_i q) = alpha_i + alpha_q,i q;
 //  - M_P,j: the passive moment of Riener & Edrich 1999 (model/passive_torque.h) along the
 //    coordinate, with a fitted scale s_P (1 = as published);
 //  - a missing gluteus maximus (no GMAX channel): the vasti channels at the hip, GMAX's synergists of
 //    the weight-acceptance module (Neptune, Kautz & Zajac 2004; Ivanenko et al. 2004);
+//  - collinear channels of one muscle (the vasti, the two hamstrings) pooled (spec.pooled): one alpha
+//    of their mean envelope, channel named "a+b";
 //  - robust fit: rows whose moment lies beyond kSpikeMads scaled MADs of the median left out of the
 //    fit (the contact spikes of inverse dynamics).
 // Channels act at the joints their muscle spans (sim/muscles.h ActionSign); alpha is fitted free of
@@ -22,6 +35,7 @@
 // moment, both joints in one stack (diagnosis/diagnose_select.h FitCols), standard errors corrected
 // for the residual's autocorrelation.
 #pragma once
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -36,17 +50,47 @@ constexpr double kSpikeMads = 6.0;
 
 // The structure of the model: which extensions are on.
 struct EmgModelSpec {
-  std::map<Muscle, double> delay_s;        // electromechanical delay per twin muscle, s (absent: 0)
+  double common_delay = 0;                 // electromechanical delay of every channel, s
+  double twitch = 0;                       // twitch time constant tau of every channel, s (0: none)
+  std::map<Muscle, double> delay_s;        // per twin muscle, s (absent: common_delay)
+  std::vector<Muscle> pooled;              // muscles whose channels enter as one mean envelope
   double a_shape = 0;                      // Lloyd & Besier A; 0 = linear activation
   bool moment_arm[2] = {false, false};     // alpha_q terms at the hip / knee
   bool passive[2] = {false, false};        // Riener & Edrich passive moment at the hip / knee
   bool gmax_proxy = false;                 // vasti channels at the hip when GMAX is missing
   bool robust = false;                     // spikes left out of the fit rows
   // Standard errors of the searched parameters (profile of the fit's sum of squares), 0 if unknown.
+  double common_delay_se = 0, twitch_se = 0;  // s
   std::map<Muscle, double> delay_se;       // s
   double a_shape_se = 0;
+  // Calibrated angle range per joint (rad): angle-dependent terms continue as the header says
+  // outside it. Off while fitting (the data's range is the range).
+  bool bounded = false;
+  double q_lo[2] = {0, 0}, q_hi[2] = {0, 0};
   double Delay(Muscle m) const;
+  bool Pooled(Muscle m) const;
 };
+
+// The range each input of a calibration covered (emg-predict's extrapolation report).
+struct EmgCalibrationRange {
+  std::vector<std::string> channels;       // as recorded (not pooled)
+  std::vector<double> e_lo, e_hi;          // envelope per channel
+  double q_lo[2] = {0, 0}, q_hi[2] = {0, 0};    // rad
+  double qd_lo[2] = {0, 0}, qd_hi[2] = {0, 0};  // rad/s
+  bool empty() const { return channels.empty(); }
+};
+
+// The range of `recs` (same channels).
+EmgCalibrationRange RangeOf(const std::vector<const EmgRecording*>& recs);
+
+// Share of the samples of `rec` outside `range`, per channel (envelope) and per joint (angle,
+// velocity). A channel the range lacks counts as wholly outside.
+struct EmgExtrapolation {
+  std::vector<std::string> channels;
+  std::vector<double> envelope_share;
+  double angle_share[2] = {0, 0}, velocity_share[2] = {0, 0};
+};
+EmgExtrapolation ExtrapolationOf(const EmgCalibrationRange& range, const EmgRecording& rec);
 
 enum class TermKind { kAlpha, kAlphaQ, kBeta, kGamma, kOffset, kPassive };
 
@@ -68,6 +112,7 @@ struct EmgJointFigures {
   double r2_heldout = 0;     // all held-out samples
   double rms_heldout = 0;    // N m
   double r2_heldout_trim = 0, rms_heldout_trim = 0;  // held-out samples within kSpikeMads of the median
+  double r2_cv = 0, rms_cv = 0;      // cross-validation (folds left out in turn), within kSpikeMads
   size_t heldout = 0, trimmed = 0;                    // held-out samples, and those left out as spikes
 };
 
@@ -81,15 +126,28 @@ struct EmgTorqueModel {
   double weight[2] = {0, 0};         // row weights of the fit, 1/N m
   double sse_fit = 0, n_fit = 0;     // weighted SSE and row count of the fit rows
   double sse_heldout[2] = {0, 0};    // weighted held-out SSE per joint (time split), for the loop
-  double sse_left_out[2] = {0, 0};   // weighted, each recording left out in turn (>= 2 recordings)
+  // Cross-validation (weighted SSE per joint over samples within kSpikeMads): each fold left out in
+  // turn and predicted by the fit on the other folds' rows. Folds: the recordings (>= 2), or
+  // contiguous blocks of the one recording.
+  std::vector<std::array<double, 2>> sse_fold;
+  double sse_cv[2] = {0, 0};
+  bool folds_are_recordings = false;
+  EmgCalibrationRange range;         // of the recordings fitted
   int nonlinear_parameters() const;  // delays and A
 };
 
 // The terms of `spec` for the channels of `rec` (coefficients zero).
 std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec);
 
-// Activation a(u) of LB03 eq. 2 (Lloyd & Besier 2003) with shape factor A (A = 0: u).
+// Activation a(u) of LB03 eq. 2 (Lloyd & Besier 2003) with shape factor A (A = 0: u) on 0 <= u <= 1,
+// continued along its tangent outside (header).
 double ActivationShape(double u, double A);
+
+// The twitch filter T_tau (header) of u sampled at times t (causal, starts at rest at u[0]).
+std::vector<double> TwitchFilter(const std::vector<double>& t, const std::vector<double>& u, double tau);
+
+// The envelope of `channel` in `rec` ("a+b": the mean of a and b). Throws InputError when missing.
+std::vector<double> ChannelEnvelope(const EmgRecording& rec, const std::string& channel);
 
 // The regressor of `term` on every sample of `rec` (N m per unit of the term's coefficient).
 // Throws InputError when the recording lacks the term's channel.
@@ -109,6 +167,7 @@ struct EmgFitOptions {
   double train_fraction = 0.7;  // first part of every recording fitted, the rest held out; 1 = all
   double weight[2] = {0, 0};    // row weights per joint (1/N m); 0: 1/SD of the moment's fit rows
   double autocorr_rows = 0;     // 0: from this fit's residual
+  int blocks = 5;               // one recording: contiguous cross-validation blocks (>= 2)
 };
 
 // Least-squares fit of `spec` on recordings with moments (>= 1). Fills coefficients, standard
