@@ -1,7 +1,10 @@
 // exotwin emg-predict (DESIGN.md): the joint moments an EMG model (emg-fit) estimates for a
-// recording, t,tau_hip,tau_knee on the EMG file's time base; with --moments, R^2 per joint.
+// recording, t,tau_hip,tau_knee on the EMG file's time base; with --moments, R^2 per joint; the
+// extrapolation report: per channel and joint, the share of samples outside the calibration's range
+// (a warning above kExtrapolationWarn).
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -12,6 +15,38 @@
 
 namespace exotwin {
 namespace {
+
+constexpr double kExtrapolationWarn = 0.05;  // share of samples outside the calibration's range
+
+void ReportExtrapolation(const EmgTorqueModel& model, const EmgRecording& rec) {
+  if (model.range.empty()) {
+    std::fprintf(stderr, "emg-predict: the model file has no calibration_range: no extrapolation report\n");
+    return;
+  }
+  const EmgExtrapolation x = ExtrapolationOf(model.range, rec);
+  std::printf("extrapolation: share of samples outside the calibration's range (warning above %.0f %%)\n",
+              100 * kExtrapolationWarn);
+  auto line = [](const std::string& what, double share, double lo, double hi, const char* unit) {
+    std::printf("  %-28s %6.1f %%   calibrated %.4g .. %.4g %s\n", what.c_str(), 100 * share, lo, hi, unit);
+    if (share > kExtrapolationWarn)
+      std::fprintf(stderr, "emg-predict: warning: %.1f %% of the samples of %s lie outside the calibration's range "
+                   "(%.4g .. %.4g %s): the model extrapolates there\n", 100 * share, what.c_str(), lo, hi, unit);
+  };
+  for (size_t c = 0; c < x.channels.size(); ++c) {
+    const auto it = std::find(model.range.channels.begin(), model.range.channels.end(), x.channels[c]);
+    const size_t k = static_cast<size_t>(it - model.range.channels.begin());
+    if (it == model.range.channels.end()) {
+      std::printf("  %-28s not in the calibration\n", ("envelope " + x.channels[c]).c_str());
+      continue;
+    }
+    line("envelope " + x.channels[c], x.envelope_share[c], model.range.e_lo[k], model.range.e_hi[k], "");
+  }
+  const char* jn[2] = {"hip", "knee"};
+  for (int j = 0; j < 2; ++j) {
+    line(std::string(jn[j]) + " angle", x.angle_share[j], model.range.q_lo[j], model.range.q_hi[j], "rad");
+    line(std::string(jn[j]) + " velocity", x.velocity_share[j], model.range.qd_lo[j], model.range.qd_hi[j], "rad/s");
+  }
+}
 
 CommandRunner RegisterEmgPredict(CLI::App& app) {
   struct Opts {
@@ -31,6 +66,7 @@ CommandRunner RegisterEmgPredict(CLI::App& app) {
     const MuscleMap map = o->map.empty() ? DefaultMuscleMap() : ReadMuscleMap(o->map);
     const EmgRecording rec = ReadEmgRecording(o->emg, o->kin, o->mom, map);
     for (const auto& n : rec.notes) std::fprintf(stderr, "emg-predict: %s: %s\n", rec.source.c_str(), n.c_str());
+    ReportExtrapolation(model, rec);
     std::vector<double> tau[2];
     for (int j = 0; j < 2; ++j) tau[j] = PredictMoment(model, rec, j);
     WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&rec.t, &tau[0], &tau[1]},

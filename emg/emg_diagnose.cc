@@ -84,21 +84,31 @@ class Loop {
     return m;
   }
   EmgTorqueModel Fit(const EmgModelSpec& s) const { return FitEmgModel(s, recs_, opt_); }
+  // The fit rows' weighted SSE of `s` (what the searches minimize).
+  double Sse(const EmgModelSpec& s) const {
+    EmgFitOptions o = opt_;
+    o.fit_only = true;
+    return FitEmgModel(s, recs_, o).sse_fit;
+  }
   const EmgFitOptions& options() const { return opt_; }
   EmgFitOptions& options() { return opt_; }
 
-  // Searched parameter: grid minimum of the fit rows' SSE, then its standard error from the
-  // profile's curvature: var = 2 s^2 / SSE''(theta) (s^2: residual variance, autocorrelation
-  // included).
+  // Searched parameter: grid minimum of the fit rows' SSE (a grid of 2 steps, then the steps on
+  // either side of its best), then its standard error from the profile's curvature: var = 2 s^2 /
+  // SSE''(theta) (s^2: residual variance, autocorrelation included).
   double Search(EmgModelSpec* s, const std::function<double&(EmgModelSpec&)>& param, double lo, double hi,
                 double step, double h, double* se) const {
     double best = param(*s), best_sse = 1e300;
-    for (double v = lo; v <= hi + 1e-12; v += step) {
+    auto probe = [&](double v) {
       EmgModelSpec t = *s;
       param(t) = v;
-      const double sse = Fit(t).sse_fit;
+      const double sse = Sse(t);
       if (sse < best_sse) best_sse = sse, best = v;
-    }
+    };
+    for (double v = lo; v <= hi + 1e-12; v += 2 * step) probe(v);
+    const double coarse = best;
+    for (double v : {coarse - step, coarse + step})
+      if (v >= lo - 1e-12 && v <= hi + 1e-12) probe(v);
     param(*s) = best;
     *se = ProfileSe(*s, param, h);
     return best;
@@ -106,8 +116,10 @@ class Loop {
   double ProfileSe(const EmgModelSpec& s, const std::function<double&(EmgModelSpec&)>& param, double h) const {
     EmgModelSpec a = s, b = s;
     param(a) -= h, param(b) += h;
-    const EmgTorqueModel m0 = Fit(s);
-    const double c = (Fit(a).sse_fit - 2 * m0.sse_fit + Fit(b).sse_fit) / (h * h);
+    EmgFitOptions o = opt_;
+    o.fit_only = true;
+    const EmgTorqueModel m0 = FitEmgModel(s, recs_, o);
+    const double c = (Sse(a) - 2 * m0.sse_fit + Sse(b)) / (h * h);
     const double s2 = m0.sse_fit / std::max(1.0, m0.n_fit - static_cast<double>(m0.terms.size())) * m0.autocorr_rows;
     return c > 0 ? std::sqrt(2 * s2 / c) : 1e300;
   }
@@ -141,11 +153,11 @@ bool Apply(const Loop& loop, const Cause& c, EmgModelSpec* s) {
       if (s->twitch != 0 || s->common_delay != 0) return false;
       double best = 1e300;
       EmgModelSpec b = *s;
-      for (double tau = kMinTwitch; tau <= kMaxTwitch + 1e-9; tau += 2 * kTwitchStep)
-        for (double dl = kMinEmd; dl <= kMaxEmd + 1e-9; dl += 2 * kDelayStep) {
+      for (double tau = kMinTwitch; tau <= kMaxTwitch + 1e-9; tau += 4 * kTwitchStep)
+        for (double dl = kMinEmd; dl <= kMaxEmd + 1e-9; dl += 4 * kDelayStep) {
           EmgModelSpec t = *s;
           t.twitch = tau, t.common_delay = dl;
-          const double sse = loop.Fit(t).sse_fit;
+          const double sse = loop.Sse(t);
           if (sse < best) best = sse, b = t;
         }
       *s = b;

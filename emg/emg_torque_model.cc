@@ -357,6 +357,7 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
   for (size_t c = 0; c < T; ++c) model.terms[c].value = f.coef[static_cast<Eigen::Index>(c)], model.terms[c].se = f.se[static_cast<Eigen::Index>(c)];
   model.bic = f.bic + model.nonlinear_parameters() * std::log(g.n_eff);
   model.sse_fit = f.sse_tr, model.n_fit = g.n_tr;
+  if (opt.fit_only) return model;
   for (int j = 0; j < 2; ++j) model.sse_heldout[j] = f.sse_te_j[j];
   model.range = RangeOf(recs);
   // Cross-validation: each fold predicted by the coefficients fitted on the others' rows, scored on

@@ -168,6 +168,7 @@ struct EmgFitOptions {
   double weight[2] = {0, 0};    // row weights per joint (1/N m); 0: 1/SD of the moment's fit rows
   double autocorr_rows = 0;     // 0: from this fit's residual
   int blocks = 5;               // one recording: contiguous cross-validation blocks (>= 2)
+  bool fit_only = false;        // coefficients, BIC and sse_fit only (no scores, figures, range)
 };
 
 // Least-squares fit of `spec` on recordings with moments (>= 1). Fills coefficients, standard

@@ -24,10 +24,11 @@ TEST(EmgRealHuman, LinearFormReproducesTheReadmeAndTheLoopGains) {
   const EmgDiagnosis d = DiagnoseEmg({&r});
   const EmgJointFigures* lin = d.steps.front().model.figures;
   const EmgJointFigures* fin = d.steps.back().model.figures;
-  std::printf("%-48s %8s %8s %8s %8s\n", "step", "hip R2", "hip rms", "knee R2", "knee rms");
+  std::printf("%-48s %8s %8s %8s %8s %8s %8s\n", "step", "hip cv", "knee cv", "hip R2", "hip rms", "knee R2", "knee rms");
   for (const auto& s : d.steps)
-    std::printf("%-48s %8.3f %8.2f %8.3f %8.2f\n", s.added.c_str(), s.model.figures[0].r2_heldout_trim,
-                s.model.figures[0].rms_heldout_trim, s.model.figures[1].r2_heldout_trim, s.model.figures[1].rms_heldout_trim);
+    std::printf("%-48s %8.3f %8.3f %8.3f %8.2f %8.3f %8.2f\n", s.added.substr(0, 48).c_str(), s.model.figures[0].r2_cv,
+                s.model.figures[1].r2_cv, s.model.figures[0].r2_heldout_trim, s.model.figures[0].rms_heldout_trim,
+                s.model.figures[1].r2_heldout_trim, s.model.figures[1].rms_heldout_trim);
   for (const auto& s : d.selection) std::printf("  %s\n", s.c_str());
   // README: linear form, all held-out samples.
   EXPECT_NEAR(lin[1].r2_heldout, 0.60, 0.02);

@@ -6,11 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "emg/emg_diagnose.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "formats/measured_data.h"
 #include "sim/muscles.h"
 #include "tests/temp_dir.h"
 
@@ -21,7 +24,7 @@ struct Truth {
   double alpha_hip[3] = {60, -40, -25};            // rect_fem_r, semimem_r, bifemlh_r at the hip
   double alpha_knee[5] = {70, 30, -35, -20, -30};  // vas_lat_r, rect_fem_r, semimem_r, bifemlh_r, med_gas_r
   double beta[2] = {-20, 15}, gamma[2] = {-2, 1.5}, offset[2] = {3, -2};
-  double vm_delay = 0;  // s, hidden in the knee's vastus channel
+  double delay = 0;     // s, electromechanical delay hidden in every channel
   double a_shape = 0;   // hidden activation nonlinearity (all channels)
   double noise = 1.0;   // N m
 };
@@ -60,8 +63,7 @@ EmgRecording Synthetic(const Truth& tr, uint64_t seed = 1) {
   std::vector<std::vector<double>> a(5, std::vector<double>(n));
   for (int c = 0; c < 5; ++c)
     for (size_t i = 0; i < n; ++i) {
-      const double d = c == 0 ? tr.vm_delay : 0.0;
-      const double tq = r.t[i] - d;
+      const double tq = r.t[i] - tr.delay;
       const double x = std::max(0.0, tq / 0.01);
       const size_t k = std::min(n - 2, static_cast<size_t>(x));
       const double fr = std::min(1.0, x - static_cast<double>(k));
@@ -134,15 +136,17 @@ TEST(EmgTorqueModel, LoopAddsNothingToTheLinearTruth) {
 
 TEST(EmgTorqueModel, HiddenDelayIsNamedAndRecovered) {
   Truth tr;
-  tr.vm_delay = 0.06;
+  tr.delay = 0.06;
   const EmgRecording r = Synthetic(tr);
   const EmgDiagnosis d = DiagnoseEmg({&r});
   for (const auto& s : d.selection) std::printf("  %s\n", s.c_str());
-  ASSERT_TRUE(d.calibration.spec.delay_s.count(Muscle::kVM));
-  const double v = d.calibration.spec.delay_s.at(Muscle::kVM), se = d.calibration.spec.delay_se.at(Muscle::kVM);
+  const double v = d.calibration.spec.common_delay, se = d.calibration.spec.common_delay_se;
   EXPECT_NEAR(v, 0.06, 0.006);
+  EXPECT_GT(se, 0.0);
   EXPECT_LT(se, 0.01);
+  EXPECT_TRUE(d.calibration.spec.delay_s.empty()) << "one delay, common to every channel";
   EXPECT_EQ(d.calibration.spec.a_shape, 0.0);
+  EXPECT_EQ(d.calibration.spec.twitch, 0.0);
   EXPECT_GT(d.steps.back().model.figures[1].r2_heldout, d.steps.front().model.figures[1].r2_heldout);
 }
 
@@ -154,26 +158,44 @@ TEST(EmgTorqueModel, HiddenActivationNonlinearityIsNamedAndRecovered) {
   for (const auto& s : d.selection) std::printf("  %s\n", s.c_str());
   EXPECT_NEAR(d.calibration.spec.a_shape, -2.0, 0.3);
   EXPECT_TRUE(d.calibration.spec.delay_s.empty());
+  EXPECT_EQ(d.calibration.spec.common_delay, 0.0);
+  EXPECT_EQ(d.calibration.spec.twitch, 0.0);
 }
 
 TEST(EmgTorqueModel, SeveralRecordingsAreLeftOutInTurn) {
   Truth tr;
-  tr.vm_delay = 0.08;
+  tr.delay = 0.08;
   const EmgRecording a = Synthetic(tr, 1), b = Synthetic(tr, 2);
   const EmgDiagnosis d = DiagnoseEmg({&a, &b});
-  EXPECT_TRUE(d.leave_one_out);
-  ASSERT_TRUE(d.calibration.spec.delay_s.count(Muscle::kVM));
-  EXPECT_NEAR(d.calibration.spec.delay_s.at(Muscle::kVM), 0.08, 0.006);
+  EXPECT_TRUE(d.folds_are_recordings);
+  EXPECT_EQ(d.folds, 2);
+  EXPECT_NEAR(d.calibration.spec.common_delay, 0.08, 0.006);
   bool scored = false;
-  for (const auto& c : d.scores) scored |= c.added && c.left_out_gain_pct[1] > 50;
+  for (const auto& c : d.scores) scored |= c.added && c.cv_gain_pct[1] > 50;
   EXPECT_TRUE(scored) << "the added delay pays on whole recordings left out";
+  ASSERT_EQ(d.steps.back().model.sse_fold.size(), 2u);
+  // Each recording left out is predicted by the fit on the other: the cross-validated SSE is the
+  // sum of the two, and recomputed by hand from a fit on the other recording alone.
+  const EmgTorqueModel& last = d.steps.back().model;
+  EmgFitOptions one;
+  one.train_fraction = 1.0;
+  one.weight[0] = last.weight[0], one.weight[1] = last.weight[1];
+  const EmgTorqueModel on_b = FitEmgModel(last.spec, {&b}, one);
+  double sse = 0;
+  for (int j = 0; j < 2; ++j) {
+    const std::vector<double> p = PredictMoment(on_b, a, j);
+    for (size_t i : WithinSpikeLimit(a.tau[j], 0, a.size())) sse += std::pow(last.weight[j] * (a.tau[j][i] - p[i]), 2);
+  }
+  EXPECT_NEAR(last.sse_fold[0][0] + last.sse_fold[0][1], sse, 1e-6 * sse);
 }
 
 TEST(EmgTorqueModel, ModelFileRoundTrips) {
   Truth tr;
-  tr.vm_delay = 0.05;
+  tr.delay = 0.05;
   const EmgRecording r = Synthetic(tr);
   EmgModelSpec s;
+  s.common_delay = 0.04;
+  s.twitch = 0.03;
   s.delay_s[Muscle::kVM] = 0.05;
   s.delay_se[Muscle::kVM] = 0.002;
   s.passive[0] = true;
@@ -191,6 +213,11 @@ TEST(EmgTorqueModel, ModelFileRoundTrips) {
   const EmgTorqueModel back = ReadEmgModel(path);
   ASSERT_EQ(back.terms.size(), m.terms.size());
   EXPECT_EQ(back.spec.Delay(Muscle::kVM), 0.05);
+  EXPECT_EQ(back.spec.Delay(Muscle::kRF), 0.04);
+  EXPECT_EQ(back.spec.twitch, 0.03);
+  ASSERT_EQ(back.range.channels, r.channels);
+  EXPECT_TRUE(back.spec.bounded);
+  for (int j = 0; j < 2; ++j) EXPECT_NEAR(back.range.q_lo[j], m.range.q_lo[j], 1e-5);
   EXPECT_TRUE(back.spec.passive[0]);
   EXPECT_TRUE(back.spec.moment_arm[1]);
   for (int j = 0; j < 2; ++j) {
@@ -204,6 +231,217 @@ TEST(EmgTorqueModel, SpikeLimit) {
   const std::vector<size_t> in = WithinSpikeLimit(x, 0, x.size());
   EXPECT_EQ(in.size(), 9u);
   EXPECT_EQ(in.back(), 8u);
+}
+
+}  // namespace
+}  // namespace exotwin
+
+// ---- Nonlinear terms outside the calibrated range, the twitch filter, the extrapolation report ----
+
+namespace exotwin {
+namespace {
+
+TEST(EmgTorqueModel, ActivationShapeContinuesAlongItsTangent) {
+  const double A = -2, h = 1e-6;
+  auto slope = [&](double u) { return (ActivationShape(u + h, A) - ActivationShape(u - h, A)) / (2 * h); };
+  // C1 at both ends of 0 <= u <= 1, linear outside (second difference zero).
+  for (double u : {0.0, 1.0}) {
+    EXPECT_NEAR(ActivationShape(u + 1e-9, A), ActivationShape(u - 1e-9, A), 1e-8);
+    EXPECT_NEAR(slope(u + 1e-4), slope(u - 1e-4), 1e-3);
+  }
+  EXPECT_NEAR(ActivationShape(3.0, A), 1 + 2 * A * std::exp(A) / std::expm1(A), 1e-12);
+  EXPECT_NEAR(ActivationShape(-0.5, A), -0.5 * A / std::expm1(A), 1e-12);
+  EXPECT_NEAR(ActivationShape(2.0, A) - 2 * ActivationShape(1.5, A) + ActivationShape(1.0, A), 0.0, 1e-12);
+}
+
+TEST(EmgTorqueModel, TwitchFilterIsTheCriticallyDampedStepResponse) {
+  // Step at t = 0 after rest: y = 1 - (1 + t / tau) e^{-t / tau}; unit gain; tau = 0: identity.
+  const double tau = 0.05, dt = 0.0005;
+  std::vector<double> t, u;
+  for (int i = 0; i < 1000; ++i) t.push_back(dt * (i - 10)), u.push_back(i >= 10 ? 1.0 : 0.0);
+  const std::vector<double> y = TwitchFilter(t, u, tau);
+  for (size_t i = 10; i < t.size(); i += 37)
+    EXPECT_NEAR(y[i], 1 - (1 + t[i] / tau) * std::exp(-t[i] / tau), 0.02) << t[i];
+  const std::vector<double> flat(t.size(), 0.7), yf = TwitchFilter(t, flat, tau);
+  for (double v : yf) EXPECT_NEAR(v, 0.7, 1e-12);  // unit gain, at rest from the start
+  EXPECT_EQ(TwitchFilter(t, u, 0.0), u);
+}
+
+TEST(EmgTorqueModel, PassiveAndMomentArmTermsAreBoundedOutsideTheCalibratedAngles) {
+  EmgRecording r;
+  r.source = "angles";
+  r.channels = {"vas_lat_r"};
+  r.muscle = {Muscle::kVM};
+  for (int i = 0; i < 400; ++i) {
+    r.t.push_back(0.01 * i);
+    r.e.resize(1);
+    r.e[0].push_back(0.5);
+    r.q[0].push_back(0.2);
+    r.q[1].push_back(-0.2 - 0.005 * i);  // knee -0.2 .. -2.195 rad
+    r.qd[0].push_back(0), r.qd[1].push_back(-0.5);
+  }
+  EmgModelSpec s;
+  s.passive[1] = true;
+  s.moment_arm[1] = true;
+  EmgTerm passive, arm;
+  passive.joint = 1, passive.kind = TermKind::kPassive;
+  arm.joint = 1, arm.kind = TermKind::kAlphaQ, arm.channel = "vas_lat_r", arm.muscle = Muscle::kVM;
+  const std::vector<double> free_p = TermColumn(passive, s, r);
+  s.bounded = true;
+  s.q_lo[0] = -1, s.q_hi[0] = 1, s.q_lo[1] = -1.2, s.q_hi[1] = -0.1;
+  const std::vector<double> p = TermColumn(passive, s, r), a = TermColumn(arm, s, r);
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (r.q[1][i] >= -1.2) EXPECT_DOUBLE_EQ(p[i], free_p[i]);                       // inside: as published
+    else EXPECT_NEAR(a[i], 0.5 * -1.2, 1e-12);                                       // moment arm held
+  }
+  // Outside: continued along the tangent at -1.2 rad (second differences vanish), below the
+  // unbounded exponential.
+  const size_t k = 300;  // q = -1.7 rad
+  EXPECT_NEAR(p[k + 20] - 2 * p[k + 10] + p[k], 0.0, 1e-9);
+  EXPECT_LT(std::abs(p.back()), std::abs(free_p.back()));
+}
+
+TEST(EmgTorqueModel, ExtrapolationSharesCountTheSamplesOutside) {
+  const EmgRecording r = Synthetic(Truth{});
+  EmgCalibrationRange g = RangeOf({&r});
+  EmgExtrapolation x = ExtrapolationOf(g, r);
+  for (double v : x.envelope_share) EXPECT_EQ(v, 0.0);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_EQ(x.angle_share[j], 0.0);
+    EXPECT_EQ(x.velocity_share[j], 0.0);
+  }
+  // Shrink the ranges: the shares are the counts beyond the new ends.
+  g.e_hi[0] = 0.3, g.q_hi[0] = 0.3, g.qd_lo[1] = 0.0;
+  x = ExtrapolationOf(g, r);
+  auto count = [&](const std::vector<double>& v, auto pred) {
+    return static_cast<double>(std::count_if(v.begin(), v.end(), pred)) / static_cast<double>(v.size());
+  };
+  EXPECT_DOUBLE_EQ(x.envelope_share[0], count(r.e[0], [](double v) { return v > 0.3; }));
+  EXPECT_DOUBLE_EQ(x.angle_share[0], count(r.q[0], [](double v) { return v > 0.3; }));
+  EXPECT_DOUBLE_EQ(x.velocity_share[1], count(r.qd[1], [](double v) { return v < 0.0; }));
+  EXPECT_GT(x.velocity_share[1], 0.3);
+}
+
+// ---- A synthetic law with trial-to-trial variation ----
+//
+// Gait-like trials drawn from one law: the linear form (HJ15 eq. 26) with one electromechanical
+// delay common to every channel. Each trial has its own cadence, burst amplitudes and burst timing
+// per channel, and every stride varies around them (amplitude, timing), as real trials differ; the
+// envelopes and angles are phase-locked to the stride, as in gait.
+struct Law {
+  double delay = 0.04;  // s
+  double noise = 1.0;   // N m
+};
+
+EmgRecording GaitTrial(const Law& law, uint64_t seed) {
+  NormalRng<NormalPolar> rng(seed);
+  EmgRecording r;
+  r.source = "gait trial " + std::to_string(seed);
+  const double fs = 100, T = 40;
+  const size_t n = static_cast<size_t>(T * fs);
+  const double cadence = rng.Uniform(0.8, 1.0);  // strides/s
+  const char* ch[] = {"vas_lat_r", "rect_fem_r", "semimem_r", "bifemlh_r", "med_gas_r"};
+  const Muscle mu[] = {Muscle::kVM, Muscle::kRF, Muscle::kST, Muscle::kST, Muscle::kGAS};
+  const double phase[] = {0.05, 0.55, 0.85, 0.92, 0.35};   // burst centres, fraction of the stride
+  const double width[] = {0.10, 0.07, 0.09, 0.08, 0.10};   // Gaussian SD, fraction of the stride
+  double amp[5], shift[5];
+  for (int c = 0; c < 5; ++c) amp[c] = rng.Uniform(0.2, 0.6), shift[c] = rng.Uniform(-0.04, 0.04);
+  // Per-stride variation, drawn stride by stride.
+  const int strides = static_cast<int>(T * cadence) + 3;
+  std::vector<std::array<double, 5>> sa(strides), sp(strides);
+  std::vector<double> qa(strides);
+  for (int k = 0; k < strides; ++k) {
+    for (int c = 0; c < 5; ++c) sa[k][c] = std::max(0.2, 1 + 0.3 * rng.Normal()), sp[k][c] = 0.02 * rng.Normal();
+    qa[k] = 1 + 0.1 * rng.Normal();
+  }
+  r.channels.assign(ch, ch + 5);
+  r.muscle.assign(mu, mu + 5);
+  r.missing = {"GMAX"};
+  r.e.assign(5, std::vector<double>(n));
+  for (size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / fs, s = t * cadence;
+    const int k = static_cast<int>(s);
+    const double ph = s - k;
+    r.t.push_back(t);
+    for (int c = 0; c < 5; ++c) {
+      double e = 0.01;
+      for (int dk = -1; dk <= 1; ++dk) {  // the bursts of this stride and its neighbours
+        const int kk = std::clamp(k + dk, 0, strides - 1);
+        const double x = ph - dk - (phase[c] + shift[c] + sp[kk][c]);
+        e += amp[c] * sa[kk][c] * std::exp(-0.5 * x * x / (width[c] * width[c]));
+      }
+      r.e[c][i] = e;
+    }
+    const double w = 2 * M_PI * cadence;
+    r.q[0].push_back(0.1 + 0.35 * qa[k] * std::sin(w * t));
+    r.qd[0].push_back(0.35 * qa[k] * w * std::cos(w * t));
+    r.q[1].push_back(-0.65 - 0.45 * qa[k] * std::sin(w * t + 1.2));
+    r.qd[1].push_back(-0.45 * qa[k] * w * std::cos(w * t + 1.2));
+  }
+  // The law: Truth's alphas, beta, gamma, offset on the envelopes delayed by law.delay.
+  const Truth tr;
+  std::vector<std::vector<double>> a(5);
+  std::vector<double> tq(n);
+  for (size_t i = 0; i < n; ++i) tq[i] = r.t[i] - law.delay;
+  for (int c = 0; c < 5; ++c) a[c] = law.delay > 0 ? Interpolate(r.t, r.e[c], tq) : r.e[c];
+  for (int j = 0; j < 2; ++j) r.tau[j].resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    r.tau[0][i] = tr.alpha_hip[0] * a[1][i] + tr.alpha_hip[1] * a[2][i] + tr.alpha_hip[2] * a[3][i] +
+                  tr.beta[0] * r.q[0][i] + tr.gamma[0] * r.qd[0][i] + tr.offset[0] + law.noise * rng.Normal();
+    r.tau[1][i] = tr.alpha_knee[0] * a[0][i] + tr.alpha_knee[1] * a[1][i] + tr.alpha_knee[2] * a[2][i] +
+                  tr.alpha_knee[3] * a[3][i] + tr.alpha_knee[4] * a[4][i] + tr.beta[1] * r.q[1][i] +
+                  tr.gamma[1] * r.qd[1][i] + tr.offset[1] + law.noise * rng.Normal();
+  }
+  return r;
+}
+
+double R2(const std::vector<double>& y, const std::vector<double>& p) {
+  std::vector<size_t> all(y.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  double r2, rms;
+  ScoreSamples(y, p, all, &r2, &rms);
+  return r2;
+}
+
+// Names of the causes the loop added (steps after the linear form).
+std::string Added(const EmgDiagnosis& d) {
+  std::string o;
+  for (size_t i = 1; i < d.steps.size(); ++i) o += d.steps[i].added + "; ";
+  return o;
+}
+
+TEST(EmgSyntheticLaw, CommonDelayIsNamedAloneAndCarriesToAnotherTrial) {
+  const Law law;
+  const EmgRecording a = GaitTrial(law, 11), b = GaitTrial(law, 12);
+  const EmgDiagnosis d = DiagnoseEmg({&a});
+  for (const auto& s : d.selection) std::printf("  %s\n", s.c_str());
+  const EmgModelSpec& s = d.calibration.spec;
+  EXPECT_NEAR(s.common_delay, law.delay, 0.010);
+  EXPECT_TRUE(s.delay_s.empty());
+  EXPECT_EQ(s.twitch, 0.0);
+  EXPECT_EQ(s.a_shape, 0.0);
+  EXPECT_FALSE(s.moment_arm[0] || s.moment_arm[1] || s.passive[0] || s.passive[1] || s.gmax_proxy || s.robust);
+  ASSERT_EQ(d.steps.size(), 2u) << Added(d);
+  // Another trial of the same law: predicted, never fitted.
+  for (int j = 0; j < 2; ++j) {
+    const double r2 = R2(b.tau[j], PredictMoment(d.calibration, b, j));
+    std::printf("  trial 12, joint %d: R^2 %.4f (cross-validated on trial 11: %.4f)\n", j, r2,
+                d.steps.back().model.figures[j].r2_cv);
+    EXPECT_GE(r2, 0.97);
+  }
+}
+
+TEST(EmgSyntheticLaw, NoDelayInTheLawNoDelayNamed) {
+  Law law;
+  law.delay = 0;
+  const EmgRecording a = GaitTrial(law, 21), b = GaitTrial(law, 22);
+  const EmgDiagnosis d = DiagnoseEmg({&a});
+  for (const auto& s : d.selection) std::printf("  %s\n", s.c_str());
+  EXPECT_EQ(d.calibration.spec.common_delay, 0.0);
+  EXPECT_TRUE(d.calibration.spec.delay_s.empty());
+  EXPECT_EQ(d.calibration.spec.twitch, 0.0);
+  EXPECT_EQ(d.steps.size(), 1u) << Added(d);
+  for (int j = 0; j < 2; ++j) EXPECT_GE(R2(b.tau[j], PredictMoment(d.calibration, b, j)), 0.97);
 }
 
 }  // namespace
