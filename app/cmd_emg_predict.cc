@@ -27,10 +27,12 @@ void ReportExtrapolation(const EmgTorqueModel& model, const EmgRecording& rec) {
   std::printf("extrapolation: share of samples outside the calibration's range (warning above %.0f %%)\n",
               100 * kExtrapolationWarn);
   auto line = [](const std::string& what, double share, double lo, double hi, const char* unit) {
-    std::printf("  %-28s %6.1f %%   calibrated %.4g .. %.4g %s\n", what.c_str(), 100 * share, lo, hi, unit);
+    std::printf("  %-28s %6.1f %%   calibrated %.4g .. %.4g%s%s\n", what.c_str(), 100 * share, lo, hi, *unit ? " " : "",
+                unit);
     if (share > kExtrapolationWarn)
       std::fprintf(stderr, "emg-predict: warning: %.1f %% of the samples of %s lie outside the calibration's range "
-                   "(%.4g .. %.4g %s): the model extrapolates there\n", 100 * share, what.c_str(), lo, hi, unit);
+                   "(%.4g .. %.4g%s%s): the model extrapolates there\n", 100 * share, what.c_str(), lo, hi, *unit ? " " : "",
+                   unit);
   };
   for (size_t c = 0; c < x.channels.size(); ++c) {
     const auto it = std::find(model.range.channels.begin(), model.range.channels.end(), x.channels[c]);

@@ -322,6 +322,62 @@ TEST(EmgTorqueModel, ExtrapolationSharesCountTheSamplesOutside) {
   EXPECT_GT(x.velocity_share[1], 0.3);
 }
 
+// ---- Collinear channels of one muscle ----
+
+// Synthetic(Truth) plus a second vastus channel vas_med_r = vas_lat_r + independent noise of SD
+// `sd`, and a knee law 100 vas_lat_r - 30 vas_med_r (the vastus' 70 split against its action).
+EmgRecording TwoVasti(double sd) {
+  EmgRecording r = Synthetic(Truth{});
+  NormalRng<NormalPolar> rng(7);
+  std::vector<double> med = r.e[0];
+  for (double& v : med) v += sd * rng.Normal();
+  r.channels.push_back("vas_med_r");
+  r.muscle.push_back(Muscle::kVM);
+  r.e.push_back(med);
+  for (size_t i = 0; i < r.size(); ++i) r.tau[1][i] += 30 * (r.e[0][i] - med[i]);
+  return r;
+}
+
+TEST(EmgTorqueModel, PooledChannelsAreOneAlphaOfTheirMeanEnvelope) {
+  const EmgRecording r = TwoVasti(0.005);
+  EmgModelSpec s;
+  s.pooled = {Muscle::kVM};
+  const std::vector<EmgTerm> terms = TermsOf(s, r);
+  int vm = 0;
+  for (const EmgTerm& t : terms)
+    if (t.muscle == Muscle::kVM) {
+      ++vm;
+      EXPECT_EQ(t.channel, "vas_lat_r+vas_med_r");
+      const std::vector<double> col = TermColumn(t, s, r);
+      for (size_t i = 0; i < r.size(); i += 101) EXPECT_DOUBLE_EQ(col[i], 0.5 * (r.e[0][i] + r.e[5][i]));
+    }
+  EXPECT_EQ(vm, 1);  // the knee only
+}
+
+TEST(EmgTorqueModel, CollinearChannelsArePooledOrReportedNotSeparable) {
+  EmgDiagnoseOptions lin;
+  lin.max_steps = 0, lin.robust_candidate = false;
+  auto note_of = [](const EmgDiagnosis& d) {
+    for (const std::string& n : d.notes)
+      if (n.find("VM's channels") != std::string::npos) return n;
+    return std::string();
+  };
+  {  // nearly identical channels: pooling costs < 5 % of the cross-validated error, alpha ~ 70
+    const EmgRecording r = TwoVasti(0.005);
+    const EmgDiagnosis d = DiagnoseEmg({&r}, lin);
+    ASSERT_EQ(d.calibration.spec.pooled, std::vector<Muscle>{Muscle::kVM}) << note_of(d);
+    EXPECT_NE(note_of(d).find("pooled"), std::string::npos);
+    EXPECT_NEAR(Term(d.calibration, 1, TermKind::kAlpha, "vas_lat_r+vas_med_r").value, 70, 3.5);
+  }
+  {  // channels that differ: pooling would cost more: kept apart, reported not separable
+    const EmgRecording r = TwoVasti(0.03);
+    const EmgDiagnosis d = DiagnoseEmg({&r}, lin);
+    EXPECT_TRUE(d.calibration.spec.pooled.empty());
+    EXPECT_NE(note_of(d).find("not separable"), std::string::npos) << note_of(d);
+    EXPECT_NEAR(Term(d.calibration, 1, TermKind::kAlpha, "vas_med_r").value, -30, 3);
+  }
+}
+
 // ---- A synthetic law with trial-to-trial variation ----
 //
 // Gait-like trials drawn from one law: the linear form (HJ15 eq. 26) with one electromechanical
