@@ -518,7 +518,8 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
     }
   }
   if (!m.range.empty()) {
-    auto pair = [](double a, double b) { return "[" + NumberText(a, 6) + ", " + NumberText(b, 6) + "]"; };
+    // 17 significant digits: the ends read back exactly (a sample at the end is inside).
+    auto pair = [](double a, double b) { return "[" + NumberText(a, 17) + ", " + NumberText(b, 17) + "]"; };
     o << "calibration_range:\n  envelope: {";
     for (size_t c = 0; c < m.range.channels.size(); ++c)
       o << (c ? ", " : "") << m.range.channels[c] << ": " << pair(m.range.e_lo[c], m.range.e_hi[c]);

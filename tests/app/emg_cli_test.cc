@@ -5,6 +5,7 @@
 #include <memory>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "formats/csv_table.h"
@@ -111,6 +112,14 @@ TEST_F(EmgCli, PredictWritesContractColumnsAndPrintsR2) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("hip: R^2 0.9"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("knee: R^2 0.9"), std::string::npos) << r.output;
+  // The calibration's own recording: nothing outside its range.
+  EXPECT_NE(r.output.find("extrapolation: share of samples outside the calibration's range"), std::string::npos);
+  for (const char* what : {"envelope vas_lat_r", "envelope med_gas_r", "hip angle", "knee velocity"}) {
+    char line[96];
+    std::snprintf(line, sizeof line, "  %-28s    0.0 %%", what);
+    EXPECT_NE(r.output.find(line), std::string::npos) << line << " not in: " << r.output;
+  }
+  EXPECT_EQ(r.output.find("warning: "), std::string::npos) << r.output;
   const CsvTable t = ReadCsv(dir_ + "/pred.csv");
   ASSERT_EQ(t.names, (std::vector<std::string>{"t", "tau_hip", "tau_knee"}));
   EXPECT_EQ(t.rows(), static_cast<size_t>(kRows));
@@ -119,6 +128,61 @@ TEST_F(EmgCli, PredictWritesContractColumnsAndPrintsR2) {
                              dir_ + "/ik.sto --out " + dir_ + "/pred2.csv");
   ASSERT_EQ(r2.exit_code, 0) << r2.output;
   EXPECT_EQ(r2.output.find("R^2"), std::string::npos);
+}
+
+TEST_F(EmgCli, PredictReportsExtrapolationPerChannelAndJoint) {
+  ASSERT_EQ(Fit("--linear").exit_code, 0);
+  // The same trial played twice as fast (velocities doubled) with the rectus femoris' envelope
+  // doubled: its samples above the calibrated peak, and the velocities beyond theirs, are counted.
+  std::string emg = EmgSto(), ik = IkSto();
+  auto faster = [](const std::string& text, int value_column_to_double) {
+    std::istringstream in(text);
+    std::ostringstream out;
+    std::string line;
+    bool body = false;
+    while (std::getline(in, line)) {
+      if (body && !line.empty()) {
+        std::istringstream f(line);
+        std::vector<double> v;
+        for (double x; f >> x;) v.push_back(x);
+        v[0] /= 2;
+        if (value_column_to_double > 0) v[value_column_to_double] *= 2;
+        for (size_t i = 0; i < v.size(); ++i) out << (i ? "\t" : "") << v[i];
+        out << "\n";
+        continue;
+      }
+      body |= line.rfind("time", 0) == 0;
+      out << line << "\n";
+    }
+    return out.str();
+  };
+  WriteText(dir_ + "/fast_emg.sto", faster(emg, 1));
+  WriteText(dir_ + "/fast_ik.sto", faster(ik, 0));
+  const auto r = RunExotwin("emg-predict --model " + dir_ + "/model.yaml --emg " + dir_ + "/fast_emg.sto --kinematics " +
+                            dir_ + "/fast_ik.sto --out " + dir_ + "/pred.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Share of the doubled rect_fem_r envelope above its calibrated peak, counted here.
+  double peak = 0, above = 0;
+  for (int i = 0; i < kRows; ++i) peak = std::max(peak, Env(0, 0.01 * i));
+  for (int i = 0; i < kRows; ++i) above += 2 * Env(0, 0.01 * i) > peak;
+  char expect[96];
+  std::snprintf(expect, sizeof expect, "  %-28s %6.1f %%", "envelope rect_fem_r", 100 * above / kRows);
+  EXPECT_GT(above, 0.05 * kRows);
+  EXPECT_NE(r.output.find(expect), std::string::npos) << expect << " not in: " << r.output;
+  EXPECT_NE(r.output.find("warning: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("of the samples of envelope rect_fem_r lie outside"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("of the samples of knee velocity lie outside"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("of the samples of knee angle"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("of the samples of envelope vas_lat_r"), std::string::npos) << r.output;
+}
+
+TEST_F(EmgCli, SeveralRecordingsAreFoldsAndBlocksNeedTwo) {
+  WriteText(dir_ + "/emg2.sto", EmgSto());
+  const auto r = RunExotwin("emg-fit" + Files() + Files("emg2.sto") + " --out " + dir_ + "/m2.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("cv = 2 recordings left out in turn"), std::string::npos) << r.output;
+  EXPECT_NE(ReadText(dir_ + "/m2.yaml").find("validation: \"each recording left out in turn\""), std::string::npos);
+  ExpectBadInput(Fit("--blocks 1"), {"--blocks 1", "at least 2"});
 }
 
 TEST_F(EmgCli, MissingEndheader) {
