@@ -481,8 +481,8 @@ TEST(EmgSyntheticLaw, CommonDelayIsNamedAloneAndCarriesToAnotherTrial) {
   // Another trial of the same law: predicted, never fitted.
   for (int j = 0; j < 2; ++j) {
     const double r2 = R2(b.tau[j], PredictMoment(d.calibration, b, j));
-    std::printf("  trial 12, joint %d: R^2 %.4f (cross-validated on trial 11: %.4f)\n", j, r2,
-                d.steps.back().model.figures[j].r2_cv);
+    std::printf("  %s predicted, %s: R^2 %.4f (cross-validated on %s: %.4f)\n", b.source.c_str(), j ? "knee" : "hip", r2,
+                a.source.c_str(), d.steps.back().model.figures[j].r2_cv);
     EXPECT_GE(r2, 0.97);
   }
 }
