@@ -39,6 +39,11 @@ nlohmann::json Effects(const EmgDiagnosis& d) {
     a.push_back({{"name", "electromechanical_delay"}, {"muscle", "common"}, {"joint", "hip+knee"}, {"value", v},
                  {"unit", "s"}, {"ci95", {v - 1.96 * se, v + 1.96 * se}}});
   }
+  if (m.spec.twitch != 0) {
+    const double v = m.spec.twitch, se = m.spec.twitch_se;
+    a.push_back({{"name", "muscle_twitch"}, {"muscle", "common"}, {"joint", "hip+knee"}, {"value", v}, {"unit", "s"},
+                 {"ci95", {v - 1.96 * se, v + 1.96 * se}}});
+  }
   for (const auto& dl : m.spec.delay_s) {
     const double se = m.spec.delay_se.count(dl.first) ? m.spec.delay_se.at(dl.first) : 0.0;
     a.push_back({{"name", "electromechanical_delay"}, {"muscle", MuscleName(dl.first)}, {"joint", Joints(dl.first)},
