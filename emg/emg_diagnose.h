@@ -13,8 +13,10 @@
 //    outside it is listed with its verdict, not named).
 // Among the admissible causes the one with the lowest BIC is added; the searched parameters are then
 // refined together, on the first 70 % of every recording (the BIC's rows).
-// Candidates (emg_torque_model.h): one electromechanical delay common to every channel, then (fewer
-// parameters first) a muscle's own delay (searched on 0-200 ms, named within 10-100 ms), the A-shape
+// Candidates (emg_torque_model.h): one electromechanical delay common to every channel (searched on
+// 0-200 ms, named within 10-100 ms), the muscle twitch common to every channel (searched on 10-150
+// ms, named within 20-100 ms), the two together (searched inside their ranges), then (fewer
+// parameters first) a muscle's own delay once a common one is named (within 10-100 ms), the A-shape
 // activation nonlinearity (-3 < A < 0), angle-dependent moment arms per joint (keeping their sign,
 // changing by at most a factor 3 over the calibrated angles), the passive moment per joint (scale in
 // (0, 3]), the vasti standing in for a missing gluteus maximus at the hip. Channels of one muscle
