@@ -1,6 +1,7 @@
 #include "deploy/controller_node.h"
 
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "core/stop_signal.h"
@@ -9,6 +10,10 @@
 
 namespace exotwin {
 namespace {
+
+// The wait for the next frame polls this long before it sleeps: in lockstep the twin's next SYNC comes
+// one plant step (microseconds) after the cycle's answer; a sleep's wake-up costs tens of them.
+constexpr double kSyncSpin = 200e-6;  // s
 
 const char* StateName(int s) {
   return s == 0 ? "running" : (s == 1 ? "safe_damping" : "safe_torque_off");
@@ -144,7 +149,7 @@ int ControllerNode::Run() {
       Summary("stopped");
       return 0;
     }
-    link_->WaitInput(0.1);
+    link_->WaitInput(0.1, kSyncSpin);
     while (!done_ && link_->Receive(&f) == CanStatus::kOk) Handle(f);
   }
   Summary(exit_code_ ? "configuration refused" : "run over (NMT stop)");
@@ -201,11 +206,13 @@ void ControllerNode::Tick(double t) {
     if (syncs_ignored_++ == 0) log_ << "exotwin-controller: SYNC before NMT start: ignored" << std::endl;
     return;
   }
+  link_->Hold();  // the cycle's commands, telemetry and done frame: one datagram
   if (hal_) {
     hal_->Tick(t);
     ++ticks_;
     SendHalTelemetry();
     link_->Send(link::DoubleFrame(link::kIdCycleDone, t));
+    link_->Flush();
     return;
   }
   ctrl_->Tick(t);
@@ -219,6 +226,7 @@ void ControllerNode::Tick(double t) {
   for (int i = 0; i < link::kTelCount; ++i)
     link_->Send(link::DoubleFrame(static_cast<uint16_t>(link::kIdTelemetryBase + i), values[i]));
   link_->Send(link::DoubleFrame(link::kIdCycleDone, t));
+  link_->Flush();
   const int state = static_cast<int>(tel.safety.state);
   if (state != state_ || tel.safety.fault_mask != faults_) {
     log_ << "exotwin-controller: t " << t << " s: safety " << StateName(state_) << " -> " << StateName(state)
@@ -243,11 +251,13 @@ void ControllerNode::SendHalTelemetry() {
 }
 
 void ControllerNode::ZeroTorque() {
+  link_->Hold();
   if (cfg_.hal || scenario_hal_) {  // a HAL-3 file, or a HAL-3 scenario before its first download
     msg::HalKneeCommand c;
     c.torque = 0.0;
     c.enable = false;
     link_->Send(msg::Encode(c));
+    link_->Flush();
     return;
   }
   for (int j = 0; j < 2; ++j) {
@@ -257,12 +267,15 @@ void ControllerNode::ZeroTorque() {
     c.enable = false;
     link_->Send(msg::Encode(c));
   }
+  link_->Flush();
 }
 
 void ControllerNode::Summary(const char* why) {
   const CanLinkStatistics& s = link_->statistics();
   log_ << "exotwin-controller: " << why << ": " << ticks_ << " ticks, frames received " << s.received << ", sent "
-       << s.sent << ", send failures " << s.send_failures + s.peer_absent << ", dropped: foreign " << s.foreign
+       << s.sent << ", send failures " << s.send_failures + s.peer_absent
+       << (s.last_send_errno ? std::string(" (last: ") + std::strerror(s.last_send_errno) + ")" : std::string())
+       << ", dropped: foreign " << s.foreign
        << ", malformed " << s.malformed << std::endl;
 }
 
