@@ -11,10 +11,6 @@
 namespace exotwin {
 namespace {
 
-// The wait for the next frame polls this long before it sleeps: in lockstep the twin's next SYNC comes
-// one plant step (microseconds) after the cycle's answer; a sleep's wake-up costs tens of them.
-constexpr double kSyncSpin = 200e-6;  // s
-
 const char* StateName(int s) {
   return s == 0 ? "running" : (s == 1 ? "safe_damping" : "safe_torque_off");
 }
@@ -149,7 +145,7 @@ int ControllerNode::Run() {
       Summary("stopped");
       return 0;
     }
-    link_->WaitInput(0.1, kSyncSpin);
+    link_->WaitInput(0.1);
     while (!done_ && link_->Receive(&f) == CanStatus::kOk) Handle(f);
   }
   Summary(exit_code_ ? "configuration refused" : "run over (NMT stop)");

@@ -10,7 +10,6 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -264,19 +263,11 @@ bool CanLink::PeerAlive() const {
   return address_.kind != BusKind::kUnix || UnixSocketInUse(address_.PeerName(end_));
 }
 
-bool CanLink::WaitInput(double timeout_s, double spin_s) {
+bool CanLink::WaitInput(double timeout_s) {
   if (!impl_->in.empty()) return true;
   pollfd p{};
   p.fd = impl_->can ? impl_->can->fd() : impl_->fd;
   p.events = POLLIN;
-  if (spin_s > 0) {
-    const double until = MonotonicSeconds() + std::min(spin_s, timeout_s);
-    do {
-      if (::poll(&p, 1, 0) > 0 && (p.revents & POLLIN)) return true;
-    } while (MonotonicSeconds() < until);
-    timeout_s -= spin_s;
-    if (timeout_s <= 0) return false;
-  }
   const int ms = timeout_s <= 0 ? 0 : static_cast<int>(std::ceil(timeout_s * 1e3));
   return ::poll(&p, 1, ms) > 0 && (p.revents & POLLIN);
 }

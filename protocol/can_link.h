@@ -59,10 +59,10 @@ class CanLink : public CanBus {
   // kOk with the oldest valid frame from the peer (out->t: CLOCK_MONOTONIC, s); kNoFrame when none
   // is waiting (foreign and malformed datagrams are dropped on the way, and counted).
   CanStatus Receive(CanFrame* out) override;
-  // Blocks until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if input waits.
-  // The first `spin_s` (s, at most timeout_s) are spent polling without sleeping: an answer expected
-  // within microseconds (lockstep) is taken without the scheduler's wake-up delay.
-  bool WaitInput(double timeout_s, double spin_s = 0);
+  // Blocks in poll(2) until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if
+  // input waits. It does not spin: on a loaded machine a spinning end takes the CPU its peer needs to
+  // answer.
+  bool WaitInput(double timeout_s);
   // False when the peer is known to be gone: a Unix peer whose socket no live process holds (the file
   // of a killed process stays behind). True otherwise (UDP and SocketCAN cannot tell).
   bool PeerAlive() const;

@@ -29,9 +29,6 @@ double Percentile(std::vector<double> v, double p) {
 }
 
 constexpr uint64_t kLinkFaultStream = 0x4c494e4b;  // "LINK": the link faults' draws
-// Lockstep: the wait for the controller's answer polls this long before it sleeps (the answer of a
-// controller on another core comes within microseconds; a sleep's wake-up costs tens of them).
-constexpr double kAnswerSpin = 200e-6;  // s
 // A due time at or before a tick's time, with the rounding of sums of simulated times.
 constexpr double kDueSlack = 1e-9;  // s
 
@@ -231,14 +228,13 @@ void RemoteController::Tick(double t) {
   awaiting_ = true;
   const double wait = clock_ == ServeClock::kLockstep ? timeout_ : 0.5 * period_;
   const double deadline = MonotonicSeconds() + wait;
-  const double spin = clock_ == ServeClock::kLockstep ? kAnswerSpin : wait;
   bool done = false;
   while (!done) {
     while (!done && link_->Receive(&f) == CanStatus::kOk) Take(f, t, &done);
     if (done) break;
     const double left = deadline - MonotonicSeconds();
     if (left <= 0) break;
-    if (!link_->WaitInput(std::min(left, 0.1), std::min(left, spin)) && !link_->PeerAlive()) {
+    if (!link_->WaitInput(std::min(left, 0.1)) && !link_->PeerAlive()) {
       Lost(t, "(its socket is gone: process gone)");
       return;
     }

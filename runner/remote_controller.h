@@ -13,7 +13,7 @@
 //     a period, answers arriving later are late (applied at the next tick), cycles without an answer
 //     before the next SYNC are missed; the tick-start jitter is recorded (percentiles, histogram).
 // A tick's frames to the controller leave as one datagram (CanLink::Hold/Flush), and so do the
-// controller's answers (ControllerNode); the wait for the answer polls before it sleeps.
+// controller's answers (ControllerNode); the wait for the answer blocks in poll(2).
 // Link faults (LinkFaults, `serve --link-delay/--link-jitter/--link-loss`) act on the device frames
 // crossing the link, both ways, on the simulated clock: seeded, so a lockstep run stays deterministic.
 #pragma once
