@@ -425,6 +425,21 @@ TEST(ServeCli, BadInputExitsTwoNamingTheProblem) {
   }
 }
 
+// --rt-priority that the kernel refuses (CAP_SYS_NICE dropped by setpriv, RLIMIT_RTPRIO below it): a
+// warning naming what was refused and why, and the run goes on at normal priority.
+TEST(ServeCli, RefusedRealtimePriorityWarnsAndRunsOn) {
+  if (Shell("setpriv --version").find("setpriv") == std::string::npos) GTEST_SKIP() << "no setpriv (util-linux)";
+  testing::ScopedTempDir dir("serve");
+  const std::string scenario = GaitScenario(dir.path(), 0.3);
+  const std::string out = Shell("setpriv --bounding-set -sys_nice --inh-caps -sys_nice " + testing::ExotwinBin() +
+                                " serve " + scenario + " --bus unix:" + dir.path() + "/bus --out " + dir.path() +
+                                "/o --rt-priority 50 --timeout 0.1");
+  EXPECT_NE(out.find("warning: real-time request refused by the kernel: SCHED_FIFO 50: Operation not permitted"),
+            std::string::npos) << out;
+  EXPECT_NE(out.find("the run goes on at normal priority"), std::string::npos) << out;
+  EXPECT_NE(out.find("300 samples"), std::string::npos) << out;  // the run went on (without a controller)
+}
+
 // serve --link-delay/--link-jitter/--link-loss: a poor bus on purpose, seeded on the run's seed: the
 // same run twice gives the same bytes (lockstep stays deterministic), and the frames lost are counted.
 TEST(ServeCli, LinkFaultsAreSeededAndDeterministic) {
