@@ -212,6 +212,18 @@ TEST(ServeCli, RealtimeTenSecondsRunsToTheEndAndReportsJitter) {
   for (const char* k : {"link_jitter_p50_us", "link_jitter_p99_us", "link_jitter_max_us", "link_late_cycles",
                         "link_missed_cycles"})
     EXPECT_TRUE(r["metrics"].contains(k)) << k;
+  // The histogram counts every tick once; the largest jitter lies in its last non-empty bin.
+  const nlohmann::json& h = r["link_jitter_histogram"];
+  const std::vector<double> edges = h["edges_us"];
+  const std::vector<double> counts = h["counts"];
+  ASSERT_EQ(edges.size(), counts.size());
+  double total = 0;
+  size_t last = 0;
+  for (size_t i = 0; i < counts.size(); ++i) total += counts[i], last = counts[i] > 0 ? i : last;
+  EXPECT_EQ(total, 10000.0);
+  const double max_us = r["metrics"]["link_jitter_max_us"];
+  EXPECT_GE(max_us, edges[last]);
+  if (last + 1 < edges.size()) EXPECT_LT(max_us, edges[last + 1]);
 }
 
 TEST(ServeCli, ControllerStartedBeforeTheTwinAndTwinRestartedUnderIt) {
