@@ -118,7 +118,7 @@ nlohmann::ordered_json BenchSweep(const BenchConfig& c);
 // Rows: lockstep serve + exotwin-controller on gait_2kmh (60 s; quick: 5 s) against the same run in
 // this process (goal <= 3x; logs_identical: measured.csv and truth.csv the same bytes); regress
 // --controller-process of the shipped suite against regress (not quick; <= 3x); real time (60 s;
-// quick: 2 s) at idle and with one core kept busy by a spinning process, SCHED_FIFO 50 asked (the row
+// quick: 2 s) with no added load and with one core kept busy by a spinning process, SCHED_FIFO 50 asked (the row
 // says whether granted): tick-start jitter p99 (goal <= 100 us), p50, max (<= 1 ms), late, missed.
 nlohmann::ordered_json BenchLink(const BenchConfig& c);
 

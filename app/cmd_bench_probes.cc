@@ -469,7 +469,7 @@ json RealtimeRun(const BenchConfig& c, const std::string& controller_bin, double
   if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) return Unavailable("the real-time run failed");
   const json r = json::parse(ReadTextFile(dir + "/result.json", "result", "JSON"));
   const json& m = r.at("metrics");
-  return json{{"load", busy_core ? "one core busy (a spinning process)" : "idle (the bench alone)"},
+  return json{{"load", busy_core ? "one core kept busy (a spinning process)" : "no added load"},
               {"scheduling", ReadTextFile(dir + "/grant.txt", "", "text")},
               {"duration_s", duration},
               {"jitter_p50_us", m.at("link_jitter_p50_us")},
