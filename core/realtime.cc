@@ -1,5 +1,6 @@
 #include "core/realtime.h"
 
+#include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
@@ -40,6 +41,14 @@ RealtimeGrant RequestRealtime(int priority) {
                  (rl.rlim_cur == RLIM_INFINITY ? std::string("unlimited") : std::to_string(rl.rlim_cur)) + ")";
   }
   return g;
+}
+
+void DropRealtimePriority() {
+  int policy = 0;
+  sched_param p{};
+  if (::pthread_getschedparam(::pthread_self(), &policy, &p) != 0 || (policy != SCHED_FIFO && policy != SCHED_RR)) return;
+  p.sched_priority = 0;
+  ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &p);
 }
 
 double WaitUntil(double deadline_s, double spin_s) {

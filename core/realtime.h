@@ -22,6 +22,11 @@ struct RealtimeGrant {
 // says what was refused, the caller warns and runs on. Throws InputError when priority is outside 1..99.
 RealtimeGrant RequestRealtime(int priority);
 
+// Puts the calling thread at normal priority (SCHED_OTHER, nice unchanged) when it runs at a real-time
+// one (inherited from the thread that started it): for background threads of a real-time process (a
+// log writer) that must not hold the CPU from its tick. Lowering a priority is always allowed.
+void DropRealtimePriority();
+
 // Sleeps until `deadline_s` (MonotonicSeconds) minus
 // `spin_s`, then spins until the deadline (the sleep's wake-up latency taken off the tick's start);
 // returns the time reached (>= deadline_s; later when the deadline had already passed).
