@@ -228,15 +228,15 @@ void RemoteController::Tick(double t) {
   const double wait = clock_ == ServeClock::kLockstep ? timeout_ : 0.5 * period_;
   const double deadline = MonotonicSeconds() + wait;
   bool done = false;
-  while (!done) {
-    while (!done && link_->Receive(&f) == CanStatus::kOk) Take(f, t, &done);
-    if (done) break;
+  while (!done) {  // poll first: the answer is rarely there before it (a read would be a wasted call)
     const double left = deadline - MonotonicSeconds();
     if (left <= 0) break;
-    if (!link_->WaitInput(std::min(left, 0.1)) && !link_->PeerAlive()) {
+    if (!link_->WaitInput(std::min(left, 0.1))) {
+      if (link_->PeerAlive()) continue;
       Lost(t, "(its socket is gone: process gone)");
       return;
     }
+    while (!done && link_->Receive(&f) == CanStatus::kOk) Take(f, t, &done);
   }
   Release(t);
   if (!done && clock_ == ServeClock::kLockstep)
