@@ -1,6 +1,7 @@
 // `exotwin bench [--out FILE.json] [--repeat R] [--quick] [--only NAME,...]`: speed of the twin, as
 // JSON (stdout, and FILE.json): start-up (--help vs /bin/true), closed loop vs bare mj_step, render
-// + encode fps, identification and diagnosis throughput, sweep speed-up on 2 worker processes; each
+// + encode fps, identification and diagnosis throughput, sweep speed-up on 2 worker processes, the
+// controller across the process boundary (lockstep speed, real-time jitter); each
 // with the ratio against its baseline measured in the same run (app/bench_probes.h). Exit 0, 2 on
 // bad options. The rows of all probes also go to stderr as one Markdown
 // table, ratio first, under the machine's cores and load.
@@ -33,12 +34,12 @@ CommandRunner RegisterBench(CLI::App& app) {
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
   sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                  "predict_long,diagnose_long");
+                  "predict_long,diagnose_long,link");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
     const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep",
-                                          "predict_long", "diagnose_long"};
+                                          "predict_long", "diagnose_long", "link"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -49,7 +50,7 @@ CommandRunner RegisterBench(CLI::App& app) {
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
                            "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                           "predict_long,diagnose_long");
+                           "predict_long,diagnose_long,link");
         selected.push_back(name);
         start = end + 1;
       }
@@ -73,7 +74,7 @@ CommandRunner RegisterBench(CLI::App& app) {
       std::fprintf(stderr, "bench: %s...\n", name.c_str());
       // Single-threaded work runs on the fastest CPU, its baseline too (bench_probes.h BenchCpu); the
       // render (llvmpipe and encoder threads), `run` (its log writer thread) and the sweep use them all.
-      const bool threaded = name == "render" || name == "run" || name == "sweep";
+      const bool threaded = name == "render" || name == "run" || name == "sweep" || name == "link";
       const ScopedCpuPin pin(threaded ? -1 : FastestCpu(c.cpus));
       if (name == "startup") j[name] = BenchStartup(c);
       if (name == "run") j[name] = BenchRunCommand(c);
@@ -84,6 +85,7 @@ CommandRunner RegisterBench(CLI::App& app) {
       if (name == "sweep") j[name] = BenchSweep(c);
       if (name == "predict_long") j[name] = BenchPredictLong(c);
       if (name == "diagnose_long") j[name] = BenchDiagnoseLong(c);
+      if (name == "link") j[name] = BenchLink(c);
       if (pin.pinned()) j[name]["pinned_cpu"] = FastestCpu(c.cpus);
       for (const BenchRow& r : BenchRowsFromJson(j[name])) rows.push_back(r);
     }

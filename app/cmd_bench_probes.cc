@@ -5,6 +5,7 @@
 #include <sched.h>
 #include <spawn.h>
 #include <sys/resource.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,6 +19,10 @@
 #include <thread>
 
 #include "app/bench_probes.h"
+#include "batch/controller_process.h"
+#include "core/file_text.h"
+#include "core/realtime.h"
+#include "formats/csv_table.h"
 #include "core/data_dir.h"
 #include "batch/fork_pool.h"
 #include "runner/runner.h"
@@ -413,6 +418,126 @@ json BenchSweep(const BenchConfig& c) {
                                       {"sweep: the parent's share of the CPU time", 100.0 * serial, "%",
                                        "parent + workers, --jobs 1", "< 2 %",
                                        Seconds(parent1) + " of " + Seconds(parent1 + cpu1)}})}};
+}
+
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// SCHED_FIFO priority the real-time rows ask for (granted or not: the row says which).
+constexpr int kBenchRtPriority = 50;
+
+// The link figures of one real-time run: gait for `duration` s, serve's twin here and exotwin-controller
+// as its child, both at kBenchRtPriority when the kernel grants it, with one core kept busy by a
+// spinning child process when `busy_core`.
+json RealtimeRun(const BenchConfig& c, const std::string& controller_bin, double duration, bool busy_core) {
+  pid_t busy = -1;
+  if (busy_core) {
+    busy = fork();
+    if (busy == 0) {
+      for (volatile unsigned long i = 0;; i = i + 1) {
+      }
+    }
+  }
+  const std::string dir = c.scratch + (busy_core ? "/rt_busy" : "/rt_idle");
+  std::filesystem::create_directories(dir);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t run = fork();
+  if (run == 0) {  // its own process: the priority taken is not the bench's
+    const RealtimeGrant g = RequestRealtime(kBenchRtPriority);
+    WriteFileAtomic(dir + "/grant.txt", g.fifo ? "SCHED_FIFO " + std::to_string(g.priority) + (g.memory_locked ? ", memory locked" : "")
+                                               : "normal priority (refused: " + g.refused + ")");
+    try {
+      RunOptions opt;
+      opt.out_dir = dir;
+      Scenario s = GaitScenario(duration);
+      RunWithControllerProcess(s, opt, controller_bin, 10.0, ServeClock::kRealtime);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench: realtime run: %s\n", e.what());
+      _exit(1);
+    }
+    _exit(0);
+  }
+  int st = 0;
+  waitpid(run, &st, 0);
+  if (busy > 0) {
+    kill(busy, SIGKILL);
+    waitpid(busy, nullptr, 0);
+  }
+  if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) return Unavailable("the real-time run failed");
+  const json r = json::parse(ReadTextFile(dir + "/result.json", "result", "JSON"));
+  const json& m = r.at("metrics");
+  return json{{"load", busy_core ? "one core kept busy (a spinning process)" : "no added load"},
+              {"scheduling", ReadTextFile(dir + "/grant.txt", "", "text")},
+              {"duration_s", duration},
+              {"jitter_p50_us", m.at("link_jitter_p50_us")},
+              {"jitter_p99_us", m.at("link_jitter_p99_us")},
+              {"jitter_max_us", m.at("link_jitter_max_us")},
+              {"late_cycles", m.at("link_late_cycles")},
+              {"missed_cycles", m.at("link_missed_cycles")}};
+}
+
+std::string Us(double us) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.0f us", us);
+  return b;
+}
+
+}  // namespace
+
+json BenchLink(const BenchConfig& c) {
+  const std::string bin = DefaultControllerBinary();
+  if (bin.empty()) return Unavailable("exotwin-controller not found next to exotwin");
+  const double duration = c.quick ? 5.0 : 60.0;
+  Scenario s = ReadScenario(DataPath("scenarios/gait_2kmh.yaml"));
+  s.protocol.duration = duration;
+  RunOptions in_opt, out_opt;
+  in_opt.out_dir = c.scratch + "/link_in_process";
+  out_opt.out_dir = c.scratch + "/link_lockstep";
+  const double in_process = BestOf(c.repeat, [&] { RunScenario(s, in_opt); });
+  const double lockstep = BestOf(c.repeat, [&] { RunWithControllerProcess(s, out_opt, bin); });
+  const bool identical = ReadTextFile(in_opt.out_dir + "/measured.csv", "", "CSV") ==
+                             ReadTextFile(out_opt.out_dir + "/measured.csv", "", "CSV") &&
+                         ReadTextFile(in_opt.out_dir + "/truth.csv", "", "CSV") ==
+                             ReadTextFile(out_opt.out_dir + "/truth.csv", "", "CSV");
+  std::vector<BenchRow> rows = {{"lockstep: serve + exotwin-controller, gait_2kmh " + Seconds(duration) +
+                                     (identical ? " (logs identical)" : " (logs DIFFER)"),
+                                 lockstep / in_process, "x", "the in-process run, same scenario", "<= 3x",
+                                 Seconds(lockstep) + " vs " + Seconds(in_process)}};
+  json j{{"status", "ok"},
+         {"duration_s", duration},
+         {"in_process_s", in_process},
+         {"lockstep_s", lockstep},
+         {"ratio_lockstep_to_in_process", lockstep / in_process},
+         {"logs_identical", identical}};
+  if (!c.quick) {  // the whole suite, both ways (about a minute)
+    try {
+      const double regress = BestOf(1, [&] { RunSelf({"regress", "--out", c.scratch + "/regress_in"}); });
+      const double remote = BestOf(1, [&] { RunSelf({"regress", "--controller-process", "--out", c.scratch + "/regress_out"}); });
+      j["regress_s"] = regress;
+      j["regress_controller_process_s"] = remote;
+      rows.push_back({"regress --controller-process (the shipped suite)", remote / regress, "x", "regress, in-process",
+                      "<= 3x", Seconds(remote) + " vs " + Seconds(regress)});
+    } catch (const std::exception& e) {
+      j["regress"] = Unavailable(e.what());
+    }
+  }
+  const double rt_duration = c.quick ? 2.0 : 60.0;
+  for (const bool busy : {false, true}) {
+    const json r = RealtimeRun(c, bin, rt_duration, busy);
+    j[busy ? "realtime_busy_core" : "realtime_idle"] = r;
+    if (r.value("status", "") == "unavailable") continue;
+    rows.push_back({"realtime gait " + Seconds(rt_duration) + ", " + r.at("load").get<std::string>() + ", " +
+                        r.at("scheduling").get<std::string>(),
+                    r.at("jitter_p99_us").get<double>(), "us p99", "tick start vs its deadline", "<= 100 us",
+                    "p50 " + Us(r.at("jitter_p50_us")) + ", max " + Us(r.at("jitter_max_us")) + " (<= 1000 us), late " +
+                        std::to_string(r.at("late_cycles").get<long>()) + ", missed " +
+                        std::to_string(r.at("missed_cycles").get<long>())});
+  }
+  j["rows"] = BenchRowsJson(rows);
+  return j;
 }
 
 }  // namespace exotwin

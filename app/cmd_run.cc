@@ -2,10 +2,15 @@
 
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "formats/opensim_storage.h"
 #include "app/commands.h"
 #include "core/stop_signal.h"
 #include "core/error.h"
+#include "core/file_text.h"
+#include "formats/csv_table.h"
+#include "core/realtime.h"
 #include "protocol/bus_address.h"
 #include "protocol/can_link.h"
 #include "batch/controller_process.h"
@@ -49,6 +54,13 @@ std::vector<std::string> WriteStorageCopies(const RunResult& r, const std::strin
     written.push_back(sto);
   }
   return written;
+}
+
+// Adds `key: value` to the top level of the result.json at `path` (written whole, atomically).
+void AddToResultJson(const std::string& path, const std::string& key, const nlohmann::ordered_json& value) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(ReadTextFile(path, "result", "JSON"));
+  j[key] = value;
+  WriteFileAtomic(path, j.dump(2) + "\n");
 }
 
 CommandRunner RegisterRun(CLI::App& app) {
@@ -124,6 +136,8 @@ CommandRunner RegisterServe(CLI::App& app) {
     std::string scenario, out = "out", bus, can, clock = "lockstep", can_log;
     uint64_t seed = 0;
     double timeout = 10.0;
+    double link_delay_ms = 0, link_jitter_ms = 0, link_loss = 0, rt_spin_us = 100;
+    int rt_priority = 0;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("serve", "Run a scenario's twin for a controller in another process");
@@ -137,11 +151,20 @@ CommandRunner RegisterServe(CLI::App& app) {
   sub->add_option("--timeout", o->timeout, "s of wall clock without an answer after which the controller is gone")
       ->check(CLI::Range(0.01, 3600.0));
   sub->add_option("--can-log", o->can_log, "candump log of every CAN frame of the twin's bus");
-  return [sub, o, seed]() -> int {
+  sub->add_option("--link-delay", o->link_delay_ms, "ms of simulated time added to each device frame crossing the link");
+  sub->add_option("--link-jitter", o->link_jitter_ms, "ms: each device frame further delayed by up to this (uniform, seeded)");
+  sub->add_option("--link-loss", o->link_loss, "probability 0..1 that a device frame crossing the link is lost (seeded)");
+  auto* rt_priority = sub->add_option("--rt-priority", o->rt_priority,
+                                      "realtime: lock the memory and take SCHED_FIFO priority 1..99 (a refusal: warning)");
+  sub->add_option("--rt-spin", o->rt_spin_us, "realtime: us spent spinning before each tick's deadline (default 100)");
+  return [sub, o, seed, rt_priority]() -> int {
     if (!*sub) return -1;
     if (o->bus.empty() && o->can.empty()) throw InputError("serve: --bus ADDR or --can IFACE is required");
+    if (!(o->rt_spin_us >= 0 && o->rt_spin_us <= 1e6))
+      throw InputError("--rt-spin: expected 0 to 1000000 us, got " + std::to_string(o->rt_spin_us));
     InstallStopSignalHandlers();
     const Scenario s = ReadScenario(o->scenario);
+    const LinkFaults faults = LinkFaultsOf(o->link_delay_ms, o->link_jitter_ms, o->link_loss, *seed ? o->seed : s.seed);
     const BusAddress address = o->can.empty() ? ParseBusAddress(o->bus) : ParseBusAddress("can:" + o->can, "--can");
     if (address.kind == BusKind::kUdp && !address.loopback())
       std::fprintf(stderr, "exotwin serve: note: UDP on %s, not loopback: torque commands cross the network\n",
@@ -150,7 +173,15 @@ CommandRunner RegisterServe(CLI::App& app) {
     const std::string controller_file = WriteControllerFile(s, o->out, *seed ? o->seed : s.seed);
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
     const ServeClock clock = o->clock == "realtime" ? ServeClock::kRealtime : ServeClock::kLockstep;
-    RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, o->timeout);
+    if (*rt_priority) {
+      const RealtimeGrant g = RequestRealtime(o->rt_priority);
+      if (!g.refused.empty())
+        std::fprintf(stderr, "exotwin serve: warning: real-time request refused by the kernel: %s; the run goes on%s\n",
+                     g.refused.c_str(), g.fifo ? "" : " at normal priority");
+      std::fprintf(stderr, "exotwin serve: memory %s, scheduling %s\n", g.memory_locked ? "locked" : "not locked",
+                   g.fifo ? ("SCHED_FIFO " + std::to_string(g.priority)).c_str() : "SCHED_OTHER (normal)");
+    }
+    RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, o->timeout, faults, 1e-6 * o->rt_spin_us);
     std::fprintf(stderr, "exotwin serve: %s on %s, %s clock; waiting for the controller (%s)\n", s.name.c_str(),
                  link->Describe().c_str(), o->clock.c_str(),
                  controller_file.empty() ? "start it on the scenario file: its trials run different controller files"
@@ -168,6 +199,7 @@ CommandRunner RegisterServe(CLI::App& app) {
       throw;
     }
     remote.EndRun();
+    if (clock == ServeClock::kRealtime) AddToResultJson(o->out + "/result.json", "link_jitter_histogram", remote.JitterHistogram());
     const CanLinkStatistics& st = link->statistics();
     std::fprintf(stderr, "exotwin serve: link %s: frames received %llu, sent %llu, dropped foreign %llu, malformed %llu%s\n",
                  link->Describe().c_str(), static_cast<unsigned long long>(st.received),

@@ -106,7 +106,7 @@ void Reap(pid_t pid, double seconds) {
 }  // namespace
 
 RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,
-                                   double timeout_s) {
+                                   double timeout_s, ServeClock clock) {
   if (controller_bin.empty() || ::access(controller_bin.c_str(), X_OK) != 0)
     throw InputError("exotwin-controller: '" + controller_bin + "' is not an executable");
   const LinkDir dir;
@@ -114,7 +114,7 @@ RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std:
   const BusAddress address = ParseBusAddress("unix:" + dir.path() + "/bus");
   std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
   const pid_t pid = StartController(controller_bin, config, address.text, opt.out_dir + "/controller.log");
-  RemoteController remote(link.get(), ServeClock::kLockstep, 1.0 / s.controller.rate_hz, timeout_s);
+  RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, timeout_s);
   opt.remote = &remote;
   RunResult r;
   try {

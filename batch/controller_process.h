@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "runner/remote_controller.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
 
@@ -28,9 +29,10 @@ std::string DefaultControllerBinary();
 // Runs `s` as RunScenario does (any device and protocol), the controller being `controller_bin` started
 // on the scenario's device and controller part (WriteControllerScenario: it downloads each run's
 // controller file from the twin) on a private Unix link (its log in opt.out_dir/controller.log) and
-// stopped at the end (NMT stop; killed if still there 5 s later). The run fails (a check result
-// "controller_link" failed) when the controller was lost. Throws InputError when the link cannot be set up.
+// stopped at the end (NMT stop; killed if still there 5 s later), in lockstep (or `clock`). The run
+// fails (a check result "controller_link" failed) when the controller was lost. Throws InputError when
+// the link cannot be set up.
 RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,
-                                   double timeout_s = 10.0);
+                                   double timeout_s = 10.0, ServeClock clock = ServeClock::kLockstep);
 
 }  // namespace exotwin

@@ -1,6 +1,7 @@
 #include "deploy/controller_node.h"
 
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "core/stop_signal.h"
@@ -201,11 +202,13 @@ void ControllerNode::Tick(double t) {
     if (syncs_ignored_++ == 0) log_ << "exotwin-controller: SYNC before NMT start: ignored" << std::endl;
     return;
   }
+  link_->Hold();  // the cycle's commands, telemetry and done frame: one datagram
   if (hal_) {
     hal_->Tick(t);
     ++ticks_;
     SendHalTelemetry();
     link_->Send(link::DoubleFrame(link::kIdCycleDone, t));
+    link_->Flush();
     return;
   }
   ctrl_->Tick(t);
@@ -219,6 +222,7 @@ void ControllerNode::Tick(double t) {
   for (int i = 0; i < link::kTelCount; ++i)
     link_->Send(link::DoubleFrame(static_cast<uint16_t>(link::kIdTelemetryBase + i), values[i]));
   link_->Send(link::DoubleFrame(link::kIdCycleDone, t));
+  link_->Flush();
   const int state = static_cast<int>(tel.safety.state);
   if (state != state_ || tel.safety.fault_mask != faults_) {
     log_ << "exotwin-controller: t " << t << " s: safety " << StateName(state_) << " -> " << StateName(state)
@@ -243,11 +247,13 @@ void ControllerNode::SendHalTelemetry() {
 }
 
 void ControllerNode::ZeroTorque() {
+  link_->Hold();
   if (cfg_.hal || scenario_hal_) {  // a HAL-3 file, or a HAL-3 scenario before its first download
     msg::HalKneeCommand c;
     c.torque = 0.0;
     c.enable = false;
     link_->Send(msg::Encode(c));
+    link_->Flush();
     return;
   }
   for (int j = 0; j < 2; ++j) {
@@ -257,12 +263,15 @@ void ControllerNode::ZeroTorque() {
     c.enable = false;
     link_->Send(msg::Encode(c));
   }
+  link_->Flush();
 }
 
 void ControllerNode::Summary(const char* why) {
   const CanLinkStatistics& s = link_->statistics();
   log_ << "exotwin-controller: " << why << ": " << ticks_ << " ticks, frames received " << s.received << ", sent "
-       << s.sent << ", send failures " << s.send_failures + s.peer_absent << ", dropped: foreign " << s.foreign
+       << s.sent << ", send failures " << s.send_failures + s.peer_absent
+       << (s.last_send_errno ? std::string(" (last: ") + std::strerror(s.last_send_errno) + ")" : std::string())
+       << ", dropped: foreign " << s.foreign
        << ", malformed " << s.malformed << std::endl;
 }
 

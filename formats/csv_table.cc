@@ -14,6 +14,7 @@
 #include "formats/number_rows.h"
 #include "core/error.h"
 #include "core/file_text.h"
+#include "core/realtime.h"
 
 namespace exotwin {
 
@@ -464,7 +465,10 @@ CsvStreamWriter::CsvStreamWriter(const std::string& path, const std::vector<std:
   block_.reserve(flush_rows_ * columns_);
   w.block.reserve(flush_rows_ * columns_);
   w.text.reserve(flush_rows_ * (columns_ * 25 + 1));  // Run's kMaxField: no allocation after start
-  w.thread = std::thread([&w] { w.Run(); });
+  w.thread = std::thread([&w] {
+    DropRealtimePriority();  // a real-time caller's (serve --rt-priority) tick never waits behind the text
+    w.Run();
+  });
 }
 
 CsvStreamWriter::~CsvStreamWriter() {

@@ -14,17 +14,13 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <deque>
+#include <vector>
 
 #include "core/error.h"
 #include "protocol/socketcan_bus.h"
 
 namespace exotwin {
-
-double MonotonicSeconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct CanLink::Impl {
   int fd = -1;
@@ -32,6 +28,9 @@ struct CanLink::Impl {
   std::string local_path;             // kUnix: unlinked on close
   sockaddr_storage peer{};
   socklen_t peer_len = 0;
+  bool held = false;
+  std::vector<can_frame> out;  // held frames (Hold .. Flush)
+  std::deque<CanFrame> in;     // valid frames of received datagrams, not yet returned by Receive
   ~Impl() {
     if (fd >= 0) ::close(fd);
     if (!local_path.empty()) ::unlink(local_path.c_str());
@@ -159,33 +158,51 @@ CanStatus CanLink::Send(const CanFrame& frame) {
       const timespec pause{0, 20000};
       ::nanosleep(&pause, nullptr);
     }
-    st == CanStatus::kOk ? ++stats_.sent : ++stats_.send_failures;
+    st == CanStatus::kOk ? (++stats_.sent, ++stats_.datagrams_sent) : ++stats_.send_failures;
     return st;
   }
   can_frame cf{};
   cf.can_id = frame.id;
   cf.can_dlc = frame.dlc;
   std::memcpy(cf.data, frame.data.data(), frame.dlc);
+  impl_->out.push_back(cf);
+  if (impl_->held && impl_->out.size() < static_cast<size_t>(kMaxFramesPerDatagram)) return CanStatus::kOk;
+  return SendQueued();
+}
+
+void CanLink::Hold() { impl_->held = true; }
+
+CanStatus CanLink::Flush() {
+  impl_->held = false;
+  return impl_->out.empty() ? CanStatus::kOk : SendQueued();
+}
+
+CanStatus CanLink::SendQueued() {
+  const size_t frames = impl_->out.size(), bytes = frames * sizeof(can_frame);
   // A Unix datagram queue holds few datagrams (net.unix.max_dgram_qlen, 10 by default): a full queue
-  // of a live peer is waited for, up to kSendWait s, before the frame is refused (kQueueFull).
+  // of a live peer is waited for, up to kSendWait s, before the datagram is refused (kQueueFull).
   ssize_t n;
   const double give_up = MonotonicSeconds() + kSendWait;
-  while ((n = ::sendto(impl_->fd, &cf, sizeof cf, MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&impl_->peer),
+  while ((n = ::sendto(impl_->fd, impl_->out.data(), bytes, MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&impl_->peer),
                        impl_->peer_len)) < 0 &&
          (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) && MonotonicSeconds() < give_up) {
     const timespec pause{0, 20000};
     ::nanosleep(&pause, nullptr);
   }
-  if (n == static_cast<ssize_t>(sizeof cf)) {
-    ++stats_.sent;
+  const int err = errno;
+  impl_->out.clear();
+  if (n != static_cast<ssize_t>(bytes)) stats_.last_send_errno = n < 0 ? err : EMSGSIZE;
+  if (n == static_cast<ssize_t>(bytes)) {
+    stats_.sent += frames;
+    ++stats_.datagrams_sent;
     return CanStatus::kOk;
   }
-  if (n < 0 && (errno == ECONNREFUSED || errno == ENOENT)) {
-    ++stats_.peer_absent;
+  if (n < 0 && (err == ECONNREFUSED || err == ENOENT)) {
+    stats_.peer_absent += frames;
     return CanStatus::kError;
   }
-  ++stats_.send_failures;
-  if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS)) return CanStatus::kQueueFull;
+  stats_.send_failures += frames;
+  if (n < 0 && (err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS)) return CanStatus::kQueueFull;
   return CanStatus::kError;
 }
 
@@ -196,39 +213,50 @@ CanStatus CanLink::Receive(CanFrame* out) {
     if (st == CanStatus::kOk) ++stats_.received;
     return st;
   }
-  for (;;) {
-    unsigned char buf[sizeof(can_frame) + 1];  // one byte more: a longer datagram is seen as such
-    sockaddr_storage from{};
-    socklen_t from_len = sizeof from;
-    const ssize_t n = ::recvfrom(impl_->fd, buf, sizeof buf, MSG_TRUNC, reinterpret_cast<sockaddr*>(&from), &from_len);
-    if (n < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK) return CanStatus::kNoFrame;
-      if (errno == ECONNREFUSED || errno == EINTR) continue;  // UDP: a refused earlier send
-      ++stats_.malformed;
-      return CanStatus::kNoFrame;
-    }
-    if (!SamePeer(from, from_len, *impl_)) {
-      ++stats_.foreign;
-      continue;
-    }
-    can_frame cf{};
-    if (n != static_cast<ssize_t>(sizeof cf)) {
-      ++stats_.malformed;
-      continue;
-    }
-    std::memcpy(&cf, buf, sizeof cf);
+  while (impl_->in.empty() && ReceiveDatagram()) {
+  }
+  if (impl_->in.empty()) return CanStatus::kNoFrame;
+  *out = impl_->in.front();
+  impl_->in.pop_front();
+  ++stats_.received;
+  return CanStatus::kOk;
+}
+
+bool CanLink::ReceiveDatagram() {
+  can_frame buf[kMaxFramesPerDatagram + 1];  // one frame more: a longer datagram is seen as such
+  sockaddr_storage from{};
+  socklen_t from_len = sizeof from;
+  const ssize_t n = ::recvfrom(impl_->fd, buf, sizeof buf, MSG_TRUNC, reinterpret_cast<sockaddr*>(&from), &from_len);
+  if (n < 0) {
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return false;
+    if (errno == ECONNREFUSED || errno == EINTR) return true;  // UDP: a refused earlier send
+    ++stats_.malformed;
+    return false;
+  }
+  if (!SamePeer(from, from_len, *impl_)) {
+    ++stats_.foreign;
+    return true;
+  }
+  const size_t frames = static_cast<size_t>(n) / sizeof(can_frame);
+  if (n == 0 || static_cast<size_t>(n) % sizeof(can_frame) != 0 || frames > static_cast<size_t>(kMaxFramesPerDatagram)) {
+    ++stats_.malformed;
+    return true;
+  }
+  const double now = MonotonicSeconds();
+  for (size_t i = 0; i < frames; ++i) {
+    const can_frame& cf = buf[i];
     if ((cf.can_id & ~CAN_SFF_MASK) != 0 || cf.can_dlc > 8) {  // EFF / RTR / ERR flags or a long DLC
       ++stats_.malformed;
       continue;
     }
-    *out = CanFrame{};
-    out->id = static_cast<uint16_t>(cf.can_id);
-    out->dlc = cf.can_dlc;
-    std::memcpy(out->data.data(), cf.data, cf.can_dlc);
-    out->t = MonotonicSeconds();
-    ++stats_.received;
-    return CanStatus::kOk;
+    CanFrame f;
+    f.id = static_cast<uint16_t>(cf.can_id);
+    f.dlc = cf.can_dlc;
+    std::memcpy(f.data.data(), cf.data, cf.can_dlc);
+    f.t = now;
+    impl_->in.push_back(f);
   }
+  return true;
 }
 
 bool CanLink::PeerAlive() const {
@@ -236,6 +264,7 @@ bool CanLink::PeerAlive() const {
 }
 
 bool CanLink::WaitInput(double timeout_s) {
+  if (!impl_->in.empty()) return true;
   pollfd p{};
   p.fd = impl_->can ? impl_->can->fd() : impl_->fd;
   p.events = POLLIN;

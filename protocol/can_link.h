@@ -1,7 +1,9 @@
-// A CAN link between two processes (DESIGN.md "The CAN transport between processes"): one datagram
-// per frame, the datagram being SocketCAN's 16-byte `struct can_frame` (can_id: 11-bit identifier,
-// no flags; can_dlc 0..8; 3 padding bytes zero; data[8]) over a Unix datagram socket or UDP, or the
-// frames of a SocketCAN interface. Implements CanBus, non-blocking, plus a wait for input.
+// A CAN link between two processes (DESIGN.md "The CAN transport between processes"): datagrams of 1
+// to kMaxFramesPerDatagram frames, each frame SocketCAN's 16-byte `struct can_frame` (can_id: 11-bit
+// identifier, no flags; can_dlc 0..8; 3 padding bytes zero; data[8]), over a Unix datagram socket or
+// UDP, or the frames of a SocketCAN interface (one frame at a time: a real bus). Implements CanBus,
+// non-blocking, plus a wait for input. Frames sent between Hold() and Flush() leave as one datagram
+// (a controller cycle's frames: one system call per direction and cycle instead of one per frame).
 //
 // Security (the link carries torque commands to a device on a person): each end accepts datagrams only
 // from the other end's configured address (BusAddress::PeerName), never from any other sender; those
@@ -13,18 +15,25 @@
 #include <memory>
 #include <string>
 
+#include "core/realtime.h"  // MonotonicSeconds
 #include "protocol/bus_address.h"
 #include "protocol/can_bus.h"
 
 namespace exotwin {
 
+// The most frames one datagram carries (1024 bytes: one Ethernet frame with its UDP header).
+constexpr int kMaxFramesPerDatagram = 64;
+
 struct CanLinkStatistics {
   uint64_t received = 0;        // frames returned by Receive
   uint64_t sent = 0;            // frames handed to the kernel
+  uint64_t datagrams_sent = 0;  // datagrams (or SocketCAN frames) handed to the kernel
   uint64_t foreign = 0;         // datagrams from an unconfigured sender, dropped
-  uint64_t malformed = 0;       // datagrams of the wrong length, or not an 11-bit data frame, dropped
+  uint64_t malformed = 0;       // datagrams not a whole number (1..64) of frames, and frames not an
+                                // 11-bit data frame, dropped
   uint64_t peer_absent = 0;     // Sends refused because the peer's socket does not exist / listen
   uint64_t send_failures = 0;   // other failed Sends (buffer full, ...)
+  int last_send_errno = 0;      // errno of the last failed send (0: none failed)
 };
 
 class CanLink : public CanBus {
@@ -39,11 +48,20 @@ class CanLink : public CanBus {
 
   // kOk; kError when the frame is invalid or the peer is absent (peer_absent counted); kQueueFull
   // when the peer's queue stayed full for 0.1 s (the send waits that long for a live peer to read).
+  // While held (Hold), a valid frame is queued (kOk) and leaves at Flush, or as soon as
+  // kMaxFramesPerDatagram are queued.
   CanStatus Send(const CanFrame& frame) override;
+  // From now on Send queues its frames for one datagram (Unix and UDP; SocketCAN sends at once).
+  void Hold();
+  // Sends the queued frames as one datagram and ends the hold: the status as Send's (kOk when none
+  // were queued; the frames of a refused datagram count as send failures or peer_absent).
+  CanStatus Flush();
   // kOk with the oldest valid frame from the peer (out->t: CLOCK_MONOTONIC, s); kNoFrame when none
   // is waiting (foreign and malformed datagrams are dropped on the way, and counted).
   CanStatus Receive(CanFrame* out) override;
-  // Blocks until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if input waits.
+  // Blocks in poll(2) until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if
+  // input waits. It does not spin: on a loaded machine a spinning end takes the CPU its peer needs to
+  // answer.
   bool WaitInput(double timeout_s);
   // False when the peer is known to be gone: a Unix peer whose socket no live process holds (the file
   // of a killed process stays behind). True otherwise (UDP and SocketCAN cannot tell).
@@ -57,13 +75,12 @@ class CanLink : public CanBus {
 
  private:
   CanLink(BusAddress address, LinkEnd end, std::unique_ptr<Impl> impl);
+  CanStatus SendQueued();   // the held frames as one datagram
+  bool ReceiveDatagram();   // one datagram's valid frames into the input queue; false when none waits
   BusAddress address_;
   LinkEnd end_;
   std::unique_ptr<Impl> impl_;
   CanLinkStatistics stats_;
 };
-
-// Monotonic wall-clock time (s) used by the links' time stamps and the real-time clock.
-double MonotonicSeconds();
 
 }  // namespace exotwin

@@ -4,10 +4,11 @@
 #include <cmath>
 #include <map>
 #include <sstream>
-#include <thread>
 
 #include <unistd.h>
 
+#include "core/error.h"
+#include "core/realtime.h"
 #include "protocol/link_frames.h"
 #include "protocol/messages.h"
 
@@ -26,6 +27,10 @@ double Percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(std::min<double>(v.size() - 1, std::floor(p * (v.size() - 1) + 0.5)))];
 }
 
+constexpr uint64_t kLinkFaultStream = 0x4c494e4b;  // "LINK": the link faults' draws
+// A due time at or before a tick's time, with the rounding of sums of simulated times.
+constexpr double kDueSlack = 1e-9;  // s
+
 std::string At(double t) {
   std::ostringstream o;
   o << "t=" << t << " ";
@@ -34,9 +39,52 @@ std::string At(double t) {
 
 }  // namespace
 
-RemoteController::RemoteController(CanLink* link, ServeClock clock, double period_s, double timeout_s)
+LinkFaults LinkFaultsOf(double delay_ms, double jitter_ms, double loss, uint64_t seed) {
+  auto check = [](const char* option, double v, double hi, const char* what) {
+    if (!(v >= 0 && v <= hi))  // NaN too
+      throw InputError(std::string(option) + ": expected " + what + ", got " + std::to_string(v));
+  };
+  check("--link-delay", delay_ms, 1000, "a delay of 0 to 1000 ms");
+  check("--link-jitter", jitter_ms, 1000, "a jitter of 0 to 1000 ms");
+  check("--link-loss", loss, 1, "a probability of loss of 0 to 1");
+  LinkFaults f;
+  f.delay_s = 1e-3 * delay_ms;
+  f.jitter_s = 1e-3 * jitter_ms;
+  f.loss = loss;
+  f.seed = seed;
+  return f;
+}
+
+const std::vector<double>& JitterHistogramEdgesUs() {
+  static const std::vector<double> edges = {0, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000};
+  return edges;
+}
+
+RemoteController::RemoteController(CanLink* link, ServeClock clock, double period_s, double timeout_s,
+                                   LinkFaults faults, double spin_s)
     : link_(link), clock_(clock), period_(period_s), timeout_(timeout_s),
-      starts_(static_cast<uint16_t>(static_cast<uint64_t>(MonotonicSeconds() * 1e9) ^ static_cast<uint64_t>(::getpid()))) {}
+      starts_(static_cast<uint16_t>(static_cast<uint64_t>(MonotonicSeconds() * 1e9) ^ static_cast<uint64_t>(::getpid()))),
+      faults_(faults), spin_(spin_s), fault_rng_(MixSeed(faults.seed ^ kLinkFaultStream)) {}
+
+bool RemoteController::Pass(double t, double* last, double* due) {
+  if (faults_.loss > 0 && fault_rng_.Uniform() < faults_.loss) {
+    ++dropped_;
+    return false;
+  }
+  *due = t;
+  if (!faults_.any()) return true;
+  *due = std::max(t + faults_.delay_s + (faults_.jitter_s > 0 ? faults_.jitter_s * fault_rng_.Uniform() : 0.0),
+                  *last);  // never overtakes the frame before it
+  *last = *due;
+  return true;
+}
+
+void RemoteController::Release(double t) {
+  while (!to_bus_.empty() && to_bus_.front().due <= t + kDueSlack) {
+    if (ep_->Send(to_bus_.front().frame) != CanStatus::kOk) ++bus_refused_;
+    to_bus_.pop_front();
+  }
+}
 
 void RemoteController::BeginTrial(int trial, CanBus* ep, std::vector<std::string>* events) {
   ep_ = ep;
@@ -48,6 +96,8 @@ void RemoteController::BeginTrial(int trial, CanBus* ep, std::vector<std::string
   awaiting_ = false;
   ticks_ = 0;
   present_ = false;
+  to_controller_.clear(), to_bus_.clear();
+  last_to_controller_ = last_to_bus_ = 0;
   const double start = MonotonicSeconds();
   const uint16_t sequence = starts_++;
   double last_nmt = -1;
@@ -63,7 +113,9 @@ void RemoteController::BeginTrial(int trial, CanBus* ep, std::vector<std::string
           link::StartSequence(f) == sequence)
         present_ = true;
       if (f.id == link::kIdConfigRequest && !configuration_.empty()) {
+        link_->Hold();
         for (const CanFrame& c : link::ConfigFrames(configuration_)) link_->Send(c);
+        link_->Flush();
         last_nmt = -1;  // the next NMT start right after the configuration
       }
     }
@@ -112,7 +164,8 @@ void RemoteController::Take(const CanFrame& f, double t, bool* done) {
                          ": not a controller frame, dropped (further ones counted in link_frames_unexpected)");
     return;
   }
-  if (ep_->Send(f) != CanStatus::kOk) ++bus_refused_;
+  double due = 0;
+  if (Pass(t, &last_to_bus_, &due)) to_bus_.push_back({due, f});
 }
 
 void RemoteController::TakeHal(int i, double v) {
@@ -138,15 +191,9 @@ void RemoteController::TakeHal(int i, double v) {
 }
 
 void RemoteController::Tick(double t) {
-  if (clock_ == ServeClock::kRealtime) {  // pace: tick k at wall0 + k period
+  if (clock_ == ServeClock::kRealtime) {  // tick k on the absolute deadline wall0 + k period
     const double due = wall0_ + static_cast<double>(ticks_) * period_;
-    double now = MonotonicSeconds();
-    if (now < due) {
-      std::this_thread::sleep_for(std::chrono::duration<double>(due - now - 50e-6));
-      while ((now = MonotonicSeconds()) < due) {
-      }
-    }
-    jitter_.push_back(now - due);
+    jitter_.push_back(WaitUntil(due, spin_) - due);
     CanFrame g;
     bool done = false;  // the last cycle's answer, after its deadline: late, applied now
     while (link_->Receive(&g) == CanStatus::kOk) Take(g, t, &done);
@@ -155,16 +202,23 @@ void RemoteController::Tick(double t) {
     awaiting_ = false;
   }
   ++ticks_;
+  Release(t);  // commands delayed by the link's faults, due by now
   CanFrame f;
   CanStatus st;
   while ((st = ep_->Receive(&f)) != CanStatus::kNoFrame) {
-    if (st != CanStatus::kOk || !present_) continue;  // error frames: the in-process controller skips them too
-    link_->Send(link::DoubleFrame(link::kIdRxStamp, f.t));
-    link_->Send(f);
-  }
+    double due = 0;
+    if (st == CanStatus::kOk && present_ && Pass(f.t, &last_to_controller_, &due)) to_controller_.push_back({due, f});
+  }  // error frames: the in-process controller skips them too
   if (!present_) return;
   const uint64_t absent = link_->statistics().peer_absent;
+  link_->Hold();  // the tick's frames and SYNC: one datagram
+  while (!to_controller_.empty() && to_controller_.front().due <= t + kDueSlack) {
+    link_->Send(link::DoubleFrame(link::kIdRxStamp, to_controller_.front().due));
+    link_->Send(to_controller_.front().frame);
+    to_controller_.pop_front();
+  }
   link_->Send(link::DoubleFrame(link::kIdSync, t));
+  link_->Flush();
   if (link_->statistics().peer_absent != absent) {
     Lost(t, "(its socket refuses frames: process gone)");
     return;
@@ -174,16 +228,17 @@ void RemoteController::Tick(double t) {
   const double wait = clock_ == ServeClock::kLockstep ? timeout_ : 0.5 * period_;
   const double deadline = MonotonicSeconds() + wait;
   bool done = false;
-  while (!done) {
-    while (!done && link_->Receive(&f) == CanStatus::kOk) Take(f, t, &done);
-    if (done) break;
+  while (!done) {  // poll first: the answer is rarely there before it (a read would be a wasted call)
     const double left = deadline - MonotonicSeconds();
     if (left <= 0) break;
-    if (!link_->WaitInput(std::min(left, 0.1)) && !link_->PeerAlive()) {
+    if (!link_->WaitInput(std::min(left, 0.1))) {
+      if (link_->PeerAlive()) continue;
       Lost(t, "(its socket is gone: process gone)");
       return;
     }
+    while (!done && link_->Receive(&f) == CanStatus::kOk) Take(f, t, &done);
   }
+  Release(t);
   if (!done && clock_ == ServeClock::kLockstep)
     Lost(t, "(no answer within " + std::to_string(timeout_) + " s of wall clock)");
 }
@@ -198,6 +253,7 @@ void RemoteController::AddMetrics(std::map<std::string, double>* m) const {
   (*m)["link_frames_malformed"] = static_cast<double>(s.malformed);
   (*m)["link_frames_unexpected"] = static_cast<double>(unexpected_);
   (*m)["link_frames_refused_by_bus"] = static_cast<double>(bus_refused_);
+  (*m)["link_frames_dropped"] = static_cast<double>(dropped_);
   if (clock_ == ServeClock::kRealtime) {
     (*m)["link_jitter_p50_us"] = 1e6 * Percentile(jitter_, 0.5);
     (*m)["link_jitter_p99_us"] = 1e6 * Percentile(jitter_, 0.99);
@@ -205,6 +261,18 @@ void RemoteController::AddMetrics(std::map<std::string, double>* m) const {
     (*m)["link_late_cycles"] = static_cast<double>(late_);
     (*m)["link_missed_cycles"] = static_cast<double>(missed_ + (awaiting_ ? 1 : 0));
   }
+}
+
+nlohmann::ordered_json RemoteController::JitterHistogram() const {
+  if (clock_ != ServeClock::kRealtime) return nullptr;
+  const std::vector<double>& edges = JitterHistogramEdgesUs();
+  std::vector<uint64_t> counts(edges.size(), 0);
+  for (double j : jitter_) {
+    const double us = 1e6 * j;
+    const auto above = std::upper_bound(edges.begin(), edges.end(), us);  // first edge > us
+    ++counts[static_cast<size_t>(std::max<std::ptrdiff_t>(0, above - edges.begin() - 1))];
+  }
+  return nlohmann::ordered_json{{"edges_us", edges}, {"counts", counts}};
 }
 
 }  // namespace exotwin

@@ -18,6 +18,7 @@ PKGS=(
   parallel                            # GNU parallel: the sweep split-and-merge test (tests/cli)
   slurm-wlm munge                     # a one-node Slurm for scripts/test_slurm.sh (the sweep job array)
   file dpkg-dev                       # cpack -G DEB: dpkg-shlibdeps computes the dependencies, `file` finds the ELF files
+  python3                             # examples/python_controller (a controller from outside the project; its serve test)
 )
 
 missing=()

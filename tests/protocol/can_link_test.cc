@@ -10,6 +10,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -109,6 +110,43 @@ TEST(CanLink, UnconfiguredPeerAndMalformedDatagramsAreDroppedAndCounted) {
   EXPECT_EQ(twin->statistics().foreign, 2u);
   EXPECT_EQ(twin->statistics().malformed, 3u);
   EXPECT_EQ(twin->statistics().received, 1u);
+}
+
+// DESIGN.md: a datagram carries 1 to 64 frames; Hold .. Flush sends a cycle's frames as one datagram;
+// a datagram of more frames, or not a whole number of them, is malformed as a whole, a bad frame in a
+// good datagram alone.
+TEST(CanLink, HeldFramesLeaveAsOneDatagramOfUpTo64) {
+  testing::ScopedTempDir dir("canlink");
+  const BusAddress a = ParseBusAddress("unix:" + dir.path() + "/bus");
+  auto twin = CanLink::Open(a, LinkEnd::kTwin);
+  auto ctl = CanLink::Open(a, LinkEnd::kController);
+  ctl->Hold();
+  for (int i = 0; i < 70; ++i) ASSERT_EQ(ctl->Send(Frame(0x100, static_cast<uint8_t>(i))), CanStatus::kOk);
+  EXPECT_EQ(ctl->statistics().datagrams_sent, 1u);  // 64 frames full: sent; 6 held
+  ASSERT_EQ(ctl->Flush(), CanStatus::kOk);
+  EXPECT_EQ(ctl->statistics().datagrams_sent, 2u);
+  EXPECT_EQ(ctl->statistics().sent, 70u);
+  ASSERT_EQ(ctl->Send(Frame(0x101, 0)), CanStatus::kOk);  // not held: a datagram of its own
+  EXPECT_EQ(ctl->statistics().datagrams_sent, 3u);
+  CanFrame f;
+  for (int i = 0; i < 70; ++i) {
+    ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk) << i;
+    EXPECT_TRUE(SamePayload(f, Frame(0x100, static_cast<uint8_t>(i)))) << i;
+  }
+  ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk);
+  EXPECT_EQ(f.id, 0x101);
+  ctl.reset();  // raw datagrams from the controller's address
+  std::vector<can_frame> frames(65);
+  for (can_frame& cf : frames) cf.can_id = 0x100, cf.can_dlc = 1;
+  frames[1].can_id |= CAN_EFF_FLAG;
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", frames.data(), 3 * sizeof(can_frame));   // 2 good, 1 bad
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", frames.data(), 65 * sizeof(can_frame));  // too many
+  SendRawUnix(dir.path() + "/bus.ctl", dir.path() + "/bus", frames.data(), 2 * sizeof(can_frame) + 1);
+  ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk);
+  ASSERT_EQ(ReceiveWait(*twin, &f), CanStatus::kOk);
+  EXPECT_EQ(twin->Receive(&f), CanStatus::kNoFrame);  // the other two, queued already, dropped
+  EXPECT_EQ(twin->statistics().received, 73u);
+  EXPECT_EQ(twin->statistics().malformed, 3u);
 }
 
 TEST(CanLink, PeerAbsentIsAStatusNotACrash) {

@@ -8,6 +8,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "protocol/link_frames.h"
 #include "protocol/messages.h"
 #include "tests/controller/fake_can_bus.h"
@@ -128,6 +130,49 @@ TEST(RemoteController, NoAnswerWithinTheTimeoutLosesTheController) {
   std::map<std::string, double> m;
   remote.AddMetrics(&m);
   EXPECT_EQ(m["link_controller_lost_s"], 0.0005);
+}
+
+// LinkFaults: a command crosses the link delay_s later on the simulated clock (put on the bus at the
+// first tick at or after its due time); with loss 1 every device frame is lost, and counted.
+TEST(RemoteController, LinkFaultsDelayCommandsOnTheSimulatedClockAndLoseThemCounted) {
+  for (const double loss : {0.0, 1.0}) {
+    testing::ScopedTempDir dir("remote");
+    const BusAddress a = ParseBusAddress("unix:" + dir.path() + "/bus");
+    auto link = CanLink::Open(a, LinkEnd::kTwin);
+    RawPeer controller(a.LocalName(LinkEnd::kController), a.path);
+    testing::FakeCanBus ep;
+    std::vector<std::string> events;
+    LinkFaults faults;
+    faults.delay_s = 2.5e-3;
+    faults.loss = loss;
+    RemoteController remote(link.get(), ServeClock::kLockstep, 1e-3, 2.0, faults);
+    controller.Send(link::ReadyFrame(0, remote.next_sequence()));
+    remote.BeginTrial(0, &ep, &events);
+    std::vector<size_t> on_bus;
+    for (int k = 0; k < 5; ++k) {
+      const double t = 0.0005 + 1e-3 * k;
+      ep.AdvanceTo(t);
+      if (k == 0) controller.Send(msg::Encode(Command(msg::Joint::kHip, 1.5)));
+      controller.Send(link::DoubleFrame(link::kIdCycleDone, t));
+      remote.Tick(t);
+      on_bus.push_back(ep.sent().size());
+    }
+    std::map<std::string, double> m;
+    remote.AddMetrics(&m);
+    EXPECT_EQ(m["link_deterministic"], 1.0);
+    if (loss == 0) {  // sent at 0.5 ms, due at 3.0 ms: on the bus at the tick of 3.5 ms
+      EXPECT_EQ(on_bus, (std::vector<size_t>{0, 0, 0, 1, 1}));
+      ASSERT_EQ(ep.sent().size(), 1u);
+      EXPECT_EQ(ep.sent()[0].t, 0.0035);
+      EXPECT_EQ(m["link_frames_dropped"], 0.0);
+    } else {
+      EXPECT_EQ(on_bus, (std::vector<size_t>{0, 0, 0, 0, 0}));
+      EXPECT_EQ(m["link_frames_dropped"], 1.0);
+    }
+  }
+  EXPECT_THROW(LinkFaultsOf(-1, 0, 0, 1), InputError);
+  EXPECT_THROW(LinkFaultsOf(0, 0, 1.01, 1), InputError);
+  EXPECT_THROW(LinkFaultsOf(0, std::nan(""), 0, 1), InputError);
 }
 
 }  // namespace
