@@ -47,6 +47,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const auto& k = d.kin;
   const size_t n = k.t.size();
   const char* jn[2] = {"hip", "knee"};
+  const int j0 = d.extended.one_joint ? 1 : 0;  // a one-joint device: its joint (the knee) alone
   std::ostringstream o;
   o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>exotwin diagnosis</title>"
        "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
@@ -86,7 +87,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<h2>Gain of the extended twin (held-out " << NumberText(100 * d.holdout_fraction, 3) << " %)</h2>"
     << "<table><tr><th>joint</th><th>rmse before (N m)</th><th>rmse after (N m)</th><th>gain</th>"
        "<th>noise (N m)</th></tr>";
-  for (int j = 0; j < 2; ++j)
+  for (int j = j0; j < 2; ++j)
     o << "<tr><td>" << jn[j] << "</td><td>" << NumberText(d.joints[j].rmse_before, 4) << "</td><td>"
       << NumberText(d.joints[j].rmse_after, 4) << "</td><td>" << NumberText(d.joints[j].gain_pct, 3) << " %</td><td>"
       << NumberText(d.noise[j], 3) << "</td></tr>";
@@ -113,6 +114,11 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
     for (const auto& s : d.implausible) o << "<li>" << HtmlEscape(s) << "</li>";
     o << "</ul>";
   }
+  if (!d.not_identifiable.empty()) {
+    o << "<p>Not identifiable from these records (even the edge of the physical range would not be significant):</p><ul>";
+    for (const auto& s : d.not_identifiable) o << "<li>" << HtmlEscape(s) << "</li>";
+    o << "</ul>";
+  }
   o << "<h2>Unexplained structure</h2>";
   if (d.unexplained.empty()) o << "<p>None above the noise.</p>";
   for (const auto& u : d.unexplained)
@@ -137,7 +143,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const size_t a0 = d.split, win = std::min(n - d.split, static_cast<size_t>(std::max<size_t>(
                                                      1, static_cast<size_t>(10.0 * n / std::max(k.t.back() - k.t.front(), 1e-9)))));
   const size_t st_line = std::max<size_t>(1, win / 1500), st_dot = std::max<size_t>(1, n / 1500);
-  for (int j = 0; j < 2; ++j) {
+  for (int j = j0; j < 2; ++j) {
     o << "<h2>" << jn[j] << "</h2>\n";
     SvgSeries m{{}, {}, "#000", "measured (filtered alike)"}, b{{}, {}, "#d62728", "twin before"}, a{{}, {}, "#1f77b4", "extended twin"};
     for (size_t i = a0; i < a0 + win; i += st_line) {
