@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -217,6 +218,13 @@ void PrintDiagnosis(const char* title, const Diagnosis& d) {
                 r.split[1].rmse_before, r.split[1].rmse_after, r.split[1].gain_pct, r.left_out[1].rmse_before,
                 r.left_out[1].rmse_after, r.left_out[1].gain_pct);
   for (const auto& s : d.implausible) std::printf("  implausible: %s\n", s.c_str());
+  for (const auto& s : d.not_identifiable) std::printf("  not identifiable: %s\n", s.c_str());
+  if (std::getenv("EXOTWIN_ONE_JOINT_VERBOSE")) {
+    std::printf("  cutoff: %s\n", d.cutoff.why.c_str());
+    for (const auto& s : d.selection) std::printf("  step: %s\n", s.c_str());
+    for (const auto& s : d.scores)
+      std::printf("  candidate %s: dBIC %.1f, held-out gain %.1f %%\n", s.label.c_str(), s.delta_bic, s.heldout_gain_pct);
+  }
 }
 
 TEST(OneJointRealRig, PendulumDynamicRecordsNameFrictionAndTheMassCorrection) {
