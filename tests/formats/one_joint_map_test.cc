@@ -45,8 +45,8 @@ TEST(OneJointMap, Hal3MeasuredMapNegatesTheStrainGauge) {
   const MeasuredData d = ReadMeasured(csv, kSrc + "/examples/hal3_measured.map.yaml");
   ASSERT_TRUE(d.one_joint);
   for (int i = 0; i < 40; ++i) {
-    EXPECT_DOUBLE_EQ(d.q_knee()[i], 0.02 * i);
-    EXPECT_DOUBLE_EQ(d.tau_knee()[i], -(0.5 - 0.1 * i));
+    EXPECT_NEAR(d.q_knee()[i], 0.02 * i, 1e-12);  // as written (6 digits)
+    EXPECT_NEAR(d.tau_knee()[i], -(0.5 - 0.1 * i), 1e-12);
   }
   ASSERT_TRUE(d.Column("cmd_knee"));
   EXPECT_EQ((*d.Column("cmd_knee"))[3], 1.5);
