@@ -98,11 +98,13 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
     auto cell = [&](const JointScore& s) {
       return NumberText(s.rmse_before, 4) + " / " + NumberText(s.rmse_after, 4) + " (" + NumberText(s.gain_pct, 3) + " %)";
     };
+    // A one-joint device has no hip: its cells stay empty.
+    auto hip = [&](const JointScore& s) { return j0 == 0 ? cell(s) : std::string("&mdash;"); };
     for (const auto& r : d.records)
-      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << r.samples << "</td><td>" << cell(r.split[0]) << "</td><td>"
-        << cell(r.split[1]) << "</td><td>" << cell(r.left_out[0]) << "</td><td>" << cell(r.left_out[1]) << "</td></tr>";
-    o << "<tr><th>all</th><td></td><td>" << cell(d.joints[0]) << "</td><td>" << cell(d.joints[1]) << "</td><td>"
-      << cell(d.left_out[0]) << "</td><td>" << cell(d.left_out[1]) << "</td></tr></table>"
+      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << r.samples << "</td><td>" << hip(r.split[0]) << "</td><td>"
+        << cell(r.split[1]) << "</td><td>" << hip(r.left_out[0]) << "</td><td>" << cell(r.left_out[1]) << "</td></tr>";
+    o << "<tr><th>all</th><td></td><td>" << hip(d.joints[0]) << "</td><td>" << cell(d.joints[1]) << "</td><td>"
+      << hip(d.left_out[0]) << "</td><td>" << cell(d.left_out[1]) << "</td></tr></table>"
       << "<p>Plots below: the first record.</p>";
   }
   o << "<p><small>" << HtmlEscape(d.method) << "</small></p>";
