@@ -281,5 +281,29 @@ TEST(OneJointRealRig, GravityCompensationNamesNoInertia) {
   EXPECT_TRUE(listed);
 }
 
+// ddp_swingup alone: Coulomb friction, and the nominal dynamics' scale. A sensor gain g is a common
+// scale of I and mgl (the motor's torque constant, or the point mass m, scales both alike): the twin's
+// I (1 + g) and mgl (1 + g) move toward the reference fit.
+TEST(OneJointRealRig, DdpSwingupNamesFrictionAndAScaleTowardTheReferenceFit) {
+  if (!std::filesystem::exists(kPend)) GTEST_SKIP() << kPend << " absent";
+  const LegParams nominal = ReadModelFile(kPendEx + "model.yaml");
+  const Diagnosis d = Diagnose(nominal, Pendulum("ddp_swingup"));
+  PrintDiagnosis("ddp_swingup:", d);
+  double coulomb = 0, gain = 0, dI = 0, dmgl = 0;
+  for (const auto& e : d.effects) {
+    if (e.effect.name == "coulomb_friction") coulomb = e.effect.value;
+    if (e.effect.name == "sensor_gain") gain = e.effect.value;
+    if (e.effect.name == "inertia_error") dI = e.effect.value;
+    if (e.effect.name == "gravity_error" && e.effect.axis == "X") dmgl = nominal.g * e.effect.value;
+  }
+  EXPECT_GE(coulomb, 0.08);
+  EXPECT_LE(coulomb, 0.25);
+  const double I = (0.168875 + dI) * (1 + gain), mgl = (3.3133 + dmgl) * (1 + gain);
+  std::printf("  equivalent I %.4f kg m^2, mgl %.4f N m\n", I, mgl);
+  EXPECT_LT(std::abs(I - 0.177), std::abs(0.168875 - 0.177));
+  EXPECT_LT(std::abs(mgl - 3.53), std::abs(3.3133 - 3.53));
+  EXPECT_GE(d.joints[1].gain_pct, 25);
+}
+
 }  // namespace
 }  // namespace exotwin
