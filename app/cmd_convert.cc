@@ -27,15 +27,16 @@ CommandRunner RegisterConvert(CLI::App& app) {
     MapReport report;
     const MeasuredData data = ReadMeasured(o->in, o->map, 1, &report);
     std::fprintf(stderr, "convert: %s", report.Summary().c_str());
+    const CsvTable table = TableAsRecorded(data);  // a one-joint record as such
     std::vector<const std::vector<double>*> cols;
-    for (const auto& c : data.table.columns) cols.push_back(&c);
+    for (const auto& c : table.columns) cols.push_back(&c);
     std::vector<std::string> comments = {"exotwin convert: measured-data CSV (DESIGN.md)",
                                          "source: " + o->in, "map: " + o->map};
     for (const std::string& m : report.mapped) comments.push_back("  " + m);
     if (report.rows_merged > 0)
       comments.push_back(std::to_string(report.rows_merged) + " rows repeating a time stamp merged (" +
                          report.duplicates + ")");
-    WriteCsv(o->out, data.table.names, cols, comments);
+    WriteCsv(o->out, table.names, cols, comments);
     return 0;
   };
 }

@@ -5,6 +5,7 @@
 
 #include "formats/column_map.h"
 #include "diagnosis/diagnose.h"
+#include "formats/number_text.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "app/commands.h"
@@ -50,6 +51,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
       MapReport report;
       data.push_back(ReadMeasured(m, o->map, 20, &report));
       if (!o->map.empty()) std::fprintf(stderr, "diagnose: %s", report.Summary().c_str());
+      CheckRecordFitsModel(params, o->params, data.back());
       if (params.human) CheckHumanJointRange(data.back());
       names += (names.empty() ? "" : ", ") + m;
     }
@@ -60,6 +62,18 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
       std::printf("diagnose: %s (%s) = %g %s [%g, %g]\n", e.effect.name.c_str(), e.effect.joint.c_str(),
                   e.effect.value, e.effect.unit.c_str(), e.ci_lo, e.ci_hi);
     if (d.effects.empty()) std::printf("diagnose: no effect named\n");
+    if (params.one_joint) {  // its one joint
+      std::printf("diagnose: held-out rmse knee %.4f -> %.4f N m; report %s/report.html\n", d.joints[1].rmse_before,
+                  d.joints[1].rmse_after, o->out.c_str());
+      for (const RecordScore& r : d.records)
+        std::printf("diagnose: %s: held-out %.4f -> %.4f N m (%.1f %%)%s\n", r.source.c_str(),
+                    r.split[1].rmse_before, r.split[1].rmse_after, r.split[1].gain_pct,
+                    d.leave_one_out ? (", left out " + NumberText(r.left_out[1].rmse_before) + " -> " +
+                                       NumberText(r.left_out[1].rmse_after) + " N m (" +
+                                       NumberText(r.left_out[1].gain_pct) + " %)").c_str()
+                                    : "");
+      return 0;
+    }
     std::printf("diagnose: held-out rmse hip %.4f -> %.4f N m, knee %.4f -> %.4f N m; report %s/report.html\n",
                 d.joints[0].rmse_before, d.joints[0].rmse_after, d.joints[1].rmse_before,
                 d.joints[1].rmse_after, o->out.c_str());

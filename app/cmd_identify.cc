@@ -15,6 +15,8 @@
 #include "diagnosis/derivative_cutoff.h"
 #include "formats/csv_table.h"
 #include "identification/identification.h"
+#include "identification/one_joint_identification.h"
+#include "model/one_joint.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "formats/number_text.h"
@@ -66,12 +68,38 @@ void ParseThreshold(const std::string& s, std::map<std::string, double>* th) {
   (*th)[name] = v;
 }
 
-CommandRunner RegisterIdentify(CLI::App& app) {
-  struct Opts {
+struct IdentifyOpts {
     std::vector<std::string> measured, thresholds;
     std::string known, map, out, passive = "riener1999", cutoff = "20";
     double L1 = 0.0, emg_reference = 2.0, emg_envelope = 0.0, trim = 0.1;
-  };
+    bool friction = false;
+};
+
+// identify's one-joint case (DESIGN.md "One-joint devices"): I and mgl (with --friction R and C) from
+// swings of the joint; --known and the two-joint options do not apply.
+int IdentifyOneJointFiles(const std::vector<MeasuredData>& files, const IdentifyOpts& o, bool cutoff_given) {
+  if (!o.known.empty())
+    throw InputError("--known " + o.known + ": one-joint records (" + files.front().source +
+                     ") are identified without a known part, expected no --known");
+  if (o.L1 != 0.0) throw InputError("--L1: a one-joint record has no thigh, expected no --L1");
+  std::vector<const MeasuredData*> recs;
+  for (const MeasuredData& f : files) recs.push_back(&f);
+  std::string why;
+  const double cutoff = ResolveCutoffOption(o.cutoff, "--cutoff", recs, kOneJointL1, LegParams{}.g, &why);
+  if (!cutoff_given) std::fprintf(stderr, "identify: assumed: derivative cutoff 20 Hz (--cutoff HZ|auto)\n");
+  if (o.cutoff == "auto") std::fprintf(stderr, "identify: derivative cutoff %s\n", why.c_str());
+  const OneJointEstimate e = IdentifyOneJoint(files, cutoff, o.trim, o.friction);
+  for (size_t k = 0; k < e.names.size(); ++k)
+    std::fprintf(stderr, "identify: %s = %.5g +- %.2g (standard error)\n", e.names[k].c_str(), e.value[k], e.se[k]);
+  std::fprintf(stderr, "identify: one joint, %zu samples, condition number %.2f, residual RMS %.4f N m\n", e.samples,
+               e.condition, e.rmse);
+  WriteFileAtomic(o.out, ModelToYaml(OneJointParamsOf(e), "exotwin identify: one-joint device (HKS05 eq. 4)",
+                                     OneJointIdentificationYaml(e, cutoff)));
+  return 0;
+}
+
+CommandRunner RegisterIdentify(CLI::App& app) {
+  using Opts = IdentifyOpts;
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
       "identify", "Least-squares identification of the lumped parameters (Hwang & Jeon 2015, steps 1-4)");
@@ -94,6 +122,8 @@ CommandRunner RegisterIdentify(CLI::App& app) {
                   "derivative filter cutoff in Hz, or 'auto' (chosen from the data by held-out "
                   "prediction error over every file); default 20 (Hwang & Jeon sec. 3.2)");
   sub->add_option("--trim", o->trim, "s dropped at both ends of every file (default 0.1)");
+  sub->add_flag("--friction", o->friction,
+                "one-joint records: identify the device's R and C too (HKS05 eq. 4), besides I and mgl");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     IdentificationOptions opt;
@@ -123,6 +153,12 @@ CommandRunner RegisterIdentify(CLI::App& app) {
     }
     std::vector<MeasuredData> files;
     for (const std::string& m : o->measured) ReadMeasuredArg(m, o->map, &files);
+    if (files.front().one_joint) return IdentifyOneJointFiles(files, *o, sub->count("--cutoff") > 0);
+    if (o->friction) throw InputError("--friction: for one-joint records (t, q_knee, tau_knee) only");
+    for (const MeasuredData& f : files)
+      if (f.one_joint)
+        throw InputError(f.source + ": a one-joint record (no hip column) among the records of two joints of " +
+                         files.front().source + ", expected t, q_hip, q_knee, tau_hip, tau_knee in every file");
     if (!o->known.empty())  // steps 3-4: the records are of a human wearing the device
       for (const MeasuredData& f : files) CheckHumanJointRange(f);
     const double L1 = o->L1 != 0.0 ? o->L1 : o->known.empty() ? 0.41 : known.L1;

@@ -47,6 +47,7 @@ CommandRunner RegisterPredict(CLI::App& app) {
     const LegParams params = ReadModelFile(o->params);
     MapReport map_report;
     MeasuredData data = ReadMeasuredKinematics(o->measured, o->map, o->side, 20, &map_report);
+    CheckRecordFitsModel(params, o->params, data);
     if (!HasTorque(data)) {
       if (o->cutoff == "auto")
         throw InputError(o->measured + ": --cutoff auto compares predicted with measured torque; this motion file "
@@ -68,7 +69,10 @@ CommandRunner RegisterPredict(CLI::App& app) {
                    "the median step and interpolated back\n",
                    o->measured.c_str());
     const Prediction p = PredictTorque(plant, kin);
-    WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&p.t, &p.tau_S[0], &p.tau_S[1]},
+    std::vector<std::string> names = {"t", "tau_hip", "tau_knee"};
+    std::vector<const std::vector<double>*> cols = {&p.t, &p.tau_S[0], &p.tau_S[1]};
+    if (params.one_joint) names.erase(names.begin() + 1), cols.erase(cols.begin() + 1);  // its one joint
+    WriteCsv(o->out, names, cols,
              {"exotwin predict: torque-sensor reading tau_S = -tau_R (N m)",
               "params: " + o->params + ", measured: " + o->measured +
                   (o->map.empty() ? "" : " (map: " + o->map + ")") + ", derivatives: " +

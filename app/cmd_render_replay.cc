@@ -85,6 +85,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
     const MeasuredData data = ReadMeasuredKinematics(o->measured, "", o->side);
+    CheckRecordFitsModel(params, o->params, data);
     Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
     plant.SetParams(params);
 

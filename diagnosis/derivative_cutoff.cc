@@ -104,6 +104,18 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       for (double v : j == 0 ? d->tau_hip() : d->tau_knee()) s += v, ss += v * v, n += 1;
     var[j] = std::max(ss / n - (s / n) * (s / n), 1e-12);
   }
+  // A joint held still with no torque in every record (a one-joint record's embedded hip, DESIGN.md
+  // "One-joint devices") carries no information: its rows are left out of the fit and the score.
+  bool absent[2];
+  for (int j = 0; j < 2; ++j) {
+    absent[j] = true;
+    for (const MeasuredData* d : records) {
+      const std::vector<double>& q = j == 0 ? d->q_hip() : d->q_knee();
+      const std::vector<double>& tau = j == 0 ? d->tau_hip() : d->tau_knee();
+      absent[j] = absent[j] && std::all_of(q.begin(), q.end(), [](double v) { return v == 0; }) &&
+                  std::all_of(tau.begin(), tau.end(), [](double v) { return v == 0; });
+    }
+  }
   std::vector<RecordBase> base(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
     const MeasuredData& d = *records[r];
@@ -219,6 +231,9 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
           }
         }
       }
+      for (int j = 0; j < 2; ++j)
+        if (absent[j])
+          for (size_t a = 0; a < at.size(); ++a) R.Y[a].row(j).setZero(), R.u_f[a][j] = 0, R.u_raw[a][j] = 0;
       for (size_t a = 0; a < at.size(); ++a) {
         R.train[a] = at[a] < B.split;
         if (!R.train[a]) continue;

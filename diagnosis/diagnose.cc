@@ -359,6 +359,14 @@ void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std:
   }
 }
 
+// Stage 3b (one-joint device): only the candidates of joint j stay (the others' columns are left unused).
+void KeepJointCandidates(int j, std::vector<ColumnBank>* banks) {
+  for (ColumnBank& b : *banks)
+    b.candidates.erase(std::remove_if(b.candidates.begin(), b.candidates.end(),
+                                      [j](const Candidate& c) { return c.joint != j; }),
+                       b.candidates.end());
+}
+
 // Stage 3c: the pooled Gram matrices of the banks, the measured torque's scale on the held-out rows
 // (materiality), and the effective sample size from the autocorrelation length (rows, *tau_eff) of
 // what no candidate explains.
@@ -417,8 +425,20 @@ PhysicalScale ScaleOf(const LegParams& params, const std::vector<Rec>& recs) {
   return scale;
 }
 
+// The largest magnitude DESIGN.md's physical range allows a one-parameter candidate (0: unbounded or
+// several parameters).
+double RangeEdge(const Candidate& c, const PhysicalScale& s) {
+  const int j = c.joint;
+  if (c.name == "inertia_error") return s.M_jj[j];
+  if (c.name == "gravity_error") return 0.5 * s.distal_moment[j] + 0.05;
+  if (c.name == "coulomb_friction" || c.name == "sensor_offset") return 0.5 * s.tau_max[j];
+  if (c.name == "sensor_gain") return 0.25;
+  return 0;
+}
+
 // Stage 4b: the report's candidate table into D->scores (the 12 best single candidates by BIC, then
-// the chosen set), single fits outside their physical range into D->implausible, and nearly
+// the chosen set), single fits outside their physical range into D->implausible, candidates whose
+// range's edge would not be significant into D->not_identifiable, and nearly
 // collinear candidate pairs (|cos| > 0.95 of their first columns, train rows) into D->collinear.
 void ScoreCandidates(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale, const Fit& f0,
                      const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D) {
@@ -440,6 +460,16 @@ void ScoreCandidates(const ColumnBank& bank, const Grams& g, const PhysicalScale
     std::string why;
     if (!Plausible(e, scale, &why))
       D->implausible.push_back(c.Label() + " = " + NumberText(e.effect.value) + " " + e.effect.unit + ": " + why);
+  }
+  for (size_t c = 0; c < bank.candidates.size(); ++c) {
+    const Candidate& cand = bank.candidates[c];
+    const double edge = RangeEdge(cand, scale);
+    if (!(edge > 0)) continue;
+    const double se = singles[c].ok ? SeOf(singles[c], cand.cols[0]) : INFINITY;
+    if (edge < kMinT * se)
+      D->not_identifiable.push_back(cand.Label() + ": standard error " + NumberText(se, 3) +
+                                    " against a physical range up to " + NumberText(edge, 3) +
+                                    ": not identifiable from these records, not fitted");
   }
   if (!chosen.empty()) {
     std::string label;
@@ -593,7 +623,7 @@ void FindUnexplained(Diagnosis* D_out) {
   const size_t n = kin.t.size();
   const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
   const double fs = 1.0 / dt;
-  for (int j = 0; j < 2; ++j) {
+  for (int j = D.extended.one_joint ? 1 : 0; j < 2; ++j) {
     std::vector<double> e(n - D.split);
     for (size_t i = D.split; i < n; ++i) e[i - D.split] = D.measured[j][i] - D.after[j][i];
     std::vector<double> elp = e;
@@ -684,6 +714,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
     PrepareRecord(params, *records[r], owned ? &(*owned)[r] : nullptr, D.cutoff, opt.holdout_fraction, &recs[r]);
   double w[2];
   NoiseAndWeights(recs, D.noise, w);
+  if (params.one_joint) w[0] = 0, D.noise[0] = 0;  // one joint: the embedding's held hip is no data
   for (Rec& rc : recs)  // the rigid torque is needed only where stage 5 refines (a long record's memory)
     for (int j = 0; j < 2; ++j) {
       rc.tau_R[j].resize(RefineRows(rc, R));
@@ -695,6 +726,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("columns + ripple search");
   FilterMeasured(&recs);
   UseSecantDelayColumns(recs, w, &banks);
+  if (params.one_joint) KeepJointCandidates(1, &banks);
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
   for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)

@@ -75,6 +75,9 @@ struct Diagnosis {
   std::vector<std::string> collinear;   // nearly collinear candidate pairs on this record, in words
   std::vector<std::string> selection;   // the selection's steps, in words
   std::vector<std::string> implausible; // candidates that fit alone but fall outside their range
+  // Candidates these records cannot identify: fitted alone, even a value at the edge of their physical
+  // range would not be significant (|t| < kMinT), e.g. an inertia on a slow, hand-guided record.
+  std::vector<std::string> not_identifiable;
   CutoffChoice cutoff;                  // derivative (and parallel torque) filter, and why
   std::vector<RecordScore> records;     // per record (first: the plotted one)
   bool leave_one_out = false;           // several records: whole records left out in turn

@@ -36,33 +36,37 @@ std::string DiagnosisJson(const Diagnosis& d) {
                                                {"corr_time", u.corr_t}}},
                                 {"hint", u.hint}});
   const char* names[2] = {"hip", "knee"};
+  const int k0 = d.extended.one_joint ? 1 : 0;  // a one-joint device reports its joint only
+  if (d.extended.one_joint) j["one_joint"] = true;
   auto score = [](const JointScore& s) {
     return json{{"rmse_before", s.rmse_before}, {"rmse_after", s.rmse_after}, {"gain_pct", s.gain_pct}};
   };
-  for (int k = 0; k < 2; ++k) j["joints"][names[k]] = score(d.joints[k]);
+  for (int k = k0; k < 2; ++k) j["joints"][names[k]] = score(d.joints[k]);
   j["validation"] = {{"method", d.method}, {"holdout_fraction", d.holdout_fraction},
                      {"leave_one_record_out", d.leave_one_out}};
-  j["noise"] = {{"hip", d.noise[0]}, {"knee", d.noise[1]}, {"autocorrelation_rows", d.tau_eff}};
+  j["noise"] = {{"knee", d.noise[1]}, {"autocorrelation_rows", d.tau_eff}};
+  if (!d.extended.one_joint) j["noise"]["hip"] = d.noise[0];
   j["collinear"] = d.collinear;
   j["cutoff"] = {{"hz", d.cutoff.from_columns ? 0.0 : d.cutoff.hz},
                  {"source", d.cutoff.from_columns ? "measured qd/qdd columns" : "butterworth"},
                  {"why", d.cutoff.why},
                  {"candidates_hz", d.cutoff.candidates_hz},
-                 {"heldout_rmse_hip", d.cutoff.heldout_rmse[0]},
                  {"heldout_rmse_knee", d.cutoff.heldout_rmse[1]}};
+  if (!d.extended.one_joint) j["cutoff"]["heldout_rmse_hip"] = d.cutoff.heldout_rmse[0];
   j["selection"] = d.selection;
   j["implausible"] = d.implausible;
+  j["not_identifiable"] = d.not_identifiable;
   j["records"] = json::array();
   for (const auto& r : d.records) {
     json x = {{"source", r.source}, {"samples", r.samples}};
-    for (int k = 0; k < 2; ++k) {
+    for (int k = k0; k < 2; ++k) {
       x["split"][names[k]] = score(r.split[k]);
       if (d.leave_one_out) x["left_out"][names[k]] = score(r.left_out[k]);
     }
     j["records"].push_back(x);
   }
   if (d.leave_one_out)
-    for (int k = 0; k < 2; ++k) j["left_out"][names[k]] = score(d.left_out[k]);
+    for (int k = k0; k < 2; ++k) j["left_out"][names[k]] = score(d.left_out[k]);
   return j.dump(2) + "\n";
 }
 

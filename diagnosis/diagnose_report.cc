@@ -47,6 +47,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const auto& k = d.kin;
   const size_t n = k.t.size();
   const char* jn[2] = {"hip", "knee"};
+  const int j0 = d.extended.one_joint ? 1 : 0;  // a one-joint device: its joint (the knee) alone
   std::ostringstream o;
   o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>exotwin diagnosis</title>"
        "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
@@ -86,7 +87,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<h2>Gain of the extended twin (held-out " << NumberText(100 * d.holdout_fraction, 3) << " %)</h2>"
     << "<table><tr><th>joint</th><th>rmse before (N m)</th><th>rmse after (N m)</th><th>gain</th>"
        "<th>noise (N m)</th></tr>";
-  for (int j = 0; j < 2; ++j)
+  for (int j = j0; j < 2; ++j)
     o << "<tr><td>" << jn[j] << "</td><td>" << NumberText(d.joints[j].rmse_before, 4) << "</td><td>"
       << NumberText(d.joints[j].rmse_after, 4) << "</td><td>" << NumberText(d.joints[j].gain_pct, 3) << " %</td><td>"
       << NumberText(d.noise[j], 3) << "</td></tr>";
@@ -97,11 +98,13 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
     auto cell = [&](const JointScore& s) {
       return NumberText(s.rmse_before, 4) + " / " + NumberText(s.rmse_after, 4) + " (" + NumberText(s.gain_pct, 3) + " %)";
     };
+    // A one-joint device has no hip: its cells stay empty.
+    auto hip = [&](const JointScore& s) { return j0 == 0 ? cell(s) : std::string("&mdash;"); };
     for (const auto& r : d.records)
-      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << r.samples << "</td><td>" << cell(r.split[0]) << "</td><td>"
-        << cell(r.split[1]) << "</td><td>" << cell(r.left_out[0]) << "</td><td>" << cell(r.left_out[1]) << "</td></tr>";
-    o << "<tr><th>all</th><td></td><td>" << cell(d.joints[0]) << "</td><td>" << cell(d.joints[1]) << "</td><td>"
-      << cell(d.left_out[0]) << "</td><td>" << cell(d.left_out[1]) << "</td></tr></table>"
+      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << r.samples << "</td><td>" << hip(r.split[0]) << "</td><td>"
+        << cell(r.split[1]) << "</td><td>" << hip(r.left_out[0]) << "</td><td>" << cell(r.left_out[1]) << "</td></tr>";
+    o << "<tr><th>all</th><td></td><td>" << hip(d.joints[0]) << "</td><td>" << cell(d.joints[1]) << "</td><td>"
+      << hip(d.left_out[0]) << "</td><td>" << cell(d.left_out[1]) << "</td></tr></table>"
       << "<p>Plots below: the first record.</p>";
   }
   o << "<p><small>" << HtmlEscape(d.method) << "</small></p>";
@@ -111,6 +114,11 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   if (!d.implausible.empty()) {
     o << "<p>Fitted alone but outside their physical range, so not named:</p><ul>";
     for (const auto& s : d.implausible) o << "<li>" << HtmlEscape(s) << "</li>";
+    o << "</ul>";
+  }
+  if (!d.not_identifiable.empty()) {
+    o << "<p>Not identifiable from these records (even the edge of the physical range would not be significant):</p><ul>";
+    for (const auto& s : d.not_identifiable) o << "<li>" << HtmlEscape(s) << "</li>";
     o << "</ul>";
   }
   o << "<h2>Unexplained structure</h2>";
@@ -137,7 +145,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const size_t a0 = d.split, win = std::min(n - d.split, static_cast<size_t>(std::max<size_t>(
                                                      1, static_cast<size_t>(10.0 * n / std::max(k.t.back() - k.t.front(), 1e-9)))));
   const size_t st_line = std::max<size_t>(1, win / 1500), st_dot = std::max<size_t>(1, n / 1500);
-  for (int j = 0; j < 2; ++j) {
+  for (int j = j0; j < 2; ++j) {
     o << "<h2>" << jn[j] << "</h2>\n";
     SvgSeries m{{}, {}, "#000", "measured (filtered alike)"}, b{{}, {}, "#d62728", "twin before"}, a{{}, {}, "#1f77b4", "extended twin"};
     for (size_t i = a0; i < a0 + win; i += st_line) {

@@ -25,6 +25,9 @@ namespace {
 
 const char* kEmgChannels[] = {"GMAX", "RF", "VM", "ST", "GAS"};
 constexpr double kJointLo[2] = {5 * kRadPerDeg, -70 * kRadPerDeg}, kJointHi[2] = {40 * kRadPerDeg, -5 * kRadPerDeg};
+// A one-joint device's angle range (HAL's convention, 0 hanging, + extension): the seated swing's
+// -0.3 .. +1.0 rad of the HAL-3 scenarios, widened a little.
+constexpr double kOneJointLo = -0.4, kOneJointHi = 1.2;
 
 struct Harmonic {
   double amp, omega, phase;
@@ -32,7 +35,7 @@ struct Harmonic {
 
 }  // namespace
 
-Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
+Effect DrawEffect(Rng& rng, const std::string& name, int joint, bool one_joint) {
   Effect e;
   e.name = name;
   e.joint = joint == 0 ? "hip" : "knee";
@@ -47,7 +50,7 @@ Effect DrawEffect(Rng& rng, const std::string& name, int joint) {
     e.axis = rng.Uniform() < 0.5 ? "X" : "Y";
   } else if (name == "joint_stiffness") {
     e.value = rng.Uniform(3.0, 15.0), e.unit = "N m/rad";
-    e.fields["q0"] = rng.Uniform(kJointLo[joint], kJointHi[joint]);
+    e.fields["q0"] = one_joint ? rng.Uniform(kOneJointLo, kOneJointHi) : rng.Uniform(kJointLo[joint], kJointHi[joint]);
   } else if (name == "backlash") {
     e.value = rng.Uniform(0.3, 1.7) * kRadPerDeg, e.unit = "rad";
   } else if (name == "series_compliance") {
@@ -84,6 +87,9 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
     throw InputError("--effects: " + std::to_string(opt.effects) + ", expected 0 .. 3");
   if (!opt.joint.empty() && opt.joint != "hip" && opt.joint != "knee")
     throw InputError("--joint: '" + opt.joint + "', expected hip or knee");
+  const bool one = params.one_joint.has_value();
+  if (one && opt.joint == "hip")
+    throw InputError("--joint: 'hip' for a one-joint model file, expected knee (its one joint)");
   std::vector<std::string> pool = opt.allowed.empty() ? AllEffectNames() : opt.allowed;
   for (const auto& n : pool)
     if (std::find(AllEffectNames().begin(), AllEffectNames().end(), n) == AllEffectNames().end())
@@ -99,8 +105,11 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
   Harmonic h[2][3];
   double centre[2], scale[2];
   for (int j = 0; j < 2; ++j) {
-    centre[j] = 0.5 * (kJointLo[j] + kJointHi[j]);
-    const double half = 0.5 * (kJointHi[j] - kJointLo[j]) * rng.Uniform(0.7, 1.0);
+    // One joint: the hip held at 0 (the embedding, model/one_joint.h), the joint over its own range.
+    const double lo = one ? (j == 0 ? 0.0 : kOneJointLo) : kJointLo[j];
+    const double hi = one ? (j == 0 ? 0.0 : kOneJointHi) : kJointHi[j];
+    centre[j] = 0.5 * (lo + hi);
+    const double half = 0.5 * (hi - lo) * rng.Uniform(0.7, 1.0);
     double sum = 0;
     for (auto& k : h[j]) {
       k.amp = rng.Uniform(0.3, 1.0);
@@ -115,8 +124,8 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
     const int pick = rng.Index(static_cast<int>(pool.size()));
     const std::string name = pool[pick];
     pool.erase(pool.begin() + pick);
-    const int joint = opt.joint.empty() ? rng.Index(2) : (opt.joint == "hip" ? 0 : 1);
-    g.truth.effects.push_back(DrawEffect(rng, name, joint));
+    const int joint = one ? 1 : opt.joint.empty() ? rng.Index(2) : (opt.joint == "hip" ? 0 : 1);
+    g.truth.effects.push_back(DrawEffect(rng, name, joint, one));
   }
   // EMG activations: 0.02 + a (0.5 + 0.5 sin(w t + p))^2 V, a in 0.05-0.3 V, w in 0.1-0.8 Hz.
   struct Act { double a, w, p; } act[5];
@@ -174,14 +183,20 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
   }
   d.table.line_of_row.resize(n);
   for (size_t i = 0; i < n; ++i) d.table.line_of_row[i] = static_cast<int>(i) + 2;
+  if (one) {  // the record of the one joint, embedded as a read one-joint record is
+    d.one_joint = true;
+    d.table = TableAsRecorded(d);
+    EmbedOneJoint(&d.table);
+  }
   d.BindRequired();
   return g;
 }
 
 void WriteGeneratedCsv(const GeneratedData& g, const std::string& path, uint64_t seed) {
   std::vector<const std::vector<double>*> cols;
-  for (const auto& c : g.data.table.columns) cols.push_back(&c);
-  WriteCsv(path, g.data.table.names, cols,
+  const CsvTable table = TableAsRecorded(g.data);
+  for (const auto& c : table.columns) cols.push_back(&c);
+  WriteCsv(path, table.names, cols,
            {"exotwin generate: synthetic measurement, seed " + std::to_string(seed) +
             " (the hidden effects are in the --truth file, not here)"});
 }

@@ -34,11 +34,12 @@ const std::vector<std::string>& AllEffectNames();
 // kg m, stiffness 3-15 N m/rad, backlash 0.3-1.7 deg, straps 150-800 N m/rad at the knee and
 // 800-3000 at the hip (resonance at least twice the motion's frequency, DESIGN.md's range), ripple
 // 0.2-1 N m at 2-8 cycles/rad, offset +-(0.2-2) N m, gain +-(2-10) %, delay 5-30 ms, muscle
-// weights 3-10 N m/V.
-Effect DrawEffect(Rng& rng, const std::string& name, int joint);
+// weights 3-10 N m/V. `one_joint`: the stiffness's q0 in the one-joint range (-0.4 .. 1.2 rad).
+Effect DrawEffect(Rng& rng, const std::string& name, int joint, bool one_joint = false);
 
 // Generates the record: trajectory of three harmonics (0.3-1.5 Hz) per joint inside hip 5..40 deg,
-// knee -70..-5 deg; EMG on GMAX, RF, VM, ST, GAS (white noise modulated by slow random activations);
+// knee -70..-5 deg (a one-joint model, params.one_joint: the hip held at 0, the joint inside
+// -0.4 .. 1.2 rad, every effect at it, a one-joint record); EMG on GMAX, RF, VM, ST, GAS (white noise modulated by slow random activations);
 // truth torque by the MuJoCo twin (analytic derivatives) plus ApplyEffects; encoder quantization
 // 2^19 counts/rev; torque sensor noise 0.02-0.04 N m (drawn) and 0.005 N m resolution.
 // Throws InputError for options out of range or params without a realization.

@@ -182,12 +182,20 @@ ColumnMap ReadColumnMap(const std::string& path) {
   YamlCheckKeys(c, cols, "columns", IsTarget, kTargets);
   for (const auto& kv : cols) m.columns.push_back(ReadSpec(c, kv.first.Scalar(), kv.second));
   std::vector<ColumnSpec> ordered;
+  // A map of a one-joint device's log (DESIGN.md "One-joint devices") targets no hip column.
+  const bool one_joint = std::none_of(m.columns.begin(), m.columns.end(), [](const ColumnSpec& s) {
+    return s.target.size() > 4 && s.target.compare(s.target.size() - 4, 4, "_hip") == 0;
+  });
   for (const char* req : kRequired) {
+    if (one_joint && (std::string(req) == "q_hip" || std::string(req) == "tau_hip")) continue;
     const auto it = std::find_if(m.columns.begin(), m.columns.end(),
                                  [&](const ColumnSpec& s) { return s.target == req; });
     if (it == m.columns.end())
       c.Fail("columns", "missing required target '" + std::string(req) +
-                            "', expected t, q_hip, q_knee, tau_hip and tau_knee" + YamlLine(cols));
+                            (one_joint ? "', expected t, q_knee and tau_knee (a one-joint map) or t, q_hip, "
+                                         "q_knee, tau_hip and tau_knee"
+                                       : "', expected t, q_hip, q_knee, tau_hip and tau_knee") +
+                            YamlLine(cols));
     ordered.push_back(*it);
   }
   for (const ColumnSpec& s : m.columns)

@@ -34,7 +34,8 @@ enum class DuplicateTimes {
 
 struct ColumnMap {
   std::string source;               // the map file, for messages
-  std::vector<ColumnSpec> columns;  // required targets first (t, q_hip, q_knee, tau_hip, tau_knee), then as in the file
+  std::vector<ColumnSpec> columns;  // required targets first (t, q_hip, q_knee, tau_hip, tau_knee; a one-joint map
+                                    // without hip targets: t, q_knee, tau_knee), then as in the file
   DuplicateTimes duplicates = DuplicateTimes::kAverage;
 };
 

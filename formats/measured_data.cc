@@ -62,9 +62,37 @@ std::string Where(const std::string& source, const CsvTable& t, size_t row, cons
 
 }  // namespace
 
+bool IsOneJointTable(const CsvTable& table) {
+  for (const char* hip : {"q_hip", "tau_hip", "qd_hip", "qdd_hip", "cmd_hip"})
+    if (table.Find(hip) >= 0) return false;
+  return table.Find("q_knee") >= 0 && table.Find("tau_knee") >= 0;
+}
+
+void EmbedOneJoint(CsvTable* table) {
+  for (const char* hip : {"q_hip", "tau_hip"}) {
+    table->names.push_back(hip);
+    table->columns.emplace_back(table->rows(), 0.0);
+  }
+}
+
+CsvTable TableAsRecorded(const MeasuredData& data) {
+  if (!data.one_joint) return data.table;
+  CsvTable out;
+  out.line_of_row = data.table.line_of_row;
+  for (size_t c = 0; c < data.table.names.size(); ++c) {
+    const std::string& n = data.table.names[c];
+    if (n == "q_hip" || n == "tau_hip") continue;
+    out.names.push_back(n);
+    out.columns.push_back(data.table.columns[c]);
+  }
+  return out;
+}
+
 MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t min_samples) {
   MeasuredData d;
   d.source = source;
+  d.one_joint = IsOneJointTable(table);
+  if (d.one_joint) EmbedOneJoint(&table);
   d.table = std::move(table);
   d.BindRequired();
   const CsvTable& t = d.table;

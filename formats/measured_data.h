@@ -21,6 +21,10 @@ enum RequiredColumn { kColT = 0, kColQHip = 1, kColQKnee = 2, kColTauHip = 3, kC
 struct MeasuredData {
   std::string source;  // file name, for messages
   CsvTable table;      // every column as read, in file order (t, q_*, tau_*, qd_*, cmd_*, emg_*, ...)
+  // A record of a one-joint device (DESIGN.md "One-joint devices"): the file held t, q_knee, tau_knee
+  // and no hip column; the table holds it embedded in the two-joint schema (q_hip = tau_hip = 0
+  // appended: the joint as the knee of a leg whose hip is held still).
+  bool one_joint = false;
 
   // The required columns: t (s, strictly increasing), q_hip, q_knee (rad), tau_hip, tau_knee (N m).
   const std::vector<double>& t() const { return Required(kColT); }
@@ -60,9 +64,20 @@ inline constexpr double kMaxHumanJointAngle = 2 * M_PI;
 // tau_knee, qd_*, qdd_*, cmd_* of hip and knee, and emg_<channel>.
 bool IsMeasuredColumn(const std::string& name);
 
+// True for a table of one joint: q_knee and tau_knee, and none of q_hip, tau_hip, qd_hip, qdd_hip,
+// cmd_hip.
+bool IsOneJointTable(const CsvTable& table);
+
+// Appends the one-joint embedding's columns q_hip = 0 and tau_hip = 0 to a one-joint table.
+void EmbedOneJoint(CsvTable* table);
+
+// The columns of `data` as its file holds them: a one-joint record without the embedding's q_hip,
+// tau_hip (what a command writes back).
+CsvTable TableAsRecorded(const MeasuredData& data);
+
 // Validates a table in the measured-data schema and returns it as MeasuredData (`source` names it in
 // messages; the table's line_of_row gives the lines): required columns t, q_hip, q_knee, tau_hip,
-// tau_knee; strictly increasing t; finite values in every schema column; angles within
+// tau_knee, or t, q_knee, tau_knee of a one-joint table (IsOneJointTable: embedded, one_joint set); strictly increasing t; finite values in every schema column; angles within
 // +-kMaxRecordedAngle rad; torques within +-1000 N m; EMG within +-100 V; at least `min_samples`
 // rows. Throws InputError naming file, line and column.
 MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t min_samples = 20);

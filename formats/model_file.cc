@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/yaml_fields.h"
+#include "model/one_joint.h"
 
 namespace exotwin {
 namespace {
@@ -105,6 +106,54 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
   return e;
 }
 
+std::vector<Effect> ReadEffects(const YamlContext& c, const YAML::Node& root) {
+  std::vector<Effect> out;
+  if (root["effects"] && !root["effects"].IsNull()) {
+    if (!root["effects"].IsSequence()) c.Fail("effects", "expected a list");
+    int i = 0;
+    for (const auto& e : root["effects"]) out.push_back(ReadEffect(c, e, "effects[" + std::to_string(i++) + "]"));
+  }
+  return out;
+}
+
+OneJointLink ReadOneJointLink(const YamlContext& c, const YAML::Node& n, const std::string& key,
+                              const std::set<std::string>& keys) {
+  if (!n.IsMap()) c.Fail(key, "expected a mapping {I, mgl" + std::string(keys.count("R") ? ", R, C}" : "}"));
+  YamlCheckKeys(c, n, key, keys);
+  OneJointLink l;
+  for (const char* req : {"I", "mgl"})
+    if (!n[req]) c.Fail(key + "." + req, "missing, expected a number");
+  l.I = YamlNumber(c, n["I"], key + ".I", 0.0, 50.0, "kg m^2");
+  l.mgl = YamlNumber(c, n["mgl"], key + ".mgl", -500.0, 500.0, "N m");
+  return l;
+}
+
+// A one-joint model file (DESIGN.md "One-joint devices"): joint, device {I, mgl, R, C}, human {I, mgl},
+// g, effects (at the knee).
+LegParams ParseOneJointYaml(const YamlContext& c, const YAML::Node& root) {
+  YamlCheckKeys(c, root, "", {"joint", "g", "device", "human", "effects", "identification", "name"});
+  const std::string joint = root["joint"].IsScalar() ? root["joint"].Scalar() : "";
+  if (joint != "knee")
+    c.Fail("joint", "'" + joint + "', expected 'knee' (a one-joint device's joint; its columns are q_knee, tau_knee)");
+  double g = 9.81;
+  if (root["g"]) g = YamlNumber(c, root["g"], "g", 0.0, 20.0, "m/s^2");
+  if (!root["device"]) c.Fail("device", "missing, expected {I, mgl, R, C} of the device's link");
+  OneJointModel m;
+  const YAML::Node dev = root["device"];
+  m.device = ReadOneJointLink(c, dev, "device", {"I", "mgl", "R", "C"});
+  if (dev["R"]) m.R = YamlNumber(c, dev["R"], "device.R", 0.0, 100.0, "N m s/rad");
+  if (dev["C"]) m.C = YamlNumber(c, dev["C"], "device.C", 0.0, 100.0, "N m");
+  if (root["human"] && !root["human"].IsNull()) m.human = ReadOneJointLink(c, root["human"], "human", {"I", "mgl"});
+  if (!(m.device.I + (m.human ? m.human->I : 0.0) > 0))
+    c.Fail("device.I", "the joint's total inertia is 0, expected > 0 kg m^2");
+  const std::vector<Effect> effects = ReadEffects(c, root);
+  for (size_t i = 0; i < effects.size(); ++i)
+    if (effects[i].joint != "knee")
+      c.Fail("effects[" + std::to_string(i) + "].joint",
+             "'" + effects[i].joint + "' in a one-joint model file, expected 'knee'");
+  return EmbedOneJointModel(m, g, effects);
+}
+
 }  // namespace
 
 LegParams ParseModelYaml(const std::string& text, const std::string& source) {
@@ -112,6 +161,7 @@ LegParams ParseModelYaml(const std::string& text, const std::string& source) {
   const YAML::Node root = ParseYaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty model file, expected L1 and exo:");
   if (!root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
+  if (root["joint"]) return ParseOneJointYaml(c, root);
   YamlCheckKeys(c, root, "", {"L1", "g", "exo", "human", "passive", "effects", "identification", "name"});
   LegParams p;
   if (!root["L1"]) c.Fail("L1", "missing, expected the thigh length in m");
@@ -128,13 +178,19 @@ LegParams ParseModelYaml(const std::string& text, const std::string& source) {
     if (p.passive != PassiveModel::kNone && !p.human)
       c.Fail("passive", "acts on the human only: expected 'none' without a human: block");
   }
-  if (root["effects"] && !root["effects"].IsNull()) {
-    if (!root["effects"].IsSequence()) c.Fail("effects", "expected a list");
-    int i = 0;
-    for (const auto& e : root["effects"])
-      p.effects.push_back(ReadEffect(c, e, "effects[" + std::to_string(i++) + "]"));
-  }
+  p.effects = ReadEffects(c, root);
   return p;
+}
+
+void CheckRecordFitsModel(const LegParams& params, const std::string& params_path, const MeasuredData& data) {
+  if (params.one_joint && !data.one_joint)
+    throw InputError(data.source + ": a record with hip columns (q_hip, tau_hip, ...) given the one-joint model file " +
+                     params_path + ", expected a one-joint record (t, q_knee, tau_knee, optional cmd_knee, emg_*; "
+                     "no hip column) or a two-joint model file");
+  if (!params.one_joint && data.one_joint)
+    throw InputError(data.source + ": a one-joint record (q_knee, tau_knee, no hip column) given the two-joint model "
+                     "file " + params_path + ", expected t, q_hip, q_knee, tau_hip, tau_knee, or a one-joint model "
+                     "file (joint: knee)");
 }
 
 LegParams ReadModelFile(const std::string& path) {
@@ -158,26 +214,12 @@ std::string Block(const LumpedParams& p) {
   return s + "}";
 }
 
-}  // namespace
-
-std::string ModelToYaml(const LegParams& params, const std::string& header,
-                        const std::string& extra_yaml) {
-  std::ostringstream os;
-  if (!header.empty()) {
-    std::stringstream hs(header);
-    std::string line;
-    while (std::getline(hs, line)) os << "# " << line << "\n";
-  }
-  os << "L1: " << Num(params.L1) << "                      # thigh length, m\n";
-  if (params.g != 9.81) os << "g: " << Num(params.g) << "\n";
-  os << "exo:   " << Block(params.exo) << "\n";
-  if (params.human) os << "human: " << Block(*params.human) << "\n";
-  os << "passive: " << PassiveModelName(params.passive) << "\n";
-  if (params.effects.empty()) {
+void WriteEffects(std::ostringstream& os, const std::vector<Effect>& effects) {
+  if (effects.empty()) {
     os << "effects: []\n";
   } else {
     os << "effects:\n";
-    for (const Effect& e : params.effects) {
+    for (const Effect& e : effects) {
       os << "  - {name: " << e.name << ", joint: " << e.joint << ", value: " << Num(e.value)
          << ", unit: \"" << e.unit << "\"";
       if (!e.axis.empty()) os << ", axis: " << e.axis;
@@ -190,6 +232,36 @@ std::string ModelToYaml(const LegParams& params, const std::string& header,
       os << "}\n";
     }
   }
+}
+
+}  // namespace
+
+std::string ModelToYaml(const LegParams& params, const std::string& header,
+                        const std::string& extra_yaml) {
+  std::ostringstream os;
+  if (!header.empty()) {
+    std::stringstream hs(header);
+    std::string line;
+    while (std::getline(hs, line)) os << "# " << line << "\n";
+  }
+  if (params.one_joint) {
+    const OneJointModel& m = *params.one_joint;
+    os << "joint: knee                    # a one-joint device (HKS05 eq. 4), th = 0 hanging, + extension\n";
+    if (params.g != 9.81) os << "g: " << Num(params.g) << "\n";
+    os << "device: {I: " << Num(m.device.I) << ", mgl: " << Num(m.device.mgl) << ", R: " << Num(m.R)
+       << ", C: " << Num(m.C) << "}\n";
+    if (m.human) os << "human: {I: " << Num(m.human->I) << ", mgl: " << Num(m.human->mgl) << "}\n";
+    WriteEffects(os, std::vector<Effect>(params.effects.begin() + static_cast<long>(m.device_effects),
+                                         params.effects.end()));
+    os << extra_yaml;
+    return os.str();
+  }
+  os << "L1: " << Num(params.L1) << "                      # thigh length, m\n";
+  if (params.g != 9.81) os << "g: " << Num(params.g) << "\n";
+  os << "exo:   " << Block(params.exo) << "\n";
+  if (params.human) os << "human: " << Block(*params.human) << "\n";
+  os << "passive: " << PassiveModelName(params.passive) << "\n";
+  WriteEffects(os, params.effects);
   os << extra_yaml;
   return os.str();
 }

@@ -2,6 +2,7 @@
 #pragma once
 #include <string>
 
+#include "formats/measured_data.h"
 #include "model/lumped_params.h"
 
 namespace exotwin {
@@ -16,8 +17,17 @@ LegParams ReadModelFile(const std::string& path);
 // Parses model YAML text; `source` names it in messages.
 LegParams ParseModelYaml(const std::string& text, const std::string& source);
 
+// Reads a model file: a two-joint MODEL.yaml or a one-joint one (top-level `joint:`, DESIGN.md
+// "One-joint devices"), returned embedded in the two-link model (model/one_joint.h, params.one_joint
+// set). ParseModelYaml dispatches the same way.
+
+// A record for the model file at `params_path`: a one-joint record (data.one_joint) for a one-joint
+// model, a record of both joints for a two-joint one. Throws InputError naming both files and what
+// was expected otherwise.
+void CheckRecordFitsModel(const LegParams& params, const std::string& params_path, const MeasuredData& data);
+
 // Serializes params as MODEL.yaml text. `extra_yaml` (already formatted top-level YAML, e.g. an
-// `identification:` block) is appended verbatim; `header` lines become '# ' comments at the top.
+// `identification:` block) is appended verbatim; a one-joint model is written as a one-joint file; `header` lines become '# ' comments at the top.
 std::string ModelToYaml(const LegParams& params, const std::string& header = "",
                         const std::string& extra_yaml = "");
 

@@ -37,6 +37,23 @@ struct Effect {
   std::string axis;                      // gravity_error only: "X" or "Y"
 };
 
+// A one-joint device (DESIGN.md "One-joint devices"): HAL-3's knee model of Lee & Sankai, HKS05
+// eq. 4 (sigma = 0, no muscle torque): I thdd + R thd + C sgn(thd) + mgl sin th = tau, th = 0 hanging,
+// positive extension. I and mgl are the device's link (frame, cuff and the motor's armature) plus the
+// operator's lower leg when present; R, C the device's viscous and Coulomb friction.
+struct OneJointLink {
+  double I = 0;    // kg m^2 about the joint
+  double mgl = 0;  // N m, gravity moment amplitude
+};
+struct OneJointModel {
+  OneJointLink device;
+  std::optional<OneJointLink> human;  // the operator's lower leg; absent = the device alone
+  double R = 0, C = 0;                // N m s/rad, N m (>= 0)
+  // Leading entries of LegParams::effects that stand for R and C (viscous_friction, coulomb_friction
+  // at the knee, in that order, each present when non-zero).
+  size_t device_effects = 0;
+};
+
 // Everything a MODEL.yaml holds.
 struct LegParams {
   double L1 = 0.41;                   // thigh length (hip to knee), m
@@ -45,6 +62,9 @@ struct LegParams {
   std::optional<LumpedParams> human;  // human limb (H); absent = exoskeleton alone
   PassiveModel passive = PassiveModel::kNone;
   std::vector<Effect> effects;
+  // A one-joint model file: its values. The fields above then hold its embedding in the two-link
+  // model (model/one_joint.h): the joint as the knee, the hip held at 0.
+  std::optional<OneJointModel> one_joint;
 
   // Combined lumped parameters (exo + human when present): the HR system of HJ15 eq. 3.
   LumpedParams Total() const;

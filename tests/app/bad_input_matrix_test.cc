@@ -266,6 +266,12 @@ std::vector<Case> Cases() {
       {"ScenarioNonScalarKey", Kind::kScenario, S + "? {a: b}\n: c\n", "s.yaml", "expected plain keys"},
       {"ScenarioMissingFile", Kind::kScenario, "", "nonexistent.yaml", "cannot open scenario file",
        "/nonexistent.yaml"},
+      // ---- one joint against two (DESIGN.md "One-joint devices") ----
+      {"CsvOneJointForTwoJointModel", Kind::kCsv, "", "d.csv: a one-joint record",
+       "m_ok.yaml, expected t, q_hip, q_knee, tau_hip, tau_knee, or a one-joint model file"},
+      {"ParamsOneJointForTwoJointRecord", Kind::kParams, "joint: knee\ndevice: {I: 0.17, mgl: 3.3}\n",
+       "d_ok.csv: a record with hip columns (q_hip, tau_hip, ...) given the one-joint model file",
+       "m.yaml, expected a one-joint record (t, q_knee, tau_knee"},
   };
   // Cases whose content is easier to build in code.
   for (auto& k : c) {
@@ -278,6 +284,11 @@ std::vector<Case> Cases() {
       std::istringstream in(GoodCsv(200, ",", ","));
       std::string l;
       for (int i = -1; std::getline(in, l); ++i) k.content += (i == 40 ? l.substr(0, l.size() - 1) : l) + "\n";
+    } else if (k.name == "CsvOneJointForTwoJointModel") {  // a one-joint record: t, q_knee, tau_knee
+      std::ostringstream os;
+      os << "t,q_knee,tau_knee\n";
+      for (int i = 0; i < 200; ++i) os << i * 0.001 << "," << 0.3 + 0.1 * std::sin(0.002 * i) << ",-5\n";
+      k.content = os.str();
     } else if (k.name == "CsvSamplingGap") {  // 1 kHz, then one sample a day later
       k.content = GoodCsv() + "86400,0.3,-0.7,-20,-5\n";
     }

@@ -48,6 +48,53 @@ TEST(DiagnoseCli, FindsTheHiddenEffectAndPredictLoadsTheExtendedModel) {
   EXPECT_EQ(ReadModelFile(d + "/out/extended.yaml").effects.size(), 1u);
 }
 
+// A one-joint device through the commands (DESIGN.md "One-joint devices"): generate a HAL-3 knee
+// record with a hidden friction, predict writes t,tau_knee, diagnose names the friction at the knee
+// alone and writes a one-joint extended.yaml that predict loads, identify fits I, mgl, R, C (the
+// record's truth: the device's plus the operator's link and R + the hidden viscous friction).
+TEST(DiagnoseCli, OneJointDeviceThroughGeneratePredictDiagnoseIdentify) {
+  const testing::ScopedTempDir tmp("diag1j");
+  const std::string d = tmp.path();
+  const std::string hal = std::string(EXOTWIN_SOURCE_DIR) + "/examples/hal3_knee.yaml";
+  auto r = RunExotwin("generate --params " + hal + " --seed 4 --effect viscous_friction --duration 20 --rate 500 --out " +
+                      d + "/knee.csv --truth " + d + "/truth.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const LegParams truth = ReadModelFile(d + "/truth.yaml");
+  ASSERT_TRUE(truth.one_joint);
+  const Effect hidden = truth.effects.back();
+  r = RunExotwin("predict --params " + hal + " --measured " + d + "/knee.csv --out " + d + "/pred.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(testing::ReadText(d + "/pred.csv").find("\nt,tau_knee\n"), std::string::npos);
+  r = RunExotwin("diagnose --params " + hal + " --measured " + d + "/knee.csv --out " + d + "/out");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(testing::ReadText(d + "/out/diagnosis.json"));
+  EXPECT_TRUE(j["one_joint"].get<bool>());
+  EXPECT_FALSE(j["joints"].contains("hip"));
+  ASSERT_EQ(j["effects"].size(), 1u) << j.dump(2);
+  EXPECT_EQ(j["effects"][0]["name"], "viscous_friction");
+  EXPECT_NEAR(j["effects"][0]["value"].get<double>(), hidden.value, 0.15 * hidden.value);
+  const LegParams ext = ReadModelFile(d + "/out/extended.yaml");
+  ASSERT_TRUE(ext.one_joint);
+  EXPECT_EQ(ext.one_joint->R, truth.one_joint->R);  // R, C as the model file gave them, the effect after
+  ASSERT_EQ(ext.effects.size(), ext.one_joint->device_effects + 1);
+  r = RunExotwin("predict --params " + d + "/out/extended.yaml --measured " + d + "/knee.csv --out " + d + "/p2.csv");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = RunExotwin("identify --measured " + d + "/knee.csv --friction --out " + d + "/id.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const LegParams id = ReadModelFile(d + "/id.yaml");
+  ASSERT_TRUE(id.one_joint);
+  const OneJointModel& m = *truth.one_joint;
+  EXPECT_NEAR(id.one_joint->device.I, m.device.I + m.human->I, 0.02 * (m.device.I + m.human->I));
+  EXPECT_NEAR(id.one_joint->device.mgl, m.device.mgl + m.human->mgl, 0.02 * (m.device.mgl + m.human->mgl));
+  EXPECT_NEAR(id.one_joint->R, m.R + hidden.value, 0.1 * (m.R + hidden.value));
+  EXPECT_NEAR(id.one_joint->C, m.C, 0.25 * m.C);
+  // One-joint and two-joint records mixed: exit 2 naming the record.
+  ASSERT_EQ(RunExotwin("generate --params " + kS1 + " --seed 4 --clean --duration 5 --rate 200 --out " + d + "/two.csv").exit_code, 0);
+  r = RunExotwin("identify --measured " + d + "/knee.csv --measured " + d + "/two.csv --out " + d + "/bad.yaml");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("two.csv: a record with hip columns among one-joint records"), std::string::npos) << r.output;
+}
+
 TEST(DiagnoseCli, MuscleActivityExtensionRunsInPredict) {
   const testing::ScopedTempDir tmp("diagemg");
   const std::string d = tmp.path();

@@ -1,0 +1,309 @@
+// One-joint devices in the discrepancy loop (DESIGN.md "One-joint devices"): the one-joint model file
+// against HAL-3's plant (sim/hal3_plant.h) and HKS05 eq. 4 in closed form; one-joint records and their
+// embedding; hidden effects in HAL-3 twin records of `generate` (singles within 15 %, pairs, nothing on
+// clean records); the real simple pendulum's targets (../shared/data, skipped when absent).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "diagnosis/diagnose.h"
+#include "diagnosis/generate.h"
+#include "diagnosis/predict.h"
+#include "core/error.h"
+#include "formats/column_map.h"
+#include "formats/csv_table.h"
+#include "formats/model_file.h"
+#include "sim/hal3_plant.h"
+#include "sim/plant.h"
+#include "tests/temp_dir.h"
+
+namespace exotwin {
+namespace {
+
+const std::string kSrc = EXOTWIN_SOURCE_DIR;
+LegParams Hal3Knee() { return ReadModelFile(kSrc + "/examples/hal3_knee.yaml"); }
+
+TEST(OneJointModel, HalKneeFileHoldsTheHal3PlantsValues) {
+  const LegParams p = Hal3Knee();
+  ASSERT_TRUE(p.one_joint);
+  const Hal3PlantParams h;  // the twin's HAL-3 plant, independent of the file
+  EXPECT_NEAR(p.one_joint->device.I, h.hal_I(), 1e-12);
+  EXPECT_NEAR(p.one_joint->device.mgl, h.hal_mgl(), 1e-9);
+  ASSERT_TRUE(p.one_joint->human);
+  EXPECT_NEAR(p.one_joint->device.I + p.one_joint->human->I, h.I(), 1e-12);
+  EXPECT_NEAR(p.one_joint->device.mgl + p.one_joint->human->mgl, h.mgl(), 1e-9);
+  EXPECT_EQ(p.one_joint->R, h.R);
+  EXPECT_EQ(p.one_joint->C, h.C);
+  // Written and read back: the same file.
+  const LegParams q = ParseModelYaml(ModelToYaml(p), "round trip");
+  EXPECT_EQ(ModelToYaml(q), ModelToYaml(p));
+  EXPECT_NE(ModelToYaml(p).find("joint: knee"), std::string::npos);
+}
+
+// predict (MuJoCo's inverse dynamics of the embedding, plus R and C) against HKS05 eq. 4 in closed
+// form: tau_R = I thdd + R thd + C sgn(thd) + mgl sin th.
+TEST(OneJointModel, PredictIsHks05Eq4) {
+  const LegParams p = Hal3Knee();
+  Plant plant(ExowheelMjcfPath(p.human.has_value()));
+  plant.SetParams(p);
+  Kinematics k;
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.005 * i;
+    k.t.push_back(t);
+    k.q[0].push_back(0), k.qd[0].push_back(0), k.qdd[0].push_back(0);
+    k.q[1].push_back(0.4 + 0.7 * std::sin(2.1 * t)), k.qd[1].push_back(1.47 * std::cos(2.1 * t));
+    k.qdd[1].push_back(-3.087 * std::sin(2.1 * t) + 2.0 * std::cos(7 * t));
+  }
+  const Prediction pr = PredictTorque(plant, k);
+  const OneJointModel& m = *p.one_joint;
+  const double I = m.device.I + m.human->I, mgl = m.device.mgl + m.human->mgl;
+  for (size_t i = 0; i < k.t.size(); ++i) {
+    const double qd = k.qd[1][i];
+    const double want = I * k.qdd[1][i] + m.R * qd + m.C * (qd > 0 ? 1 : qd < 0 ? -1 : 0) + mgl * std::sin(k.q[1][i]);
+    ASSERT_NEAR(pr.tau_R[1][i], want, 1e-6 * (1 + std::abs(want))) << "sample " << i;
+    ASSERT_NEAR(pr.tau_S[1][i], -want, 1e-6 * (1 + std::abs(want)));
+  }
+}
+
+TEST(OneJointModel, BadFilesAreRejectedNamingTheKey) {
+  auto fails = [](const std::string& yaml, const std::string& what) {
+    try {
+      ParseModelYaml(yaml, "m.yaml");
+      ADD_FAILURE() << "accepted: " << yaml;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  fails("joint: hip\ndevice: {I: 0.1, mgl: 1}\n", "joint");
+  fails("joint: knee\n", "device");
+  fails("joint: knee\ndevice: {I: 0.1}\n", "device.mgl");
+  fails("joint: knee\ndevice: {I: 0.1, mgl: 1, R: -1}\n", "device.R");
+  fails("joint: knee\ndevice: {I: 0.1, mgl: 1}\nL1: 0.4\n", "L1");
+  fails("joint: knee\ndevice: {I: 0.1, mgl: 1}\neffects: [{name: backlash, joint: hip, value: 0.01}]\n",
+        "effects[0].joint");
+}
+
+// A one-joint CSV reads as an embedded record; a record and a model of different joints are bad input.
+TEST(OneJointData, RecordsAreEmbeddedAndMustFitTheModel) {
+  testing::ScopedTempDir dir("one_joint");
+  const std::string one = dir.path() + "/one.csv", two = dir.path() + "/two.csv";
+  std::vector<double> t, q, tau, z;
+  for (int i = 0; i < 50; ++i) t.push_back(0.01 * i), q.push_back(0.1 * i), tau.push_back(-0.2 * i), z.push_back(0);
+  WriteCsv(one, {"t", "q_knee", "tau_knee"}, {&t, &q, &tau});
+  WriteCsv(two, {"t", "q_hip", "q_knee", "tau_hip", "tau_knee"}, {&t, &z, &q, &z, &tau});
+  const MeasuredData a = ReadMeasuredCsv(one), b = ReadMeasuredCsv(two);
+  EXPECT_TRUE(a.one_joint);
+  EXPECT_FALSE(b.one_joint);
+  EXPECT_EQ(a.q_knee(), q);
+  EXPECT_EQ(a.q_hip(), z);
+  EXPECT_EQ(TableAsRecorded(a).names, (std::vector<std::string>{"t", "q_knee", "tau_knee"}));
+  const LegParams hal = Hal3Knee(), s1 = ReadModelFile(kSrc + "/examples/S1.yaml");
+  EXPECT_NO_THROW(CheckRecordFitsModel(hal, "hal3_knee.yaml", a));
+  EXPECT_NO_THROW(CheckRecordFitsModel(s1, "S1.yaml", b));
+  for (const auto& [params, path, data] :
+       {std::tuple{&hal, "hal3_knee.yaml", &b}, std::tuple{&s1, "S1.yaml", &a}}) {
+    try {
+      CheckRecordFitsModel(*params, path, *data);
+      ADD_FAILURE() << path;
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(path), std::string::npos) << m;
+      EXPECT_NE(m.find(data->source), std::string::npos) << m;
+      EXPECT_NE(m.find("expected"), std::string::npos) << m;
+    }
+  }
+}
+
+int EnvInt(const char* name, int def) {
+  const char* v = std::getenv(name);
+  return v ? std::atoi(v) : def;
+}
+
+const DiagnosedEffect* Find(const Diagnosis& d, const Effect& truth) {
+  for (const auto& e : d.effects)
+    if (e.effect.name == truth.name && e.effect.joint == truth.joint &&
+        (truth.name != "gravity_error" || e.effect.axis == truth.axis))
+      return &e;
+  return nullptr;
+}
+
+double ValueError(const Effect& truth, const Effect& found) {
+  if (truth.name == "muscle_activity") {
+    double worst = 0;
+    for (const auto& f : truth.fields) {
+      const auto it = found.fields.find(f.first);
+      worst = std::max(worst, std::abs((it == found.fields.end() ? 0.0 : it->second) - f.second) / std::abs(f.second));
+    }
+    return worst;
+  }
+  return std::abs(found.value - truth.value) / std::abs(truth.value);
+}
+
+GeneratedData Hal3Record(const LegParams& base, uint64_t seed, int effects, const std::vector<std::string>& allowed) {
+  GenerateOptions g;
+  g.seed = seed;
+  g.effects = effects;
+  g.allowed = allowed;
+  g.duration = 20;
+  g.rate = 500;
+  return GenerateMeasured(base, g);
+}
+
+// Every effect of DESIGN.md's table hidden alone in a HAL-3 twin record: named, at its value within
+// 15 %, the only one named.
+TEST(OneJointHiddenEffect, EverySingleEffectIsNamedAtItsValue) {
+  const LegParams base = Hal3Knee();
+  std::printf("%-18s %6s %10s %10s %8s\n", "effect", "seed", "truth", "found", "err_%");
+  const int seeds = EnvInt("EXOTWIN_ONE_JOINT_SEEDS", 1);
+  for (const std::string& name : AllEffectNames()) {
+    for (uint64_t seed = 11; seed < 11 + static_cast<uint64_t>(seeds); ++seed) {
+      const GeneratedData data = Hal3Record(base, seed + 100 * (&name - &AllEffectNames()[0]), 1, {name});
+      ASSERT_TRUE(data.data.one_joint);
+      const Effect& truth = data.truth.effects.back();
+      EXPECT_EQ(truth.joint, "knee");
+      const Diagnosis d = Diagnose(base, data.data);
+      const DiagnosedEffect* f = Find(d, truth);
+      const double err = f ? ValueError(truth, f->effect) : 1.0;
+      std::printf("%-18s %6llu %10.4g %10.4g %7.1f%%\n", name.c_str(), (unsigned long long)seed, truth.value,
+                  f ? f->effect.value : NAN, 100 * err);
+      EXPECT_TRUE(f) << name << " seed " << seed;
+      EXPECT_LE(err, 0.15) << name << " seed " << seed;
+      EXPECT_EQ(d.effects.size(), 1u) << name << " seed " << seed;
+      EXPECT_GE(d.joints[1].gain_pct, 50) << name << " seed " << seed;
+    }
+  }
+}
+
+TEST(OneJointHiddenEffect, PairsAreNamed) {
+  const LegParams base = Hal3Knee();
+  int both = 0;
+  const int seeds = EnvInt("EXOTWIN_ONE_JOINT_PAIR_SEEDS", 6);
+  for (int s = 0; s < seeds; ++s) {
+    const GeneratedData data = Hal3Record(base, 500 + s, 2, {});
+    const Effect& a = data.truth.effects[data.truth.effects.size() - 2];
+    const Effect& b = data.truth.effects.back();
+    const Diagnosis d = Diagnose(base, data.data);
+    const bool ok = Find(d, a) && Find(d, b);
+    both += ok;
+    std::printf("pair seed %d: %s = %g + %s = %g: found", 500 + s, a.name.c_str(), a.value, b.name.c_str(), b.value);
+    for (const auto& e : d.effects) std::printf(" %s = %g", e.effect.name.c_str(), e.effect.value);
+    std::printf("\n");
+  }
+  EXPECT_GE(both * 10, seeds * 8);
+}
+
+TEST(OneJointHiddenEffect, NothingIsNamedOnCleanRecords) {
+  const LegParams base = Hal3Knee();
+  const int seeds = EnvInt("EXOTWIN_ONE_JOINT_CLEAN", 10);
+  for (int s = 0; s < seeds; ++s) {
+    const Diagnosis d = Diagnose(base, Hal3Record(base, 900 + s, 0, {}).data);
+    for (const auto& e : d.effects) ADD_FAILURE() << "clean seed " << 900 + s << ": named " << e.effect.name;
+  }
+}
+
+// The real simple pendulum (shared/data/real_rig/dfki_simple_pendulum, README there) against the
+// makers' nominal point mass (examples/real_rig/simple_pendulum/model.yaml: I 0.169 kg m^2, mgl
+// 3.31 N m, no friction). The README's careful fit: I 0.177, Coulomb 0.15, viscous 0.002, mgl 3.53.
+const std::string kPend = kSrc + "/../shared/data/real_rig/dfki_simple_pendulum/";
+const std::string kPendEx = kSrc + "/examples/real_rig/simple_pendulum/";
+
+MeasuredData Pendulum(const std::string& name) {
+  return ReadMeasured(kPend + name + ".csv", kPendEx + "dfki_simple_pendulum.map.yaml");
+}
+
+void PrintDiagnosis(const char* title, const Diagnosis& d) {
+  std::printf("%s\n", title);
+  for (const auto& e : d.effects)
+    std::printf("  %s%s = %.5g %s [%.5g, %.5g], explains %.1f %%\n", e.effect.name.c_str(),
+                e.effect.axis.empty() ? "" : ("." + e.effect.axis).c_str(), e.effect.value, e.effect.unit.c_str(),
+                e.ci_lo, e.ci_hi, e.explained_pct);
+  for (const auto& r : d.records)
+    std::printf("  %s: held-out %.4f -> %.4f N m (%.1f %%), left out %.4f -> %.4f N m (%.1f %%)\n", r.source.c_str(),
+                r.split[1].rmse_before, r.split[1].rmse_after, r.split[1].gain_pct, r.left_out[1].rmse_before,
+                r.left_out[1].rmse_after, r.left_out[1].gain_pct);
+  for (const auto& s : d.implausible) std::printf("  implausible: %s\n", s.c_str());
+  for (const auto& s : d.not_identifiable) std::printf("  not identifiable: %s\n", s.c_str());
+  if (std::getenv("EXOTWIN_ONE_JOINT_VERBOSE")) {
+    std::printf("  cutoff: %s\n", d.cutoff.why.c_str());
+    for (const auto& s : d.selection) std::printf("  step: %s\n", s.c_str());
+    for (const auto& s : d.scores)
+      std::printf("  candidate %s: dBIC %.1f, held-out gain %.1f %%\n", s.label.c_str(), s.delta_bic, s.heldout_gain_pct);
+  }
+}
+
+TEST(OneJointRealRig, PendulumDynamicRecordsNameCoulombFrictionInItsRange) {
+  if (!std::filesystem::exists(kPend)) GTEST_SKIP() << kPend << " absent";
+  const char* model_env = std::getenv("EXOTWIN_ONE_JOINT_MODEL");
+  const LegParams nominal = ReadModelFile(model_env ? model_env : kPendEx + "model.yaml");
+  std::vector<MeasuredData> recs;
+  recs.push_back(Pendulum("pd_system_identification"));
+  recs.push_back(Pendulum("ddp_swingup"));
+  DiagnoseOptions opt;
+  if (const char* c = std::getenv("EXOTWIN_ONE_JOINT_CUTOFF")) opt.cutoff_hz = std::atof(c);
+  const Diagnosis d = Diagnose(nominal, std::move(recs), opt);
+  PrintDiagnosis("pd_system_identification + ddp_swingup:", d);
+  const DiagnosedEffect* coulomb = nullptr;
+  double I = nominal.one_joint->device.I, mgl = nominal.one_joint->device.mgl;
+  for (const auto& e : d.effects) {
+    if (e.effect.name == "coulomb_friction") coulomb = &e;
+    if (e.effect.name == "inertia_error") I += e.effect.value;
+    if (e.effect.name == "gravity_error" && e.effect.axis == "X") mgl += nominal.g * e.effect.value;
+  }
+  ASSERT_TRUE(coulomb);
+  EXPECT_GE(coulomb->effect.value, 0.08);
+  EXPECT_LE(coulomb->effect.value, 0.25);
+  // A mass correction, when named, goes toward the reference fit (not away from it).
+  EXPECT_LE(std::abs(I - 0.177), std::abs(0.168875 - 0.177) + 1e-9) << "I " << I;
+  EXPECT_LE(std::abs(mgl - 3.53), std::abs(3.3133 - 3.53) + 1e-9) << "mgl " << mgl;
+  // ddp_swingup's whole record, predicted by what pd_system_identification alone supports, gains
+  // >= 25 %. (pd_system_identification's whole record is not improved by the reference fit either:
+  // its filtered residual is not in the model's structure.)
+  ASSERT_EQ(d.records.size(), 2u);
+  EXPECT_GE(d.records[1].left_out[1].gain_pct, 25) << d.records[1].source;
+}
+
+TEST(OneJointRealRig, GravityCompensationNamesNoInertia) {
+  if (!std::filesystem::exists(kPend)) GTEST_SKIP() << kPend << " absent";
+  const LegParams nominal = ReadModelFile(kPendEx + "model.yaml");
+  const Diagnosis d = Diagnose(nominal, Pendulum("gravity_compensation"));
+  PrintDiagnosis("gravity_compensation:", d);
+  // The motor's torque is the controller's gravity compensation, the hand's is not measured: the
+  // inertia is not in the record. It is not named; its fit (-100 % of the twin's) is listed as
+  // implausible.
+  for (const auto& e : d.effects) EXPECT_NE(e.effect.name, "inertia_error");
+  bool listed = false;
+  for (const auto& s : d.implausible) listed = listed || s.rfind("inertia_error(knee)", 0) == 0;
+  for (const auto& s : d.not_identifiable) listed = listed || s.rfind("inertia_error(knee)", 0) == 0;
+  EXPECT_TRUE(listed);
+}
+
+// ddp_swingup alone: Coulomb friction, and the nominal dynamics' scale. A sensor gain g is a common
+// scale of I and mgl (the motor's torque constant, or the point mass m, scales both alike): the twin's
+// I (1 + g) and mgl (1 + g) move toward the reference fit.
+TEST(OneJointRealRig, DdpSwingupNamesFrictionAndAScaleTowardTheReferenceFit) {
+  if (!std::filesystem::exists(kPend)) GTEST_SKIP() << kPend << " absent";
+  const LegParams nominal = ReadModelFile(kPendEx + "model.yaml");
+  const Diagnosis d = Diagnose(nominal, Pendulum("ddp_swingup"));
+  PrintDiagnosis("ddp_swingup:", d);
+  double coulomb = 0, gain = 0, dI = 0, dmgl = 0;
+  for (const auto& e : d.effects) {
+    if (e.effect.name == "coulomb_friction") coulomb = e.effect.value;
+    if (e.effect.name == "sensor_gain") gain = e.effect.value;
+    if (e.effect.name == "inertia_error") dI = e.effect.value;
+    if (e.effect.name == "gravity_error" && e.effect.axis == "X") dmgl = nominal.g * e.effect.value;
+  }
+  EXPECT_GE(coulomb, 0.08);
+  EXPECT_LE(coulomb, 0.25);
+  const double I = (0.168875 + dI) * (1 + gain), mgl = (3.3133 + dmgl) * (1 + gain);
+  std::printf("  equivalent I %.4f kg m^2, mgl %.4f N m\n", I, mgl);
+  EXPECT_LT(std::abs(I - 0.177), std::abs(0.168875 - 0.177));
+  EXPECT_LT(std::abs(mgl - 3.53), std::abs(3.3133 - 3.53));
+  EXPECT_GE(d.joints[1].gain_pct, 25);
+}
+
+}  // namespace
+}  // namespace exotwin
