@@ -1,4 +1,4 @@
-// A scenario run with its controller in another process (issue 17): the twin of `exotwin serve` and
+// A scenario run with its controller in another process: the twin of `exotwin serve` and
 // the deployable controller (exotwin-controller) on a private Unix link, in lockstep, so the result is
 // the in-process run's (the regression gate's `regress --controller-process`).
 #pragma once
