@@ -128,13 +128,16 @@ LegParams ParseModelYaml(const std::string& text, const std::string& source) {
     if (p.passive != PassiveModel::kNone && !p.human)
       c.Fail("passive", "acts on the human only: expected 'none' without a human: block");
   }
-  if (root["effects"] && !root["effects"].IsNull()) {
-    if (!root["effects"].IsSequence()) c.Fail("effects", "expected a list");
-    int i = 0;
-    for (const auto& e : root["effects"])
-      p.effects.push_back(ReadEffect(c, e, "effects[" + std::to_string(i++) + "]"));
-  }
+  if (root["effects"] && !root["effects"].IsNull()) p.effects = ReadEffectList(c, root["effects"], "effects");
   return p;
+}
+
+std::vector<Effect> ReadEffectList(const YamlContext& c, const YAML::Node& n, const std::string& key) {
+  if (!n.IsSequence()) c.Fail(key, "expected a list" + YamlLine(n));
+  std::vector<Effect> out;
+  int i = 0;
+  for (const auto& e : n) out.push_back(ReadEffect(c, e, key + "[" + std::to_string(i++) + "]"));
+  return out;
 }
 
 LegParams ReadModelFile(const std::string& path) {

@@ -2,6 +2,9 @@
 #pragma once
 #include <string>
 
+#include <vector>
+
+#include "core/yaml_fields.h"
 #include "model/lumped_params.h"
 
 namespace exotwin {
@@ -15,6 +18,11 @@ LegParams ReadModelFile(const std::string& path);
 
 // Parses model YAML text; `source` names it in messages.
 LegParams ParseModelYaml(const std::string& text, const std::string& source);
+
+// A list of effects as a model file's `effects:` holds them (DESIGN.md "Effects"), read from the
+// sequence n under `key` of the file c.source (a scenario's plant.effects): messages name
+// "<key>[i].<field>" as ReadModelFile's name "effects[i].<field>".
+std::vector<Effect> ReadEffectList(const YamlContext& c, const YAML::Node& n, const std::string& key);
 
 // Serializes params as MODEL.yaml text. `extra_yaml` (already formatted top-level YAML, e.g. an
 // `identification:` block) is appended verbatim; `header` lines become '# ' comments at the top.

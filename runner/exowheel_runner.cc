@@ -260,6 +260,15 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   const LegParams truth = ResolveSubject(s);
   Plant plant(ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
   plant.SetParams(truth);
+  if (!s.plant_effects.empty()) {  // the scenario's plant: the rigid twin plus the effects it carries
+    LegParams carried = truth;
+    carried.effects = s.plant_effects;
+    const PlantEffects fx = ToPlantEffects(carried, s.plant_effects_source);
+    if (!fx.sensor[0].empty() || !fx.sensor[1].empty())
+      throw InputError(s.plant_effects_source + ": sensor effects (sensor_offset, sensor_gain, sensor_delay) are not "
+                       "carried by a scenario's torque-sensor node yet; expected link effects only");
+    plant.CarryEffects(fx);
+  }
   const CosimSchedule schedule = ScheduleOf(s, plant.timestep());
 
   std::unique_ptr<CandumpWriter> can_log;
