@@ -38,6 +38,20 @@ void ExpectScenarioError(const std::string& text, const std::string& must_contai
   }
 }
 
+// A 1 s gait on a plant carrying `effects` must throw InputError containing must_contain.
+void ExpectRunRefused(const std::string& effects, const std::string& out_dir, const std::string& must_contain) {
+  Scenario s = ParseScenarioYaml(GaitWith("plant: {effects: " + effects + "}"), "s.yaml");
+  s.protocol.duration = 1;
+  RunOptions o;
+  o.out_dir = out_dir;
+  try {
+    RunScenario(s, o);
+    ADD_FAILURE() << effects << " carried";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(must_contain), std::string::npos) << e.what();
+  }
+}
+
 TEST(PlantScenario, TheBlockIsReadOrRefusedNamingTheKey) {
   const Scenario s = ParseScenarioYaml(
       GaitWith("plant: {effects: [{name: coulomb_friction, joint: knee, value: 2}, "
@@ -60,31 +74,12 @@ TEST(PlantScenario, TheBlockIsReadOrRefusedNamingTheKey) {
   const Scenario f = ParseScenarioYaml(GaitWith("plant: {effects_from: extended.yaml}"), tmp.path() + "/s.yaml");
   ASSERT_EQ(f.plant_effects.size(), 1u);
   EXPECT_EQ(f.plant_effects[0].name, "inertia_error");
-  // A sensor delay that is not a whole number of the joint modules' 1 ms samples is refused.
-  Scenario dl = ParseScenarioYaml(GaitWith("plant: {effects: [{name: sensor_delay, joint: knee, value: 0.0005}]}"),
-                                  "s.yaml");
-  dl.protocol.duration = 1;
-  RunOptions od;
-  od.out_dir = tmp.path() + "/delay";
-  try {
-    RunScenario(dl, od);
-    ADD_FAILURE() << "half-sample delay carried";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("sensor_delay 0.000500 s of the knee: expected a whole number"), std::string::npos)
-        << e.what();
-  }
-  // An effect the plant cannot carry: the run refuses it naming the effect.
-  Scenario b = ParseScenarioYaml(GaitWith("plant: {effects: [{name: backlash, joint: knee, value: 0.01}]}"), "s.yaml");
-  b.protocol.duration = 1;
-  RunOptions o;
-  o.out_dir = tmp.path() + "/run";
-  try {
-    RunScenario(b, o);
-    ADD_FAILURE() << "backlash carried";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("s.yaml: plant.effects: effects[0] (backlash, knee)"), std::string::npos)
-        << e.what();
-  }
+  // Refused when the run builds the plant, naming the effect: a sensor delay that is not a whole
+  // number of the joint modules' 1 ms samples, an effect the plant cannot carry.
+  ExpectRunRefused("[{name: sensor_delay, joint: knee, value: 0.0005}]", tmp.path() + "/delay",
+                   "sensor_delay 0.000500 s of the knee: expected a whole number");
+  ExpectRunRefused("[{name: backlash, joint: knee, value: 0.01}]", tmp.path() + "/run",
+                   "s.yaml: plant.effects: effects[0] (backlash, knee)");
 }
 
 // 20 s of the shipped gait (as tests/runner/runner_test.cc) on the rigid plant and on a plant whose
