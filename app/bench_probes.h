@@ -105,6 +105,10 @@ nlohmann::ordered_json BenchRender(const BenchConfig& c);
 // Identification (steps 3-4, S1, 80 s of 1 kHz data; quick: 40 s): data seconds per wall second.
 nlohmann::ordered_json BenchIdentification(const BenchConfig& c);
 
+// replay (diagnosis/replay.h) of 600 s at 1 kHz (quick: 20 s) on the DFKI rig's model carrying
+// friction and armature, 0.5 s windows, vs a bare mj_step loop of the same model over the same time.
+nlohmann::ordered_json BenchReplay(const BenchConfig& c);
+
 // Diagnosis of 60 s of 1 kHz data with one hidden effect (quick: 20 s): data seconds per wall second.
 nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 

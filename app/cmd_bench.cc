@@ -34,12 +34,12 @@ CommandRunner RegisterBench(CLI::App& app) {
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
   sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                  "predict_long,diagnose_long,link");
+                  "predict_long,diagnose_long,link,replay");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
     const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep",
-                                          "predict_long", "diagnose_long", "link"};
+                                          "predict_long", "diagnose_long", "link", "replay"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -50,7 +50,7 @@ CommandRunner RegisterBench(CLI::App& app) {
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
                            "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                           "predict_long,diagnose_long,link");
+                           "predict_long,diagnose_long,link,replay");
         selected.push_back(name);
         start = end + 1;
       }
@@ -86,6 +86,7 @@ CommandRunner RegisterBench(CLI::App& app) {
       if (name == "predict_long") j[name] = BenchPredictLong(c);
       if (name == "diagnose_long") j[name] = BenchDiagnoseLong(c);
       if (name == "link") j[name] = BenchLink(c);
+      if (name == "replay") j[name] = BenchReplay(c);
       if (pin.pinned()) j[name]["pinned_cpu"] = FastestCpu(c.cpus);
       for (const BenchRow& r : BenchRowsFromJson(j[name])) rows.push_back(r);
     }

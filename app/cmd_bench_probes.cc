@@ -36,6 +36,7 @@
 #include "identification/identification_data.h"
 #include "diagnosis/diagnose.h"
 #include "diagnosis/generate.h"
+#include "diagnosis/replay.h"
 #include "formats/model_file.h"
 
 namespace exotwin {
@@ -97,21 +98,26 @@ json Unavailable(const std::string& why) { return json{{"status", "unavailable"}
 
 // Best wall time (s) of `repeat` bare mj_step loops of n steps on the plant's model (S1's masses), from
 // the same start and with constant torques: the floor, MuJoCo alone.
-double BareMjStepSeconds(int repeat, long n) {
-  Plant plant(ShippedModelPath("leg_exowheel.xml"));
-  plant.SetParams(SubjectLegParams(PresetSubject("S1")));
+// The same loop on `plant`'s model from q0 with constant torques u (N m).
+double BareMjStepSeconds(int repeat, long n, Plant& plant, const Eigen::Vector2d& q0, const Eigen::Vector2d& u) {
   mjModel* m = const_cast<mjModel*>(plant.model());
   mjData* d = plant.data();
   return BestOf(repeat, [&] {
     mj_resetData(m, d);
-    d->qpos[0] = 0.3;
-    d->qpos[1] = -0.5;
+    d->qpos[0] = q0[0];
+    d->qpos[1] = q0[1];
     for (long i = 0; i < n; ++i) {
-      d->ctrl[0] = 20.0;
-      d->ctrl[1] = 5.0;
+      d->ctrl[0] = u[0];
+      d->ctrl[1] = u[1];
       mj_step(m, d);
     }
   });
+}
+
+double BareMjStepSeconds(int repeat, long n) {
+  Plant plant(ShippedModelPath("leg_exowheel.xml"));
+  plant.SetParams(SubjectLegParams(PresetSubject("S1")));
+  return BareMjStepSeconds(repeat, n, plant, {0.3, -0.5}, {20.0, 5.0});
 }
 
 std::string Seconds(double s) {
@@ -320,6 +326,58 @@ GenerateOptions BenchFrictionRecord(double duration_s) {
   g.effects = 1;
   g.allowed = {"coulomb_friction"};
   return g;
+}
+
+json BenchReplay(const BenchConfig& c) {
+  // The DFKI rig's model (examples/real_rig/model.yaml) with the effects diagnose names there.
+  LegParams p = ReadModelFile(DataPath("examples/real_rig/model.yaml"));
+  auto fx_of = [](const char* name, const char* joint, double v) {
+    Effect e;
+    e.name = name, e.joint = joint, e.value = v;
+    return e;
+  };
+  p.effects = {fx_of("coulomb_friction", "hip", 0.155), fx_of("coulomb_friction", "knee", 0.147),
+               fx_of("inertia_error", "knee", 0.00275)};
+  const PlantEffects fx = ToPlantEffects(p, "bench");
+  Plant plant(ExowheelMjcfPath(false));
+  plant.SetParams(p);
+  plant.CarryEffects(fx);
+  plant.FreeJointsAndTorque();
+  // The record: the plant itself driven by sums of sines at 1 kHz (angles and torque as a rig logs).
+  const double duration = c.quick ? 20.0 : 600.0;
+  const long n = std::lround(duration / plant.timestep());
+  ReplaySeries s;
+  s.source = "bench";
+  plant.Reset({0.2, -0.3}, {0, 0});
+  for (long i = 0; i < n; ++i) {
+    const double t = plant.time();
+    const Eigen::Vector2d u(0.8 * std::sin(2 * M_PI * 0.7 * t) + 0.3 * std::sin(2 * M_PI * 1.9 * t),
+                            0.3 * std::sin(2 * M_PI * 1.1 * t) + 0.1 * std::sin(2 * M_PI * 2.7 * t));
+    s.t.push_back(t);
+    for (int j = 0; j < 2; ++j) {
+      s.q[j].push_back(plant.q()[j]);
+      s.q0[j].push_back(plant.q()[j]);
+      s.qd0[j].push_back(plant.qd()[j]);
+      s.tau_R[j].push_back(u[j]);
+    }
+    plant.Step(u);
+  }
+  ReplayScore score;
+  const double replay = BestOf(c.repeat, [&] { score = Replay(plant, s, 0.5).score; });
+  // The floor: a bare mj_step loop of the same (rigid) model over the same simulated time.
+  Plant bare_plant(ExowheelMjcfPath(false));
+  bare_plant.SetParams(p);
+  const double bare = BareMjStepSeconds(c.repeat, n, bare_plant, {0.2, -0.3}, {0.5, 0.2});
+  return json{{"ratio_replay_to_bare", replay / bare},
+              {"record_s", duration},
+              {"steps", n},
+              {"windows", score.windows},
+              {"replay_s", replay},
+              {"bare_mj_step_s", bare},
+              {"rows", BenchRowsJson({{"replay of " + std::to_string(static_cast<int>(duration)) +
+                                           " s at 1 kHz (DFKI rig, friction + armature, 0.5 s windows)",
+                                       replay / bare, "x", "bare mj_step loop (same model, same time)", "<= 2x",
+                                       Seconds(replay) + " vs " + Seconds(bare)}})}};
 }
 
 json BenchDiagnosis(const BenchConfig& c) {

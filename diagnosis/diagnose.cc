@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -592,6 +593,7 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
         e.value *= refine_ratio[k];
         p.effects.push_back(e);
       }
+      rs.left_out_effects = p.effects;
       Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
       loo_plant.SetParams(p);
       const Prediction whole = PredictTorque(loo_plant, rc.kin);
@@ -612,6 +614,109 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
     D.joints[j] = ScoreOf(sb[j], sa[j], cnt);
     if (D.leave_one_out) D.left_out[j] = ScoreOf(lb[j], la[j], lcnt);
   }
+}
+
+// Stage 6b: the rigid and the extended twin simulated forward (replay.h) on every record's held-out
+// part and, with several records, on every whole record with the effects fitted on the others
+// (D->simulation, RecordScore::sim_*). Needs the records' kinematics and raw torque, D->extended and
+// D->records[r].left_out_effects.
+void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const DiagnoseOptions& opt, Diagnosis* D_out) {
+  Diagnosis& D = *D_out;
+  SimulationScores& S = D.simulation;
+  S.horizon_s = opt.replay_horizon_s;
+  S.cutoff_hz = opt.replay_cutoff_hz;
+  if (!opt.simulate) {
+    S.note = "not simulated (DiagnoseOptions::simulate off)";
+    return;
+  }
+  if (params.one_joint) {
+    S.note = "not simulated: the forward replay takes two-joint models only (a one-joint model's hip is "
+             "held only in its inverse dynamics)";
+    return;
+  }
+  // A plant carrying `model`'s effects; false (and S.note) when it cannot carry them.
+  auto Make = [&](const LegParams& model, const std::string& which, std::unique_ptr<Plant>* plant,
+                  PlantEffects* fx) {
+    try {
+      *fx = ToPlantEffects(model, which);
+    } catch (const InputError& e) {
+      S.note = std::string("not simulated: ") + e.what();
+      return false;
+    }
+    *plant = std::make_unique<Plant>(opt.mjcf.empty() ? ExowheelMjcfPath(model.human.has_value()) : opt.mjcf);
+    (*plant)->SetParams(model);
+    (*plant)->CarryEffects(*fx);
+    (*plant)->FreeJointsAndTorque();
+    return true;
+  };
+  std::unique_ptr<Plant> rigid, ext;
+  PlantEffects rigid_fx, ext_fx;
+  if (!Make(params, "the model given", &rigid, &rigid_fx) || !Make(D.extended, "the extended twin", &ext, &ext_fx))
+    return;
+  ReplayScore sb, sa, lb, la;
+  for (size_t r = 0; r < recs.size(); ++r) {
+    const Rec& rc = recs[r];
+    RecordScore& rs = D.records[r];
+    const size_t n = rc.n();
+    const std::vector<double> tau_S[2] = {std::vector<double>(rc.raw[0], rc.raw[0] + n),
+                                          std::vector<double>(rc.raw[1], rc.raw[1] + n)};
+    // One series; its input re-formed for each twin's sensor effects (memory of long records).
+    ReplaySeries series = ReplaySeriesOf(rc.source, rc.kin.t, rc.kin.q, tau_S, rigid_fx, opt.replay_cutoff_hz);
+    auto Score = [](const ReplayScore& b, const ReplayScore& a, JointScore out[2]) {
+      for (int j = 0; j < 2; ++j) out[j] = ScoreOf(b.sse[j], a.sse[j], static_cast<double>(std::max<size_t>(1, b.count)));
+    };
+    const bool split_long = rc.kin.t.back() - rc.kin.t[rc.split] >= opt.replay_horizon_s;
+    const bool whole_long = D.leave_one_out && rc.kin.t.back() - rc.kin.t.front() >= opt.replay_horizon_s;
+    ReplayScore b_split, b_whole;
+    std::vector<double> b_sim[2];
+    if (split_long) {
+      ReplayRecord b = Replay(*rigid, series, opt.replay_horizon_s, rc.split, n);
+      b_split = b.score;
+      if (r == 0)
+        for (int j = 0; j < 2; ++j) b_sim[j] = std::move(b.sim[j]);
+    }
+    if (whole_long) b_whole = Replay(*rigid, series, opt.replay_horizon_s).score;
+    if (split_long) {
+      ActuatorTorqueFromReading(ext_fx, rc.kin.t, tau_S, series.tau_R);
+      const ReplayRecord a = Replay(*ext, series, opt.replay_horizon_s, rc.split, n);
+      Score(b_split, a.score, rs.sim_split);
+      rs.sim_split_windows = b_split.windows;
+      sb.Add(b_split), sa.Add(a.score);
+      if (r == 0) {
+        const long from = static_cast<long>(rc.split);
+        S.t.assign(rc.kin.t.begin() + from, rc.kin.t.end());
+        for (int j = 0; j < 2; ++j) {
+          S.measured[j].assign(rc.kin.q[j].begin() + from, rc.kin.q[j].end());
+          S.rigid[j].assign(b_sim[j].begin() + from, b_sim[j].end());
+          S.extended[j].assign(a.sim[j].begin() + from, a.sim[j].end());
+        }
+      }
+    }
+    if (whole_long) {
+      LegParams loo = params;
+      loo.effects = rs.left_out_effects;
+      std::unique_ptr<Plant> loo_plant;
+      PlantEffects loo_fx;
+      if (!Make(loo, rc.source + " left out", &loo_plant, &loo_fx)) return;
+      ActuatorTorqueFromReading(loo_fx, rc.kin.t, tau_S, series.tau_R);
+      const ReplayScore a = Replay(*loo_plant, series, opt.replay_horizon_s).score;
+      Score(b_whole, a, rs.sim_left_out);
+      rs.sim_left_out_windows = b_whole.windows;
+      lb.Add(b_whole), la.Add(a);
+    }
+  }
+  for (int j = 0; j < 2; ++j) {
+    S.split[j] = ScoreOf(sb.sse[j], sa.sse[j], static_cast<double>(std::max<size_t>(1, sb.count)));
+    S.left_out[j] = ScoreOf(lb.sse[j], la.sse[j], static_cast<double>(std::max<size_t>(1, lb.count)));
+  }
+  S.done = sb.windows > 0 || lb.windows > 0;
+  std::ostringstream os;
+  os << "the rigid and the extended twin (their effects in the MuJoCo plant, joint limits off) driven by the "
+        "measured torque, restarted every " << NumberText(opt.replay_horizon_s)
+     << " s from the measured state (angle low-passed at " << NumberText(opt.replay_cutoff_hz)
+     << " Hz, zero-phase 2nd-order Butterworth, and its velocity): " << sb.windows << " windows on the held-out parts"
+     << (D.leave_one_out ? ", " + std::to_string(lb.windows) + " on the whole records left out" : std::string());
+  S.note = S.done ? os.str() : "not simulated: every part is shorter than the horizon of " + NumberText(opt.replay_horizon_s) + " s";
 }
 
 // Stage 7: structure the extended twin leaves in the first record's held-out residual (5 Hz
@@ -751,9 +856,11 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   });
   D.extended.effects.resize(params.effects.size());
   for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  Lap("extended twin");
+  SimulateTwins(params, recs, opt, &D);
   D.kin = std::move(recs[0].kin);  // recs are done with: the plot series take the first record's kinematics
   D.split = recs[0].split;
-  Lap("extended twin");
+  Lap("forward simulation");
 
   FindUnexplained(&D);
   Lap("unexplained");

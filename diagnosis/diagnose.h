@@ -20,6 +20,12 @@
 //     30 % of every record and, with several records, every whole record left out in turn).
 //  5. the extended twin (predict with the effects) runs on the held-out parts: rmse_after; with
 //     several records, each whole record is also predicted by the effects fitted on the others.
+//  6b. forward simulation (replay.h): the rigid twin (the model given) and the extended twin, their
+//     effects in the MuJoCo plant, driven by the measured torque and restarted from the measured
+//     state every DiagnoseOptions::replay_horizon_s, on the held-out part of every record and, with
+//     several records, on every whole record with the effects fitted on the others: the gain in
+//     simulated angle (Diagnosis::simulation). Skipped, with the reason, when a twin holds an effect
+//     the plant cannot carry (sim/plant_effects.h).
 //  6. structure left in the held-out residual (low-passed rms well above the noise) is reported as
 //     unexplained with its dominant frequency and its correlation with angle, velocity, accel, time.
 #pragma once
@@ -27,6 +33,7 @@
 #include <vector>
 
 #include "diagnosis/derivative_cutoff.h"
+#include "diagnosis/replay.h"
 #include "formats/measured_data.h"
 #include "model/lumped_params.h"
 
@@ -53,7 +60,7 @@ struct CandidateScore {
 };
 
 struct JointScore {
-  double rmse_before = 0, rmse_after = 0, gain_pct = 0;  // on the held-out part, N m
+  double rmse_before = 0, rmse_after = 0, gain_pct = 0;  // on the held-out part, N m (simulation: rad)
 };
 
 // Scores of one record.
@@ -62,6 +69,24 @@ struct RecordScore {
   size_t samples = 0;
   JointScore split[2];     // its last 30 %, effects fitted on the first 70 % of every record
   JointScore left_out[2];  // the whole record, effects fitted on the other records (>= 2 records)
+  std::vector<Effect> left_out_effects;  // the model's effects and those (>= 2 records)
+  // Simulated angle, rigid (before) vs extended (after) twin, rad: the held-out part, and the whole
+  // record with left_out_effects; windows 0 where the part is shorter than the horizon.
+  JointScore sim_split[2], sim_left_out[2];
+  size_t sim_split_windows = 0, sim_left_out_windows = 0;
+};
+
+// The forward simulation of the twins (step 6b).
+struct SimulationScores {
+  bool done = false;
+  std::string note;          // why not done, or what was done
+  double horizon_s = 0.5;
+  double cutoff_hz = 10;     // the restart state's filter
+  JointScore split[2];       // pooled over the held-out parts, rad
+  JointScore left_out[2];    // pooled over the whole records left out, rad
+  // First record's held-out part: time, measured angle, rigid and extended twin's simulated angle
+  // (NaN between windows).
+  std::vector<double> t, measured[2], rigid[2], extended[2];
 };
 
 struct Diagnosis {
@@ -84,6 +109,7 @@ struct Diagnosis {
   JointScore left_out[2];               // pooled over the left-out records
   double noise[2] = {0, 0};             // white noise of the residual, N m
   double tau_eff = 1;                   // residual autocorrelation length (fit rows)
+  SimulationScores simulation;          // step 6b
   // Series for plots (first record): measured (filtered alike), twin before, extended twin after
   // (held-out part); split index.
   Kinematics kin;
@@ -97,6 +123,9 @@ struct DiagnoseOptions {
   int max_effects = 6;
   double cutoff_hz = 0;          // derivative and parallel torque filter, Hz; 0 = chosen from the data
   std::string mjcf;              // MJCF instead of the shipped model
+  bool simulate = true;          // step 6b (false: the torque analysis alone)
+  double replay_horizon_s = 0.5; // step 6b: restart interval of the forward simulation, s
+  double replay_cutoff_hz = kReplayCutoffHz;  // step 6b: filter of the restart state
 };
 
 // Runs the discrepancy analysis. `params` is the twin to confront, `records` the measured records of

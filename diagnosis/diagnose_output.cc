@@ -67,6 +67,28 @@ std::string DiagnosisJson(const Diagnosis& d) {
   }
   if (d.leave_one_out)
     for (int k = k0; k < 2; ++k) j["left_out"][names[k]] = score(d.left_out[k]);
+  // Forward simulation (DESIGN.md "Diagnosis output and method": simulation), angles in rad.
+  const SimulationScores& S = d.simulation;
+  auto sim = [](const JointScore& s) {
+    return json{{"rmse_before_rad", s.rmse_before}, {"rmse_after_rad", s.rmse_after}, {"gain_pct", s.gain_pct}};
+  };
+  json js = {{"done", S.done}, {"method", S.note}, {"horizon_s", S.horizon_s}, {"cutoff_hz", S.cutoff_hz}};
+  if (S.done) {
+    for (int k = k0; k < 2; ++k) js["joints"][names[k]] = sim(S.split[k]);
+    if (d.leave_one_out)
+      for (int k = k0; k < 2; ++k) js["left_out"][names[k]] = sim(S.left_out[k]);
+    js["records"] = json::array();
+    for (const auto& r : d.records) {
+      json x = {{"source", r.source}, {"windows_split", r.sim_split_windows}};
+      for (int k = k0; k < 2; ++k) x["split"][names[k]] = sim(r.sim_split[k]);
+      if (d.leave_one_out) {
+        x["windows_left_out"] = r.sim_left_out_windows;
+        for (int k = k0; k < 2; ++k) x["left_out"][names[k]] = sim(r.sim_left_out[k]);
+      }
+      js["records"].push_back(x);
+    }
+  }
+  j["simulation"] = js;
   return j.dump(2) + "\n";
 }
 

@@ -108,6 +108,24 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
       << "<p>Plots below: the first record.</p>";
   }
   o << "<p><small>" << HtmlEscape(d.method) << "</small></p>";
+  const SimulationScores& S = d.simulation;
+  o << "<h2>Forward simulation</h2><p>" << HtmlEscape(S.note) << "</p>";
+  if (S.done) {
+    auto deg = [&](const JointScore& s) {
+      return NumberText(s.rmse_before * kDegPerRad, 3) + " / " + NumberText(s.rmse_after * kDegPerRad, 3) + " deg (" +
+             NumberText(s.gain_pct, 3) + " %)";
+    };
+    o << "<table><tr><th>record</th><th>hip: held-out, rigid / extended</th><th>knee: held-out</th>"
+      << (d.leave_one_out ? "<th>hip: whole record left out</th><th>knee: whole record left out</th>" : "") << "</tr>";
+    for (const auto& r : d.records) {
+      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << deg(r.sim_split[0]) << "</td><td>" << deg(r.sim_split[1]) << "</td>";
+      if (d.leave_one_out) o << "<td>" << deg(r.sim_left_out[0]) << "</td><td>" << deg(r.sim_left_out[1]) << "</td>";
+      o << "</tr>";
+    }
+    o << "<tr><th>all</th><td>" << deg(S.split[0]) << "</td><td>" << deg(S.split[1]) << "</td>";
+    if (d.leave_one_out) o << "<td>" << deg(S.left_out[0]) << "</td><td>" << deg(S.left_out[1]) << "</td>";
+    o << "</tr></table><p>RMS error of the simulated angle against the measured one.</p>";
+  }
   o << "<h2>Selection</h2><ol>";
   for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
   o << "</ol>";
@@ -154,6 +172,18 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
       a.x.push_back(k.t[i]), a.y.push_back(d.after[j][i]);
     }
     o << SvgChart("measured vs predicted torque (held-out)", "t (s)", "tau_S (N m)", {m, b, a});
+    if (S.done && !S.t.empty()) {  // the first 10 s of the first record's held-out part
+      SvgSeries sm{{}, {}, "#000", "measured"}, sr{{}, {}, "#d62728", "rigid twin, simulated"},
+          se{{}, {}, "#1f77b4", "extended twin, simulated"};
+      for (size_t i = 0; i < S.t.size() && S.t[i] <= S.t.front() + 10.0; ++i) {
+        if (std::isnan(S.rigid[j][i])) continue;  // a window's restart
+        sm.x.push_back(S.t[i]), sm.y.push_back(S.measured[j][i] * kDegPerRad);
+        sr.x.push_back(S.t[i]), sr.y.push_back(S.rigid[j][i] * kDegPerRad);
+        se.x.push_back(S.t[i]), se.y.push_back(S.extended[j][i] * kDegPerRad);
+      }
+      o << SvgChart("simulated vs measured angle (held-out, restarted every " + NumberText(S.horizon_s) + " s)", "t (s)",
+                    "angle (deg)", {sm, sr, se});
+    }
     std::vector<double> rb(n), ra(n);
     for (size_t i = 0; i < n; ++i) rb[i] = d.measured[j][i] - d.before[j][i], ra[i] = d.measured[j][i] - d.after[j][i];
     const std::vector<double> qdeg = [&] { std::vector<double> v(n); for (size_t i = 0; i < n; ++i) v[i] = k.q[j][i] * kDegPerRad; return v; }();

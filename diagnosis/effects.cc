@@ -8,6 +8,7 @@
 #include "dsp/emg_envelope.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
+#include "sim/plant_effects.h"
 
 namespace exotwin {
 
@@ -97,17 +98,12 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
       const double q0 = e.fields.at("q0");
       for (size_t i = 0; i < n; ++i) tr[i] += e.value * (kin.q[j][i] - q0);
     } else if (e.name == "torque_ripple") {
-      const double k = e.fields.at("cycles_per_rad"), ph = e.fields.at("phase");
-      for (size_t i = 0; i < n; ++i) tr[i] += e.value * std::sin(2 * M_PI * k * kin.q[j][i] + ph);
+      for (size_t i = 0; i < n; ++i) tr[i] += TorqueRippleTorque(e, kin.q[j][i]);
     } else if (e.name == "gravity_error") {
-      // The lumped X (or Y) of the segment distal to joint j is off by value: its gravity torque
-      // changes by g dX sin(angle) (or g dY cos(angle)) at that joint and every proximal joint
-      // (HJ15 eq. 7); for the thigh (j = 0) only the hip row changes.
       for (size_t i = 0; i < n; ++i) {
-        const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
-        const double dG = params.g * e.value * (e.axis == "Y" ? std::cos(ang) : std::sin(ang));
-        tau_R[0][i] += dG;
-        if (j == 1) tau_R[1][i] += dG;
+        const Eigen::Vector2d dG = GravityErrorTorque(e, params.g, At(kin.q, i));
+        tau_R[0][i] += dG[0];
+        if (j == 1) tau_R[1][i] += dG[1];
       }
     } else if (e.name == "backlash") {
       for (size_t i = 0; i < n; ++i) {

@@ -107,13 +107,8 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
 }
 
 std::vector<Effect> ReadEffects(const YamlContext& c, const YAML::Node& root) {
-  std::vector<Effect> out;
-  if (root["effects"] && !root["effects"].IsNull()) {
-    if (!root["effects"].IsSequence()) c.Fail("effects", "expected a list");
-    int i = 0;
-    for (const auto& e : root["effects"]) out.push_back(ReadEffect(c, e, "effects[" + std::to_string(i++) + "]"));
-  }
-  return out;
+  if (!root["effects"] || root["effects"].IsNull()) return {};
+  return ReadEffectList(c, root["effects"], "effects");
 }
 
 OneJointLink ReadOneJointLink(const YamlContext& c, const YAML::Node& n, const std::string& key,
@@ -191,6 +186,14 @@ void CheckRecordFitsModel(const LegParams& params, const std::string& params_pat
     throw InputError(data.source + ": a one-joint record (q_knee, tau_knee, no hip column) given the two-joint model "
                      "file " + params_path + ", expected t, q_hip, q_knee, tau_hip, tau_knee, or a one-joint model "
                      "file (joint: knee)");
+}
+
+std::vector<Effect> ReadEffectList(const YamlContext& c, const YAML::Node& n, const std::string& key) {
+  if (!n.IsSequence()) c.Fail(key, "expected a list" + YamlLine(n));
+  std::vector<Effect> out;
+  int i = 0;
+  for (const auto& e : n) out.push_back(ReadEffect(c, e, key + "[" + std::to_string(i++) + "]"));
+  return out;
 }
 
 LegParams ReadModelFile(const std::string& path) {

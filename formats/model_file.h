@@ -1,7 +1,9 @@
 // MODEL.yaml (DESIGN.md "Model parameter file"): reading with strict validation, and writing.
 #pragma once
 #include <string>
+#include <vector>
 
+#include "core/yaml_fields.h"
 #include "formats/measured_data.h"
 #include "model/lumped_params.h"
 
@@ -25,6 +27,11 @@ LegParams ParseModelYaml(const std::string& text, const std::string& source);
 // model, a record of both joints for a two-joint one. Throws InputError naming both files and what
 // was expected otherwise.
 void CheckRecordFitsModel(const LegParams& params, const std::string& params_path, const MeasuredData& data);
+
+// A list of effects as a model file's `effects:` holds them (DESIGN.md "Effects"), read from the
+// sequence n under `key` of the file c.source (a scenario's plant.effects): messages name
+// "<key>[i].<field>" as ReadModelFile's name "effects[i].<field>".
+std::vector<Effect> ReadEffectList(const YamlContext& c, const YAML::Node& n, const std::string& key);
 
 // Serializes params as MODEL.yaml text. `extra_yaml` (already formatted top-level YAML, e.g. an
 // `identification:` block) is appended verbatim; a one-joint model is written as a one-joint file; `header` lines become '# ' comments at the top.

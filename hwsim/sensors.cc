@@ -21,7 +21,7 @@ double TorqueSensor::Read(double tau) {
   // Non-linearity: a cubic bow x - x^3 scaled so its largest deviation (at x = 1/sqrt(3)) equals
   // nonlinearity_fs * FS: max(x - x^3) = 2/(3 sqrt 3).
   const double bow = spec_.nonlinearity_fs * fs * (x - x * x * x) / (2.0 / (3.0 * std::sqrt(3.0)));
-  double v = tau + spec_.offset + bow + spec_.repeatability_fs * fs * noise;
+  double v = (tau + spec_.offset) * (1.0 + spec_.gain) + bow + spec_.repeatability_fs * fs * noise;
   if (fault_ == SensorFault::kGlitch) v += 0.1 * fs;
   v = std::clamp(v, -fs, fs);
   v = std::round(v / spec_.resolution) * spec_.resolution;

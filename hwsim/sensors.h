@@ -19,12 +19,13 @@ struct TorqueSensorSpec {
   double nonlinearity_fs = 0.0003;  // max deviation from linear as a fraction of FS (a cubic bow)
   double repeatability_fs = 0.0002; // 1-sigma random error as a fraction of FS
   double offset = 0.0;              // N m
+  double gain = 0.0;                // relative: the reading (tau + offset) * (1 + gain) before the bow and noise
 };
 
 class TorqueSensor {
  public:
   TorqueSensor(const TorqueSensorSpec& spec, uint64_t seed);
-  // Reading (N m) of a true torque tau (N m): offset + non-linearity + noise, saturation at the
+  // Reading (N m) of a true torque tau (N m): (tau + offset) (1 + gain) + non-linearity + noise, saturation at the
   // range, quantization to the resolution. NaN when the kNaN fault is on; the last reading when stuck.
   double Read(double tau);
   void SetFault(SensorFault f) { fault_ = f; }

@@ -62,8 +62,10 @@ class ExowheelTrial : public CosimDevice {
         rig_(BusConfigOf(s.hardware, seed_), can_log, trial * (s.protocol.duration + 1.0)),  // trials follow each other
         ctrl_ep_(rig_.bus().AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee, msg::kIdEmgSamples})),
         emg_ep_(rig_.bus().AddNode("emg_amplifier", {0x7FF})),  // sends only
-        hip_(JointModuleSpecOf(s.hardware, 0), rig_.bus().AddNode("hip_module", {msg::kIdJointCommandHip}), seed_ + 1),
-        knee_(JointModuleSpecOf(s.hardware, 1), rig_.bus().AddNode("knee_module", {msg::kIdJointCommandKnee}), seed_ + 2),
+        hip_(JointModuleSpecOf(s.hardware, 0, plant.effects().sensor[0], plant.timestep(), s.plant_effects_source),
+             rig_.bus().AddNode("hip_module", {msg::kIdJointCommandHip}), seed_ + 1),
+        knee_(JointModuleSpecOf(s.hardware, 1, plant.effects().sensor[1], plant.timestep(), s.plant_effects_source),
+              rig_.bus().AddNode("knee_module", {msg::kIdJointCommandKnee}), seed_ + 2),
         ctrl_cfg_(ControllerConfig(s, truth)),
         ctrl_(ctrl_cfg_, trajectory_, ctrl_ep_),
         human_(truth.human.has_value()),
@@ -260,6 +262,11 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   const LegParams truth = ResolveSubject(s);
   Plant plant(ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
   plant.SetParams(truth);
+  if (!s.plant_effects.empty()) {  // the scenario's plant: the rigid twin plus the effects it carries
+    LegParams carried = truth;
+    carried.effects = s.plant_effects;
+    plant.CarryEffects(ToPlantEffects(carried, s.plant_effects_source));  // sensor effects: the joint modules
+  }
   const CosimSchedule schedule = ScheduleOf(s, plant.timestep());
 
   std::unique_ptr<CandumpWriter> can_log;

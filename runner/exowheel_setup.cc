@@ -151,6 +151,32 @@ hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j) {
   return ms;
 }
 
+hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j, const std::vector<SensorEffect>& sensor,
+                                         double sample_s, const std::string& source) {
+  hwsim::JointModuleSpec ms = JointModuleSpecOf(hw, j);
+  if (sensor.empty()) return ms;
+  // The reading as an affine map a tau + b of the true torque, the effects applied in order; then
+  // (tau + offset) (1 + gain) with offset = b / a + the sensor's own, gain = a - 1.
+  double a = 1, b = 0;
+  for (const SensorEffect& e : sensor) {
+    if (e.name == "sensor_offset") {
+      b += e.value;
+    } else if (e.name == "sensor_gain") {
+      a *= 1 + e.value, b *= 1 + e.value;
+    } else {
+      const double k = e.value / sample_s;
+      if (std::abs(k - std::round(k)) > 1e-9)
+        throw InputError(source + ": sensor_delay " + std::to_string(e.value) + " s of the " +
+                         (j == 0 ? "hip" : "knee") + ": expected a whole number of the joint module's " +
+                         std::to_string(sample_s) + " s samples");
+      ms.torque_sensor_skew += static_cast<int>(std::lround(k));
+    }
+  }
+  ms.torque_sensor.offset += b / a;
+  ms.torque_sensor.gain = a - 1;
+  return ms;
+}
+
 MuscleParams SubjectMuscles(const Scenario& s, const Eigen::Vector2d& start) {
   MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);
   mp.q_rest = CoContractionPosture(s, mp, start);

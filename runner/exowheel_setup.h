@@ -12,6 +12,7 @@
 #include "model/lumped_params.h"
 #include "runner/scenario.h"
 #include "sim/muscles.h"
+#include "sim/plant_effects.h"
 
 namespace exotwin {
 
@@ -36,6 +37,12 @@ controller::ControllerFile ControllerFileOf(const Scenario& s, const LegParams& 
 
 // The joint module of joint j (0 hip, 1 knee) with the scenario's hardware (sensors, encoder, driver).
 hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j);
+// The same with the torque-sensor effects of the scenario's plant block at that joint (DESIGN.md
+// "Effects": sensor_offset, sensor_gain in the order listed, folded into the sensor's offset and
+// gain; sensor_delay as a delay of the torque sample, a whole number of sample_s). Throws InputError
+// naming `source` for a delay that is not a whole number of samples.
+hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j, const std::vector<SensorEffect>& sensor,
+                                         double sample_s, const std::string& source);
 
 // The subject's muscles: ground truth alpha, beta, gamma drawn from human.muscle_seed (Tables 6-7),
 // with co-contraction stiffening the joints about the trial's posture (the held start pose `start`

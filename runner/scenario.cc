@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "formats/model_file.h"
 #include "core/yaml_fields.h"
 #include "sim/subjects.h"
 
@@ -145,6 +146,29 @@ void ParseFixedJoints(const YamlContext& r, const YAML::Node& n, Scenario& s) {
     const std::string j = kv.first.as<std::string>();
     s.fixed_joints[j] = YamlNumber(r, kv.second, "fixed_joints." + j, -2.5, 2.5);
   }
+}
+
+// plant: the effects the plant carries, listed (effects) or those of a model file (effects_from,
+// relative to the scenario file's folder, e.g. diagnose's extended.yaml). EXOwheel devices without
+// emg_calibration (the HAL-3 knee and the calibration's trials build other plants).
+void ParsePlant(const YamlContext& r, const YAML::Node& n, Scenario& s) {
+  YamlCheckKeys(r, n, "plant", {"effects", "effects_from"});
+  if (s.device == Device::kHal3) r.Fail("plant", "only allowed with device: exowheel or exowheel_exo_only");
+  if (s.emg_calibration) r.Fail("plant", "not used with emg_calibration");
+  if (!!n["effects"] == !!n["effects_from"]) r.Fail("plant", "expected one of effects: [...] or effects_from: FILE.yaml");
+  if (n["effects"]) {
+    s.plant_effects = ReadEffectList(r, n["effects"], "plant.effects");
+    s.plant_effects_source = s.source + ": plant.effects";
+    return;
+  }
+  std::string path = YamlString(r, n["effects_from"], "plant.effects_from");
+  if (path.empty()) r.Fail("plant.effects_from", "empty (expected a model file, e.g. diagnose's extended.yaml)");
+  const size_t slash = s.source.find_last_of('/');
+  if (path[0] != '/' && slash != std::string::npos) path = s.source.substr(0, slash + 1) + path;
+  if (!std::ifstream(path).good())
+    r.Fail("plant.effects_from", "file '" + path + "' not found (expected a model file with effects)" + YamlLine(n["effects_from"]));
+  s.plant_effects = ReadModelFile(path).effects;
+  s.plant_effects_source = path;
 }
 
 // protocol: the recorded trajectory's settings (trajectory: file): path (relative to the scenario
@@ -286,7 +310,7 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
   if (!root.IsMap()) throw InputError(source + ": expected a YAML mapping at the top level");
   YamlCheckKeys(r, root, "", {"name", "description", "seed", "subject", "human", "device", "fixed_joints", "protocol",
-                    "hardware", "controller", "faults", "logs", "checks", "hal", "emg_calibration"});
+                    "hardware", "controller", "faults", "logs", "checks", "hal", "emg_calibration", "plant"});
   Scenario s;
   s.source = source;
   ParseHeader(r, root, s);
@@ -302,6 +326,7 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   if (root["logs"]) ParseLogs(r, root["logs"], s);
   if (root["checks"] && !root["checks"].IsNull()) ParseChecks(r, root["checks"], s);
   if (s.emg_calibration) CheckEmgCalibration(r, root, s);
+  if (root["plant"]) ParsePlant(r, root["plant"], s);
   return s;
 }
 

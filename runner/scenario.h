@@ -144,6 +144,10 @@ struct Scenario {
   double log_rate_hz = 1000;
   std::vector<CheckSpec> checks;
   uint64_t seed = 1;
+  // plant: {effects: [...]} or {effects_from: FILE.yaml} (EXOwheel devices): effects the forward
+  // plant carries (sim/plant_effects.h) on top of the subject's rigid twin.
+  std::vector<Effect> plant_effects;
+  std::string plant_effects_source;  // where they were read ("<scenario>: plant.effects" or the file)
 };
 
 // Reads and validates a scenario file. Throws InputError naming the file, the key and what was

@@ -91,6 +91,17 @@ Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
       throw InputError(mjcf_path + ": expected exactly two hinge joints named 'hip' and 'knee'");
     hip_dof_ = m_->jnt_dofadr[hip];
     knee_dof_ = m_->jnt_dofadr[knee];
+    hip_jnt_ = hip;
+    knee_jnt_ = knee;
+    for (int j = 0; j < 2; ++j) {
+      const int dof = j == 0 ? hip_dof_ : knee_dof_, jnt = j == 0 ? hip : knee;
+      base_frictionloss_[j] = m_->dof_frictionloss[dof];
+      base_solref_[j] = m_->dof_solref[mjNREF * dof];
+      base_damping_[j] = m_->dof_damping[dof];
+      base_armature_[j] = m_->dof_armature[dof];
+      base_stiffness_[j] = m_->jnt_stiffness[jnt];
+      base_springref_[j] = m_->qpos_spring[m_->jnt_qposadr[jnt]];
+    }
     if (m_->nu != 2)
       throw InputError(mjcf_path + ": expected two torque actuators (hip, knee), found " +
                        std::to_string(m_->nu));
@@ -224,8 +235,40 @@ Eigen::Vector2d Plant::InverseDynamics(const Eigen::Vector2d& q, const Eigen::Ve
   mj_inverse(m_, d);
   m_->opt.disableflags = saved;
   Eigen::Vector2d tau(d->qfrc_inverse[hip_dof_], d->qfrc_inverse[knee_dof_]);
+  // The carried effects are not the rigid twin's: mj_inverse counted their armature (in M) and
+  // their damping and spring (minus qfrc_passive).
+  if (!fx_.link_empty())
+    for (int j = 0; j < 2; ++j)
+      tau[j] -= fx_.armature[j] * qdd[j] + fx_.damping[j] * qd[j] + fx_.stiffness[j] * (q[j] - fx_.springref[j]);
   if (params_.human) tau += PassiveElasticTorque(params_.passive, q);
   return tau;
+}
+
+void Plant::CarryEffects(const PlantEffects& fx) {
+  if (!fx_.link_empty() || !fx.link_empty()) {
+    for (int j = 0; j < 2; ++j) {
+      const int dof = j == 0 ? hip_dof_ : knee_dof_, jnt = j == 0 ? hip_jnt_ : knee_jnt_;
+      m_->dof_frictionloss[dof] = base_frictionloss_[j] + fx.frictionloss[j];
+      // The frictionloss constraint's time constant: the shortest MuJoCo integrates safely (2 steps),
+      // so that its stiction zone around qd = 0 is as narrow as the step allows.
+      m_->dof_solref[mjNREF * dof] = fx.frictionloss[j] > 0 ? 2 * m_->opt.timestep : base_solref_[j];
+      m_->dof_damping[dof] = base_damping_[j] + fx.damping[j];
+      m_->dof_armature[dof] = base_armature_[j] + fx.armature[j];
+      if (fx.stiffness[j] != 0) {
+        m_->jnt_stiffness[jnt] = base_stiffness_[j] + fx.stiffness[j];
+        m_->qpos_spring[m_->jnt_qposadr[jnt]] = fx.springref[j];
+      } else {
+        m_->jnt_stiffness[jnt] = base_stiffness_[j];
+        m_->qpos_spring[m_->jnt_qposadr[jnt]] = base_springref_[j];
+      }
+    }
+  }
+  fx_ = fx;
+  mj_forward(m_, d_);
+}
+
+void Plant::FreeJointsAndTorque() {
+  m_->opt.disableflags |= mjDSBL_LIMIT | mjDSBL_CLAMPCTRL;
 }
 
 void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t) {
@@ -245,6 +288,7 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
     throw SimulationError(d_->time, "non-finite torque command");
   Eigen::Vector2d applied = tau_ext;
   if (params_.human) applied -= PassiveElasticTorque(params_.passive, q());
+  if (!fx_.applied.empty()) applied += fx_.AppliedForce(q());
   d_->qfrc_applied[hip_dof_] = applied[0];
   d_->qfrc_applied[knee_dof_] = applied[1];
   // Actuators are plain motors with gear 1: ctrl is the joint torque (clamped by ctrlrange).

@@ -9,6 +9,7 @@
 
 #include "core/error.h"  // SimulationError, thrown by Plant
 #include "model/lumped_params.h"
+#include "sim/plant_effects.h"
 #include "sim/realization.h"
 
 struct mjModel_;
@@ -38,8 +39,20 @@ class Plant {
   const LegParams& params() const { return params_; }
   bool has_human_bodies() const { return human_thigh_ >= 0; }
 
-  // Actuator torque tau_R (N m) for a relaxed subject: MuJoCo's inverse dynamics (mj_inverse, joint
-  // limits disabled) plus the passive elastic torque P(q). Does not change the simulation state.
+  // Carries the link-side effects of `fx` in the forward simulation (sim/plant_effects.h: MuJoCo's
+  // frictionloss, damping, armature, stiffness/springref, and an applied force for gravity_error and
+  // torque_ripple), replacing those carried before. Sensor effects are for the reader of tau_S.
+  // Without effects (fx.link_empty()) the model is the MJCF's, bit for bit.
+  void CarryEffects(const PlantEffects& fx);
+  const PlantEffects& effects() const { return fx_; }
+
+  // Disables the joint limits and the actuators' ctrlrange clamp (replay of a foreign rig's record:
+  // its joints turn beyond the EXOwheel's range and its motors beyond the EXOwheel's torque).
+  void FreeJointsAndTorque();
+
+  // Actuator torque tau_R (N m) for a relaxed subject: MuJoCo's rigid inverse dynamics (mj_inverse,
+  // joint limits, frictionloss and carried effects excluded) plus the passive elastic torque P(q).
+  // Does not change the simulation state.
   Eigen::Vector2d InverseDynamics(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                                   const Eigen::Vector2d& qdd);
 
@@ -47,7 +60,7 @@ class Plant {
   void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0);
   // Advances one physics step (model timestep) with actuator torque tau_R (N m) and an extra joint
   // torque tau_ext (N m, e.g. muscles or effects) acting on the link. Throws SimulationError on
-  // divergence. P(q) is applied automatically when params.human is set.
+  // divergence. P(q) is applied automatically when params.human is set, and the carried effects.
   void Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext = Eigen::Vector2d::Zero());
 
   Eigen::Vector2d q() const;
@@ -70,6 +83,11 @@ class Plant {
   int exo_thigh_ = -1, exo_shank_ = -1, human_thigh_ = -1, human_shank_ = -1;
   int hip_dof_ = -1, knee_dof_ = -1;
   LegParams params_;
+  PlantEffects fx_;
+  // The MJCF's own per-dof values, which CarryEffects adds to.
+  double base_frictionloss_[2] = {0, 0}, base_damping_[2] = {0, 0}, base_armature_[2] = {0, 0};
+  double base_stiffness_[2] = {0, 0}, base_springref_[2] = {0, 0}, base_solref_[2] = {0, 0};
+  int hip_jnt_ = -1, knee_jnt_ = -1;
 };
 
 }  // namespace exotwin

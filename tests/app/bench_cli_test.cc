@@ -19,7 +19,7 @@ namespace {
 TEST(BenchCli, QuickJsonHasRatios) {
   const testing::ScopedTempDir tmp("bench");
   const std::string dir = tmp.path();
-  const RunResult r = RunExotwin("bench --quick --repeat 1 --only startup,closed_loop,sweep --out " + dir + "/b.json");
+  const RunResult r = RunExotwin("bench --quick --repeat 1 --only startup,closed_loop,sweep,replay --out " + dir + "/b.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream f(dir + "/b.json");
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(f);  // key order as written
@@ -34,6 +34,10 @@ TEST(BenchCli, QuickJsonHasRatios) {
   EXPECT_GT(j["startup"]["help_s"].get<double>(), 0.0);
   EXPECT_GT(j["startup"]["true_s"].get<double>(), 0.0);
   EXPECT_FALSE(j.contains("render"));
+  EXPECT_EQ(j["replay"].begin().key(), "ratio_replay_to_bare");
+  EXPECT_EQ(j["replay"]["steps"], 20000);
+  EXPECT_EQ(j["replay"]["windows"], 39);  // 20 s minus the last sample: 39 whole windows of 0.5 s
+  EXPECT_GT(j["replay"]["ratio_replay_to_bare"].get<double>(), 0.0);
   // The table (stderr): one row per figure, ratio first, under the machine's cores and load.
   EXPECT_EQ(j["closed_loop"]["rows"].size(), 2u);
   EXPECT_EQ(j["sweep"]["rows"][0]["goal"], ">= 1.85x");

@@ -18,6 +18,14 @@
 namespace exotwin {
 namespace {
 
+// The torque analysis alone: these tests check what is named, not the forward simulation (step 6b,
+// tested on the real rig and in replay_test.cc).
+DiagnoseOptions TorqueOnly() {
+  DiagnoseOptions o;
+  o.simulate = false;
+  return o;
+}
+
 int EnvInt(const char* name, int def) {
   const char* v = std::getenv(name);
   return v ? std::atoi(v) : def;
@@ -71,7 +79,7 @@ TEST(DiagnoseHiddenEffect, EverySingleEffectIsNamedMeasuredAndRemoved) {
       g.rate = 500;
       const GeneratedData data = GenerateMeasured(base, g);
       const Effect& truth = data.truth.effects[0];
-      const Diagnosis d = Diagnose(base, data.data);
+      const Diagnosis d = Diagnose(base, data.data, TorqueOnly());
       const DiagnosedEffect* f = Find(d, truth);
       ++row.runs;
       const int j = truth.joint == "hip" ? 0 : 1;
@@ -121,7 +129,7 @@ TEST(DiagnoseHiddenEffect, PairsAreFound) {
     g.duration = 40;
     g.rate = 500;
     const GeneratedData data = GenerateMeasured(base, g);
-    const Diagnosis d = Diagnose(base, data.data);
+    const Diagnosis d = Diagnose(base, data.data, TorqueOnly());
     const bool both = Find(d, data.truth.effects[0]) && Find(d, data.truth.effects[1]);
     if (both) ++found_both;
     else {
@@ -156,7 +164,7 @@ TEST(DiagnoseHiddenEffect, OffsetAndFrictionTogetherAreBothNamed) {
     g.effects = 0;
     g.duration = 30;
     g.rate = 500;
-    const Diagnosis d = Diagnose(base, GenerateMeasured(truth, g).data);
+    const Diagnosis d = Diagnose(base, GenerateMeasured(truth, g).data, TorqueOnly());
     const DiagnosedEffect* off = Find(d, truth.effects[0]);
     const DiagnosedEffect* fr = Find(d, truth.effects[1]);
     for (const auto& e : d.effects) EXPECT_NE(e.effect.name, "joint_stiffness") << "seed " << g.seed;
@@ -186,7 +194,7 @@ TEST(DiagnoseHiddenEffect, NoEffectNamedOnCleanData) {
     g.effects = 0;
     g.duration = 20;
     g.rate = 500;
-    const Diagnosis d = Diagnose(base, GenerateMeasured(base, g).data);
+    const Diagnosis d = Diagnose(base, GenerateMeasured(base, g).data, TorqueOnly());
     if (!d.effects.empty()) {
       ++false_pos;
       std::printf("  clean seed %d: named %s(%s) = %g\n", 90000 + s, d.effects[0].effect.name.c_str(),

@@ -16,6 +16,7 @@
 #include "diagnosis/diagnose.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
+#include "diagnosis/replay.h"
 
 namespace exotwin {
 namespace {
@@ -63,12 +64,20 @@ void Print(const Diagnosis& d) {
 
 bool HaveData() { return std::ifstream(kDir + "/trajectory_00.csv").good(); }
 
+// The diagnosis of the seven records together (default options), computed once for the tests below.
+const Diagnosis& AllSeven() {
+  static const Diagnosis d = [] {
+    const std::vector<MeasuredData> rig = ReadRig();
+    std::vector<const MeasuredData*> recs;
+    for (const auto& r : rig) recs.push_back(&r);
+    return Diagnose(RigModel(), recs);
+  }();
+  return d;
+}
+
 TEST(DiagnoseRealRig, AllSevenRecordsNameFrictionAtBothJointsAndNothingImplausible) {
   if (!HaveData()) GTEST_SKIP() << kDir << " not found (shared/data beside the project)";
-  const std::vector<MeasuredData> rig = ReadRig();
-  std::vector<const MeasuredData*> recs;
-  for (const auto& r : rig) recs.push_back(&r);
-  const Diagnosis d = Diagnose(RigModel(), recs);
+  const Diagnosis& d = AllSeven();
   Print(d);
   const double makers[2] = {0.146, 0.123};  // cf pi/2 + b, N m at 1 rad/s
   const char* joints[2] = {"hip", "knee"};
@@ -94,6 +103,53 @@ TEST(DiagnoseRealRig, AllSevenRecordsNameFrictionAtBothJointsAndNothingImplausib
   }
   // The cutoff: chosen well below the paper's 20 Hz on this 500 Hz rig with a coarse encoder.
   EXPECT_LT(d.cutoff.hz, 20.0);
+}
+
+// The twin that learned the rig also moves like it: every record replayed whole (forward MuJoCo
+// simulation, restarted from the measured state every 0.5 s) with the effects diagnose fitted on the
+// other six; the simulated-angle RMS error, pooled over the records, falls by at least 60 % at both
+// joints against the rigid twin. The independent reference: an integrator written apart from the
+// project gave 81 % / 89 % on records 00 and 01 (issue 28). 0.25 s and 1 s are printed.
+TEST(DiagnoseRealRig, EveryRecordLeftOutMovesLikeTheRigInSimulation) {
+  if (!HaveData()) GTEST_SKIP() << kDir << " not found (shared/data beside the project)";
+  const Diagnosis& d = AllSeven();
+  // diagnose's own block: the records trimmed of the filters' edges (0.5 s), as all its scores.
+  ASSERT_TRUE(d.simulation.done) << d.simulation.note;
+  EXPECT_EQ(d.simulation.horizon_s, 0.5);
+  for (int j = 0; j < 2; ++j) EXPECT_GE(d.simulation.left_out[j].gain_pct, 60.0) << j;
+  // The whole records, untrimmed, at three horizons (replay.h, as `exotwin replay` does).
+  const std::vector<MeasuredData> rig = ReadRig();
+  const LegParams model = RigModel();
+  std::printf("record        horizon  hip rigid / extended (deg)  knee rigid / extended (deg)\n");
+  for (double h : {0.25, 0.5, 1.0}) {
+    ReplayScore before, after;
+    for (size_t r = 0; r < rig.size(); ++r) {
+      LegParams loo = model;
+      loo.effects = d.records[r].left_out_effects;
+      ReplayScore s[2];
+      for (int k = 0; k < 2; ++k) {
+        const LegParams& p = k == 0 ? model : loo;
+        const PlantEffects fx = ToPlantEffects(p, "test");
+        Plant plant(ExowheelMjcfPath(false));
+        plant.SetParams(p);
+        plant.CarryEffects(fx);
+        plant.FreeJointsAndTorque();
+        s[k] = Replay(plant, ReplaySeriesOf(rig[r], fx, ReplayInput::kTorque, kReplayCutoffHz), h).score;
+      }
+      before.Add(s[0]), after.Add(s[1]);
+      std::printf("%s  %4.2f s   %6.2f / %5.2f               %6.2f / %5.2f\n", kRecords[r], h, s[0].Rmse(0) * 180 / M_PI,
+                  s[1].Rmse(0) * 180 / M_PI, s[0].Rmse(1) * 180 / M_PI, s[1].Rmse(1) * 180 / M_PI);
+    }
+    std::printf("pooled         %4.2f s   %6.2f / %5.2f (%.0f %%)       %6.2f / %5.2f (%.0f %%)\n", h,
+                before.Rmse(0) * 180 / M_PI, after.Rmse(0) * 180 / M_PI, 100 * (1 - after.Rmse(0) / before.Rmse(0)),
+                before.Rmse(1) * 180 / M_PI, after.Rmse(1) * 180 / M_PI, 100 * (1 - after.Rmse(1) / before.Rmse(1)));
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_LT(after.Rmse(j), before.Rmse(j)) << h << " s, joint " << j;
+      if (h == 0.5) {
+        EXPECT_GE(100 * (1 - after.Rmse(j) / before.Rmse(j)), 60.0) << "joint " << j;
+      }
+    }
+  }
 }
 
 TEST(DiagnoseRealRig, EveryRecordAloneNamesNothingImplausible) {

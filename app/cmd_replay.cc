@@ -1,0 +1,128 @@
+// `exotwin replay`: the twin (its effects in the MuJoCo plant) simulated forward on measured records,
+// driven by the recorded actuator torque and restarted from the measured state every horizon.
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "diagnosis/replay.h"
+#include "formats/column_map.h"
+#include "formats/csv_table.h"
+#include "formats/model_file.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+namespace {
+
+CommandRunner RegisterReplay(CLI::App& app) {
+  struct Opts {
+    std::string params, out, map, mjcf, input = "torque";
+    std::vector<std::string> measured;
+    double horizon = 0.5, cutoff = kReplayCutoffHz;
+  };
+  auto o = std::make_shared<Opts>();
+  CLI::App* sub = app.add_subcommand(
+      "replay", "Forward simulation of measured records by the twin with its effects in the plant");
+  sub->add_option("--params", o->params, "MODEL.yaml of the twin (its effects carried by the MuJoCo plant)")->required();
+  sub->add_option("--measured", o->measured, "measured-data CSV; repeat for several records")->required();
+  sub->add_option("--out", o->out, "output folder (replay.csv, replay.json)")->required();
+  sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs into the schema");
+  sub->add_option("--input", o->input,
+                  "torque (tau_R = -tau_S of the record, sensor effects inverted; default) or command (cmd_* columns)");
+  sub->add_option("--horizon", o->horizon, "seconds between restarts from the measured state (default 0.5)");
+  sub->add_option("--cutoff", o->cutoff,
+                  "Hz, the zero-phase 2nd-order Butterworth giving the restart state (filtered angle and its "
+                  "velocity); default 10");
+  sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
+  return [sub, o]() -> int {
+    if (!*sub) return -1;
+    if (o->input != "torque" && o->input != "command")
+      throw InputError("replay --input: expected 'torque' or 'command', got '" + o->input + "'");
+    if (!(o->horizon > 0) || !std::isfinite(o->horizon))
+      throw InputError("replay --horizon: expected a time > 0 s, got " + std::to_string(o->horizon));
+    if (!(o->cutoff > 0) || !std::isfinite(o->cutoff))
+      throw InputError("replay --cutoff: expected a frequency > 0 Hz, got " + std::to_string(o->cutoff));
+    const LegParams params = ReadModelFile(o->params);
+    if (params.one_joint)
+      throw InputError(o->params + ": a one-joint model file; replay takes two-joint model files (hip and knee) "
+                       "for now");
+    const PlantEffects fx = ToPlantEffects(params, o->params);
+    Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
+    plant.SetParams(params);
+    plant.CarryEffects(fx);
+    plant.FreeJointsAndTorque();
+    const ReplayInput input = o->input == "command" ? ReplayInput::kCommand : ReplayInput::kTorque;
+
+    // Everything is read and checked before anything is simulated or written.
+    std::vector<ReplaySeries> series;
+    for (const std::string& m : o->measured) {
+      MapReport report;
+      const MeasuredData data = ReadMeasured(m, o->map, 20, &report);
+      if (!o->map.empty()) std::fprintf(stderr, "replay: %s", report.Summary().c_str());
+      if (params.human) CheckHumanJointRange(data);
+      if (data.t().back() - data.t().front() < o->horizon)
+        throw InputError(m + ": --horizon " + std::to_string(o->horizon) + " s is longer than the record (" +
+                         std::to_string(data.t().back() - data.t().front()) + " s)");
+      series.push_back(ReplaySeriesOf(data, fx, input, o->cutoff));
+    }
+
+    std::vector<double> col_t, col_q[2], col_sim[2], col_w, col_r;
+    ReplayScore total;
+    nlohmann::json records = nlohmann::json::array();
+    const char* names[2] = {"hip", "knee"};
+    for (size_t r = 0; r < series.size(); ++r) {
+      const ReplaySeries& s = series[r];
+      const ReplayRecord rec = Replay(plant, s, o->horizon);
+      total.Add(rec.score);
+      nlohmann::json x = {{"source", s.source}, {"windows", rec.score.windows}, {"samples", rec.score.count}};
+      for (int j = 0; j < 2; ++j) x["joints"][names[j]] = {{"rmse_rad", rec.score.Rmse(j)}};
+      records.push_back(x);
+      for (size_t i = 0; i < s.t.size(); ++i) {
+        if (rec.window[i] < 0) continue;
+        col_t.push_back(s.t[i]);
+        for (int j = 0; j < 2; ++j) {
+          col_q[j].push_back(s.q[j][i]);
+          col_sim[j].push_back(rec.sim[j][i]);
+        }
+        col_w.push_back(rec.window[i]);
+        col_r.push_back(static_cast<double>(r));
+      }
+      std::printf("replay: %s: %zu windows of %g s, RMS angle error hip %.4f rad (%.2f deg), knee %.4f rad (%.2f deg)\n",
+                  s.source.c_str(), rec.score.windows, o->horizon, rec.score.Rmse(0), rec.score.Rmse(0) * 180 / M_PI,
+                  rec.score.Rmse(1), rec.score.Rmse(1) * 180 / M_PI);
+    }
+    nlohmann::json j = {{"horizon_s", o->horizon},
+                        {"windows", total.windows},
+                        {"input", o->input},
+                        {"restart_state", "angle low-passed by a zero-phase 2nd-order Butterworth at " +
+                                              std::to_string(o->cutoff) + " Hz and its velocity (central differences)"},
+                        {"joint_limits", "disabled (and the actuators' ctrlrange)"},
+                        {"records", records}};
+    for (int k = 0; k < 2; ++k) j["joints"][names[k]] = {{"rmse_rad", total.Rmse(k)}};
+
+    if (mkdir(o->out.c_str(), 0755) != 0 && errno != EEXIST)
+      throw InputError(o->out + ": cannot create the output folder: " + std::strerror(errno));
+    WriteCsv(o->out + "/replay.csv", {"t", "q_hip", "q_hip_sim", "q_knee", "q_knee_sim", "window", "record"},
+             {&col_t, &col_q[0], &col_sim[0], &col_q[1], &col_sim[1], &col_w, &col_r},
+             {"exotwin replay: measured and simulated angles (rad); window: restart index in its record; "
+              "record: index of --measured",
+              "params: " + o->params + ", horizon " + std::to_string(o->horizon) + " s, input " + o->input});
+    WriteFileAtomic(o->out + "/replay.json", j.dump(2) + "\n");
+    std::printf("replay: %zu windows of %g s, RMS angle error hip %.4f rad (%.2f deg), knee %.4f rad (%.2f deg)\n",
+                total.windows, o->horizon, total.Rmse(0), total.Rmse(0) * 180 / M_PI, total.Rmse(1),
+                total.Rmse(1) * 180 / M_PI);
+    return 0;
+  };
+}
+
+const CommandRegistration kReplay(RegisterReplay);
+
+}  // namespace
+}  // namespace exotwin

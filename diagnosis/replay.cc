@@ -1,0 +1,139 @@
+#include "diagnosis/replay.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace exotwin {
+
+void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>& t,
+                               const std::vector<double> tau_S[2], std::vector<double> tau_R[2]) {
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> s = tau_S[j];
+    for (auto it = fx.sensor[j].rbegin(); it != fx.sensor[j].rend(); ++it) {
+      if (it->name == "sensor_offset") {
+        for (double& v : s) v -= it->value;
+      } else if (it->name == "sensor_gain") {
+        for (double& v : s) v /= 1.0 + it->value;
+      } else if (it->value != 0) {  // sensor_delay: the reading at t + delay is the torque at t
+        std::vector<double> tq(t.size());
+        for (size_t i = 0; i < t.size(); ++i) tq[i] = t[i] + it->value;
+        s = Interpolate(t, s, tq);
+      }
+    }
+    tau_R[j].resize(s.size());
+    for (size_t i = 0; i < s.size(); ++i) tau_R[j][i] = -s[i];
+  }
+}
+
+namespace {
+
+void RestartState(const std::string& source, double cutoff_hz, ReplaySeries* out) {
+  const Sampling sampling = ExamineSampling(out->t, source);
+  for (int j = 0; j < 2; ++j) {
+    out->q0[j] = LowPassOnTimeBase(out->t, out->q[j], cutoff_hz, source);
+    out->qd0[j] = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, source).qd;
+  }
+}
+
+}  // namespace
+
+ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
+                            const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz) {
+  ReplaySeries s;
+  s.source = source;
+  s.t = t;
+  s.q[0] = q[0];
+  s.q[1] = q[1];
+  RestartState(source, cutoff_hz, &s);
+  ActuatorTorqueFromReading(fx, t, tau_S, s.tau_R);
+  return s;
+}
+
+ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, ReplayInput input, double cutoff_hz) {
+  if (input == ReplayInput::kTorque) {
+    const std::vector<double> q[2] = {data.q_hip(), data.q_knee()};
+    const std::vector<double> tau_S[2] = {data.tau_hip(), data.tau_knee()};
+    return ReplaySeriesOf(data.source, data.t(), q, tau_S, fx, cutoff_hz);
+  }
+  ReplaySeries s;
+  s.source = data.source;
+  s.t = data.t();
+  s.q[0] = data.q_hip();
+  s.q[1] = data.q_knee();
+  const char* names[2] = {"cmd_hip", "cmd_knee"};
+  for (int j = 0; j < 2; ++j) {
+    const std::vector<double>* c = data.Column(names[j]);
+    if (!c)
+      throw InputError(data.source + ": --input command needs the column '" + names[j] +
+                       "' (the commanded actuator torque, N m); the record has none");
+    s.tau_R[j] = *c;
+  }
+  RestartState(data.source, cutoff_hz, &s);
+  return s;
+}
+
+double ReplayScore::Rmse(int j) const { return count ? std::sqrt(sse[j] / static_cast<double>(count)) : 0.0; }
+
+void ReplayScore::Add(const ReplayScore& o) {
+  sse[0] += o.sse[0];
+  sse[1] += o.sse[1];
+  count += o.count;
+  windows += o.windows;
+}
+
+ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin, size_t end) {
+  const std::vector<double>& t = s.t;
+  end = std::min(end, t.size());
+  if (!(horizon_s > 0)) throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s, expected > 0");
+  if (begin >= end || t[end - 1] - t[begin] < horizon_s)
+    throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s is longer than the part replayed (" +
+                     std::to_string(begin < end ? t[end - 1] - t[begin] : 0.0) + " s)");
+  ReplayRecord out;
+  out.source = s.source;
+  for (auto& v : out.sim) v.assign(t.size(), std::nan(""));
+  out.window.assign(t.size(), -1);
+  const double dt = plant.timestep();
+  size_t start = begin;
+  size_t in = begin;  // input interpolation: t[in] <= time < t[in + 1]
+  auto Input = [&](double time) -> Eigen::Vector2d {
+    while (in + 1 < t.size() && t[in + 1] <= time) ++in;
+    if (in + 1 >= t.size() || time <= t[in]) return {s.tau_R[0][in], s.tau_R[1][in]};
+    const double a = (time - t[in]) / (t[in + 1] - t[in]);
+    return {s.tau_R[0][in] + a * (s.tau_R[0][in + 1] - s.tau_R[0][in]),
+            s.tau_R[1][in] + a * (s.tau_R[1][in + 1] - s.tau_R[1][in])};
+  };
+  while (start < end && t[end - 1] - t[start] >= horizon_s) {
+    const double t0 = t[start], t_end = t0 + horizon_s;
+    const int w = static_cast<int>(out.score.windows);
+    plant.Reset({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0);
+    in = start;
+    Eigen::Vector2d q_prev = plant.q();
+    double time_prev = t0;
+    size_t i = start + 1;
+    for (; i < end && t[i] <= t_end + 1e-12; ++i) {
+      while (plant.time() < t[i] - 1e-12) {
+        q_prev = plant.q();
+        time_prev = plant.time();
+        plant.Step(Input(plant.time() + 0.5 * dt));
+      }
+      const double span = plant.time() - time_prev;
+      const double a = span > 0 ? (t[i] - time_prev) / span : 1.0;
+      const Eigen::Vector2d qs = q_prev + a * (plant.q() - q_prev);
+      for (int j = 0; j < 2; ++j) {
+        out.sim[j][i] = qs[j];
+        out.score.sse[j] += (qs[j] - s.q[j][i]) * (qs[j] - s.q[j][i]);
+      }
+      out.window[i] = w;
+      ++out.score.count;
+    }
+    ++out.score.windows;
+    // The next window starts at the first sample at or after t_end.
+    start = static_cast<size_t>(std::lower_bound(t.begin() + static_cast<long>(start), t.begin() + static_cast<long>(end),
+                                                 t_end - 1e-12) - t.begin());
+  }
+  return out;
+}
+
+}  // namespace exotwin

@@ -1,0 +1,75 @@
+// `exotwin replay` (DESIGN.md): the twin simulated forward on measured records. The MuJoCo plant
+// carrying the model's effects (Plant::CarryEffects) is driven by the record's actuator torque and
+// restarted from the measured state every `horizon` seconds; the simulated angles are scored against
+// the measured ones.
+//
+// Method:
+//  - input: tau_R = -tau_S, the reading with the model's sensor effects inverted (ActuatorTorque
+//    FromReading), or the commanded torque (cmd_* columns); linearly interpolated at the middle of
+//    each physics step (model timestep, 1 ms) and held over the step.
+//  - restart state: the angle low-passed by the zero-phase 2nd-order Butterworth at the cutoff
+//    (formats/measured_data.h LowPassOnTimeBase) and its velocity (DeriveAngleRates at the same
+//    cutoff), at the window's first sample.
+//  - windows: from the first sample, each window starts at the first sample at or after the previous
+//    window's start + horizon and is scored on its samples up to start + horizon (its first sample,
+//    the restart, excluded); a last part shorter than the horizon is not run.
+//  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "formats/measured_data.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+
+enum class ReplayInput { kTorque, kCommand };
+
+// One record on its time base, ready to replay.
+struct ReplaySeries {
+  std::string source;
+  std::vector<double> t;
+  std::vector<double> q[2];              // measured angle, rad (scored)
+  std::vector<double> q0[2], qd0[2];     // restart state: filtered angle (rad) and velocity (rad/s)
+  std::vector<double> tau_R[2];          // actuator torque input, N m
+};
+
+// The default cutoff of the restart state's filter, Hz.
+constexpr double kReplayCutoffHz = 10.0;
+
+// tau_R on t from a measured reading tau_S with the sensor effects of fx inverted, in reverse order
+// of the model file (tau_S = (reading - offset) / (1 + gain); a delayed reading is read value s later,
+// held at the record's end): the torque the actuator applied.
+void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>& t,
+                               const std::vector<double> tau_S[2], std::vector<double> tau_R[2]);
+
+// The series of a record: t, q (measured), restart state at cutoff_hz, and the input (kTorque: from
+// tau_hip/tau_knee through ActuatorTorqueFromReading; kCommand: cmd_hip/cmd_knee). Throws InputError
+// naming the record for --input command without cmd_* columns.
+ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, ReplayInput input, double cutoff_hz);
+// The same from kinematics and a measured reading (diagnose's records).
+ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
+                            const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz);
+
+struct ReplayScore {
+  double sse[2] = {0, 0};  // sum of squared angle errors, rad^2
+  size_t count = 0;        // scored samples
+  size_t windows = 0;
+  double Rmse(int j) const;
+  void Add(const ReplayScore& o);
+};
+
+struct ReplayRecord {
+  std::string source;
+  ReplayScore score;
+  std::vector<double> sim[2];  // simulated angle per sample of s.t (NaN where not scored)
+  std::vector<int> window;     // window index per sample (-1 where not scored)
+};
+
+// Replays samples [begin, end) of `s` with `plant` (parameters set and effects carried) in windows
+// of horizon_s. Throws InputError when [begin, end) is shorter than one horizon, SimulationError on
+// divergence.
+ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin = 0,
+                    size_t end = static_cast<size_t>(-1));
+
+}  // namespace exotwin

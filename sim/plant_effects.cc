@@ -1,0 +1,117 @@
+#include "sim/plant_effects.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+
+#include "core/error.h"
+#include "model/leg_dynamics.h"
+
+namespace exotwin {
+
+Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q) {
+  const int j = e.joint == "hip" ? 0 : 1;
+  const double ang = j == 0 ? q[0] : q[0] + q[1];
+  const double dG = g * e.value * (e.axis == "Y" ? std::cos(ang) : std::sin(ang));
+  return {dG, j == 1 ? dG : 0.0};
+}
+
+double TorqueRippleTorque(const Effect& e, double q_j) {
+  return e.value * std::sin(2 * M_PI * e.fields.at("cycles_per_rad") * q_j + e.fields.at("phase"));
+}
+
+bool PlantEffects::link_empty() const {
+  for (int j = 0; j < 2; ++j)
+    if (frictionloss[j] != 0 || damping[j] != 0 || armature[j] != 0 || stiffness[j] != 0) return false;
+  return applied.empty();
+}
+
+bool PlantEffects::empty() const { return link_empty() && sensor[0].empty() && sensor[1].empty(); }
+
+Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q) const {
+  Eigen::Vector2d f = Eigen::Vector2d::Zero();
+  for (const Effect& e : applied) {
+    if (e.name == "gravity_error") {
+      f -= GravityErrorTorque(e, g, q);
+    } else {
+      const int j = e.joint == "hip" ? 0 : 1;
+      f[j] -= TorqueRippleTorque(e, q[j]);
+    }
+  }
+  return f;
+}
+
+namespace {
+
+// Smallest eigenvalue of M(th2) + diag(armature) over th2 in [-pi, pi) (360 points; M is periodic
+// in th2, HJ15 eq. 5).
+double SmallestInertiaEigenvalue(const LegParams& params, const double armature[2]) {
+  const LumpedParams total = params.Total();
+  double lo = INFINITY;
+  for (int k = 0; k < 360; ++k) {
+    Eigen::Matrix2d M = MassMatrix(total, params.L1, -M_PI + 2 * M_PI * k / 360.0);
+    M(0, 0) += armature[0];
+    M(1, 1) += armature[1];
+    lo = std::min(lo, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(M, Eigen::EigenvaluesOnly).eigenvalues()[0]);
+  }
+  return lo;
+}
+
+}  // namespace
+
+PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) {
+  PlantEffects fx;
+  fx.g = params.g;
+  for (size_t i = 0; i < params.effects.size(); ++i) {
+    const Effect& e = params.effects[i];
+    const int j = e.joint == "hip" ? 0 : 1;
+    const std::string where = source + ": effects[" + std::to_string(i) + "] (" + e.name + ", " + e.joint + ")";
+    if (e.name == "coulomb_friction") {
+      if (e.value < 0) throw InputError(where + ": a negative Coulomb friction cannot be a MuJoCo frictionloss");
+      fx.frictionloss[j] += e.value;
+    } else if (e.name == "viscous_friction") {
+      fx.damping[j] += e.value;
+    } else if (e.name == "inertia_error") {
+      fx.armature[j] += e.value;
+    } else if (e.name == "joint_stiffness") {
+      if (fx.stiffness[j] != 0)
+        throw InputError(where + ": a second joint_stiffness at this joint; the plant carries one spring per joint");
+      fx.stiffness[j] = e.value;
+      fx.springref[j] = e.fields.at("q0");
+    } else if (e.name == "gravity_error" || e.name == "torque_ripple") {
+      fx.applied.push_back(e);
+    } else if (e.name == "sensor_offset" || e.name == "sensor_gain" || e.name == "sensor_delay") {
+      if (e.name == "sensor_gain" && !(e.value > -1))
+        throw InputError(where + ": a sensor gain of " + std::to_string(e.value) + " reads no torque; expected > -1");
+      if (e.name == "sensor_delay" && e.value < 0)
+        throw InputError(where + ": expected a delay >= 0 s");
+      fx.sensor[j].push_back({e.name, e.value});
+    } else {
+      throw InputError(where + ": the forward plant cannot carry this effect (" +
+                       (e.name == "muscle_activity" ? std::string("no muscles in the plant of a measured record")
+                                                    : std::string("no dead band or compliant strap in the MJCF")) +
+                       "); carried: coulomb_friction, viscous_friction, inertia_error, joint_stiffness, "
+                       "gravity_error, torque_ripple, sensor_offset, sensor_gain, sensor_delay");
+    }
+  }
+  for (int j = 0; j < 2; ++j)
+    if (fx.damping[j] < 0 || fx.stiffness[j] < 0)
+      throw InputError(source + ": the " + std::string(j == 0 ? "hip" : "knee") +
+                       (fx.damping[j] < 0 ? "'s viscous friction" : "'s joint stiffness") +
+                       " is negative: the plant would gain energy from it; expected >= 0");
+  if (fx.armature[0] < 0 || fx.armature[1] < 0) {
+    const double lo = SmallestInertiaEigenvalue(params, fx.armature);
+    if (!(lo > 1e-6)) {
+      std::ostringstream os;
+      os << source << ": inertia_error " << fx.armature[0] << " / " << fx.armature[1]
+         << " kg m^2 (hip / knee) leaves the inertia matrix with eigenvalue " << lo
+         << " kg m^2 at some knee angle: the forward plant cannot carry it (expected M + diag(armature) "
+            "positive definite)";
+      throw InputError(os.str());
+    }
+  }
+  return fx;
+}
+
+}  // namespace exotwin

@@ -1,0 +1,73 @@
+// The effects of DESIGN.md "Effects" as the forward MuJoCo plant carries them, and the per-sample
+// forms of the state-dependent ones (shared with the inverse form, diagnosis/effects.cc).
+//
+// Mapping onto MuJoCo's own model properties (Plant::CarryEffects):
+//  - coulomb_friction  -> dof_frictionloss. MuJoCo's frictionloss is a soft constraint bounded by the
+//    value: while the joint slides it resists with exactly value * sign(qd) (the table's form); near
+//    qd = 0 it holds the joint (stiction) where the table's sign(qd) would chatter, and as the joint
+//    decelerates towards a reversal it may already push the other way (it steers the velocity to
+//    zero within its time constant). The time constant (dof_solref) is set to 2 physics steps, the
+//    shortest MuJoCo integrates safely (its default 0.02 s widened the zone tenfold). Forward and
+//    inverse agree to 2e-3 N m where |qd| > 0.1 rad/s (tests/diagnosis/replay_test.cc).
+//  - viscous_friction  -> dof_damping (the passive force -value qd: exactly the table's form).
+//  - inertia_error     -> dof_armature (value added to M_jj: the table's value * qdd). A negative
+//    value is carried when M + diag(armature) stays positive definite at every knee angle (M depends
+//    on the knee angle only), else refused (InputError).
+//  - joint_stiffness   -> jnt_stiffness + qpos_spring (springref = q0): -value (q - q0), as the table.
+//  - gravity_error     -> an applied generalized force (qfrc_applied) equal to minus the table's
+//    torque, not a change of the segment's mass and centre of mass: a real mass change moves the
+//    segment's inertia and its coupling terms (L1 X2 cos th2) too, which the effect's form (HJ15 eq. 7
+//    with X or Y changed) does not carry; the applied force keeps forward and inverse one model.
+//  - torque_ripple     -> an applied generalized force -value sin(2 pi k q + phase).
+//  - sensor_offset, sensor_gain, sensor_delay act where the reading tau_S is formed, not on the
+//    link: PlantEffects::sensor holds them for that reader (diagnosis/replay.h inverts them).
+//  - backlash, series_compliance, muscle_activity: not carried (no dead band or strap in the MJCF,
+//    no muscles on the exoskeleton-only plant): ToPlantEffects refuses them (InputError).
+#pragma once
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// The torque (N m) the actuator needs in addition, at both joints, for a gravity_error effect:
+// the lumped X (or Y) of the segment distal to the effect's joint off by e.value, HJ15 eq. 7
+// (thigh: the hip row only; lower leg: both rows, at the absolute angle th1 + th2).
+Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q);
+
+// The torque (N m) the actuator needs in addition at the effect's joint for a torque_ripple effect
+// (fields cycles_per_rad, phase): value sin(2 pi cycles_per_rad q_j + phase).
+double TorqueRippleTorque(const Effect& e, double q_j);
+
+// Torque-sensor effects of one joint, in the order the model file lists them (DESIGN.md: tau_S +=
+// offset, tau_S *= 1 + gain, tau_S(t) = true reading at t - delay).
+struct SensorEffect {
+  std::string name;  // sensor_offset | sensor_gain | sensor_delay
+  double value = 0;
+};
+
+struct PlantEffects {
+  double frictionloss[2] = {0, 0};  // N m
+  double damping[2] = {0, 0};       // N m s/rad
+  double armature[2] = {0, 0};      // kg m^2
+  double stiffness[2] = {0, 0};     // N m/rad
+  double springref[2] = {0, 0};     // rad
+  std::vector<Effect> applied;      // gravity_error and torque_ripple: qfrc_applied each step
+  std::vector<SensorEffect> sensor[2];
+  double g = 9.81;                  // for gravity_error
+  bool empty() const;
+  bool link_empty() const;          // no effect on the link (only sensor effects, or none)
+  // The generalized force (N m) of `applied` at q: minus the torques the actuator needs for them.
+  Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q) const;
+};
+
+// Sorts `params.effects` into the plant's form. Throws InputError naming `source`, the effect
+// (effects[i], its name and joint) and why, for an effect the plant cannot carry (backlash,
+// series_compliance, muscle_activity) and for a negative inertia_error that leaves M + diag(armature)
+// not positive definite at some knee angle (checked on the closed form, HJ15 eq. 5).
+PlantEffects ToPlantEffects(const LegParams& params, const std::string& source);
+
+}  // namespace exotwin

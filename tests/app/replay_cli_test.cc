@@ -1,0 +1,109 @@
+// `exotwin replay` through the command line: the files of DESIGN.md on the shipped real-rig example
+// (the rig's rigid model against the model with the friction and rotor inertia diagnose names), and
+// bad input that exits 2 naming the place, with nothing written in --out.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <string>
+#include <sys/stat.h>
+
+#include "formats/csv_table.h"
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::RunExotwin;
+using testing::WriteText;
+
+const std::string kRig = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/";
+const std::string kRecord = kRig + "trajectory_05.csv";
+const std::string kMap = kRig + "dfki_double_pendulum_A0.map.yaml";
+
+std::string RigModel(const std::string& effects) {
+  return "L1: 0.3\n"
+         "exo: {J1: 0.131785691, J2: 0.023923745, X1: 0.349117969, X2: 0.111064801, Y1: 0, Y2: 0, m1: 0.559380615, "
+         "m2: 0.604345947}\n"
+         "passive: none\n"
+         "effects: " + effects + "\n";
+}
+
+// The effects diagnose names on the two shipped records (coulomb hip / knee, the knee's rotor
+// inertia), rounded.
+const char* kLearned =
+    "[{name: coulomb_friction, joint: hip, value: 0.13}, {name: coulomb_friction, joint: knee, value: 0.145},"
+    " {name: inertia_error, joint: knee, value: 0.0031}]";
+
+bool Exists(const std::string& p) {
+  struct stat st;
+  return stat(p.c_str(), &st) == 0;
+}
+
+class ReplayCli : public ::testing::Test {
+ protected:
+  testing::RunResult Replay(const std::string& model, const std::string& extra, const std::string& out = "out") {
+    WriteText(dir_ + "/m.yaml", model);
+    return RunExotwin("replay --params " + dir_ + "/m.yaml --measured " + kRecord + " --map " + kMap + " --out " +
+                      dir_ + "/" + out + " " + extra);
+  }
+  void ExpectBadInput(const testing::RunResult& r, const std::string& must_contain) {
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(must_contain), std::string::npos) << "expected '" << must_contain << "': " << r.output;
+    EXPECT_FALSE(Exists(dir_ + "/out")) << "something written in --out";
+  }
+  const testing::ScopedTempDir tmp_{"replay"};
+  const std::string dir_ = tmp_.path();
+};
+
+TEST_F(ReplayCli, TheLearnedFrictionMovesLikeTheRig) {
+  const auto rigid = Replay(RigModel("[]"), "", "rigid");
+  ASSERT_EQ(rigid.exit_code, 0) << rigid.output;
+  const auto learned = Replay(RigModel(kLearned), "", "learned");
+  ASSERT_EQ(learned.exit_code, 0) << learned.output;
+  auto Read = [&](const std::string& sub) {
+    return nlohmann::json::parse(std::ifstream(dir_ + "/" + sub + "/replay.json"));
+  };
+  const auto a = Read("rigid"), b = Read("learned");
+  EXPECT_EQ(a["horizon_s"], 0.5);
+  EXPECT_EQ(a["windows"], 19);  // 9.99 s of record
+  ASSERT_EQ(a["records"].size(), 1u);
+  for (const char* j : {"hip", "knee"}) {
+    const double before = a["joints"][j]["rmse_rad"], after = b["joints"][j]["rmse_rad"];
+    std::printf("%s: rigid %.2f deg, learned %.2f deg\n", j, before * 57.2958, after * 57.2958);
+    EXPECT_LT(after, 0.4 * before) << j;  // measured: 6.5 -> 1.1 deg (hip), 23.3 -> 2.5 deg (knee)
+  }
+  const CsvTable t = ReadCsv(dir_ + "/learned/replay.csv");
+  ASSERT_EQ(t.names.size(), 7u);
+  EXPECT_EQ(t.names[2], "q_hip_sim");
+  EXPECT_EQ(t.columns[5].back(), 18);  // the last window's index
+  // --input command drives the twin with the commanded torque (the rig's motor tracks it).
+  const auto cmd = Replay(RigModel(kLearned), "--input command --horizon 0.25", "cmd");
+  EXPECT_EQ(cmd.exit_code, 0) << cmd.output;
+  EXPECT_EQ(Read("cmd")["horizon_s"], 0.25);
+}
+
+TEST_F(ReplayCli, HorizonNotPositive) { ExpectBadInput(Replay(RigModel("[]"), "--horizon 0"), "--horizon"); }
+
+TEST_F(ReplayCli, HorizonLongerThanTheRecord) {
+  ExpectBadInput(Replay(RigModel("[]"), "--horizon 11"), "trajectory_05.csv: --horizon 11");
+}
+
+TEST_F(ReplayCli, CommandInputWithoutCommandColumns) {
+  const std::string csv = dir_ + "/plain.csv";
+  std::string text = "t,q_hip,q_knee,tau_hip,tau_knee\n";
+  for (int i = 0; i < 1000; ++i) text += std::to_string(i * 0.002) + ",0.1,-0.2,0.05,0.01\n";
+  WriteText(csv, text);
+  WriteText(dir_ + "/m.yaml", RigModel("[]"));
+  ExpectBadInput(RunExotwin("replay --params " + dir_ + "/m.yaml --measured " + csv + " --input command --out " + dir_ + "/out"),
+                 "plain.csv: --input command needs the column 'cmd_hip'");
+}
+
+TEST_F(ReplayCli, AnEffectThePlantCannotCarry) {
+  ExpectBadInput(Replay(RigModel("[{name: viscous_friction, joint: hip, value: 0.01}, {name: backlash, joint: knee, value: 0.01}]"), ""),
+                 "m.yaml: effects[1] (backlash, knee): the forward plant cannot carry");
+}
+
+}  // namespace
+}  // namespace exotwin

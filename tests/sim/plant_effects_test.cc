@@ -1,0 +1,144 @@
+// The effects the forward plant carries (sim/plant_effects.h), checked against the closed form
+// (model/leg_dynamics.h, HJ15 eq. 5-7): the forward acceleration MuJoCo computes with an effect
+// carried equals (M + diag(armature))^-1 (tau - V - G - effect torques).
+#include "sim/plant_effects.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "core/error.h"
+#include "tests/real_rig_model.h"
+#include "model/leg_dynamics.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+namespace {
+
+// Forward acceleration of the plant at (q, qd) under tau with the effects of p carried (one step
+// from the state: MuJoCo's qacc of that step).
+Eigen::Vector2d PlantAcceleration(const LegParams& p, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                                  const Eigen::Vector2d& tau) {
+  Plant plant(ExowheelMjcfPath(false));
+  plant.SetParams(p);
+  plant.CarryEffects(ToPlantEffects(p, "test"));
+  plant.FreeJointsAndTorque();
+  plant.Reset(q, qd);
+  plant.Step(tau);
+  return plant.qdd();
+}
+
+// The closed form with the table's effect torques (DESIGN.md "Effects": what the actuator needs in
+// addition), sliding (qd != 0).
+Eigen::Vector2d ClosedFormAcceleration(const LegParams& p, const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                                       const Eigen::Vector2d& tau) {
+  Eigen::Matrix2d M = MassMatrix(p.exo, p.L1, q[1]);
+  Eigen::Vector2d f = tau - CoriolisCentrifugal(p.exo, p.L1, q, qd) - GravityTorque(p.exo, p.g, q);
+  for (const Effect& e : p.effects) {
+    const int j = e.joint == "hip" ? 0 : 1;
+    if (e.name == "coulomb_friction") f[j] -= e.value * (qd[j] > 0 ? 1 : -1);
+    if (e.name == "viscous_friction") f[j] -= e.value * qd[j];
+    if (e.name == "inertia_error") M(j, j) += e.value;
+    if (e.name == "joint_stiffness") f[j] -= e.value * (q[j] - e.fields.at("q0"));
+    if (e.name == "gravity_error") f -= GravityErrorTorque(e, p.g, q);
+    if (e.name == "torque_ripple") f[j] -= TorqueRippleTorque(e, q[j]);
+  }
+  return M.ldlt().solve(f);
+}
+
+TEST(PlantEffects, EachCarriedEffectMatchesTheClosedForm) {
+  Effect stiff = MakeEffect("joint_stiffness", "knee", 0.8);
+  stiff.fields["q0"] = 0.2;
+  Effect grav = MakeEffect("gravity_error", "knee", 0.02);
+  grav.axis = "X";
+  Effect gravy = MakeEffect("gravity_error", "hip", -0.03);
+  gravy.axis = "Y";
+  Effect ripple = MakeEffect("torque_ripple", "hip", 0.05);
+  ripple.fields["cycles_per_rad"] = 3.0;
+  ripple.fields["phase"] = 0.4;
+  const std::vector<std::vector<Effect>> cases = {
+      {MakeEffect("viscous_friction", "hip", 0.05)}, {MakeEffect("viscous_friction", "knee", 0.02)},
+      {MakeEffect("inertia_error", "hip", 0.01)},    {MakeEffect("inertia_error", "knee", 0.0028)},
+      {MakeEffect("inertia_error", "knee", -0.005)}, {stiff},
+      {grav},                                {gravy},
+      {ripple},                              {MakeEffect("coulomb_friction", "hip", 0.15), MakeEffect("coulomb_friction", "knee", 0.12)}};
+  const Eigen::Vector2d q(0.7, -1.1), qd(1.5, -2.0), tau(0.4, -0.3);
+  for (const auto& fx : cases) {
+    LegParams p = RealRigModel();
+    p.effects = fx;
+    const Eigen::Vector2d a = PlantAcceleration(p, q, qd, tau);
+    const Eigen::Vector2d b = ClosedFormAcceleration(p, q, qd, tau);
+    // Damping is integrated implicitly by MuJoCo's Euler (qacc is the explicit one); the
+    // realization of the lumped parameters is exact to round-off.
+    EXPECT_LT((a - b).norm(), 1e-8 * (1 + b.norm())) << fx[0].name << " " << fx[0].joint << ": " << a.transpose()
+                                                      << " vs " << b.transpose();
+    // The effect is felt: the rigid twin accelerates differently.
+    LegParams rigid = RealRigModel();
+    EXPECT_GT((a - ClosedFormAcceleration(rigid, q, qd, tau)).norm(), 1e-4) << fx[0].name;
+  }
+}
+
+TEST(PlantEffects, NoEffectsLeaveThePlantBitIdentical) {
+  LegParams p = RealRigModel();
+  Plant a(ExowheelMjcfPath(false)), b(ExowheelMjcfPath(false));
+  a.SetParams(p);
+  b.SetParams(p);
+  b.CarryEffects(ToPlantEffects(p, "test"));
+  a.Reset({0.3, -0.4}, {0.1, 0.2});
+  b.Reset({0.3, -0.4}, {0.1, 0.2});
+  for (int i = 0; i < 500; ++i) {
+    a.Step({0.2 * std::sin(0.01 * i), 0.1});
+    b.Step({0.2 * std::sin(0.01 * i), 0.1});
+  }
+  EXPECT_EQ(a.q()[0], b.q()[0]);
+  EXPECT_EQ(a.q()[1], b.q()[1]);
+  EXPECT_EQ(a.qd()[1], b.qd()[1]);
+}
+
+TEST(PlantEffects, InverseDynamicsStaysTheRigidTwins) {
+  LegParams p = RealRigModel();
+  Plant rigid(ExowheelMjcfPath(false));
+  rigid.SetParams(p);
+  Effect stiff = MakeEffect("joint_stiffness", "hip", 0.5);
+  stiff.fields["q0"] = 0.1;
+  p.effects = {MakeEffect("viscous_friction", "knee", 0.03), MakeEffect("inertia_error", "hip", 0.01), stiff,
+               MakeEffect("coulomb_friction", "knee", 0.1)};
+  Plant carried(ExowheelMjcfPath(false));
+  carried.SetParams(p);
+  carried.CarryEffects(ToPlantEffects(p, "test"));
+  const Eigen::Vector2d q(0.4, -0.9), qd(1.2, -0.7), qdd(3.0, -5.0);
+  EXPECT_LT((rigid.InverseDynamics(q, qd, qdd) - carried.InverseDynamics(q, qd, qdd)).norm(), 1e-12);
+}
+
+TEST(PlantEffects, RefusesWhatThePlantCannotCarryNamingTheEffect) {
+  for (const char* name : {"backlash", "series_compliance", "muscle_activity"}) {
+    LegParams p = RealRigModel();
+    p.effects = {MakeEffect("viscous_friction", "hip", 0.01), MakeEffect(name, "knee", 0.05)};
+    try {
+      ToPlantEffects(p, "m.yaml");
+      ADD_FAILURE() << name << " accepted";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("m.yaml: effects[1] (" + std::string(name) + ", knee)"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("cannot carry"), std::string::npos) << msg;
+    }
+  }
+  // A negative inertia larger than the knee's own (J2 = 0.0239 kg m^2) is refused; -0.005 is carried.
+  LegParams p = RealRigModel();
+  p.effects = {MakeEffect("inertia_error", "knee", -0.03)};
+  EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError);
+  p.effects = {MakeEffect("inertia_error", "knee", -0.005)};
+  EXPECT_NO_THROW(ToPlantEffects(p, "m.yaml"));
+  // The sensor effects are for the reader, not the link.
+  p.effects = {MakeEffect("sensor_offset", "hip", 0.1), MakeEffect("sensor_gain", "knee", 0.05)};
+  const PlantEffects fx = ToPlantEffects(p, "m.yaml");
+  EXPECT_TRUE(fx.link_empty());
+  EXPECT_FALSE(fx.empty());
+  ASSERT_EQ(fx.sensor[1].size(), 1u);
+  EXPECT_EQ(fx.sensor[1][0].name, "sensor_gain");
+}
+
+}  // namespace
+}  // namespace exotwin
