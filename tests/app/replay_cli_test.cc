@@ -105,5 +105,15 @@ TEST_F(ReplayCli, AnEffectThePlantCannotCarry) {
                  "m.yaml: effects[1] (backlash, knee): the forward plant cannot carry");
 }
 
+// A one-joint model file (DESIGN.md "One-joint devices") is refused by name: the forward replay takes
+// two-joint models for now.
+TEST_F(ReplayCli, AOneJointModelIsRefused) {
+  const std::string pendulum = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/simple_pendulum/";
+  const std::string model = pendulum + "model.yaml";
+  ExpectBadInput(RunExotwin("replay --params " + model + " --measured " + pendulum + "pd_system_identification.csv" +
+                            " --map " + pendulum + "dfki_simple_pendulum.map.yaml --out " + dir_ + "/out"),
+                 model + ": a one-joint model file; replay takes two-joint model files");
+}
+
 }  // namespace
 }  // namespace exotwin
