@@ -12,11 +12,16 @@
 
 #include "diagnosis/diagnose.h"
 #include "diagnosis/generate.h"
+#include "tests/diagnosis/hidden_effect_util.h"
 #include "formats/model_file.h"
 #include "core/rng.h"
 
 namespace exotwin {
 namespace {
+
+using testing_hidden::EnvInt;
+using testing_hidden::Find;
+using testing_hidden::ValueError;
 
 // The torque analysis alone: these tests check what is named, not the forward simulation (step 6b,
 // tested on the real rig and in replay_test.cc).
@@ -26,34 +31,7 @@ DiagnoseOptions TorqueOnly() {
   return o;
 }
 
-int EnvInt(const char* name, int def) {
-  const char* v = std::getenv(name);
-  return v ? std::atoi(v) : def;
-}
-
 LegParams S1() { return ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml"); }
-
-// Relative error of the diagnosed value against the truth (muscle: worst true weight).
-double ValueError(const Effect& truth, const Effect& found) {
-  if (truth.name == "muscle_activity") {
-    double worst = 0;
-    for (const auto& f : truth.fields) {
-      const auto it = found.fields.find(f.first);
-      const double v = it == found.fields.end() ? 0.0 : it->second;
-      worst = std::max(worst, std::abs(v - f.second) / std::abs(f.second));
-    }
-    return worst;
-  }
-  return std::abs(found.value - truth.value) / std::abs(truth.value);
-}
-
-const DiagnosedEffect* Find(const Diagnosis& d, const Effect& truth) {
-  for (const auto& e : d.effects)
-    if (e.effect.name == truth.name && e.effect.joint == truth.joint &&
-        (truth.name != "gravity_error" || e.effect.axis == truth.axis))
-      return &e;
-  return nullptr;
-}
 
 struct Row {
   int runs = 0, found = 0, exact = 0, ok = 0;

@@ -13,6 +13,7 @@
 #include "diagnosis/diagnose.h"
 #include "diagnosis/generate.h"
 #include "diagnosis/predict.h"
+#include "tests/diagnosis/hidden_effect_util.h"
 #include "core/error.h"
 #include "formats/column_map.h"
 #include "formats/csv_table.h"
@@ -23,6 +24,10 @@
 
 namespace exotwin {
 namespace {
+
+using testing_hidden::EnvInt;
+using testing_hidden::Find;
+using testing_hidden::ValueError;
 
 const std::string kSrc = EXOTWIN_SOURCE_DIR;
 LegParams Hal3Knee() { return ReadModelFile(kSrc + "/examples/hal3_knee.yaml"); }
@@ -116,31 +121,6 @@ TEST(OneJointData, RecordsAreEmbeddedAndMustFitTheModel) {
       EXPECT_NE(m.find("expected"), std::string::npos) << m;
     }
   }
-}
-
-int EnvInt(const char* name, int def) {
-  const char* v = std::getenv(name);
-  return v ? std::atoi(v) : def;
-}
-
-const DiagnosedEffect* Find(const Diagnosis& d, const Effect& truth) {
-  for (const auto& e : d.effects)
-    if (e.effect.name == truth.name && e.effect.joint == truth.joint &&
-        (truth.name != "gravity_error" || e.effect.axis == truth.axis))
-      return &e;
-  return nullptr;
-}
-
-double ValueError(const Effect& truth, const Effect& found) {
-  if (truth.name == "muscle_activity") {
-    double worst = 0;
-    for (const auto& f : truth.fields) {
-      const auto it = found.fields.find(f.first);
-      worst = std::max(worst, std::abs((it == found.fields.end() ? 0.0 : it->second) - f.second) / std::abs(f.second));
-    }
-    return worst;
-  }
-  return std::abs(found.value - truth.value) / std::abs(truth.value);
 }
 
 GeneratedData Hal3Record(const LegParams& base, uint64_t seed, int effects, const std::vector<std::string>& allowed) {
