@@ -29,6 +29,21 @@ struct Truth {
   double noise = 1.0;   // N m
 };
 
+// The moments of HJ15 eq. 26's linear form with `tr`'s alphas, beta, gamma and offset on the
+// activations a (the recording's five channels), plus white noise of SD `noise` (N m), into r->tau.
+void LinearLawMoments(const Truth& tr, const std::vector<std::vector<double>>& a, double noise,
+                      NormalRng<NormalPolar>& rng, EmgRecording* r) {
+  const size_t n = r->t.size();
+  for (int j = 0; j < 2; ++j) r->tau[j].resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    r->tau[0][i] = tr.alpha_hip[0] * a[1][i] + tr.alpha_hip[1] * a[2][i] + tr.alpha_hip[2] * a[3][i] +
+                   tr.beta[0] * r->q[0][i] + tr.gamma[0] * r->qd[0][i] + tr.offset[0] + noise * rng.Normal();
+    r->tau[1][i] = tr.alpha_knee[0] * a[0][i] + tr.alpha_knee[1] * a[1][i] + tr.alpha_knee[2] * a[2][i] +
+                   tr.alpha_knee[3] * a[3][i] + tr.alpha_knee[4] * a[4][i] + tr.beta[1] * r->q[1][i] +
+                   tr.gamma[1] * r->qd[1][i] + tr.offset[1] + noise * rng.Normal();
+  }
+}
+
 // A 60 s recording at 100 Hz: gait-like envelopes (bursts at different phases and rates so that no
 // two channels are collinear), hip and knee angles, and moments made by the model with `truth`.
 EmgRecording Synthetic(const Truth& tr, uint64_t seed = 1) {
@@ -70,14 +85,7 @@ EmgRecording Synthetic(const Truth& tr, uint64_t seed = 1) {
       const double u = r.e[c][k] * (1 - fr) + r.e[c][k + 1] * fr;
       a[c][i] = ActivationShape(u, tr.a_shape);
     }
-  for (int j = 0; j < 2; ++j) r.tau[j].resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    r.tau[0][i] = tr.alpha_hip[0] * a[1][i] + tr.alpha_hip[1] * a[2][i] + tr.alpha_hip[2] * a[3][i] +
-                  tr.beta[0] * r.q[0][i] + tr.gamma[0] * r.qd[0][i] + tr.offset[0] + tr.noise * rng.Normal();
-    r.tau[1][i] = tr.alpha_knee[0] * a[0][i] + tr.alpha_knee[1] * a[1][i] + tr.alpha_knee[2] * a[2][i] +
-                  tr.alpha_knee[3] * a[3][i] + tr.alpha_knee[4] * a[4][i] + tr.beta[1] * r.q[1][i] +
-                  tr.gamma[1] * r.qd[1][i] + tr.offset[1] + tr.noise * rng.Normal();
-  }
+  LinearLawMoments(tr, a, tr.noise, rng, &r);
   return r;
 }
 
@@ -440,14 +448,7 @@ EmgRecording GaitTrial(const Law& law, uint64_t seed) {
   std::vector<double> tq(n);
   for (size_t i = 0; i < n; ++i) tq[i] = r.t[i] - law.delay;
   for (int c = 0; c < 5; ++c) a[c] = law.delay > 0 ? Interpolate(r.t, r.e[c], tq) : r.e[c];
-  for (int j = 0; j < 2; ++j) r.tau[j].resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    r.tau[0][i] = tr.alpha_hip[0] * a[1][i] + tr.alpha_hip[1] * a[2][i] + tr.alpha_hip[2] * a[3][i] +
-                  tr.beta[0] * r.q[0][i] + tr.gamma[0] * r.qd[0][i] + tr.offset[0] + law.noise * rng.Normal();
-    r.tau[1][i] = tr.alpha_knee[0] * a[0][i] + tr.alpha_knee[1] * a[1][i] + tr.alpha_knee[2] * a[2][i] +
-                  tr.alpha_knee[3] * a[3][i] + tr.alpha_knee[4] * a[4][i] + tr.beta[1] * r.q[1][i] +
-                  tr.gamma[1] * r.qd[1][i] + tr.offset[1] + law.noise * rng.Normal();
-  }
+  LinearLawMoments(tr, a, law.noise, rng, &r);
   return r;
 }
 
