@@ -33,7 +33,7 @@ class GhostLegModel {
   GhostLegModel(const GhostLegModel&) = delete;
   GhostLegModel& operator=(const GhostLegModel&) = delete;
 
-  static constexpr double kGhostStepY = 0.2;  // m
+  static constexpr double kGhostStepY = 0.1;  // m
 
   // Poses leg `leg` (-1: the MJCF's own, k >= 0: ghost k) at hip and knee angles (rad) in data().
   void SetLeg(int leg, double q_hip, double q_knee);
