@@ -188,6 +188,10 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
       }
 
     const auto wall0 = std::chrono::steady_clock::now();
+    if (!sims.empty()) o->render.legend.push_back({"measured", {0.25, 0.45, 0.85}});  // the exoskeleton's blue
+    for (size_t k = 0; k < sims.size(); ++k)
+      o->render.legend.push_back({sims[k].label + " (simulated)",
+                                  {styles[k].rgba[0], styles[k].rgba[1], styles[k].rgba[2]}});
     for (size_t k = 0; k < sims.size(); ++k)
       std::fprintf(stderr, "render-replay: ghost leg %zu (%s): %s from %s\n", k + 1,
                    std::array<const char*, 4>{"red", "green", "magenta", "orange"}[k % 4], sims[k].label.c_str(),
