@@ -65,8 +65,14 @@ void ReadPredicted(const std::string& path, const MeasuredData& data, std::vecto
 
 // Ghost colours, in --sim order (red, green, magenta, orange; then again). Not blue: the
 // exoskeleton is.
-constexpr std::array<double, 4> kGhostRgba[] = {
-    {0.95, 0.1, 0.1, 0.45}, {0.1, 0.8, 0.2, 0.45}, {0.85, 0.2, 0.85, 0.45}, {1.0, 0.6, 0.0, 0.45}};
+struct GhostColour {
+  const char* name;
+  std::array<double, 4> rgba;
+};
+constexpr GhostColour kGhostColours[] = {{"red", {0.95, 0.1, 0.1, 0.45}},
+                                         {"green", {0.1, 0.8, 0.2, 0.45}},
+                                         {"magenta", {0.85, 0.2, 0.85, 0.45}},
+                                         {"orange", {1.0, 0.6, 0.0, 0.45}}};
 
 // A simulated leg from a `replay` CSV, on the measured time base.
 struct SimLeg {
@@ -86,9 +92,9 @@ SimLeg ReadSimLeg(const std::string& path, const MeasuredData& data) {
                        "q_knee, q_knee_sim, window, record)");
   const std::vector<double>& t = p.columns[p.Find("t")];
   if (t.size() < 2) throw InputError(path + ": needs at least 2 rows");
-  if (p.Find("record") >= 0)
+  if (const int rec = p.Find("record"); rec >= 0)
     for (size_t i = 0; i < t.size(); ++i)
-      if (p.columns[p.Find("record")][i] != p.columns[p.Find("record")][0])
+      if (p.columns[rec][i] != p.columns[rec][0])
         throw InputError(path + ":" + std::to_string(p.line_of_row[i]) + ": rows of more than one record; "
                          "replay the record alone (one --measured)");
   for (size_t i = 1; i < t.size(); ++i)
@@ -164,7 +170,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
     for (size_t k = 0; k < o->sims.size(); ++k) {
       sims.push_back(ReadSimLeg(o->sims[k], data));
       sims.back().label = k < o->sim_labels.size() ? o->sim_labels[k] : SimLabel(o->sims[k]);
-      styles.push_back({"_ghost" + std::to_string(k + 1), kGhostRgba[k % std::size(kGhostRgba)]});
+      styles.push_back({"_ghost" + std::to_string(k + 1), kGhostColours[k % std::size(kGhostColours)].rgba});
     }
     // Without --sim the video renders the plant's own model, posed through the hinges hip/knee.
     std::unique_ptr<GhostLegModel> ghosts;
@@ -194,7 +200,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
                                   {styles[k].rgba[0], styles[k].rgba[1], styles[k].rgba[2]}});
     for (size_t k = 0; k < sims.size(); ++k)
       std::fprintf(stderr, "render-replay: ghost leg %zu (%s): %s from %s\n", k + 1,
-                   std::array<const char*, 4>{"red", "green", "magenta", "orange"}[k % 4], sims[k].label.c_str(),
+                   kGhostColours[k % std::size(kGhostColours)].name, sims[k].label.c_str(),
                    o->sims[k].c_str());
     const std::unique_ptr<VideoSink> video =
         OpenVideo(ghosts ? ghosts->model() : plant.model(), o->out, o->render);
