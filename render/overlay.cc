@@ -146,6 +146,19 @@ void OverlayHistory::Draw(cv::Mat& f) const {
   std::snprintf(buf, sizeof buf, "knee %+7.1f deg", last_.q_knee * kDegPerRad);
   Text(f, buf, {int(24 * sc), int(108 * sc)}, 0.65 * sc, kWhite);
 
+  // Legend of the legs (e.g. measured and simulated), under the angles.
+  if (!opt_.legend.empty()) {
+    const int line = int(24 * sc), y0 = int(130 * sc);
+    Panel(f, cv::Rect(int(12 * sc), y0, int(300 * sc), int(opt_.legend.size() * line + 10 * sc)));
+    for (size_t i = 0; i < opt_.legend.size(); ++i) {
+      const auto& e = opt_.legend[i];
+      const int y = y0 + int((i + 1) * line);
+      const cv::Scalar c(255 * e.rgb[2], 255 * e.rgb[1], 255 * e.rgb[0]);
+      cv::rectangle(f, cv::Rect(int(24 * sc), y - int(14 * sc), int(28 * sc), int(14 * sc)), c, cv::FILLED);
+      Text(f, e.label, {int(62 * sc), y}, 0.55 * sc, kWhite);
+    }
+  }
+
   // Strip charts, right-hand side: hip, knee, then EMG if any channel is present.
   const bool emg = !last_.emg.empty();
   const int n = emg ? 3 : 2;

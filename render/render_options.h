@@ -25,6 +25,12 @@ struct RenderOptions {
   bool overlays = true;                 // text, strip charts, events
   double chart_window_s = 4.0;          // time span of the strip charts (s)
   std::vector<std::string> emg_names;   // labels of OverlaySample::emg channels (optional)
+  // Key of the legs drawn (optional), under the angles: a swatch of colour rgb (0..1) per label.
+  struct LegendEntry {
+    std::string label;
+    double rgb[3] = {1, 1, 1};
+  };
+  std::vector<LegendEntry> legend;
 };
 
 }  // namespace exotwin

@@ -13,7 +13,7 @@ struct mjModel_;
 namespace exotwin {
 
 // Raised whenever the table or a type that crosses the boundary changes meaning.
-inline constexpr int kRenderPluginAbi = 1;
+inline constexpr int kRenderPluginAbi = 2;  // 2: RenderOptions::legend
 inline constexpr char kRenderPluginEntry[] = "exotwin_render_plugin_v1";
 
 struct RenderPluginTable {

@@ -61,6 +61,20 @@ std::string ExowheelMjcfPath(bool with_human) {
   return ShippedModelPath(with_human ? "leg_exowheel.xml" : "exowheel_exo_only.xml");
 }
 
+void SetThighLength(mjModel* m, double L1, const std::string& suffix) {
+  const int shank = mj_name2id(m, mjOBJ_BODY, ("exo_shank" + suffix).c_str());
+  if (shank < 0) throw InputError("model has no body 'exo_shank" + suffix + "'");
+  m->body_pos[3 * shank + 2] = -L1;
+  // Visual only: stretch the thigh geoms to the new L1 (centred at mid-thigh, half-length L1/2).
+  for (const char* g : {"human_thigh_geom", "exo_thigh_bar"}) {
+    const int id = mj_name2id(m, mjOBJ_GEOM, (g + suffix).c_str());
+    if (id < 0) continue;
+    m->geom_pos[3 * id + 2] = -0.5 * L1;
+    const int axis = m->geom_type[id] == mjGEOM_BOX ? 2 : 1;  // box half-height / capsule half-length
+    m->geom_size[3 * id + axis] = 0.5 * L1;
+  }
+}
+
 Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
   char err[1000] = "";
   m_ = LoadMjcfModel(mjcf_path, err, sizeof(err));
@@ -198,15 +212,7 @@ void Plant::SetParams(const LegParams& params) {
 
   m_->opt.gravity[0] = m_->opt.gravity[1] = 0.0;
   m_->opt.gravity[2] = -params.g;
-  m_->body_pos[3 * exo_shank_ + 2] = -params.L1;
-  // Visual only: stretch the thigh geoms to the new L1 (centred at mid-thigh, half-length L1/2).
-  for (const char* g : {"human_thigh_geom", "exo_thigh_bar"}) {
-    const int id = mj_name2id(m_, mjOBJ_GEOM, g);
-    if (id < 0) continue;
-    m_->geom_pos[3 * id + 2] = -0.5 * params.L1;
-    const int axis = m_->geom_type[id] == mjGEOM_BOX ? 2 : 1;  // box half-height / capsule half-length
-    m_->geom_size[3 * id + axis] = 0.5 * params.L1;
-  }
+  SetThighLength(m_, params.L1);
   WriteBody(m_, exo_thigh_, exo.thigh);
   WriteBody(m_, exo_shank_, exo.lower_leg);
   if (human_thigh_ >= 0) {

@@ -24,6 +24,13 @@ std::string ShippedModelPath(const std::string& file);
 // exowheel_exo_only.xml (the exoskeleton alone).
 std::string ExowheelMjcfPath(bool with_human);
 
+// Writes the thigh length L1 (m) into one leg of `m` (the leg's names end in `suffix`, "" for the
+// MJCF's own): body exo_shank<suffix> sits at z = -L1 in its parent, and the thigh geoms
+// human_thigh_geom<suffix> and exo_thigh_bar<suffix> (those present; visual only) span 0..-L1.
+// Throws InputError if the model has no body exo_shank<suffix>. Call mj_setConst afterwards when
+// the model simulates.
+void SetThighLength(mjModel_* m, double L1, const std::string& suffix = "");
+
 class Plant {
  public:
   // Loads an MJCF file with bodies exo_thigh, exo_shank (+ human_thigh, human_shank) and hinges

@@ -1,5 +1,6 @@
 // `exotwin render-replay` through the command line: a measured CSV becomes a decodable MP4 with one
-// frame per 1/30 s of data, with or without a --predicted file; bad input exits 2 naming the problem.
+// frame per 1/30 s of data, with or without a --predicted file; --sim adds ghost legs from `replay`
+// outputs; bad input exits 2 naming the problem.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,6 +30,35 @@ std::string MeasuredCsv() {
        << 0.02 * std::sin(170 * t) * std::sin(t) << "\n";
   }
   return os.str();
+}
+
+// A `replay` output for the first 1.5 s of MeasuredCsv() (three 0.5 s windows), the twin holding
+// (q_hip_sim, q_knee_sim); `t0` shifts its time base.
+std::string ReplayCsv(double q_hip_sim, double q_knee_sim, double t0 = 0.0) {
+  std::ostringstream os;
+  os << "# exotwin replay\nt,q_hip,q_hip_sim,q_knee,q_knee_sim,window,record\n";
+  for (int i = 0; i < 1500; ++i)
+    os << t0 + i * 0.001 << ",0.5," << q_hip_sim << ",-0.8," << q_knee_sim << "," << i / 500 << ",0\n";
+  return os.str();
+}
+
+// Pixels of a frame's lower 60 % (below the legend) that are strongly red (the first ghost: rgba
+// 0.95 0.1 0.1 0.45), which neither the skin, the exoskeleton, the floor nor the charts are.
+int RedPixels(const cv::Mat& bgr) {
+  int n = 0;
+  for (int y = int(0.4 * bgr.rows); y < bgr.rows; ++y)
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3b c = bgr.at<cv::Vec3b>(y, x);
+      n += c[2] > 70 && c[2] > c[1] + 50 && c[2] > c[0] + 50;
+    }
+  return n;
+}
+
+cv::Mat FirstFrame(const std::string& path) {
+  cv::VideoCapture cap(path, cv::CAP_FFMPEG);
+  cv::Mat f;
+  if (cap.isOpened()) cap.read(f);
+  return f;
 }
 
 long DecodedFrames(const std::string& path) {
@@ -73,6 +103,45 @@ TEST_F(RenderReplayCli, PredictedFileWithoutTorqueColumn) {
   const auto r = RunExotwin(Args(dir_ + "/x.mp4") + " --predicted " + dir_ + "/pred.csv");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("missing column 'tau_knee'"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/x.mp4"));
+}
+
+TEST_F(RenderReplayCli, GhostLegsFromReplayFiles) {
+  std::filesystem::create_directories(dir_ + "/rigid");
+  std::filesystem::create_directories(dir_ + "/extended");
+  WriteText(dir_ + "/rigid/replay.csv", ReplayCsv(1.5, -1.5));  // thigh out forward, shank hanging
+  WriteText(dir_ + "/extended/replay.csv", ReplayCsv(-0.4, -1.5));
+  const std::string small = " --width 160 --height 96 --fps 5";
+  const auto plain = RunExotwin(Args(dir_ + "/plain.mp4") + small);
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const auto r = RunExotwin(Args(dir_ + "/ghosts.mp4") + small + " --sim " + dir_ + "/rigid/replay.csv --sim " +
+                            dir_ + "/extended/replay.csv --sim-label stiff");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("ghost leg 1 (red): stiff"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("ghost leg 2 (green): extended"), std::string::npos) << r.output;
+  EXPECT_EQ(DecodedFrames(dir_ + "/ghosts.mp4"), 10);
+  // The red ghost's shank is drawn (forward of the measured leg); without --sim nothing is red.
+  const cv::Mat ghosts = FirstFrame(dir_ + "/ghosts.mp4"), plain_frame = FirstFrame(dir_ + "/plain.mp4");
+  ASSERT_FALSE(ghosts.empty());
+  ASSERT_FALSE(plain_frame.empty());
+  EXPECT_GT(RedPixels(ghosts), 40);
+  EXPECT_EQ(RedPixels(plain_frame), 0);
+}
+
+TEST_F(RenderReplayCli, SimFileWithoutSimulatedAnglesIsRefused) {
+  WriteText(dir_ + "/bad.csv", "t,q_hip,q_hip_sim,q_knee\n0,0,0,0\n0.001,0,0,0\n");
+  const auto r = RunExotwin(Args(dir_ + "/x.mp4") + " --sim " + dir_ + "/bad.csv");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(dir_ + "/bad.csv: missing column 'q_knee_sim'"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/x.mp4"));
+}
+
+TEST_F(RenderReplayCli, SimFileOfAnotherTimeRangeIsRefused) {
+  WriteText(dir_ + "/late.csv", ReplayCsv(0.5, -0.8, 5.0));  // 5..6.5 s; the record covers 0..2 s
+  const auto r = RunExotwin(Args(dir_ + "/x.mp4") + " --sim " + dir_ + "/late.csv");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(dir_ + "/late.csv: covers"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not a replay of this record"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/x.mp4"));
 }
 
