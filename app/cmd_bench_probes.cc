@@ -338,11 +338,9 @@ json BenchReplay(const BenchConfig& c) {
   };
   p.effects = {fx_of("coulomb_friction", "hip", 0.155), fx_of("coulomb_friction", "knee", 0.147),
                fx_of("inertia_error", "knee", 0.00275)};
-  const PlantEffects fx = ToPlantEffects(p, "bench");
-  Plant plant(ExowheelMjcfPath(false));
-  plant.SetParams(p);
-  plant.CarryEffects(fx);
-  plant.FreeJointsAndTorque();
+  PlantEffects fx;
+  const std::unique_ptr<Plant> twin = MakeReplayPlant(p, "bench", "", &fx);
+  Plant& plant = *twin;
   // The record: the plant itself driven by sums of sines at 1 kHz (angles and torque as a rig logs).
   const double duration = c.quick ? 20.0 : 600.0;
   const long n = std::lround(duration / plant.timestep());

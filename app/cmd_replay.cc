@@ -53,11 +53,9 @@ CommandRunner RegisterReplay(CLI::App& app) {
     if (params.one_joint)
       throw InputError(o->params + ": a one-joint model file; replay takes two-joint model files (hip and knee) "
                        "for now");
-    const PlantEffects fx = ToPlantEffects(params, o->params);
-    Plant plant(o->mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : o->mjcf);
-    plant.SetParams(params);
-    plant.CarryEffects(fx);
-    plant.FreeJointsAndTorque();
+    PlantEffects fx;
+    const std::unique_ptr<Plant> twin = MakeReplayPlant(params, o->params, o->mjcf, &fx);
+    Plant& plant = *twin;
     const ReplayInput input = o->input == "command" ? ReplayInput::kCommand : ReplayInput::kTorque;
 
     // Everything is read and checked before anything is simulated or written.

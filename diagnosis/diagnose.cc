@@ -638,15 +638,11 @@ void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const 
   auto Make = [&](const LegParams& model, const std::string& which, std::unique_ptr<Plant>* plant,
                   PlantEffects* fx) {
     try {
-      *fx = ToPlantEffects(model, which);
+      *plant = MakeReplayPlant(model, which, opt.mjcf, fx);
     } catch (const InputError& e) {
       S.note = std::string("not simulated: ") + e.what();
       return false;
     }
-    *plant = std::make_unique<Plant>(opt.mjcf.empty() ? ExowheelMjcfPath(model.human.has_value()) : opt.mjcf);
-    (*plant)->SetParams(model);
-    (*plant)->CarryEffects(*fx);
-    (*plant)->FreeJointsAndTorque();
     return true;
   };
   std::unique_ptr<Plant> rigid, ext;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sim/plant_effects.h"
 
 namespace exotwin {
 
@@ -81,6 +82,17 @@ void ReplayScore::Add(const ReplayScore& o) {
   sse[1] += o.sse[1];
   count += o.count;
   windows += o.windows;
+}
+
+std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::string& source, const std::string& mjcf,
+                                       PlantEffects* fx) {
+  const PlantEffects effects = ToPlantEffects(params, source);
+  auto plant = std::make_unique<Plant>(mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : mjcf);
+  plant->SetParams(params);
+  plant->CarryEffects(effects);
+  plant->FreeJointsAndTorque();
+  if (fx) *fx = effects;
+  return plant;
 }
 
 ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin, size_t end) {

@@ -15,6 +15,7 @@
 //    the restart, excluded); a last part shorter than the horizon is not run.
 //  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,13 @@ struct ReplayRecord {
 // Replays samples [begin, end) of `s` with `plant` (parameters set and effects carried) in windows
 // of horizon_s. Throws InputError when [begin, end) is shorter than one horizon, SimulationError on
 // divergence.
+// The plant a replay drives: the MJCF `mjcf` (empty: the shipped EXOwheel model, with or without the
+// human by params) realizing params, carrying its effects (ToPlantEffects: InputError naming `source`
+// for an effect the plant cannot carry; *fx receives them when given) with joint limits and torque
+// clamping off (Plant::FreeJointsAndTorque).
+std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::string& source, const std::string& mjcf = "",
+                                       PlantEffects* fx = nullptr);
+
 ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin = 0,
                     size_t end = static_cast<size_t>(-1));
 

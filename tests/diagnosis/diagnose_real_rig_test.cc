@@ -129,12 +129,9 @@ TEST(DiagnoseRealRig, EveryRecordLeftOutMovesLikeTheRigInSimulation) {
       ReplayScore s[2];
       for (int k = 0; k < 2; ++k) {
         const LegParams& p = k == 0 ? model : loo;
-        const PlantEffects fx = ToPlantEffects(p, "test");
-        Plant plant(ExowheelMjcfPath(false));
-        plant.SetParams(p);
-        plant.CarryEffects(fx);
-        plant.FreeJointsAndTorque();
-        s[k] = Replay(plant, ReplaySeriesOf(rig[r], fx, ReplayInput::kTorque, kReplayCutoffHz), h).score;
+        PlantEffects fx;
+        const std::unique_ptr<Plant> plant = MakeReplayPlant(p, "test", "", &fx);
+        s[k] = Replay(*plant, ReplaySeriesOf(rig[r], fx, ReplayInput::kTorque, kReplayCutoffHz), h).score;
       }
       before.Add(s[0]), after.Add(s[1]);
       std::printf("%s  %4.2f s   %6.2f / %5.2f               %6.2f / %5.2f\n", kRecords[r], h, s[0].Rmse(0) * 180 / M_PI,
