@@ -4,7 +4,6 @@
 #include <cmath>
 #include <sstream>
 
-#include "diagnosis/diagnose_columns.h"
 #include "diagnosis/diagnose_select.h"
 #include "formats/measured_data.h"
 #include "formats/number_text.h"
@@ -292,32 +291,63 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
     const size_t m = recs[0]->size(), K = static_cast<size_t>(std::max(1, opt.blocks));
     for (size_t f = 0; f < K; ++f) folds.push_back({0, f * m / K, (f + 1) * m / K});
   }
-  // Unweighted columns per recording (for predictions) and the weighted banks, one per fold (its
-  // fit rows first, as MakeGrams expects).
+  // Unweighted columns per recording (for predictions), and the Gram matrices of the weighted
+  // columns (diagnose_select.h Grams: fit rows pooled, held-out rows per joint, and each fold's rows)
+  // accumulated from them directly: a column enters only the rows of its joint, rows left out
+  // (keep) count as zero rows.
   std::vector<std::vector<std::vector<double>>> cols(recs.size());
   for (size_t k = 0; k < recs.size(); ++k)
     for (const EmgTerm& t : model.terms) cols[k].push_back(TermColumn(t, spec, *recs[k]));
-  std::vector<ColumnBank> banks;
-  for (const Fold& fo : folds) {
-    const EmgRecording& r = *recs[fo.rec];
-    const size_t m = fo.b - fo.a, mtr = n_train(r);
-    ColumnBank b;
-    b.n = m;
-    for (size_t i = fo.a; i < fo.b; ++i) b.sample.push_back(i), b.train.push_back(i < mtr);
-    b.X = Eigen::MatrixXd::Zero(2 * static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(T));
-    b.r = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(m));
-    for (int j = 0; j < 2; ++j)
-      for (size_t i = fo.a; i < fo.b; ++i) {
-        if (!keep[j][fo.rec][i]) continue;
-        const Eigen::Index row = j * static_cast<Eigen::Index>(m) + static_cast<Eigen::Index>(i - fo.a);
-        b.r[row] = w[j] * r.tau[j][i];
-        for (size_t c = 0; c < T; ++c)
-          if (model.terms[c].joint == j) b.X(row, static_cast<Eigen::Index>(c)) = w[j] * cols[fo.rec][c][i];
+  Grams g;
+  {
+    const Eigen::Index C = static_cast<Eigen::Index>(T);
+    g.Gtr = Eigen::MatrixXd::Zero(C, C), g.btr = Eigen::VectorXd::Zero(C);
+    for (int j = 0; j < 2; ++j) g.Gte[j] = Eigen::MatrixXd::Zero(C, C), g.bte[j] = Eigen::VectorXd::Zero(C);
+    std::vector<size_t> of[2];  // the columns of each joint
+    for (size_t c = 0; c < T; ++c) of[model.terms[c].joint].push_back(c);
+    // Row factor w_j^2 of each joint's rows, zero where a row is left out.
+    std::vector<double> m2[2];
+    auto dot = [](const std::vector<double>& m, const std::vector<double>& u, const std::vector<double>& v,
+                  size_t lo, size_t hi) {
+      double s = 0;
+      for (size_t i = lo; i < hi; ++i) s += m[i] * u[i] * v[i];
+      return s;
+    };
+    size_t cur = recs.size();
+    for (const Fold& fo : folds) {
+      const EmgRecording& r = *recs[fo.rec];
+      if (fo.rec != cur) {
+        cur = fo.rec;
+        for (int j = 0; j < 2; ++j) {
+          m2[j].resize(r.size());
+          for (size_t i = 0; i < r.size(); ++i) m2[j][i] = keep[j][cur][i] ? w[j] * w[j] : 0.0;
+        }
       }
-    b.used = static_cast<int>(T);
-    banks.push_back(std::move(b));
+      const std::vector<std::vector<double>>& x = cols[cur];
+      const size_t mtr = std::clamp(n_train(r), fo.a, fo.b);
+      for (int j = 0; j < 2; ++j) {
+        Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(C, C), Ge = Eigen::MatrixXd::Zero(C, C);
+        Eigen::VectorXd bt = Eigen::VectorXd::Zero(C), be = Eigen::VectorXd::Zero(C);
+        for (size_t a = 0; a < of[j].size(); ++a) {
+          const size_t ca = of[j][a];
+          bt[static_cast<Eigen::Index>(ca)] = dot(m2[j], x[ca], r.tau[j], fo.a, mtr);
+          be[static_cast<Eigen::Index>(ca)] = dot(m2[j], x[ca], r.tau[j], mtr, fo.b);
+          for (size_t b2 = 0; b2 <= a; ++b2) {
+            const size_t cb = of[j][b2];
+            const Eigen::Index ia = static_cast<Eigen::Index>(ca), ib = static_cast<Eigen::Index>(cb);
+            Gt(ia, ib) = Gt(ib, ia) = dot(m2[j], x[ca], x[cb], fo.a, mtr);
+            Ge(ia, ib) = Ge(ib, ia) = dot(m2[j], x[ca], x[cb], mtr, fo.b);
+          }
+        }
+        const double rt = dot(m2[j], r.tau[j], r.tau[j], fo.a, mtr), re = dot(m2[j], r.tau[j], r.tau[j], mtr, fo.b);
+        g.Gtr += Gt, g.btr += bt, g.rrtr += rt;
+        g.Gte[j] += Ge, g.bte[j] += be, g.rrte[j] += re;
+        g.Grec[j].push_back(Gt + Ge);
+        g.brec[j].push_back(bt + be);
+        g.rrrec[j].push_back(rt + re);
+      }
+    }
   }
-  Grams g = MakeGrams(banks);
   // Fit rows actually used (zero-weight rows do not count).
   double rows = 0;
   for (int j = 0; j < 2; ++j)
