@@ -33,7 +33,8 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
   sub->add_option("--map", o->map, "muscle map YAML (EMG channel names per twin muscle); default: OpenSim names");
   sub->add_option("--out", o->out, "calibration output, EMGMODEL.yaml")->required();
   sub->add_option("--report", o->report, "folder for diagnosis.json and report.html of the discrepancy loop");
-  sub->add_flag("--linear", o->linear, "fit the linear form of HJ15 eq. 26 only (no discrepancy loop)");
+  sub->add_flag("--linear", o->linear,
+                "fit the linear form of HJ15 eq. 26 only (alphas free of sign, no discrepancy loop)");
   sub->add_option("--blocks", o->blocks,
                   "one recording: contiguous cross-validation blocks, each left out in turn (default 5; several "
                   "recordings: each recording is left out instead)");
@@ -53,7 +54,7 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
     for (const auto& r : recs) ptrs.push_back(&r);
     EmgDiagnoseOptions opt;
     opt.blocks = o->blocks;
-    if (o->linear) opt.max_steps = 0, opt.robust_candidate = false;
+    if (o->linear) opt.max_steps = 0, opt.robust_candidate = false, opt.signed_alphas = false;
     const EmgDiagnosis d = DiagnoseEmg(ptrs, opt);
     std::vector<std::string> header = {"exotwin emg-fit: EMG-driven joint moment model (HJ15 eq. 26-27 + discrepancy loop)"};
     std::string files;

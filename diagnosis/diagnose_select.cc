@@ -50,6 +50,15 @@ double Sse(const Eigen::MatrixXd& G, const Eigen::VectorXd& b, double rr, const 
   return std::max(0.0, rr - 2 * x.dot(b) + x.dot(G * x));
 }
 
+// The normal equations of `cols` over every record's rows but `left_out`'s.
+void SumLeavingOut(const Grams& g, const std::vector<int>& cols, size_t left_out, Eigen::MatrixXd* A, Eigen::VectorXd* b) {
+  *A = Eigen::MatrixXd::Zero(cols.size(), cols.size());
+  *b = Eigen::VectorXd::Zero(cols.size());
+  for (size_t k = 0; k < g.records(); ++k)
+    for (int j = 0; j < 2; ++j)
+      if (k != left_out) *A += Sub(g.Grec[j][k], cols), *b += Sub(g.brec[j][k], cols);
+}
+
 }  // namespace
 
 Grams MakeGrams(const std::vector<ColumnBank>& banks) {
@@ -131,13 +140,93 @@ Fit FitCols(const Grams& g, std::vector<int> cols) {
 }
 
 Eigen::VectorXd FitLeavingOut(const Grams& g, const std::vector<int>& cols, size_t left_out) {
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(cols.size(), cols.size());
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(cols.size());
-  for (size_t k = 0; k < g.records(); ++k)
-    for (int j = 0; j < 2; ++j)
-      if (k != left_out) A += Sub(g.Grec[j][k], cols), b += Sub(g.brec[j][k], cols);
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  SumLeavingOut(g, cols, left_out, &A, &b);
   Eigen::VectorXd x;
   if (!Solve(A, b, &x, nullptr)) return {};
+  return x;
+}
+
+bool SolveSigned(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const std::vector<int>& sign, Eigen::VectorXd* x) {
+  const int n = static_cast<int>(b.size());
+  std::vector<char> passive(n);  // fitted (free or off its bound); else held at zero
+  for (int i = 0; i < n; ++i) passive[i] = sign[i] == 0;
+  // The unconstrained least squares of the passive set, zero elsewhere.
+  auto solve = [&](Eigen::VectorXd* z) {
+    std::vector<int> p;
+    for (int i = 0; i < n; ++i)
+      if (passive[i]) p.push_back(i);
+    *z = Eigen::VectorXd::Zero(n);
+    if (p.empty()) return true;
+    Eigen::VectorXd zp;
+    if (!Solve(Sub(A, p), Sub(b, p), &zp, nullptr)) return false;
+    for (size_t k = 0; k < p.size(); ++k) (*z)[p[k]] = zp[static_cast<Eigen::Index>(k)];
+    return true;
+  };
+  if (!solve(x)) return false;  // feasible: only free variables are off zero
+  // Each outer step frees the held variable whose bound costs most (the largest w_i = sign_i times
+  // the descent direction b - A x); the inner loop steps back along the segment to the new solution
+  // until every constrained variable keeps its sign. Finite: the cost drops at each outer step.
+  for (int outer = 0; outer < 3 * n + 10; ++outer) {
+    const Eigen::VectorXd grad = b - A * *x;
+    int best = -1;
+    double wbest = 0;
+    for (int i = 0; i < n; ++i) {
+      if (passive[i]) continue;
+      const double scale = std::abs(b[i]) + (A.row(i).cwiseAbs() * x->cwiseAbs()).sum();
+      const double wi = sign[i] * grad[i];
+      if (wi > 1e-12 * scale && wi > wbest) wbest = wi, best = i;
+    }
+    if (best < 0) return true;  // Kuhn-Tucker conditions hold
+    passive[best] = 1;
+    for (int inner = 0; inner < n + 1; ++inner) {
+      Eigen::VectorXd z;
+      if (!solve(&z)) return false;
+      double step = 1;
+      int blocking = -1;
+      for (int i = 0; i < n; ++i)
+        if (passive[i] && sign[i] != 0 && sign[i] * z[i] <= 0) {
+          const double d = (*x)[i] - z[i];
+          const double s = d != 0 ? (*x)[i] / d : 0.0;
+          if (s < step) step = s, blocking = i;
+        }
+      if (blocking < 0) {
+        *x = z;
+        break;
+      }
+      if (blocking == best && step <= 0) {  // rounding: the freed variable cannot move off its bound
+        passive[best] = 0;
+        return true;
+      }
+      *x += step * (z - *x);
+      for (int i = 0; i < n; ++i)
+        if (passive[i] && sign[i] != 0 && (i == blocking || sign[i] * (*x)[i] <= 0)) passive[i] = 0, (*x)[i] = 0;
+    }
+  }
+  return true;
+}
+
+Fit FitColsSigned(const Grams& g, const std::vector<int>& cols, const std::vector<int>& sign) {
+  std::vector<int> local(cols.size());
+  for (size_t k = 0; k < cols.size(); ++k) local[k] = sign[static_cast<size_t>(cols[k])];
+  Eigen::VectorXd x;
+  if (!SolveSigned(Sub(g.Gtr, cols), Sub(g.btr, cols), local, &x)) return Fit{};
+  std::vector<int> passive;
+  for (size_t k = 0; k < cols.size(); ++k)
+    if (local[k] == 0 || x[static_cast<Eigen::Index>(k)] != 0) passive.push_back(cols[k]);
+  return FitCols(g, passive);
+}
+
+Eigen::VectorXd FitLeavingOutSigned(const Grams& g, const std::vector<int>& cols, const std::vector<int>& sign,
+                                    size_t left_out) {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  SumLeavingOut(g, cols, left_out, &A, &b);
+  std::vector<int> local(cols.size());
+  for (size_t k = 0; k < cols.size(); ++k) local[k] = sign[static_cast<size_t>(cols[k])];
+  Eigen::VectorXd x;
+  if (!SolveSigned(A, b, local, &x)) return {};
   return x;
 }
 

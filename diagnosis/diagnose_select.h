@@ -66,6 +66,24 @@ Fit FitCols(const Grams& g, std::vector<int> cols);
 // Coefficients of `cols` fitted on all rows of every record but `left_out` (leave-one-record-out).
 Eigen::VectorXd FitLeavingOut(const Grams& g, const std::vector<int>& cols, size_t left_out);
 
+// Sign-constrained least squares: minimizes x'Ax - 2 b'x subject to sign[i] x_i >= 0 (sign[i] = +1:
+// x_i >= 0, -1: x_i <= 0, 0: free), by the active-set method of Lawson & Hanson (1974, Solving Least
+// Squares Problems, ch. 23, NNLS) with free variables. *x: the solution, exactly zero where held at
+// its bound; its nonzero and free entries are the unconstrained least squares of those columns (the
+// passive set). False when the passive set's normal equations are nearly singular.
+bool SolveSigned(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const std::vector<int>& sign, Eigen::VectorXd* x);
+
+// FitCols under the sign constraints `sign` (one per column of the Grams, SolveSigned's meaning) on
+// the train rows: the unconstrained fit of the passive set (the columns held at zero left out: its
+// coefficients, standard errors and BIC count the passive columns only, the degrees of freedom of
+// a sign-constrained fit; Meyer & Woodroofe 2000, Ann. Statist. 28:1083-1104).
+Fit FitColsSigned(const Grams& g, const std::vector<int>& cols, const std::vector<int>& sign);
+
+// FitLeavingOut under the sign constraints `sign` (per column of the Grams): coefficients aligned
+// with `cols`, zero where held; empty when unidentifiable.
+Eigen::VectorXd FitLeavingOutSigned(const Grams& g, const std::vector<int>& cols, const std::vector<int>& sign,
+                                    size_t left_out);
+
 // The columns of the candidates `set` (indices into bank.candidates), sorted, without repeats.
 std::vector<int> ColumnsOf(const ColumnBank& bank, const std::vector<int>& set);
 

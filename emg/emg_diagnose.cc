@@ -334,16 +334,20 @@ std::string Scores(const EmgTorqueModel& m) {
 
 
 // Muscles with several channels (the vasti, the two hamstrings) whose channels' alphas in `m` are
-// not separable: one of them against its muscle's action (HJ15 eq. 23-24 signs) beyond two
-// standard errors. `why` per muscle.
+// not separable: one of them held at zero by the signed fit or, fitted free of sign, against its
+// muscle's action (HJ15 eq. 23-24 signs) beyond two standard errors. `why` per muscle.
 std::map<Muscle, std::string> WrongSignMuscles(const EmgTorqueModel& m, const EmgRecording& r) {
   std::map<Muscle, std::string> out;
   for (const EmgTerm& t : m.terms) {
     if (t.kind != TermKind::kAlpha || t.proxy || t.channel.find('+') != std::string::npos) continue;
     if (std::count(r.muscle.begin(), r.muscle.end(), t.muscle) < 2) continue;
-    if (t.value * ActionSign(t.muscle, t.joint) < 0 && std::abs(t.value) > 2 * t.se)
-      out[t.muscle] += std::string(out[t.muscle].empty() ? "" : "; ") + t.Name() + " " + Num(t.value) + " +- " +
-                       Num(t.se) + " N m at the " + kJoint[t.joint];
+    std::string& o = out[t.muscle];
+    if (t.held)
+      o += std::string(o.empty() ? "" : "; ") + t.Name() + " held at zero at the " + kJoint[t.joint];
+    else if (t.value * t.ExpectedSign() < 0 && std::abs(t.value) > 2 * t.se)
+      o += std::string(o.empty() ? "" : "; ") + t.Name() + " " + Num(t.value) + " +- " + Num(t.se) + " N m at the " +
+           kJoint[t.joint] + ", against the muscle's action";
+    if (o.empty()) out.erase(t.muscle);
   }
   return out;
 }
@@ -414,6 +418,25 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     return "cross-validated gain (" + fold_word + "s left out) hip " + Num(sc.cv_gain_pct[0]) + " %, knee " +
            Num(sc.cv_gain_pct[1]) + " %; last 30 % hip " + Num(sc.gain_pct[0]) + " %, knee " + Num(sc.gain_pct[1]) + " %";
   };
+  // Physiology first: every alpha with its muscle's sign (a muscle only pulls), whatever it costs
+  // the linear form; freeing the signs is judged at the end like a cause.
+  if (opt.signed_alphas) {
+    spec.signed_alphas = true;
+    const EmgTorqueModel m = loop.Fit(spec);
+    std::string list;
+    for (const EmgTerm& t : m.terms)
+      if (t.held) list += (list.empty() ? "" : ", ") + t.Name() + " at the " + kJoint[t.joint];
+    auto change = [&](int j) {
+      const double v = -gain(m.sse_cv[j], cur.sse_cv[j]);
+      return (v > 0 ? "+" : "") + Num(v) + " %";
+    };
+    const std::string why = "alphas with their muscles' signs (sign-constrained least squares); held at zero: " +
+                            (list.empty() ? std::string("none") : list) + "; cross-validated error hip " + change(0) +
+                            ", knee " + change(1);
+    cur = m;
+    if (!list.empty()) d.steps.push_back({"alphas signed (muscles pull)", why, cur});  // else the same model
+    d.selection.push_back(why + ": " + Scores(cur));
+  }
   std::vector<Cause> causes = {{Kind::kCommonDelay}, {Kind::kTwitch}, {Kind::kTiming}};
   for (int m = 0; m < kNumMuscles; ++m)
     if (std::find(recs[0]->muscle.begin(), recs[0]->muscle.end(), MuscleAt(m)) != recs[0]->muscle.end())
@@ -495,6 +518,47 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     d.steps.push_back({sc.label, why, cur});
     d.selection.push_back("add " + sc.label + " (" + why + "): " + Scores(cur));
   }
+  // Signs: the loop's fits keep every alpha's sign (EmgModelSpec::signed_alphas). Freeing them is
+  // a cause like the others: the alphas against their muscles' action must pay where they act on
+  // the data left out (the gates above: BIC, cross-validated gain at a joint with a held alpha, every
+  // recording left out gaining); else the alphas held at zero are reported as not separable there.
+  if (spec.signed_alphas) {
+    std::vector<std::string> held;
+    for (const EmgTerm& t : cur.terms)
+      if (t.held) held.push_back(t.Name() + " at the " + kJoint[t.joint]);
+    if (!held.empty()) {
+      EmgModelSpec s = spec;
+      s.signed_alphas = false;
+      const EmgTorqueModel m = loop.Fit(s);
+      EmgCandidateScore sc;
+      sc.round = static_cast<int>(d.steps.size());
+      sc.label = "alphas_free_of_sign";
+      sc.delta_bic = m.bic - cur.bic;
+      auto acts = [&](int j) {
+        for (const EmgTerm& t : cur.terms)
+          if (t.held && t.joint == j) return true;
+        return false;
+      };
+      if (!(sc.delta_bic < -kBicMargin)) {
+        sc.verdict = "BIC drop " + Num(-sc.delta_bic) + " <= " + Num(kBicMargin);
+        for (int j = 0; j < 2; ++j)
+          sc.gain_pct[j] = gain(m.sse_heldout[j], cur.sse_heldout[j]), sc.cv_gain_pct[j] = gain(m.sse_cv[j], cur.sse_cv[j]);
+      } else if (validate(m, acts, &sc)) {
+        sc.added = true, sc.verdict = "added: the signs pay on the data left out";
+      }
+      d.scores.push_back(sc);
+      std::string list;
+      for (const std::string& h : held) list += (list.empty() ? "" : ", ") + h;
+      if (sc.added) {
+        spec = s, cur = m;
+        d.steps.push_back({sc.label, list + " against their muscles' action; " + gains_text(sc), cur});
+        d.selection.push_back("free the alphas' signs (" + list + "; " + gains_text(sc) + "): " + Scores(cur));
+      } else {
+        d.selection.push_back("signs kept: " + list + " held at zero; freeing them: " + sc.verdict + " (" +
+                              gains_text(sc) + ")");
+      }
+    }
+  }
   // Collinear channels of one muscle (the vasti, the two hamstrings): when the chosen structure
   // fitted on every sample gives one of them an alpha against the muscle's action, the channels are
   // pooled (one alpha of their mean envelope) if the pooled alphas keep their expected signs and
@@ -509,11 +573,11 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
       const EmgTorqueModel pooled = all.Fit(s);
       bool signs = true;
       for (const EmgTerm& t : pooled.terms)
-        if (t.kind == TermKind::kAlpha && t.muscle == w.first && !t.proxy && t.value * ActionSign(w.first, t.joint) < 0 &&
-            std::abs(t.value) > 2 * t.se)
+        if (t.kind == TermKind::kAlpha && t.muscle == w.first && !t.proxy &&
+            (t.held || (t.value * t.ExpectedSign() < 0 && std::abs(t.value) > 2 * t.se)))
           signs = false;
       const double before = full.sse_cv[0] + full.sse_cv[1], after = pooled.sse_cv[0] + pooled.sse_cv[1];
-      const std::string what = std::string(MuscleName(w.first)) + "'s channels (" + w.second + ", against the muscle's action; " +
+      const std::string what = std::string(MuscleName(w.first)) + "'s channels (" + w.second + "; " +
                                "envelope correlation " + Num(ChannelCorrelation(*recs[0], w.first)) + ")";
       if (signs && after <= (1 + kParsimony) * before) {
         spec = s;
@@ -525,7 +589,8 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
         d.notes.push_back(what + ": not separable (pooled, " +
                           (signs ? "the cross-validated error rises by " + Num(100 * (after / before - 1)) + " %"
                                  : std::string("their alpha is still against the action")) +
-                          "); kept apart, their alphas are not physiological");
+                          (spec.signed_alphas ? "); kept apart, one held at zero at its joint"
+                                              : "); kept apart, their alphas are not physiological"));
       }
     }
   }
@@ -542,14 +607,28 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
       d.calibration.spec.q_lo[j] = d.calibration.range.q_lo[j], d.calibration.spec.q_hi[j] = d.calibration.range.q_hi[j];
   }
   // Channels whose fitted alpha contradicts their muscle's action (HJ15 eq. 23-24 signs): crosstalk,
-  // a channel standing for a missing muscle, or collinearity; reported, not constrained.
+  // a channel standing for a missing muscle, or collinearity. Fitted free of sign, reported; held at
+  // zero by the signed fit, reported with the value the same structure gives it free of sign.
+  EmgTorqueModel free_signs;
   for (const EmgTerm& t : d.calibration.terms) {
     if (t.kind != TermKind::kAlpha) continue;
-    const int expected = t.proxy ? ActionSign(Muscle::kGMAX, t.joint) : ActionSign(t.muscle, t.joint);
-    if (t.value * expected < 0 && std::abs(t.value) > 2 * t.se)
+    const std::string why = "crosstalk, a missing muscle's activity, or collinearity";
+    if (t.held) {
+      if (free_signs.terms.empty()) {
+        Loop all(recs, 1.0, opt.blocks);
+        EmgModelSpec s = spec;
+        s.signed_alphas = false;
+        free_signs = all.Fit(s);
+      }
+      for (const EmgTerm& f : free_signs.terms)
+        if (f.kind == TermKind::kAlpha && f.joint == t.joint && f.channel == t.channel && f.proxy == t.proxy)
+          d.notes.push_back(t.Name() + " at the " + kJoint[t.joint] + ": held at zero (" + MuscleName(t.muscle) +
+                            "'s sign there); free of sign it is " + Num(f.value) + " +- " + Num(f.se) + " N m (" + why +
+                            "): not separable at this joint");
+    } else if (t.value * t.ExpectedSign() < 0 && std::abs(t.value) > 2 * t.se) {
       d.notes.push_back(t.Name() + " at the " + kJoint[t.joint] + ": " + Num(t.value) + " +- " + Num(t.se) +
-                        " N m, against the " + MuscleName(t.muscle) +
-                        "'s action there (crosstalk, a missing muscle's activity, or collinearity)");
+                        " N m, against the " + MuscleName(t.muscle) + "'s action there (" + why + ")");
+    }
   }
   // Plot series of the first recording.
   const EmgRecording& r = *recs[0];

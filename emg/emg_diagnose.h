@@ -67,6 +67,7 @@ struct EmgDiagnoseOptions {
   double holdout_fraction = 0.3;
   int max_steps = 10;
   bool robust_candidate = true;  // consider the robust fit
+  bool signed_alphas = true;     // fit every alpha with its muscle's sign (EmgModelSpec::signed_alphas)
   int blocks = 5;                // one recording: contiguous cross-validation blocks (>= 2)
 };
 

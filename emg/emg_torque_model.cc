@@ -61,6 +61,11 @@ std::string EmgTerm::Kind() const {
   return "";
 }
 
+int EmgTerm::ExpectedSign() const {
+  if (kind != TermKind::kAlpha && kind != TermKind::kAlphaQ) return 0;
+  return proxy ? ActionSign(Muscle::kGMAX, joint) : ActionSign(muscle, joint);
+}
+
 std::string EmgTerm::Name() const {
   if (kind == TermKind::kAlpha || kind == TermKind::kAlphaQ)
     return Kind() + "[" + channel + (proxy ? " as GMAX" : "") + "]";
@@ -363,9 +368,23 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
         for (size_t i = 0; i < p.size(); ++i) p[i] += coef[static_cast<Eigen::Index>(c)] * cols[k][c][i];
     return p;
   };
+  // With spec.signed_alphas every alpha keeps its muscle's sign (EmgTerm::ExpectedSign): the
+  // sign-constrained fit, the alphas it holds at zero marked `held`.
+  std::vector<int> sign(T, 0);
+  if (spec.signed_alphas)
+    for (size_t c = 0; c < T; ++c)
+      if (model.terms[c].kind == TermKind::kAlpha) sign[c] = model.terms[c].ExpectedSign();
+  Eigen::VectorXd coef, se;
+  auto fit = [&] {
+    const Fit r = spec.signed_alphas ? FitColsSigned(g, all, sign) : FitCols(g, all);
+    coef = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(T)), se = coef;
+    for (size_t k = 0; k < r.cols.size() && r.ok; ++k)
+      coef[r.cols[k]] = r.coef[static_cast<Eigen::Index>(k)], se[r.cols[k]] = r.se[static_cast<Eigen::Index>(k)];
+    return r;
+  };
   double L = opt.autocorr_rows;
   g.n_eff = g.n_tr / std::max(1.0, L);
-  Fit f = FitCols(g, all);
+  Fit f = fit();
   if (!f.ok)
     throw InputError(recs[0]->source + ": the model's regressors are nearly collinear (a channel that "
                      "is constant or copies another?)");
@@ -373,18 +392,22 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
     L = 1;
     for (size_t k = 0; k < recs.size(); ++k)
       for (int j = 0; j < 2; ++j) {
-        const std::vector<double> p = predict(f.coef, k, j);
+        const std::vector<double> p = predict(coef, k, j);
         std::vector<double> res;
         for (size_t i = 0; i < n_train(*recs[k]); ++i)
           if (keep[j][k][i]) res.push_back(recs[k]->tau[j][i] - p[i]);
         if (res.size() > 8) L = std::max(L, AutocorrelationLength(res.data(), res.size()));
       }
     g.n_eff = g.n_tr / L;
-    f = FitCols(g, all);
+    f = fit();
   }
   model.autocorr_rows = L;
   model.weight[0] = w[0], model.weight[1] = w[1];
-  for (size_t c = 0; c < T; ++c) model.terms[c].value = f.coef[static_cast<Eigen::Index>(c)], model.terms[c].se = f.se[static_cast<Eigen::Index>(c)];
+  for (size_t c = 0; c < T; ++c) {
+    EmgTerm& t = model.terms[c];
+    t.value = coef[static_cast<Eigen::Index>(c)], t.se = se[static_cast<Eigen::Index>(c)];
+    t.held = sign[c] != 0 && std::find(f.cols.begin(), f.cols.end(), static_cast<int>(c)) == f.cols.end();
+  }
   model.bic = f.bic + model.nonlinear_parameters() * std::log(g.n_eff);
   model.sse_fit = f.sse_tr, model.n_fit = g.n_tr;
   if (opt.fit_only) return model;
@@ -403,7 +426,7 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
     std::vector<double> meas[2], res[2];
     for (size_t fi = 0; fi < folds.size() && folds.size() >= 2; ++fi) {
       const Fold& fo = folds[fi];
-      const Eigen::VectorXd x = FitLeavingOut(g, all, fi);
+      const Eigen::VectorXd x = spec.signed_alphas ? FitLeavingOutSigned(g, all, sign, fi) : FitLeavingOut(g, all, fi);
       std::array<double, 2> sse = {0, 0};
       for (int j = 0; j < 2; ++j)
         for (size_t i = fo.a; i < fo.b; ++i) {
@@ -430,7 +453,7 @@ EmgTorqueModel FitEmgModel(const EmgModelSpec& spec, const std::vector<const Emg
     std::vector<double> mf, pf, mh, ph, mt, pt;
     EmgJointFigures& F = model.figures[j];
     for (size_t k = 0; k < recs.size(); ++k) {
-      const std::vector<double> p = predict(f.coef, k, j);
+      const std::vector<double> p = predict(coef, k, j);
       const std::vector<double>& tau = recs[k]->tau[j];
       const size_t m = tau.size(), mtr = n_train(*recs[k]);
       for (size_t i = 0; i < m; ++i) {
@@ -527,7 +550,8 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
   auto yn = [](bool b) { return b ? "true" : "false"; };
   o << "structure:\n  moment_arm: {hip: " << yn(m.spec.moment_arm[0]) << ", knee: " << yn(m.spec.moment_arm[1])
     << "}\n  passive: {hip: " << yn(m.spec.passive[0]) << ", knee: " << yn(m.spec.passive[1])
-    << "}\n  gmax_proxy: " << yn(m.spec.gmax_proxy) << "\n  robust_fit: " << yn(m.spec.robust) << "\n  pooled: [";
+    << "}\n  gmax_proxy: " << yn(m.spec.gmax_proxy) << "\n  robust_fit: " << yn(m.spec.robust)
+    << "\n  signed_alphas: " << yn(m.spec.signed_alphas) << "\n  pooled: [";
   for (size_t i = 0; i < m.spec.pooled.size(); ++i) o << (i ? ", " : "") << MuscleName(m.spec.pooled[i]);
   o << "]\n";
   o << "missing_channels: [";
@@ -542,7 +566,7 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
       if (!t.channel.empty())
         o << ", channel: " << t.channel << ", muscle: " << MuscleName(t.muscle)
           << (t.proxy ? ", proxy_for: GMAX" : "")
-          << ", expected_sign: " << (t.proxy ? ActionSign(Muscle::kGMAX, j) : ActionSign(t.muscle, j));
+          << ", expected_sign: " << t.ExpectedSign() << (t.held ? ", held_at_zero: true" : "");
       o << ", value: " << NumberText(t.value, 10) << ", se: " << NumberText(t.se, 4) << ", unit: \"" << t.Unit()
         << "\"}\n";
     }
@@ -604,6 +628,7 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
     }
     m.spec.gmax_proxy = flag(s["gmax_proxy"], "structure.gmax_proxy");
     m.spec.robust = flag(s["robust_fit"], "structure.robust_fit");
+    if (s["signed_alphas"]) m.spec.signed_alphas = flag(s["signed_alphas"], "structure.signed_alphas");
     if (const YAML::Node pl = s["pooled"]) {
       if (!pl.IsSequence()) c.Fail("structure.pooled", "expected a list of muscles" + YamlLine(pl));
       for (const auto& x : pl) {
@@ -657,6 +682,11 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
           c.Fail(ek, "expected channel: and muscle: (GMAX, VM, RF, ST, GAS)" + YamlLine(e));
         t.channel = e["channel"].as<std::string>();
         t.proxy = static_cast<bool>(e["proxy_for"]);
+        if (e["held_at_zero"]) {
+          if (!e["held_at_zero"].IsScalar() || e["held_at_zero"].as<std::string>() != "true")
+            c.Fail(ek + ".held_at_zero", "expected true (absent when the alpha is fitted)" + YamlLine(e["held_at_zero"]));
+          t.held = true;
+        }
       }
       t.value = YamlNumber(c, e["value"], ek + ".value", -1e6, 1e6, t.Unit());
       if (e["se"]) t.se = YamlNumber(c, e["se"], ek + ".se", 0, 1e12, t.Unit());

@@ -31,7 +31,7 @@
 //  - robust fit: rows whose moment lies beyond kSpikeMads scaled MADs of the median left out of the
 //    fit (the contact spikes of inverse dynamics).
 // Channels act at the joints their muscle spans (sim/muscles.h ActionSign); alpha is fitted free of
-// sign (its expected sign is reported). Least squares on rows weighted by 1/SD of each joint's
+// sign (its expected sign is reported) or, with spec.signed_alphas, constrained to it. Least squares on rows weighted by 1/SD of each joint's
 // moment, both joints in one stack (diagnosis/diagnose_select.h FitCols), standard errors corrected
 // for the residual's autocorrelation.
 #pragma once
@@ -59,6 +59,11 @@ struct EmgModelSpec {
   bool passive[2] = {false, false};        // Riener & Edrich passive moment at the hip / knee
   bool gmax_proxy = false;                 // vasti channels at the hip when GMAX is missing
   bool robust = false;                     // spikes left out of the fit rows
+  // Every alpha keeps the sign of its muscle's action at the joint (EmgTerm::ExpectedSign): a
+  // muscle only pulls, so its moment has the sign of its moment arm (HJ15 eq. 23-24 signs).
+  // Sign-constrained least squares (diagnose_select.h SolveSigned); an alpha the data would give
+  // the other sign is held at zero (EmgTerm::held), the channel not separable at that joint.
+  bool signed_alphas = false;
   // Standard errors of the searched parameters (profile of the fit's sum of squares), 0 if unknown.
   double common_delay_se = 0, twitch_se = 0;  // s
   std::map<Muscle, double> delay_se;       // s
@@ -102,6 +107,10 @@ struct EmgTerm {
   Muscle muscle = Muscle::kGMAX;  // the twin muscle of the channel
   bool proxy = false;             // a vasti channel standing in for the missing GMAX at the hip
   double value = 0, se = 0;
+  bool held = false;              // alpha held at zero by spec.signed_alphas (se 0)
+  // Sign of the muscle's action at the joint (sim/muscles.h ActionSign; a proxy: GMAX's), for
+  // alpha and alpha_q; 0 for the other terms.
+  int ExpectedSign() const;
   std::string Name() const;       // e.g. "alpha[rect_fem_r]", "alpha_q[vas_lat_r as GMAX]", "beta"
   std::string Unit() const;       // e.g. "N m", "N m/rad", "N m s/rad", "1"
   std::string Kind() const;       // "alpha", "alpha_q", "beta", "gamma", "offset", "passive_scale"

@@ -200,8 +200,10 @@ TEST(EmgTorqueModel, SeveralRecordingsAreLeftOutInTurn) {
 TEST(EmgTorqueModel, ModelFileRoundTrips) {
   Truth tr;
   tr.delay = 0.05;
+  tr.alpha_hip[0] = -20;  // RF against its action at the hip: held at zero by the signed fit
   const EmgRecording r = Synthetic(tr);
   EmgModelSpec s;
+  s.signed_alphas = true;
   s.common_delay = 0.04;
   s.twitch = 0.03;
   s.delay_s[Muscle::kVM] = 0.05;
@@ -228,6 +230,9 @@ TEST(EmgTorqueModel, ModelFileRoundTrips) {
   for (int j = 0; j < 2; ++j) EXPECT_NEAR(back.range.q_lo[j], m.range.q_lo[j], 1e-5);
   EXPECT_TRUE(back.spec.passive[0]);
   EXPECT_TRUE(back.spec.moment_arm[1]);
+  EXPECT_TRUE(back.spec.signed_alphas);
+  EXPECT_TRUE(Term(m, 0, TermKind::kAlpha, "rect_fem_r").held);
+  for (size_t k = 0; k < m.terms.size(); ++k) EXPECT_EQ(back.terms[k].held, m.terms[k].held) << m.terms[k].Name();
   for (int j = 0; j < 2; ++j) {
     const std::vector<double> a = PredictMoment(m, r, j), b = PredictMoment(back, r, j);
     for (size_t i = 0; i < a.size(); i += 97) EXPECT_NEAR(a[i], b[i], 1e-6 * (1 + std::abs(a[i])));
@@ -362,14 +367,23 @@ TEST(EmgTorqueModel, PooledChannelsAreOneAlphaOfTheirMeanEnvelope) {
   EXPECT_EQ(vm, 1);  // the knee only
 }
 
+// The first note of `d` that contains `key` ("" if none).
+std::string NoteWith(const EmgDiagnosis& d, const std::string& key) {
+  for (const std::string& n : d.notes)
+    if (n.find(key) != std::string::npos) return n;
+  return std::string();
+}
+
+// The loop's options for the linear form alone (signs, pooling and their gates only).
+EmgDiagnoseOptions LinearOnly() {
+  EmgDiagnoseOptions o;
+  o.max_steps = 0, o.robust_candidate = false;
+  return o;
+}
+
 TEST(EmgTorqueModel, CollinearChannelsArePooledOrReportedNotSeparable) {
-  EmgDiagnoseOptions lin;
-  lin.max_steps = 0, lin.robust_candidate = false;
-  auto note_of = [](const EmgDiagnosis& d) {
-    for (const std::string& n : d.notes)
-      if (n.find("VM's channels") != std::string::npos) return n;
-    return std::string();
-  };
+  const EmgDiagnoseOptions lin = LinearOnly();
+  auto note_of = [](const EmgDiagnosis& d) { return NoteWith(d, "VM's channels"); };
   {  // nearly identical channels: pooling costs < 5 % of the cross-validated error, alpha ~ 70
     const EmgRecording r = TwoVasti(0.005);
     const EmgDiagnosis d = DiagnoseEmg({&r}, lin);
@@ -384,6 +398,40 @@ TEST(EmgTorqueModel, CollinearChannelsArePooledOrReportedNotSeparable) {
     EXPECT_NE(note_of(d).find("not separable"), std::string::npos) << note_of(d);
     EXPECT_NEAR(Term(d.calibration, 1, TermKind::kAlpha, "vas_med_r").value, -30, 3);
   }
+}
+
+// A channel against its muscle's action: held at zero by the signed fit and reported, unless
+// freeing its sign pays on the data left out (the loop's gates), as a strong one does.
+TEST(EmgTorqueModel, AlphaAgainstItsMuscleIsHeldAtZeroUnlessItsSignPays) {
+  const EmgDiagnoseOptions lin = LinearOnly();
+  auto note_of = [](const EmgDiagnosis& d) { return NoteWith(d, "alpha[rect_fem_r] at the hip"); };
+  auto diagnose = [&](double alpha_rf_hip) {
+    Truth tr;
+    tr.alpha_hip[0] = alpha_rf_hip;
+    const EmgRecording r = Synthetic(tr);
+    return DiagnoseEmg({&r}, lin);
+  };
+  const EmgDiagnosis weak = diagnose(-1);  // -1 N m at full activation (envelope <= 0.52): below the noise
+  ASSERT_EQ(weak.steps.size(), 2u);
+  EXPECT_EQ(weak.steps[1].added, "alphas signed (muscles pull)");
+  EXPECT_TRUE(weak.calibration.spec.signed_alphas);
+  const EmgTerm& held = Term(weak.calibration, 0, TermKind::kAlpha, "rect_fem_r");
+  EXPECT_TRUE(held.held);
+  EXPECT_EQ(held.value, 0.0);
+  EXPECT_NE(note_of(weak).find("held at zero"), std::string::npos) << note_of(weak);
+  EXPECT_NE(note_of(weak).find("not separable"), std::string::npos) << note_of(weak);
+  // Every other alpha fitted with its sign, near the truth.
+  EXPECT_NEAR(Term(weak.calibration, 0, TermKind::kAlpha, "semimem_r").value, -40, 2);
+  EXPECT_NEAR(Term(weak.calibration, 1, TermKind::kAlpha, "vas_lat_r").value, 70, 3.5);
+  // -30 N m: freeing the signs pays cross-validated; the alpha is fitted and reported against RF's action.
+  const EmgDiagnosis strong = diagnose(-30);
+  ASSERT_EQ(strong.steps.size(), 3u);
+  EXPECT_EQ(strong.steps[2].added, "alphas_free_of_sign");
+  EXPECT_FALSE(strong.calibration.spec.signed_alphas);
+  const EmgTerm& freed = Term(strong.calibration, 0, TermKind::kAlpha, "rect_fem_r");
+  EXPECT_FALSE(freed.held);
+  EXPECT_NEAR(freed.value, -30, 1.5);
+  EXPECT_NE(note_of(strong).find("against the RF's action"), std::string::npos) << note_of(strong);
 }
 
 // ---- A synthetic law with trial-to-trial variation ----
