@@ -19,9 +19,13 @@
 // parameters first) a muscle's own delay once a common one is named (within 10-100 ms), the A-shape
 // activation nonlinearity (-3 < A < 0), angle-dependent moment arms per joint (keeping their sign,
 // changing by at most a factor 3 over the calibrated angles), the passive moment per joint (scale in
-// (0, 3]), the vasti standing in for a missing gluteus maximus at the hip. Channels of one muscle
-// whose alphas are not separable (one against the muscle's action in the linear form) are pooled
-// before the loop. The robust handling of contact spikes (fit rows beyond kSpikeMads left out) is
+// (0, 3]), the vasti standing in for a missing gluteus maximus at the hip.
+// Signs: after the papers' linear form (alphas free of sign) every alpha is fitted with its muscle's
+// sign (EmgModelSpec::signed_alphas; a muscle only pulls); when the loop stops with alphas held at
+// zero, freeing the signs is judged by the same gates, else the held alphas are reported (not
+// separable at their joint, with the value they take free of sign). Channels of one muscle one of
+// which is held (or against the muscle's action) are then pooled when that keeps the sign and costs
+// at most kParsimony of the cross-validated error, else reported not separable. The robust handling of contact spikes (fit rows beyond kSpikeMads left out) is
 // decided first, because it changes the rows every other cause is fitted on; it must pay on the
 // cross-validation like the others.
 #pragma once

@@ -83,6 +83,13 @@ std::string EmgDiagnosisJson(const EmgDiagnosis& d) {
   using nlohmann::json;
   json j;
   j["effects"] = Effects(d);
+  // Every alpha of the calibration with its muscle's sign: held at zero by the signed fit, or not.
+  j["alphas"] = json::array();
+  for (const EmgTerm& t : d.calibration.terms)
+    if (t.kind == TermKind::kAlpha)
+      j["alphas"].push_back({{"parameter", t.Name()}, {"joint", kJoint[t.joint]}, {"value", t.value}, {"se", t.se},
+                             {"unit", t.Unit()}, {"expected_sign", t.ExpectedSign()}, {"held_at_zero", t.held}});
+  j["signed_alphas"] = d.calibration.spec.signed_alphas;
   const EmgTorqueModel& first = d.steps.front().model;
   const EmgTorqueModel& last = d.steps.back().model;
   for (int k = 0; k < 2; ++k) {
