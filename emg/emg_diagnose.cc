@@ -427,7 +427,7 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     for (const EmgTerm& t : m.terms)
       if (t.held) list += (list.empty() ? "" : ", ") + t.Name() + " at the " + kJoint[t.joint];
     auto change = [&](int j) {
-      const double v = -gain(m.sse_cv[j], cur.sse_cv[j]);
+      const double g = -gain(m.sse_cv[j], cur.sse_cv[j]), v = g == 0 ? 0.0 : g;  // no "-0"
       return (v > 0 ? "+" : "") + Num(v) + " %";
     };
     const std::string why = "alphas with their muscles' signs (sign-constrained least squares); held at zero: " +
