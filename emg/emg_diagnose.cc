@@ -544,7 +544,14 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
         for (int j = 0; j < 2; ++j)
           sc.gain_pct[j] = gain(m.sse_heldout[j], cur.sse_heldout[j]), sc.cv_gain_pct[j] = gain(m.sse_cv[j], cur.sse_cv[j]);
       } else if (validate(m, acts, &sc)) {
-        sc.added = true, sc.verdict = "added: the signs pay on the data left out";
+        double t_max = 0;  // the freed alphas: significant against their muscles' action
+        for (const EmgTerm& h : cur.terms)
+          for (const EmgTerm& f : m.terms)
+            if (h.held && f.kind == h.kind && f.joint == h.joint && f.channel == h.channel && f.proxy == h.proxy &&
+                f.se > 0)
+              t_max = std::max(t_max, std::abs(f.value) / f.se);
+        if (t_max > kMinT) sc.added = true, sc.verdict = "added: the signs pay on the data left out";
+        else sc.verdict = "no freed alpha with |t| > " + Num(kMinT) + " (largest " + Num(t_max) + ")";
       }
       d.scores.push_back(sc);
       std::string list;
@@ -560,7 +567,8 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     }
   }
   // Collinear channels of one muscle (the vasti, the two hamstrings): when the chosen structure
-  // fitted on every sample gives one of them an alpha against the muscle's action, the channels are
+  // fitted on every sample holds one of them at zero or (free of sign) gives it an alpha against
+  // the muscle's action, the channels are
   // pooled (one alpha of their mean envelope) if the pooled alphas keep their expected signs and
   // the cross-validated error rises by at most kParsimony; otherwise they are reported as not
   // separable.
