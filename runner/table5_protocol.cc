@@ -11,14 +11,15 @@
 #include "identification/identification.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
+#include "formats/number_text.h"
 #include "formats/csv_table.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
+#include "sim/paper_tables.h"
 #include "sim/plant_effects.h"
 #include "sim/subjects.h"
-#include "formats/number_text.h"
 
 namespace exotwin {
 
@@ -69,12 +70,13 @@ void Log(const Table5Options& opt, const std::string& line) {
   if (opt.log) opt.log(line);
 }
 
-// The scenario's plant with the protocol's effects added (Table5PlantEffects).
-void AddPlant(const std::vector<Effect>& fx, const Table5Options& opt, Scenario* s) {
+// The scenario's plant with the protocol's effects added (Table5PlantEffects(opt, worn)); the source
+// that messages name lists the files they came from.
+void AddPlant(const std::vector<Effect>& fx, const Table5Options& opt, bool worn, Scenario* s) {
   if (fx.empty()) return;
   s->plant_effects.insert(s->plant_effects.end(), fx.begin(), fx.end());
   std::string src = opt.plant_file;
-  if (!opt.plant_worn_file.empty()) src += (src.empty() ? "" : " + ") + opt.plant_worn_file;
+  if (worn && !opt.plant_worn_file.empty()) src += (src.empty() ? "" : " + ") + opt.plant_worn_file;
   s->plant_effects_source = s->plant_effects_source.empty() ? src : s->plant_effects_source + " + " + src;
 }
 
@@ -136,7 +138,7 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
     Scenario s = LoadStep(opt, steps[k], subject);
     s.protocol.trials = opt.trials;
     s.protocol.duration = opt.trial_duration;
-    AddPlant(k < 2 ? device_fx : worn_fx, opt, &s);
+    AddPlant(k < 2 ? device_fx : worn_fx, opt, k >= 2, &s);
     if (k == 2) e.truth = ResolveSubject(s);  // exo + human + passive as the twin holds them
     const std::string dir = base + "/step" + std::to_string(k + 1);
     const RunResult r = RunInto(s, dir, subject + " step " + std::to_string(k + 1), &run.failed_checks);
@@ -167,7 +169,7 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   // strides x period after the ramp, plus a tail so that the derivative filter's edge stays outside.
   const double t_from = gait.protocol.ramp, t_to = t_from + opt.strides * gait.protocol.stride_period;
   gait.protocol.duration = t_to + kGaitTail;
-  AddPlant(worn_fx, opt, &gait);
+  AddPlant(worn_fx, opt, true, &gait);
   const std::string gdir = base + "/gait";
   RunInto(gait, gdir, subject + " gait", &run.failed_checks);
   const MeasuredData g = ReadRun(gdir).front();
@@ -188,7 +190,6 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
 }
 
 namespace {
-
 
 // The set value of (name, joint) summed over `fx`, and whether any is set.
 bool SetValue(const std::vector<Effect>& fx, const std::string& name, const std::string& joint, double* v) {
@@ -225,14 +226,19 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
   s += "Per record set: the effects named (value [95 % interval], deviation from the plant's value of that "
        "effect at that joint), and the held-out torque RMS error (N m, diagnose's filtered last 30 %) of the "
        "identified twin -> the extended twin.\n\n";
-  s += "| subject | records | named | hip held-out | knee held-out |\n| --- | --- | --- | --- | --- |\n";
+  s += "| subject | records | named | hip held-out | knee held-out | paper's identified hip / knee (Table 5) |\n"
+       "| --- | --- | --- | --- | --- | --- |\n";
   struct Acc { double sum = 0; int n = 0; };
   std::vector<std::pair<std::string, Acc>> named_gait;  // "name(joint)" -> gait values
   for (const Table5SubjectRun& r : runs)
     for (const Table5Diagnosis& d : r.diagnoses) {
+      std::string paper = "-";
+      for (const Table5Row& p : PaperTable5())
+        if (r.entry.subject == p.subject)
+          paper = FormatNumber("%.2f", p.hip_identified) + " / " + FormatNumber("%.2f", p.knee_identified);
       s += "| " + r.entry.subject + " | " + d.records + " | ";
       if (!d.done) {
-        s += "not run: " + d.error + " | - | - |\n";
+        s += "not run: " + d.error + " | - | - | " + paper + " |\n";
         continue;
       }
       if (d.named.empty()) s += "nothing";
@@ -254,7 +260,8 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
         }
       }
       s += " | " + FormatNumber("%.3f", d.rmse_before[0]) + " -> " + FormatNumber("%.3f", d.rmse_after[0]) + " | " +
-           FormatNumber("%.3f", d.rmse_before[1]) + " -> " + FormatNumber("%.3f", d.rmse_after[1]) + " |\n";
+           FormatNumber("%.3f", d.rmse_before[1]) + " -> " + FormatNumber("%.3f", d.rmse_after[1]) + " | " + paper +
+           " |\n";
     }
   // The plant's link and sensor effects against what the gait records revealed, over the subjects.
   s += "\nThe plant's effects against diagnose on the gait records (" + std::to_string(runs.size()) +
