@@ -13,4 +13,12 @@ inline std::string NumberText(double v, int significant = 6) {
   return b;
 }
 
+// v formatted by one printf conversion of a double (e.g. "%.2f", "%+.1f %%"); longer text is cut at
+// 63 characters.
+inline std::string FormatNumber(const char* printf_format, double v) {
+  char b[64];
+  std::snprintf(b, sizeof(b), printf_format, v);
+  return b;
+}
+
 }  // namespace exotwin

@@ -10,21 +10,15 @@
 #include "core/units.h"
 #include "model/passive_torque.h"
 #include "model/regressors.h"
+#include "formats/number_text.h"
 
 namespace exotwin {
 
 namespace {
 
-
-std::string Fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof(b), f, v);
-  return b;
-}
-
 std::string RangeText(const JointRanges& r, int j) {
-  return Fmt("%.1f", r.min[j] * kDegPerRad) + ".." + Fmt("%.1f", r.max[j] * kDegPerRad) + " deg (range " +
-         Fmt("%.1f", (r.max[j] - r.min[j]) * kDegPerRad) + ", mean " + Fmt("%.1f", r.mean[j] * kDegPerRad) + ")";
+  return FormatNumber("%.1f", r.min[j] * kDegPerRad) + ".." + FormatNumber("%.1f", r.max[j] * kDegPerRad) + " deg (range " +
+         FormatNumber("%.1f", (r.max[j] - r.min[j]) * kDegPerRad) + ", mean " + FormatNumber("%.1f", r.mean[j] * kDegPerRad) + ")";
 }
 
 }  // namespace
@@ -56,8 +50,8 @@ IdConfiguration ClassifyConfiguration(const MeasuredData& data, const Identifica
     return IdConfiguration::kHipSwing;
   throw InputError(data.source + ": fits neither identification configuration: hip " +
                    RangeText(r, 0) + ", knee " + RangeText(r, 1) +
-                   "; expected one joint moving over at least " + Fmt("%.1f", opt.moving_min_range * kDegPerRad) +
-                   " deg while the other is held within " + Fmt("%.1f", opt.held_max_range * kDegPerRad) +
+                   "; expected one joint moving over at least " + FormatNumber("%.1f", opt.moving_min_range * kDegPerRad) +
+                   " deg while the other is held within " + FormatNumber("%.1f", opt.held_max_range * kDegPerRad) +
                    " deg (knee swing with the hip at 90 deg, or hip swing with the knee at -90 deg)");
 }
 
@@ -81,7 +75,7 @@ void AppendSamples(const MeasuredData& data, bool select_passive, const Identifi
     into->u[1].push_back(-data.tau_knee()[i]);
   }
   if (into->size() == before)
-    throw InputError(data.source + ": no usable sample after trimming " + Fmt("%g", opt.trim_s) +
+    throw InputError(data.source + ": no usable sample after trimming " + FormatNumber("%g", opt.trim_s) +
                      " s at both ends" + (select_passive ? " and the EMG selection of eq. (13)" : "") +
                      ", expected a longer recording of a relaxed subject");
   into->total += data.size();

@@ -9,16 +9,11 @@
 #include "model/leg_dynamics.h"
 #include "sim/anthropometry.h"
 #include "sim/paper_tables.h"
+#include "formats/number_text.h"
 
 namespace exotwin {
 
 namespace {
-
-std::string Fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof(b), f, v);
-  return b;
-}
 
 // The paper's Table 5 row of a subject, or nullptr (a subject outside S1..S10).
 const Table5Row* PaperRow(const std::string& subject) {
@@ -36,12 +31,12 @@ bool PaperEntry(const std::string& subject, Table5JointRmse* hip, Table5JointRms
   return true;
 }
 
-std::string Cell(double v, const char* f = "%.2f") { return std::isfinite(v) ? Fmt(f, v) : "-"; }
+std::string Cell(double v, const char* f = "%.2f") { return std::isfinite(v) ? FormatNumber(f, v) : "-"; }
 
 // Relative error (%) of a J or X, absolute error of a Y (kg m), as "est (err)".
 std::string Compare(double est, double truth, bool absolute) {
-  if (absolute) return Fmt("%.3f", est) + " (" + Fmt("%+.3f", est - truth) + ")";
-  return Fmt("%.3f", est) + " (" + Fmt("%+.2f", 100.0 * (est - truth) / truth) + " %)";
+  if (absolute) return FormatNumber("%.3f", est) + " (" + FormatNumber("%+.3f", est - truth) + ")";
+  return FormatNumber("%.3f", est) + " (" + FormatNumber("%+.2f", 100.0 * (est - truth) / truth) + " %)";
 }
 
 std::string ParamTable(const std::vector<Table5Entry>& entries, bool human) {
@@ -49,8 +44,8 @@ std::string ParamTable(const std::vector<Table5Entry>& entries, bool human) {
   for (const Table5Entry& e : entries) {
     const LumpedParams& t = human ? *e.truth.human : e.truth.exo;
     const LumpedParams& i = human ? *e.identified.human : e.identified.exo;
-    s += "| " + e.subject + " truth | " + Fmt("%.2f", t.J1) + " | " + Fmt("%.2f", t.J2) + " | " + Fmt("%.2f", t.X1) +
-         " | " + Fmt("%.2f", t.X2) + " | " + Fmt("%.2f", t.Y1) + " | " + Fmt("%.2f", t.Y2) + " |\n";
+    s += "| " + e.subject + " truth | " + FormatNumber("%.2f", t.J1) + " | " + FormatNumber("%.2f", t.J2) + " | " + FormatNumber("%.2f", t.X1) +
+         " | " + FormatNumber("%.2f", t.X2) + " | " + FormatNumber("%.2f", t.Y1) + " | " + FormatNumber("%.2f", t.Y2) + " |\n";
     s += "| " + e.subject + " identified | " + Compare(i.J1, t.J1, false) + " | " + Compare(i.J2, t.J2, false) +
          " | " + Compare(i.X1, t.X1, false) + " | " + Compare(i.X2, t.X2, false) + " | " +
          Compare(i.Y1, t.Y1, true) + " | " + Compare(i.Y2, t.Y2, true) + " |\n";
@@ -88,7 +83,7 @@ std::pair<double, double> GaitTorqueRmse(const MeasuredData& gait, const LegPara
     s2[1] += e_knee * e_knee;
     ++n;
   }
-  if (n == 0) throw InputError(gait.source + ": no sample in t = " + Fmt("%.3f", t_from) + " .. " + Fmt("%.3f", t_to) + " s");
+  if (n == 0) throw InputError(gait.source + ": no sample in t = " + FormatNumber("%.3f", t_from) + " .. " + FormatNumber("%.3f", t_to) + " s");
   return {std::sqrt(s2[0] / n), std::sqrt(s2[1] / n)};
 }
 
@@ -122,9 +117,14 @@ std::string Table5Markdown(const std::vector<Table5Entry>& entries, const std::s
   std::string s = header.empty() ? "" : header + "\n\n";
   s += "## Table 5: RMS error (N m) of the predicted vs measured torque, relaxed gait at 2 km/h\n\n";
   s += "Columns: identified / De Leva / Dempster human parameters (exoskeleton identified in all three).\n\n";
-  s += "| subject | hip twin | hip paper | knee twin | knee paper |\n| --- | --- | --- | --- | --- |\n";
+  s += "Ratio: twin / paper per set.\n\n";
+  s += "| subject | hip twin | hip paper | knee twin | knee paper | hip ratio | knee ratio |\n"
+       "| --- | --- | --- | --- | --- | --- | --- |\n";
   auto tri = [](const Table5JointRmse& r) {
     return Cell(r.identified) + " / " + Cell(r.deleva) + " / " + Cell(r.dempster);
+  };
+  auto over = [](const Table5JointRmse& t, const Table5JointRmse& p) {
+    return Cell(t.identified / p.identified) + " / " + Cell(t.deleva / p.deleva) + " / " + Cell(t.dempster / p.dempster);
   };
   Table5JointRmse tm[2], pm[2];  // means: twin, paper (hip, knee)
   int np = 0;
@@ -145,14 +145,16 @@ std::string Table5Markdown(const std::vector<Table5Entry>& entries, const std::s
       tm[j].deleva += t.deleva;
       tm[j].dempster += t.dempster;
     }
-    s += "| " + e.subject + " | " + tri(e.hip) + " | " + tri(ph) + " | " + tri(e.knee) + " | " + tri(pk) + " |\n";
+    s += "| " + e.subject + " | " + tri(e.hip) + " | " + tri(ph) + " | " + tri(e.knee) + " | " + tri(pk) + " | " +
+         over(e.hip, ph) + " | " + over(e.knee, pk) + " |\n";
   }
   const double nt = static_cast<double>(entries.size());
   for (int j = 0; j < 2; ++j) {
     for (double* v : {&tm[j].identified, &tm[j].deleva, &tm[j].dempster}) *v /= nt;
     for (double* v : {&pm[j].identified, &pm[j].deleva, &pm[j].dempster}) *v = np ? *v / np : NAN;
   }
-  s += "| mean | " + tri(tm[0]) + " | " + tri(pm[0]) + " | " + tri(tm[1]) + " | " + tri(pm[1]) + " |\n";
+  s += "| mean | " + tri(tm[0]) + " | " + tri(pm[0]) + " | " + tri(tm[1]) + " | " + tri(pm[1]) + " | " +
+       over(tm[0], pm[0]) + " | " + over(tm[1], pm[1]) + " |\n";
   auto ratio = [](const Table5JointRmse& r) {
     return Cell(r.deleva / r.identified, "%.2f") + " / " + Cell(r.dempster / r.identified, "%.2f");
   };
@@ -168,11 +170,11 @@ std::string Table5Markdown(const std::vector<Table5Entry>& entries, const std::s
   s += "J in kg m^2, X and Y in kg m; (relative error for J and X, absolute error for Y).\n\n";
   s += ParamTable(entries, false);
   WorstErrors(entries, false, &jx, &y);
-  s += "\nWorst: J, X " + Fmt("%.2f", jx) + " %, Y " + Fmt("%.4f", y) + " kg m.\n";
+  s += "\nWorst: J, X " + FormatNumber("%.2f", jx) + " %, Y " + FormatNumber("%.4f", y) + " kg m.\n";
   s += "\n## Table 4: human identified (steps 3-4) vs the twin's truth (the paper's Table 4)\n\n";
   s += ParamTable(entries, true);
   WorstErrors(entries, true, &jx, &y);
-  s += "\nWorst: J, X " + Fmt("%.2f", jx) + " %, Y " + Fmt("%.4f", y) + " kg m.\n";
+  s += "\nWorst: J, X " + FormatNumber("%.2f", jx) + " %, Y " + FormatNumber("%.4f", y) + " kg m.\n";
   return s;
 }
 
@@ -186,7 +188,7 @@ std::string Table5Csv(const std::vector<Table5Entry>& entries) {
     PaperEntry(e.subject, &ph, &pk);
     s += e.subject;
     for (const Table5JointRmse* r : {&e.hip, &e.knee, static_cast<const Table5JointRmse*>(&ph), static_cast<const Table5JointRmse*>(&pk)})
-      for (double v : {r->identified, r->deleva, r->dempster}) s += "," + (std::isfinite(v) ? Fmt("%.4f", v) : "");
+      for (double v : {r->identified, r->deleva, r->dempster}) s += "," + (std::isfinite(v) ? FormatNumber("%.4f", v) : "");
     s += "\n";
   }
   return s;

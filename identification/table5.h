@@ -44,8 +44,9 @@ std::vector<LegParams> Table5ParameterSets(const LegParams& identified, double w
 void ComputeTable5Rmse(const MeasuredData& gait, double t_from, double t_to, double weight, double L2,
                        Table5Entry* entry);
 
-// Human-readable side-by-side text (Markdown tables): Table 5 twin vs paper per subject, the means
-// and the mean ratios anthropometric / identified; Tables 3-4 identified vs truth per subject.
+// Human-readable side-by-side text (Markdown tables): Table 5 twin vs paper per subject with the ratio
+// twin / paper of each set, the means and the mean ratios anthropometric / identified; Tables 3-4
+// identified vs truth per subject.
 std::string Table5Markdown(const std::vector<Table5Entry>& entries, const std::string& header);
 
 // CSV of Table 5: subject, then twin_* and paper_* RMS errors per joint and parameter set.

@@ -2,6 +2,8 @@
 // (scenarios/identification/*.yaml through RunScenario: plant, virtual CAN, joint modules, the real
 // controller), least squares in-process (identification/identification.h: exo, then human), then relaxed
 // passive-mode gait at 2 km/h (scenarios/gait_2kmh.yaml) and the RMS errors of identification/table5.h.
+// Optionally with plant effects in every scenario (a realistic EXOwheel, data/plants/) and the
+// discrepancy analysis (diagnosis/diagnose.h) of the twin's own records with the identified model.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "identification/table5.h"
+#include "model/lumped_params.h"
 
 namespace exotwin {
 
@@ -20,19 +23,53 @@ struct Table5Options {
   std::string out_dir = "out/table5"; // DIR/<subject>/step{1..4}, DIR/<subject>/gait, model files
   std::string scenario_dir;           // holds identification/step*.yaml and gait_2kmh.yaml ("" = shipped)
   bool keep_logs = true;              // false: the step and gait CSVs are deleted after use
+  // Plant effects (DESIGN.md "Effects in the forward plant"), each from a model file's effect list
+  // (its parameters are not used), added to those of the scenarios themselves:
+  std::string plant_file;       // the device's: every scenario (steps 1-4 and gait); "" = none
+  std::string plant_worn_file;  // the worn leg's: where the subject wears the exoskeleton (steps 3-4, gait)
+  bool diagnose = false;        // diagnose the gait and the steps 3-4 records with the identified model
   std::function<void(const std::string&)> log;  // progress lines (may be empty)
+};
+
+// `diagnose` (diagnosis/diagnose.h, default options) on one set of a subject's records, with the
+// identified rigid model (Table5Entry::identified, passive riener1999, no effects).
+struct Table5Diagnosis {
+  std::string records;                  // "gait" or "steps 3-4"
+  bool done = false;
+  std::string error;                    // why not done (the InputError's message)
+  std::vector<Effect> named;            // the effects named, with their 95 % intervals in `ci`
+  std::vector<std::pair<double, double>> ci;
+  std::vector<std::string> not_identifiable;  // candidates these records cannot identify
+  double cutoff_hz = 0;
+  double rmse_before[2] = {0, 0}, rmse_after[2] = {0, 0};  // held-out, N m: identified vs extended twin
 };
 
 // Outcome of one subject: the entry of Table 5 and every scenario check that failed ("step: name").
 struct Table5SubjectRun {
   Table5Entry entry;
   std::vector<std::string> failed_checks;
+  std::vector<Table5Diagnosis> diagnoses;  // opt.diagnose: gait, then steps 3-4
   double wall_s = 0;
 };
 
 // Runs steps 1-4, identification and gait for one preset subject. Writes DIR/<subject>/exo.yaml and
 // subject.yaml (identified). Throws InputError on bad options, SimulationError on divergence.
 Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Options& opt);
+
+// The effects of the plant a scenario of the protocol carries on top of its own: the device's in every
+// scenario, plus the worn leg's where `worn` (steps 3-4, gait). Reads the files (InputError naming a
+// missing or bad file, or an effect the plant cannot carry: sim/plant_effects.h).
+std::vector<Effect> Table5PlantEffects(const Table5Options& opt, bool worn);
+
+// Markdown of the plant's effects against what diagnose named per subject (value, % of the set value
+// at that joint and name), the held-out errors of the identified and the extended twin beside the
+// paper's Table 5, and the candidates said not identifiable.
+std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<Table5SubjectRun>& runs);
+
+// JSON of the diagnoses: {"subjects": [{"subject", "diagnoses": [{"records", "done", "error",
+// "cutoff_hz", "effects": [{"name", "joint", "value", "unit", "ci95"}], "not_identifiable",
+// "heldout": {"hip": {"rmse_before", "rmse_after"}, "knee": {...}}}]}]}.
+std::string Table5DiagnosisJson(const std::vector<Table5SubjectRun>& runs);
 
 // The shipped scenarios folder: scenarios/ of the data folder (core/data_dir.h).
 std::string ShippedScenarioDir();
