@@ -629,11 +629,6 @@ void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const 
     S.note = "not simulated (DiagnoseOptions::simulate off)";
     return;
   }
-  if (params.one_joint) {
-    S.note = "not simulated: the forward replay takes two-joint models only (a one-joint model's hip is "
-             "held only in its inverse dynamics)";
-    return;
-  }
   // A plant carrying `model`'s effects; false (and S.note) when it cannot carry them.
   auto Make = [&](const LegParams& model, const std::string& which, std::unique_ptr<Plant>* plant,
                   PlantEffects* fx) {
