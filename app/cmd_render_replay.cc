@@ -81,15 +81,17 @@ struct SimLeg {
   std::vector<bool> covered;          // the replay has the sample (else the ghost takes the measured pose)
 };
 
-// Reads DIR/replay.csv (t, q_hip_sim, q_knee_sim, record) of one record. The rows must lie within
-// the measured record's time range (1.5 median steps of slack); the angles are linearly interpolated
-// onto the measured times within the replay's first..last row, the samples outside are not covered.
+// Reads DIR/replay.csv (t, q_hip_sim, q_knee_sim, record) of one record; of a one-joint record, t,
+// q_knee_sim (the hip held at 0, as the replay held it). The rows must lie within the measured
+// record's time range (1.5 median steps of slack); the angles are linearly interpolated onto the
+// measured times within the replay's first..last row, the samples outside are not covered.
 SimLeg ReadSimLeg(const std::string& path, const MeasuredData& data) {
   const CsvTable p = ReadCsv(path);
   for (const char* n : {"t", "q_hip_sim", "q_knee_sim"})
-    if (p.Find(n) < 0)
+    if (p.Find(n) < 0 && !(data.one_joint && std::string(n) == "q_hip_sim"))
       throw InputError(path + ": missing column '" + n + "' (expected a `replay` output: t, q_hip, q_hip_sim, "
-                       "q_knee, q_knee_sim, window, record)");
+                       "q_knee, q_knee_sim, window, record; of a one-joint record t, q_knee, q_knee_sim, window, "
+                       "record)");
   const std::vector<double>& t = p.columns[p.Find("t")];
   if (t.size() < 2) throw InputError(path + ": needs at least 2 rows");
   if (const int rec = p.Find("record"); rec >= 0)
@@ -106,7 +108,8 @@ SimLeg ReadSimLeg(const std::string& path, const MeasuredData& data) {
                      "] s, outside the measurement's [" + std::to_string(data.t().front()) + ", " +
                      std::to_string(data.t().back()) + "] s: not a replay of this record");
   SimLeg leg;
-  leg.q_hip = Interpolate(t, p.columns[p.Find("q_hip_sim")], data.t());
+  leg.q_hip = data.one_joint ? std::vector<double>(data.size(), 0.0)
+                             : Interpolate(t, p.columns[p.Find("q_hip_sim")], data.t());
   leg.q_knee = Interpolate(t, p.columns[p.Find("q_knee_sim")], data.t());
   leg.covered.resize(data.size());
   for (size_t i = 0; i < data.size(); ++i)

@@ -21,6 +21,19 @@
 namespace exotwin {
 namespace {
 
+// " hip X rad (Y deg), knee X rad (Y deg)" from joint j0 on (1: the knee of a one-joint device).
+std::string ErrorText(const ReplayScore& score, int j0) {
+  const char* names[2] = {"hip", "knee"};
+  std::string out;
+  char buf[96];
+  for (int j = j0; j < 2; ++j) {
+    std::snprintf(buf, sizeof buf, "%s %s %.4f rad (%.2f deg)", j > j0 ? "," : "", names[j], score.Rmse(j),
+                  score.Rmse(j) * 180 / M_PI);
+    out += buf;
+  }
+  return out;
+}
+
 CommandRunner RegisterReplay(CLI::App& app) {
   struct Opts {
     std::string params, out, map, mjcf, input = "torque";
@@ -50,9 +63,6 @@ CommandRunner RegisterReplay(CLI::App& app) {
     if (!(o->cutoff > 0) || !std::isfinite(o->cutoff))
       throw InputError("replay --cutoff: expected a frequency > 0 Hz, got " + std::to_string(o->cutoff));
     const LegParams params = ReadModelFile(o->params);
-    if (params.one_joint)
-      throw InputError(o->params + ": a one-joint model file; replay takes two-joint model files (hip and knee) "
-                       "for now");
     PlantEffects fx;
     const std::unique_ptr<Plant> twin = MakeReplayPlant(params, o->params, o->mjcf, &fx);
     Plant& plant = *twin;
@@ -64,6 +74,7 @@ CommandRunner RegisterReplay(CLI::App& app) {
       MapReport report;
       const MeasuredData data = ReadMeasured(m, o->map, 20, &report);
       if (!o->map.empty()) std::fprintf(stderr, "replay: %s", report.Summary().c_str());
+      CheckRecordFitsModel(params, o->params, data);
       if (params.human) CheckHumanJointRange(data);
       if (data.t().back() - data.t().front() < o->horizon)
         throw InputError(m + ": --horizon " + std::to_string(o->horizon) + " s is longer than the record (" +
@@ -75,12 +86,13 @@ CommandRunner RegisterReplay(CLI::App& app) {
     ReplayScore total;
     nlohmann::json records = nlohmann::json::array();
     const char* names[2] = {"hip", "knee"};
+    const int j0 = params.one_joint ? 1 : 0;  // a one-joint device (its hip held at 0) reports its knee only
     for (size_t r = 0; r < series.size(); ++r) {
       const ReplaySeries& s = series[r];
       const ReplayRecord rec = Replay(plant, s, o->horizon);
       total.Add(rec.score);
       nlohmann::json x = {{"source", s.source}, {"windows", rec.score.windows}, {"samples", rec.score.count}};
-      for (int j = 0; j < 2; ++j) x["joints"][names[j]] = {{"rmse_rad", rec.score.Rmse(j)}};
+      for (int j = j0; j < 2; ++j) x["joints"][names[j]] = {{"rmse_rad", rec.score.Rmse(j)}};
       records.push_back(x);
       for (size_t i = 0; i < s.t.size(); ++i) {
         if (rec.window[i] < 0) continue;
@@ -92,9 +104,8 @@ CommandRunner RegisterReplay(CLI::App& app) {
         col_w.push_back(rec.window[i]);
         col_r.push_back(static_cast<double>(r));
       }
-      std::printf("replay: %s: %zu windows of %g s, RMS angle error hip %.4f rad (%.2f deg), knee %.4f rad (%.2f deg)\n",
-                  s.source.c_str(), rec.score.windows, o->horizon, rec.score.Rmse(0), rec.score.Rmse(0) * 180 / M_PI,
-                  rec.score.Rmse(1), rec.score.Rmse(1) * 180 / M_PI);
+      std::printf("replay: %s: %zu windows of %g s, RMS angle error%s\n", s.source.c_str(), rec.score.windows,
+                  o->horizon, ErrorText(rec.score, j0).c_str());
     }
     nlohmann::json j = {{"horizon_s", o->horizon},
                         {"windows", total.windows},
@@ -103,19 +114,23 @@ CommandRunner RegisterReplay(CLI::App& app) {
                                               std::to_string(o->cutoff) + " Hz and its velocity (central differences)"},
                         {"joint_limits", "disabled (and the actuators' ctrlrange)"},
                         {"records", records}};
-    for (int k = 0; k < 2; ++k) j["joints"][names[k]] = {{"rmse_rad", total.Rmse(k)}};
+    if (params.one_joint) j["one_joint"] = true;
+    for (int k = j0; k < 2; ++k) j["joints"][names[k]] = {{"rmse_rad", total.Rmse(k)}};
 
     if (mkdir(o->out.c_str(), 0755) != 0 && errno != EEXIST)
       throw InputError(o->out + ": cannot create the output folder: " + std::strerror(errno));
-    WriteCsv(o->out + "/replay.csv", {"t", "q_hip", "q_hip_sim", "q_knee", "q_knee_sim", "window", "record"},
-             {&col_t, &col_q[0], &col_sim[0], &col_q[1], &col_sim[1], &col_w, &col_r},
+    std::vector<std::string> csv_names = {"t", "q_hip", "q_hip_sim", "q_knee", "q_knee_sim", "window", "record"};
+    std::vector<const std::vector<double>*> csv_cols = {&col_t, &col_q[0], &col_sim[0], &col_q[1], &col_sim[1], &col_w, &col_r};
+    if (params.one_joint) {  // no hip columns
+      csv_names.erase(csv_names.begin() + 1, csv_names.begin() + 3);
+      csv_cols.erase(csv_cols.begin() + 1, csv_cols.begin() + 3);
+    }
+    WriteCsv(o->out + "/replay.csv", csv_names, csv_cols,
              {"exotwin replay: measured and simulated angles (rad); window: restart index in its record; "
               "record: index of --measured",
               "params: " + o->params + ", horizon " + std::to_string(o->horizon) + " s, input " + o->input});
     WriteFileAtomic(o->out + "/replay.json", j.dump(2) + "\n");
-    std::printf("replay: %zu windows of %g s, RMS angle error hip %.4f rad (%.2f deg), knee %.4f rad (%.2f deg)\n",
-                total.windows, o->horizon, total.Rmse(0), total.Rmse(0) * 180 / M_PI, total.Rmse(1),
-                total.Rmse(1) * 180 / M_PI);
+    std::printf("replay: %zu windows of %g s, RMS angle error%s\n", total.windows, o->horizon, ErrorText(total, j0).c_str());
     return 0;
   };
 }

@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -301,6 +302,33 @@ std::vector<Eigen::VectorXd> KitchenSinkResiduals(const std::vector<ColumnBank>&
   const Eigen::VectorXd c = Gr.ldlt().solve(br);
   std::vector<Eigen::VectorXd> out;
   for (const ColumnBank& b : banks) out.push_back(b.r - b.X * c);
+  return out;
+}
+
+// Stage 3d: every record's ceiling (RecordScore::ceiling): all candidate columns at once fitted on
+// that record's bank alone, each effect's value of the sign its range allows (coulomb, viscous,
+// backlash, series_compliance's 1/k, sensor_delay, joint_stiffness >= 0; the others free: a
+// relaxation of DESIGN.md's ranges, so the ceiling bounds any in-range combination), scored on its
+// fit rows against the residual of the model given (weights undone; a joint of weight 0, a
+// one-joint device's held hip, scores 0).
+std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]) {
+  static const std::set<std::string> kNonNegative = {"coulomb_friction", "viscous_friction", "backlash",
+                                                     "series_compliance", "sensor_delay", "joint_stiffness"};
+  std::vector<std::array<JointScore, 2>> out(banks.size());
+  for (size_t r = 0; r < banks.size(); ++r) {
+    const ColumnBank& b = banks[r];
+    std::vector<bool> nonneg(static_cast<size_t>(b.X.cols()), false);
+    for (const Candidate& c : b.candidates)
+      if (kNonNegative.count(c.name)) nonneg[static_cast<size_t>(c.cols[0])] = true;
+    const Eigen::VectorXd e = b.r - b.X * SignConstrainedLeastSquares(b.X, b.r, nonneg);
+    const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
+    for (int j = 0; j < 2; ++j) {
+      if (!(w[j] > 0) || m == 0) continue;
+      const double before = b.r.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
+      const double after = e.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
+      out[r][j] = ScoreOf(before, after, static_cast<double>(m));
+    }
+  }
   return out;
 }
 
@@ -629,11 +657,6 @@ void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const 
     S.note = "not simulated (DiagnoseOptions::simulate off)";
     return;
   }
-  if (params.one_joint) {
-    S.note = "not simulated: the forward replay takes two-joint models only (a one-joint model's hip is "
-             "held only in its inverse dynamics)";
-    return;
-  }
   // A plant carrying `model`'s effects; false (and S.note) when it cannot carry them.
   auto Make = [&](const LegParams& model, const std::string& which, std::unique_ptr<Plant>* plant,
                   PlantEffects* fx) {
@@ -828,6 +851,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   FilterMeasured(&recs);
   UseSecantDelayColumns(recs, w, &banks);
   if (params.one_joint) KeepJointCandidates(1, &banks);
+  const std::vector<std::array<JointScore, 2>> ceilings = Ceilings(banks, w);
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
   for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
@@ -846,6 +870,8 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("refinement");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  for (size_t r = 0; r < R; ++r)
+    for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r][j];
   // Effects in order of what they explain.
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
     return a.explained_pct > b.explained_pct;

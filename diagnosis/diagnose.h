@@ -69,6 +69,10 @@ struct RecordScore {
   size_t samples = 0;
   JointScore split[2];     // its last 30 %, effects fitted on the first 70 % of every record
   JointScore left_out[2];  // the whole record, effects fitted on the other records (>= 2 records)
+  // The whole record (its fit rows), every candidate column at once fitted on this record alone, in
+  // sample: the least error any combination of the candidate effects, in their columns' linear form
+  // and at any values, reaches on it. Bounds the left-out gain (effects fitted on the other records).
+  JointScore ceiling[2];
   std::vector<Effect> left_out_effects;  // the model's effects and those (>= 2 records)
   // Simulated angle, rigid (before) vs extended (after) twin, rad: the held-out part, and the whole
   // record with left_out_effects; windows 0 where the part is shorter than the horizon.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Cholesky>
+
 #include "diagnosis/effects.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
@@ -290,6 +292,62 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       b.candidates.push_back(c);
     }
   }
+}
+
+Eigen::VectorXd SignConstrainedLeastSquares(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                            const std::vector<bool>& nonneg) {
+  const Eigen::Index C = X.cols();
+  Eigen::MatrixXd G = X.transpose() * X;
+  G.diagonal() += 1e-9 * G.diagonal().cwiseMax(1e-300);
+  const Eigen::VectorXd h = X.transpose() * y;
+  std::vector<bool> passive(static_cast<size_t>(C));
+  for (Eigen::Index k = 0; k < C; ++k) passive[k] = !nonneg[k];
+  auto Solve = [&]() {  // least squares on the passive columns, the others at 0
+    std::vector<Eigen::Index> idx;
+    for (Eigen::Index k = 0; k < C; ++k)
+      if (passive[k]) idx.push_back(k);
+    const Eigen::Index P = static_cast<Eigen::Index>(idx.size());
+    Eigen::MatrixXd Gp(P, P);
+    Eigen::VectorXd hp(P);
+    for (Eigen::Index a = 0; a < P; ++a) {
+      hp[a] = h[idx[a]];
+      for (Eigen::Index c = 0; c < P; ++c) Gp(a, c) = G(idx[a], idx[c]);
+    }
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(C);
+    if (P == 0) return z;
+    const Eigen::VectorXd zp = Gp.ldlt().solve(hp);
+    for (Eigen::Index a = 0; a < P; ++a) z[idx[a]] = zp[a];
+    return z;
+  };
+  Eigen::VectorXd x = Solve();  // feasible: every constrained coefficient at 0
+  const double tol = 1e-12 * std::max(h.cwiseAbs().maxCoeff(), 1e-300);
+  for (Eigen::Index it = 0; it < 3 * C; ++it) {
+    const Eigen::VectorXd grad = h - G * x;  // -(1/2) d|X x - y|^2 / dx
+    Eigen::Index add = -1;
+    double best = tol;
+    for (Eigen::Index k = 0; k < C; ++k)
+      if (nonneg[k] && !passive[k] && grad[k] > best) add = k, best = grad[k];
+    if (add < 0) break;  // the Kuhn-Tucker conditions hold
+    passive[add] = true;
+    for (Eigen::Index inner = 0; inner <= C; ++inner) {
+      const Eigen::VectorXd z = Solve();
+      double alpha = 1;
+      bool feasible = true;
+      for (Eigen::Index k = 0; k < C; ++k)
+        if (nonneg[k] && passive[k] && z[k] <= 0) {
+          feasible = false;
+          alpha = std::min(alpha, x[k] / std::max(x[k] - z[k], 1e-300));
+        }
+      if (feasible) {
+        x = z;
+        break;
+      }
+      x += alpha * (z - x);
+      for (Eigen::Index k = 0; k < C; ++k)
+        if (nonneg[k] && passive[k] && x[k] <= 0) passive[k] = false, x[k] = 0;
+    }
+  }
+  return x;
 }
 
 }  // namespace exotwin

@@ -62,6 +62,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
     for (int k = k0; k < 2; ++k) {
       x["split"][names[k]] = score(r.split[k]);
       if (d.leave_one_out) x["left_out"][names[k]] = score(r.left_out[k]);
+      x["ceiling"][names[k]] = score(r.ceiling[k]);
     }
     j["records"].push_back(x);
   }

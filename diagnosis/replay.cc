@@ -65,6 +65,10 @@ ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, Re
   s.q[1] = data.q_knee();
   const char* names[2] = {"cmd_hip", "cmd_knee"};
   for (int j = 0; j < 2; ++j) {
+    if (j == 0 && data.one_joint) {  // no hip: the embedding's held hip gets no command
+      s.tau_R[0].assign(s.t.size(), 0.0);
+      continue;
+    }
     const std::vector<double>* c = data.Column(names[j]);
     if (!c)
       throw InputError(data.source + ": --input command needs the column '" + names[j] +
@@ -91,6 +95,7 @@ std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::strin
   plant->SetParams(params);
   plant->CarryEffects(effects);
   plant->FreeJointsAndTorque();
+  if (params.one_joint) plant->HoldHip();  // the embedding's hip (model/one_joint.h)
   if (fx) *fx = effects;
   return plant;
 }

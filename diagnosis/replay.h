@@ -45,8 +45,9 @@ void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>
                                const std::vector<double> tau_S[2], std::vector<double> tau_R[2]);
 
 // The series of a record: t, q (measured), restart state at cutoff_hz, and the input (kTorque: from
-// tau_hip/tau_knee through ActuatorTorqueFromReading; kCommand: cmd_hip/cmd_knee). Throws InputError
-// naming the record for --input command without cmd_* columns.
+// tau_hip/tau_knee through ActuatorTorqueFromReading; kCommand: cmd_hip/cmd_knee, cmd_knee alone for a
+// one-joint record, whose held hip is given 0). Throws InputError naming the record for --input command
+// without those columns.
 ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, ReplayInput input, double cutoff_hz);
 // The same from kinematics and a measured reading (diagnose's records).
 ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
@@ -73,7 +74,8 @@ struct ReplayRecord {
 // The plant a replay drives: the MJCF `mjcf` (empty: the shipped EXOwheel model, with or without the
 // human by params) realizing params, carrying its effects (ToPlantEffects: InputError naming `source`
 // for an effect the plant cannot carry; *fx receives them when given) with joint limits and torque
-// clamping off (Plant::FreeJointsAndTorque).
+// clamping off (Plant::FreeJointsAndTorque); a one-joint model's plant holds its hip at 0 (Plant::HoldHip),
+// its knee following HKS05 eq. 4 with the device's R, C and the knee's effects.
 std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::string& source, const std::string& mjcf = "",
                                        PlantEffects* fx = nullptr);
 

@@ -246,6 +246,7 @@ Eigen::Vector2d Plant::InverseDynamics(const Eigen::Vector2d& q, const Eigen::Ve
   if (!fx_.link_empty())
     for (int j = 0; j < 2; ++j)
       tau[j] -= fx_.armature[j] * qdd[j] + fx_.damping[j] * qd[j] + fx_.stiffness[j] * (q[j] - fx_.springref[j]);
+  if (hip_held_) tau[0] -= kHeldHipArmature * qdd[0];  // the rigid twin's hip (HoldHip's armature is no body's)
   if (params_.human) tau += PassiveElasticTorque(params_.passive, q);
   return tau;
 }
@@ -259,7 +260,7 @@ void Plant::CarryEffects(const PlantEffects& fx) {
       // so that its stiction zone around qd = 0 is as narrow as the step allows.
       m_->dof_solref[mjNREF * dof] = fx.frictionloss[j] > 0 ? 2 * m_->opt.timestep : base_solref_[j];
       m_->dof_damping[dof] = base_damping_[j] + fx.damping[j];
-      m_->dof_armature[dof] = base_armature_[j] + fx.armature[j];
+      m_->dof_armature[dof] = base_armature_[j] + fx.armature[j] + (j == 0 && hip_held_ ? kHeldHipArmature : 0.0);
       if (fx.stiffness[j] != 0) {
         m_->jnt_stiffness[jnt] = base_stiffness_[j] + fx.stiffness[j];
         m_->qpos_spring[m_->jnt_qposadr[jnt]] = fx.springref[j];
@@ -277,12 +278,21 @@ void Plant::FreeJointsAndTorque() {
   m_->opt.disableflags |= mjDSBL_LIMIT | mjDSBL_CLAMPCTRL;
 }
 
+void Plant::HoldHip() {
+  hip_held_ = true;
+  m_->dof_armature[hip_dof_] = base_armature_[0] + fx_.armature[0] + kHeldHipArmature;
+  d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0;
+  d_->qvel[hip_dof_] = 0;
+  mj_forward(m_, d_);
+}
+
 void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t) {
   mj_resetData(m_, d_);
   d_->qpos[0] = q[0];
   d_->qpos[1] = q[1];
   d_->qvel[0] = qd[0];
   d_->qvel[1] = qd[1];
+  if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;
   d_->time = t;
   mj_forward(m_, d_);
   CheckDivergence("reset");
@@ -301,6 +311,7 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   d_->ctrl[0] = tau_R[0];
   d_->ctrl[1] = tau_R[1];
   mj_step(m_, d_);
+  if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;
   CheckDivergence("step");
 }
 

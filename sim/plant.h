@@ -57,6 +57,16 @@ class Plant {
   // its joints turn beyond the EXOwheel's range and its motors beyond the EXOwheel's torque).
   void FreeJointsAndTorque();
 
+  // Holds the hip at 0 in the forward simulation (a one-joint device embedded in the two-link model,
+  // model/one_joint.h): the hip's dof gets the armature kHeldHipArmature, so that its acceleration
+  // under any torque of the leg (|tau| < 1e3 N m) is below 1e-6 rad/s^2 and the knee row of
+  // M qdd = tau - c - g is the knee's alone (M21 qdd1 ~ 1e-6 of M22 qdd2); after every step the hip's
+  // angle and velocity are set back to 0. Reset ignores the hip's q and qd given. The knee then
+  // follows HKS05 eq. 4: I qdd + mgl sin q = tau (+ the knee's carried effects).
+  void HoldHip();
+  bool hip_held() const { return hip_held_; }
+  static constexpr double kHeldHipArmature = 1e9;  // kg m^2
+
   // Actuator torque tau_R (N m) for a relaxed subject: MuJoCo's rigid inverse dynamics (mj_inverse,
   // joint limits, frictionloss and carried effects excluded) plus the passive elastic torque P(q).
   // Does not change the simulation state.
@@ -95,6 +105,7 @@ class Plant {
   double base_frictionloss_[2] = {0, 0}, base_damping_[2] = {0, 0}, base_armature_[2] = {0, 0};
   double base_stiffness_[2] = {0, 0}, base_springref_[2] = {0, 0}, base_solref_[2] = {0, 0};
   int hip_jnt_ = -1, knee_jnt_ = -1;
+  bool hip_held_ = false;
 };
 
 }  // namespace exotwin

@@ -128,6 +128,24 @@ TEST_F(RenderReplayCli, GhostLegsFromReplayFiles) {
   EXPECT_EQ(RedPixels(plain_frame), 0);
 }
 
+// A one-joint record (the shipped pendulum) with its one-joint `replay` output (t, q_knee, q_knee_sim,
+// window, record): the ghost's hip is the held 0. A two-joint record refuses that file.
+TEST_F(RenderReplayCli, GhostLegOfAOneJointReplay) {
+  const std::string pendulum = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/simple_pendulum/";
+  const std::string args = " --params " + pendulum + "model.yaml --measured " + pendulum +
+                           "pd_system_identification.csv --map " + pendulum + "dfki_simple_pendulum.map.yaml";
+  const auto rep = RunExotwin("replay" + args + " --horizon 1 --out " + dir_ + "/one");
+  ASSERT_EQ(rep.exit_code, 0) << rep.output;
+  const auto r = RunExotwin("render-replay" + args + " --sim " + dir_ + "/one/replay.csv --width 160 --height 96 "
+                            "--fps 2 -o " + dir_ + "/one.mp4");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_GT(DecodedFrames(dir_ + "/one.mp4"), 5);
+  const auto two = RunExotwin(Args(dir_ + "/x.mp4") + " --sim " + dir_ + "/one/replay.csv");
+  EXPECT_EQ(two.exit_code, 2) << two.output;
+  EXPECT_NE(two.output.find(dir_ + "/one/replay.csv: missing column 'q_hip_sim'"), std::string::npos) << two.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/x.mp4"));
+}
+
 TEST_F(RenderReplayCli, SimFileWithoutSimulatedAnglesIsRefused) {
   WriteText(dir_ + "/bad.csv", "t,q_hip,q_hip_sim,q_knee\n0,0,0,0\n0.001,0,0,0\n");
   const auto r = RunExotwin(Args(dir_ + "/x.mp4") + " --sim " + dir_ + "/bad.csv");

@@ -105,14 +105,49 @@ TEST_F(ReplayCli, AnEffectThePlantCannotCarry) {
                  "m.yaml: effects[1] (backlash, knee): the forward plant cannot carry");
 }
 
-// A one-joint model file (DESIGN.md "One-joint devices") is refused by name: the forward replay takes
-// two-joint models for now.
-TEST_F(ReplayCli, AOneJointModelIsRefused) {
+// A one-joint model file (DESIGN.md "One-joint devices") replays a one-joint record: the embedding's
+// hip held, the files carry the knee alone (no hip columns or keys). The makers' nominal point mass
+// against the README's reference fit (I 0.177, mgl 3.53, R 0.002, C 0.15) on the shipped record.
+TEST_F(ReplayCli, AOneJointModelReplaysAOneJointRecord) {
   const std::string pendulum = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/simple_pendulum/";
-  const std::string model = pendulum + "model.yaml";
-  ExpectBadInput(RunExotwin("replay --params " + model + " --measured " + pendulum + "pd_system_identification.csv" +
+  auto Run = [&](const std::string& model, const std::string& out) {
+    return RunExotwin("replay --params " + model + " --measured " + pendulum + "pd_system_identification.csv" +
+                      " --map " + pendulum + "dfki_simple_pendulum.map.yaml --out " + dir_ + "/" + out);
+  };
+  const auto nominal = Run(pendulum + "model.yaml", "nominal");
+  ASSERT_EQ(nominal.exit_code, 0) << nominal.output;
+  EXPECT_EQ(nominal.output.find("hip"), std::string::npos) << nominal.output;
+  WriteText(dir_ + "/fit.yaml", "joint: knee\ndevice: {I: 0.177, mgl: 3.53, R: 0.002, C: 0.15}\neffects: []\n");
+  const auto fit = Run(dir_ + "/fit.yaml", "fit");
+  ASSERT_EQ(fit.exit_code, 0) << fit.output;
+  const auto a = nlohmann::json::parse(std::ifstream(dir_ + "/nominal/replay.json"));
+  const auto b = nlohmann::json::parse(std::ifstream(dir_ + "/fit/replay.json"));
+  EXPECT_EQ(a["one_joint"], true);
+  EXPECT_EQ(a["windows"], 7);  // 3.9 s of record
+  EXPECT_FALSE(a["joints"].contains("hip"));
+  EXPECT_FALSE(a["records"][0]["joints"].contains("hip"));
+  const double before = a["joints"]["knee"]["rmse_rad"], after = b["joints"]["knee"]["rmse_rad"];
+  std::printf("knee: nominal %.2f deg, reference fit %.2f deg\n", before * 57.2958, after * 57.2958);
+  EXPECT_GT(before, 0.02);  // measured 2.93 deg
+  EXPECT_LT(after, before);  // measured 2.80 deg
+  const CsvTable t = ReadCsv(dir_ + "/fit/replay.csv");
+  EXPECT_EQ(t.names, (std::vector<std::string>{"t", "q_knee", "q_knee_sim", "window", "record"}));
+  EXPECT_EQ(t.columns[3].back(), 6);
+}
+
+// A record with both joints given a one-joint model file, and a one-joint record given a two-joint
+// one: exit 2 naming the record and the model file.
+TEST_F(ReplayCli, ARecordOfTheOtherKindIsRefused) {
+  const std::string pendulum = std::string(EXOTWIN_SOURCE_DIR) + "/examples/real_rig/simple_pendulum/";
+  const std::string one = pendulum + "model.yaml";
+  ExpectBadInput(RunExotwin("replay --params " + one + " --measured " + kRecord + " --map " + kMap + " --out " + dir_ +
+                            "/out"),
+                 "trajectory_05.csv: a record with hip columns (q_hip, tau_hip, ...) given the one-joint model file " + one);
+  WriteText(dir_ + "/m.yaml", RigModel("[]"));
+  ExpectBadInput(RunExotwin("replay --params " + dir_ + "/m.yaml --measured " + pendulum + "pd_system_identification.csv" +
                             " --map " + pendulum + "dfki_simple_pendulum.map.yaml --out " + dir_ + "/out"),
-                 model + ": a one-joint model file; replay takes two-joint model files");
+                 "pd_system_identification.csv: a one-joint record (q_knee, tau_knee, no hip column) given the two-joint "
+                 "model file " + dir_ + "/m.yaml");
 }
 
 }  // namespace

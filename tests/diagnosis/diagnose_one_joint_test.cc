@@ -133,6 +133,13 @@ GeneratedData Hal3Record(const LegParams& base, uint64_t seed, int effects, cons
   return GenerateMeasured(base, g);
 }
 
+// The torque analysis alone (the forward replay is checked on the single effects).
+DiagnoseOptions TorqueOnly() {
+  DiagnoseOptions o;
+  o.simulate = false;
+  return o;
+}
+
 // Every effect of DESIGN.md's table hidden alone in a HAL-3 twin record: named, at its value within
 // 15 %, the only one named.
 TEST(OneJointHiddenEffect, EverySingleEffectIsNamedAtItsValue) {
@@ -154,6 +161,18 @@ TEST(OneJointHiddenEffect, EverySingleEffectIsNamedAtItsValue) {
       EXPECT_LE(err, 0.15) << name << " seed " << seed;
       EXPECT_EQ(d.effects.size(), 1u) << name << " seed " << seed;
       EXPECT_GE(d.joints[1].gain_pct, 50) << name << " seed " << seed;
+      // The record's ceiling (every candidate fitted on it, in sample) holds at least the effect.
+      EXPECT_GE(d.records[0].ceiling[1].gain_pct, 50) << name << " seed " << seed;
+      EXPECT_EQ(d.records[0].ceiling[0].rmse_before, 0.0);  // the held hip is no data
+      // The forward replay of the held-out part (the one-joint plant, its hip held): a hidden friction
+      // the extended twin carries is felt in the simulated knee angle; the hip is no data.
+      if (name == "coulomb_friction" || name == "viscous_friction") {
+        std::printf("%-18s simulated knee %.4f -> %.4f rad (%.1f %%)\n", "", d.simulation.split[1].rmse_before,
+                    d.simulation.split[1].rmse_after, d.simulation.split[1].gain_pct);
+        EXPECT_TRUE(d.simulation.done) << d.simulation.note;
+        EXPECT_GE(d.simulation.split[1].gain_pct, 30) << name << " seed " << seed;
+        EXPECT_EQ(d.simulation.split[0].rmse_before, 0.0);
+      }
     }
   }
 }
@@ -166,7 +185,7 @@ TEST(OneJointHiddenEffect, PairsAreNamed) {
     const GeneratedData data = Hal3Record(base, 500 + s, 2, {});
     const Effect& a = data.truth.effects[data.truth.effects.size() - 2];
     const Effect& b = data.truth.effects.back();
-    const Diagnosis d = Diagnose(base, data.data);
+    const Diagnosis d = Diagnose(base, data.data, TorqueOnly());
     const bool ok = Find(d, a) && Find(d, b);
     both += ok;
     std::printf("pair seed %d: %s = %g + %s = %g: found", 500 + s, a.name.c_str(), a.value, b.name.c_str(), b.value);
@@ -180,7 +199,7 @@ TEST(OneJointHiddenEffect, NothingIsNamedOnCleanRecords) {
   const LegParams base = Hal3Knee();
   const int seeds = EnvInt("EXOTWIN_ONE_JOINT_CLEAN", 10);
   for (int s = 0; s < seeds; ++s) {
-    const Diagnosis d = Diagnose(base, Hal3Record(base, 900 + s, 0, {}).data);
+    const Diagnosis d = Diagnose(base, Hal3Record(base, 900 + s, 0, {}).data, TorqueOnly());
     for (const auto& e : d.effects) ADD_FAILURE() << "clean seed " << 900 + s << ": named " << e.effect.name;
   }
 }
@@ -240,10 +259,21 @@ TEST(OneJointRealRig, PendulumDynamicRecordsNameCoulombFrictionInItsRange) {
   EXPECT_LE(std::abs(I - 0.177), std::abs(0.168875 - 0.177) + 1e-9) << "I " << I;
   EXPECT_LE(std::abs(mgl - 3.53), std::abs(3.3133 - 3.53) + 1e-9) << "mgl " << mgl;
   // ddp_swingup's whole record, predicted by what pd_system_identification alone supports, gains
-  // >= 25 %. (pd_system_identification's whole record is not improved by the reference fit either:
-  // its filtered residual is not in the model's structure.)
+  // >= 25 %.
   ASSERT_EQ(d.records.size(), 2u);
   EXPECT_GE(d.records[1].left_out[1].gain_pct, 25) << d.records[1].source;
+  // pd_system_identification's whole record cannot gain 25 % from any effects fitted elsewhere: every
+  // candidate at once, fitted on it alone with the signs the ranges allow, removes 20.6 % of its
+  // error (measured; the reference fit loses 3.6 %). Its torque is the stiff position controller's
+  // current, chattering (above 20 Hz: 2.1 N m rms against 0.25 on ddp_swingup; spikes of 17 N m)
+  // and sampled at 300 Hz: what leaks into the 4 Hz band is not in the motion.
+  for (const RecordScore& r : d.records) {
+    std::printf("  %s: ceiling %.4f -> %.4f N m (%.1f %%)\n", r.source.c_str(), r.ceiling[1].rmse_before,
+                r.ceiling[1].rmse_after, r.ceiling[1].gain_pct);
+    EXPECT_NEAR(r.ceiling[1].rmse_before, r.left_out[1].rmse_before, 0.01 * r.left_out[1].rmse_before);
+    EXPECT_GE(r.ceiling[1].gain_pct, r.left_out[1].gain_pct) << r.source;
+  }
+  EXPECT_LT(d.records[0].ceiling[1].gain_pct, 25) << d.records[0].source;
 }
 
 TEST(OneJointRealRig, GravityCompensationNamesNoInertia) {

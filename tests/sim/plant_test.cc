@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "model/one_joint.h"
 #include "sim/subjects.h"
 
 namespace exotwin {
@@ -70,6 +71,43 @@ TEST(ExowheelMjcfPath, ChoosesTheModelWithHumanBodiesOnlyWithAHuman) {
   EXPECT_EQ(ExowheelMjcfPath(false), ShippedModelPath("exowheel_exo_only.xml"));
   EXPECT_TRUE(Plant(ExowheelMjcfPath(true)).has_human_bodies());
   EXPECT_FALSE(Plant(ExowheelMjcfPath(false)).has_human_bodies());
+}
+
+// HoldHip: a one-joint device embedded in the two-link model (model/one_joint.h) and driven forward.
+// Reference: HKS05 eq. 4 without friction, I qdd + mgl sin q = tau, integrated by the scheme MuJoCo's
+// Euler uses (qd += h qdd; q += h qd). The knee follows it to 1e-6 rad over 2 s of a 1.5 N m swing
+// (the held hip's coupling is ~1e-8 of the knee's acceleration); the hip stays at exactly 0.
+TEST(PlantHoldHip, TheKneeFollowsHks05Eq4AndTheHipStaysAtZero) {
+  OneJointModel m;
+  m.device = {0.168875, 3.3133};  // the DFKI pendulum's nominal point mass
+  const LegParams params = EmbedOneJointModel(m, 9.81, {});
+  Plant plant(ExowheelMjcfPath(false));
+  plant.SetParams(params);
+  plant.FreeJointsAndTorque();
+  plant.HoldHip();
+  EXPECT_TRUE(plant.hip_held());
+  plant.Reset({0.7, 0.4}, {-1.0, 0.3});  // the hip's state given is ignored
+  EXPECT_EQ(plant.q()[0], 0.0);
+  double q = 0.4, qd = 0.3, worst = 0;
+  const double h = plant.timestep();
+  for (int i = 0; i < 2000; ++i) {
+    const double tau = 1.5 * std::sin(2 * M_PI * 0.8 * plant.time()) + 4.0 * (i > 1000);
+    plant.Step({2.0, tau});  // a hip torque too: held anyway
+    qd += h * (tau - m.device.mgl * std::sin(q)) / m.device.I;
+    q += h * qd;
+    worst = std::max(worst, std::abs(plant.q()[1] - q));
+    ASSERT_EQ(plant.q()[0], 0.0);
+    ASSERT_EQ(plant.qd()[0], 0.0);
+  }
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_GT(std::abs(q - 0.4), 0.5);  // the knee swung
+  // Without the hold the hip swings and the knee leaves the one-joint law.
+  Plant free_hip(ExowheelMjcfPath(false));
+  free_hip.SetParams(params);
+  free_hip.FreeJointsAndTorque();
+  free_hip.Reset({0.0, 0.4}, {0.0, 0.3});
+  for (int i = 0; i < 500; ++i) free_hip.Step({2.0, 0.0});
+  EXPECT_GT(std::abs(free_hip.q()[0]), 0.1);
 }
 
 }  // namespace
