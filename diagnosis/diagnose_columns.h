@@ -37,13 +37,6 @@ struct ColumnBank {
   size_t n = 0;                // samples of the record
 };
 
-// The least squares min |X x - y| with x_k >= 0 where nonneg[k] (the others free): Lawson & Hanson's
-// active-set NNLS (Solving Least Squares Problems, 1974, ch. 23), the free columns always in the
-// passive set, on the normal equations (diagonal regularized by 1e-9 of itself, as the kitchen-sink
-// fit). Returns x (X.cols()).
-Eigen::VectorXd SignConstrainedLeastSquares(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                                            const std::vector<bool>& nonneg);
-
 // Builds every candidate for both joints. tau_S: the twin's prediction (N m) on all samples (its rigid
 // tau_R, ActuatorTorque, is evaluated where a column needs it); resid[j]: measured - predicted
 // tau_S, released (left empty) once the fit rows' values are taken; w[j]: row weights (1/N m);
