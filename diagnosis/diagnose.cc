@@ -321,8 +321,9 @@ std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& b
     for (const Candidate& c : b.candidates)
       if (kNonNegative.count(c.name)) sign[static_cast<size_t>(c.cols[0])] = 1;
     // The normal equations of the columns this record moves (a column of zeros, e.g. a held hip's,
-    // stays at 0), diagonal regularized by 1e-7 of itself: collinear candidates (the kitchen sink of
-    // one record) pass SolveSigned's conditioning test (1e-8) at a cost below 1e-6 of the fit.
+    // stays at 0), diagonal regularized by 1e-6 of itself: collinear candidates (the kitchen sink of
+    // one record, up to ~50 columns) pass SolveSigned's conditioning test (1e-8 of the largest
+    // eigenvalue of the unit-diagonal Gram) at a cost of the order of 1e-6 of the fit.
     std::vector<int> live;
     for (Eigen::Index k = 0; k < b.X.cols(); ++k)
       if (b.X.col(k).squaredNorm() > 0) live.push_back(static_cast<int>(k));
@@ -334,7 +335,7 @@ std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& b
       live_sign[a] = sign[static_cast<size_t>(live[a])];
       for (size_t c = 0; c < live.size(); ++c) G(a, c) = b.X.col(live[a]).dot(b.X.col(live[c]));
     }
-    G.diagonal() += 1e-7 * G.diagonal();
+    G.diagonal() += 1e-6 * G.diagonal();
     Eigen::VectorXd x_live, x = Eigen::VectorXd::Zero(b.X.cols());
     if (!live.empty() && !SolveSigned(G, h, live_sign, &x_live))
       continue;  // columns this record cannot tell apart: no ceiling (scores stay 0, "not measured")
