@@ -21,6 +21,13 @@ namespace exotwin {
 
 namespace {
 
+// The rotor of a dead band or strap without a human: this share of the exoskeleton's J of its joint
+// (Plant::CarryEffects).
+constexpr double kRotorInertiaFraction = 0.05;
+// A strap's damping, as a share of its mode's critical damping: its start-up and impact transients
+// decay within a few of its periods.
+constexpr double kStrapDampingRatio = 0.5;
+
 // The first real number of the model (options and every mjtNum array) that is not finite or is
 // huge (|x| > 1e9, beyond any physical value in SI units here), as "field[i] = value"; "" if none.
 // MuJoCo loads such models (armature="inf", gear="1e300") without complaint, and the twin then
@@ -350,11 +357,15 @@ void Plant::CarryEffects(const PlantEffects& fx) {
       const int jnt = in_jnt_[j], dof = in_v_[j];
       if (structure_.backlash[j]) {
         // The dead band's flanks: limit constraints with MuJoCo's solref time constant at its safe
-        // minimum, 2 steps (as frictionloss), critically damped.
+        // minimum, 2 steps (as frictionloss), critically damped (MuJoCo XML reference, solref/solimp).
         m_->jnt_range[2 * jnt] = -0.5 * fx.backlash[j];
         m_->jnt_range[2 * jnt + 1] = 0.5 * fx.backlash[j];
         m_->jnt_solref[mjNREF * jnt] = 2 * m_->opt.timestep;
         m_->jnt_solref[mjNREF * jnt + 1] = 1.0;
+        // A hard flank: impedance 0.99 .. 0.999 (MuJoCo's default 0.9 .. 0.95 lets the load press the
+        // link 5x deeper past the flank, ~2.6e-4 rad on the development rig's knee at rest).
+        m_->jnt_solimp[mjNIMP * jnt] = 0.99;
+        m_->jnt_solimp[mjNIMP * jnt + 1] = 0.999;
         continue;
       }
       // The strap: stiffness k about springref 0, damped at kStrapDampingRatio of its mode's critical

@@ -54,15 +54,13 @@ class Plant {
   // Without effects (fx.link_empty()) the model is the MJCF's, bit for bit.
   // Backlash and series compliance rebuild the model with internal hinges (sim/internal_joints.h);
   // SetParams must have been called (the rotor's inertia comes out of the exoskeleton's segment).
-  // Their numbers: a rotor body of inertia kRotorInertiaFraction x the exoskeleton's J of that joint
+  // Their numbers (sim/plant.cc): a rotor body of inertia kRotorInertiaFraction x the exoskeleton's J of that joint
   // (at least 4 k dt^2 behind a strap: its mode at most 0.5 / dt rad/s), taken out of the segment so
   // that with the internal hinge held the plant is the rigid one; a dead band's flanks are limit
   // constraints with MuJoCo's solref time constant 2 dt; a strap has stiffness k, springref 0 and
-  // damping kStrapDampingRatio of its mode's critical value. Throws InputError when the rotor cannot
+  // damping kStrapDampingRatio of its mode's critical value (sim/plant.cc). Throws InputError when the rotor cannot
   // be taken out of the segment (no realization left) or a strap's mode is too fast for the step.
   void CarryEffects(const PlantEffects& fx);
-  static constexpr double kRotorInertiaFraction = 0.05;
-  static constexpr double kStrapDampingRatio = 0.5;
   const InternalJoints& internal_joints() const { return structure_; }
   // Internal hinge angle of joint j (rad; 0 without one): the followers' angle is q + internal_q.
   Eigen::Vector2d internal_q() const;

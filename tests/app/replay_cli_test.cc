@@ -101,7 +101,7 @@ TEST_F(ReplayCli, CommandInputWithoutCommandColumns) {
 }
 
 TEST_F(ReplayCli, AnEffectThePlantCannotCarry) {
-  ExpectBadInput(Replay(RigModel("[{name: viscous_friction, joint: hip, value: 0.01}, {name: muscle_activity, joint: knee, value: 1, w_vl: 0.1}]"), ""),
+  ExpectBadInput(Replay(RigModel("[{name: viscous_friction, joint: hip, value: 0.01}, {name: muscle_activity, joint: knee, value: 1, weights: {vl: 0.1}}]"), ""),
                  "m.yaml: effects[1] (muscle_activity, knee): the forward plant cannot carry");
 }
 

@@ -167,14 +167,5 @@ TEST(PlantScenario, EffectsCarriedByTheForwardPlantAreNamed) {
   for (size_t k = 0; k < cases.size(); ++k) ExpectNamed(cases[k], 0.1, tmp.path() + "/case" + std::to_string(k));
 }
 
-// The internal hinges (sim/internal_joints.h): a knee dead band (the whole chain behind it, the
-// motor side a rotor) and a knee strap (the human's lower leg behind it), each named by diagnose with
-// the rigid model within the 15 % and nothing else.
-TEST(PlantScenario, BacklashAndComplianceInThePlantAreNamed) {
-  const testing::ScopedTempDir tmp("plant_internal");
-  ExpectNamed("[{name: backlash, joint: knee, value: 0.03}]", 0.15, tmp.path() + "/backlash");
-  ExpectNamed("[{name: series_compliance, joint: knee, value: 300}]", 0.15, tmp.path() + "/compliance");
-}
-
 }  // namespace
 }  // namespace exotwin
