@@ -59,7 +59,8 @@ class Plant {
   // that with the internal hinge held the plant is the rigid one; a dead band's flanks are limit
   // constraints with MuJoCo's solref time constant 2 dt; a strap has stiffness k, springref 0 and
   // damping kStrapDampingRatio of its mode's critical value (sim/plant.cc). Throws InputError when the rotor cannot
-  // be taken out of the segment (no realization left) or a strap's mode is too fast for the step.
+  // be taken out of the segment (no realization left) or a strap's mode is too fast for the step;
+  // after such a throw the plant is to be discarded.
   void CarryEffects(const PlantEffects& fx);
   const InternalJoints& internal_joints() const { return structure_; }
   // Internal hinge angle of joint j (rad; 0 without one): the followers' angle is q + internal_q.
