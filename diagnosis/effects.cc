@@ -49,31 +49,6 @@ std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<
   return dsp::ZeroPhaseEnvelope(hp, lp, emg, pad);
 }
 
-Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
-                                    const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
-  if (!params.human) return ActuatorTorque(params, q, qd, qdd);
-  return RigidInverseDynamics(*params.human, params.L1, params.g, q, qd, qdd) +
-         PassiveElasticTorque(params.passive, q);
-}
-
-Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
-                               const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
-  // Newton on f(x) = x - q_j + tau_C,j(x)/k with a central-difference slope (1e-6 rad).
-  Eigen::Vector2d qc = q;
-  for (int it = 0; it < 6; ++it) {
-    const double f = qc[j] - q[j] + CompliantPartTorque(params, qc, qd, qdd)[j] / k;
-    Eigen::Vector2d a = qc, b = qc;
-    a[j] += 1e-6;
-    b[j] -= 1e-6;
-    const double slope = 1.0 + (CompliantPartTorque(params, a, qd, qdd)[j] -
-                                CompliantPartTorque(params, b, qd, qdd)[j]) / (2e-6 * k);
-    const double step = f / std::max(slope, 0.1);  // a slope <= 0 would be a buckling strap
-    qc[j] -= step;
-    if (std::abs(step) < 1e-12) break;
-  }
-  return qc;
-}
-
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
                   std::vector<double> tau_S[2]) {
   const size_t n = kin.t.size();

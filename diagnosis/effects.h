@@ -23,11 +23,9 @@
 
 #include "formats/measured_data.h"
 #include "model/lumped_params.h"
+#include "sim/plant_effects.h"  // CompliantPartTorque, CompliantAngle, kBacklashTorqueWidth
 
 namespace exotwin {
-
-// Transition width of the backlash flank selection s(tau) = tanh(tau / width), N m.
-constexpr double kBacklashTorqueWidth = 0.1;
 
 // Joint index of an effect ("hip" -> 0, "knee" -> 1).
 int EffectJoint(const Effect& e);
@@ -45,14 +43,5 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
 // envelope low-pass, padded by up to 1 s at both ends. t strictly increasing with a sample rate above
 // 40 Hz (median step). Throws InputError otherwise.
 std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg);
-
-// Torque (N m) the series-compliant part needs: human rigid dynamics + P(q) when params.human,
-// else the whole chain's actuator torque (HJ15 eq. 5-7).
-Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
-                                    const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
-
-// Link angle of joint j under a strap of stiffness k (N m/rad): solves q_c,j = q_j - tau_C,j(q_c)/k.
-Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
-                               const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
 
 }  // namespace exotwin

@@ -11,21 +11,11 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "sim/mjcf_text.h"
 #include "sim/plant.h"
 
 namespace exotwin {
 namespace {
-
-// End (one past '>') of the tag that starts at `open` ('<'); npos if unterminated.
-size_t TagEnd(const std::string& s, size_t open) {
-  const size_t gt = s.find('>', open);
-  return gt == std::string::npos ? gt : gt + 1;
-}
-
-bool SelfClosing(const std::string& s, size_t open) {
-  const size_t end = TagEnd(s, open);
-  return end != std::string::npos && end >= 2 && s[end - 2] == '/';
-}
 
 // The copy of a body element: names suffixed, geoms recoloured.
 std::string GhostCopy(const std::string& element, const GhostLegStyle& g) {
@@ -53,27 +43,8 @@ std::string AddGhostLegs(const std::string& xml_in, const std::string& source,
                          const std::vector<GhostLegStyle>& ghosts) {
   static const std::regex kComment(R"(<!--[\s\S]*?-->)");
   const std::string xml = std::regex_replace(xml_in, kComment, "");
-  static const std::regex kThigh(R"(<body\b[^>]*\sname\s*=\s*(["'])exo_thigh\1[^>]*>)");
-  std::smatch m;
-  if (!std::regex_search(xml, m, kThigh)) throw InputError(source + ": no body named 'exo_thigh'");
-  const size_t begin = m.position(0);
-  if (SelfClosing(xml, begin)) throw InputError(source + ": body 'exo_thigh' has no joints or children");
-  // Matching </body>: count nested body elements (self-closing ones do not nest).
-  size_t pos = TagEnd(xml, begin);
-  int depth = 1;
-  while (depth > 0) {
-    const size_t open = xml.find("<body", pos), close = xml.find("</body", pos);
-    if (close == std::string::npos) throw InputError(source + ": body 'exo_thigh' is not closed");
-    if (open != std::string::npos && open < close) {
-      const char next = open + 5 < xml.size() ? xml[open + 5] : '\0';
-      if ((std::isspace(static_cast<unsigned char>(next)) || next == '>') && !SelfClosing(xml, open)) ++depth;
-      pos = TagEnd(xml, open);
-    } else {
-      --depth;
-      pos = TagEnd(xml, close);
-    }
-    if (pos == std::string::npos) throw InputError(source + ": body 'exo_thigh' is not closed");
-  }
+  const BodyElement body = FindBodyElement(xml, "exo_thigh", source);
+  const size_t begin = body.begin, pos = body.end;
   const std::string element = xml.substr(begin, pos - begin);
   std::string copies;
   for (size_t k = 0; k < ghosts.size(); ++k) {
@@ -86,24 +57,8 @@ std::string AddGhostLegs(const std::string& xml_in, const std::string& source,
 }
 
 GhostLegModel::GhostLegModel(const std::string& mjcf_path, const std::vector<GhostLegStyle>& ghosts, double L1) {
-  std::ifstream in(mjcf_path, std::ios::binary);
-  std::ostringstream text;
-  if (!in || !(text << in.rdbuf())) throw InputError(mjcf_path + ": cannot read the MJCF file");
-  const std::string xml = AddGhostLegs(text.str(), mjcf_path, ghosts);
-
-  // The text goes in a virtual file of the original's name: MuJoCo strips the folder when it looks a
-  // file up in the VFS, and resolves everything else relative to the original's folder.
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  const size_t slash = mjcf_path.find_last_of('/');
-  const std::string base = slash == std::string::npos ? mjcf_path : mjcf_path.substr(slash + 1);
-  if (mj_makeEmptyFileVFS(vfs.get(), base.c_str(), static_cast<int>(xml.size())) != 0)
-    throw InputError(mjcf_path + ": cannot stage the ghost-leg model in MuJoCo's virtual file system");
-  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), base.c_str())], xml.data(), xml.size());
-  char err[1000] = "";
-  m_ = mj_loadXML(mjcf_path.c_str(), vfs.get(), err, sizeof err);
-  mj_deleteVFS(vfs.get());
-  if (!m_) throw InputError(mjcf_path + ": the model with ghost legs does not load: " + err);
+  const std::string xml = AddGhostLegs(ReadMjcfText(mjcf_path), mjcf_path, ghosts);
+  m_ = LoadMjcfText(mjcf_path, xml, "the model with ghost legs");
   d_ = mj_makeData(m_);
 
   auto hinge = [this, &mjcf_path](const std::string& name) {

@@ -5,17 +5,28 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
+#include <algorithm>
 #include <type_traits>
 
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "sim/mjcf_cache.h"
+#include "sim/mjcf_text.h"
+#include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 #include "sim/realizability.h"
 
 namespace exotwin {
 
 namespace {
+
+// The rotor of a dead band or strap without a human: this share of the exoskeleton's J of its joint
+// (Plant::CarryEffects).
+constexpr double kRotorInertiaFraction = 0.05;
+// A strap's damping, as a share of its mode's critical damping: its start-up and impact transients
+// decay within a few of its periods.
+constexpr double kStrapDampingRatio = 0.5;
 
 // The first real number of the model (options and every mjtNum array) that is not finite or is
 // huge (|x| > 1e9, beyond any physical value in SI units here), as "field[i] = value"; "" if none.
@@ -64,7 +75,8 @@ std::string ExowheelMjcfPath(bool with_human) {
 void SetThighLength(mjModel* m, double L1, const std::string& suffix) {
   const int shank = mj_name2id(m, mjOBJ_BODY, ("exo_shank" + suffix).c_str());
   if (shank < 0) throw InputError("model has no body 'exo_shank" + suffix + "'");
-  m->body_pos[3 * shank + 2] = -L1;
+  const int rotor = mj_name2id(m, mjOBJ_BODY, (RotorBodyName(1) + suffix).c_str());
+  m->body_pos[3 * (rotor >= 0 ? rotor : shank) + 2] = -L1;
   // Visual only: stretch the thigh geoms to the new L1 (centred at mid-thigh, half-length L1/2).
   for (const char* g : {"human_thigh_geom", "exo_thigh_bar"}) {
     const int id = mj_name2id(m, mjOBJ_GEOM, (g + suffix).c_str());
@@ -92,45 +104,7 @@ Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
   d_ = mj_makeData(m_);
   d_inv_ = mj_makeData(m_);
   try {
-    exo_thigh_ = Body("exo_thigh", true);
-    exo_shank_ = Body("exo_shank", true);
-    human_thigh_ = Body("human_thigh", false);
-    human_shank_ = Body("human_shank", false);
-    if ((human_thigh_ < 0) != (human_shank_ < 0))
-      throw InputError(mjcf_path + ": needs both human_thigh and human_shank bodies or neither");
-    const int hip = mj_name2id(m_, mjOBJ_JOINT, "hip");
-    const int knee = mj_name2id(m_, mjOBJ_JOINT, "knee");
-    if (hip < 0 || knee < 0 || m_->jnt_type[hip] != mjJNT_HINGE || m_->jnt_type[knee] != mjJNT_HINGE ||
-        m_->nv != 2)
-      throw InputError(mjcf_path + ": expected exactly two hinge joints named 'hip' and 'knee'");
-    hip_dof_ = m_->jnt_dofadr[hip];
-    knee_dof_ = m_->jnt_dofadr[knee];
-    hip_jnt_ = hip;
-    knee_jnt_ = knee;
-    for (int j = 0; j < 2; ++j) {
-      const int dof = j == 0 ? hip_dof_ : knee_dof_, jnt = j == 0 ? hip : knee;
-      base_frictionloss_[j] = m_->dof_frictionloss[dof];
-      base_solref_[j] = m_->dof_solref[mjNREF * dof];
-      base_damping_[j] = m_->dof_damping[dof];
-      base_armature_[j] = m_->dof_armature[dof];
-      base_stiffness_[j] = m_->jnt_stiffness[jnt];
-      base_springref_[j] = m_->qpos_spring[m_->jnt_qposadr[jnt]];
-    }
-    if (m_->nu != 2)
-      throw InputError(mjcf_path + ": expected two torque actuators (hip, knee), found " +
-                       std::to_string(m_->nu));
-    // Step() writes the joint torques into ctrl[0] (hip) and ctrl[1] (knee): plain motors, gear 1.
-    for (int i = 0; i < 2; ++i) {
-      const int joint = i == 0 ? hip : knee;
-      if (m_->actuator_trntype[i] != mjTRN_JOINT || m_->actuator_trnid[2 * i] != joint ||
-          m_->actuator_gear[6 * i] != 1.0 || m_->actuator_gaintype[i] != mjGAIN_FIXED ||
-          m_->actuator_gainprm[mjNGAIN * i] != 1.0 || m_->actuator_biastype[i] != mjBIAS_NONE) {
-        const char* name = mj_id2name(m_, mjOBJ_ACTUATOR, i);
-        throw InputError(mjcf_path + ": actuator " + std::to_string(i) + " ('" + (name ? name : "") +
-                         "'): expected a <motor> on joint '" + (i == 0 ? "hip" : "knee") +
-                         "' with gear 1 (ctrl is the joint torque in N m)");
-      }
-    }
+    BindModel();
   } catch (...) {
     mj_deleteData(d_);
     mj_deleteData(d_inv_);
@@ -138,6 +112,80 @@ Plant::Plant(const std::string& mjcf_path) : path_(mjcf_path) {
     throw;
   }
   params_.L1 = -m_->body_pos[3 * exo_shank_ + 2];
+}
+
+void Plant::BindModel() {
+  const std::string& mjcf_path = path_;
+  exo_thigh_ = Body("exo_thigh", true);
+  exo_shank_ = Body("exo_shank", true);
+  human_thigh_ = Body("human_thigh", false);
+  human_shank_ = Body("human_shank", false);
+  if ((human_thigh_ < 0) != (human_shank_ < 0))
+    throw InputError(mjcf_path + ": needs both human_thigh and human_shank bodies or neither");
+  const int hip = mj_name2id(m_, mjOBJ_JOINT, "hip");
+  const int knee = mj_name2id(m_, mjOBJ_JOINT, "knee");
+  const int internal = (structure_.kind[0] != InternalHinge::kNone) + (structure_.kind[1] != InternalHinge::kNone);
+  if (hip < 0 || knee < 0 || m_->jnt_type[hip] != mjJNT_HINGE || m_->jnt_type[knee] != mjJNT_HINGE ||
+      m_->nv != 2 + internal)
+    throw InputError(mjcf_path + ": expected exactly two hinge joints named 'hip' and 'knee'");
+  hip_dof_ = m_->jnt_dofadr[hip];
+  knee_dof_ = m_->jnt_dofadr[knee];
+  hip_jnt_ = hip;
+  knee_jnt_ = knee;
+  q_adr_[0] = m_->jnt_qposadr[hip];
+  q_adr_[1] = m_->jnt_qposadr[knee];
+  for (int j = 0; j < 2; ++j) {
+    in_jnt_[j] = in_q_[j] = in_v_[j] = rotor_body_[j] = -1;
+    if (structure_.kind[j] == InternalHinge::kNone) continue;
+    in_jnt_[j] = mj_name2id(m_, mjOBJ_JOINT, InternalHingeName(j, structure_).c_str());
+    if (in_jnt_[j] < 0) throw InputError(mjcf_path + ": the internal hinge did not compile");
+    in_q_[j] = m_->jnt_qposadr[in_jnt_[j]];
+    in_v_[j] = m_->jnt_dofadr[in_jnt_[j]];
+    if (structure_.kind[j] == InternalHinge::kRotor) rotor_body_[j] = Body(RotorBodyName(j).c_str(), true);
+  }
+  for (int j = 0; j < 2; ++j) {
+    const int dof = j == 0 ? hip_dof_ : knee_dof_, jnt = j == 0 ? hip : knee;
+    base_frictionloss_[j] = m_->dof_frictionloss[dof];
+    base_solref_[j] = m_->dof_solref[mjNREF * dof];
+    base_damping_[j] = m_->dof_damping[dof];
+    base_armature_[j] = m_->dof_armature[dof];
+    base_stiffness_[j] = m_->jnt_stiffness[jnt];
+    base_springref_[j] = m_->qpos_spring[m_->jnt_qposadr[jnt]];
+  }
+  if (m_->nu != 2)
+    throw InputError(mjcf_path + ": expected two torque actuators (hip, knee), found " + std::to_string(m_->nu));
+  // Step() writes the joint torques into ctrl[0] (hip) and ctrl[1] (knee): plain motors, gear 1.
+  for (int i = 0; i < 2; ++i) {
+    const int joint = i == 0 ? hip : knee;
+    if (m_->actuator_trntype[i] != mjTRN_JOINT || m_->actuator_trnid[2 * i] != joint ||
+        m_->actuator_gear[6 * i] != 1.0 || m_->actuator_gaintype[i] != mjGAIN_FIXED ||
+        m_->actuator_gainprm[mjNGAIN * i] != 1.0 || m_->actuator_biastype[i] != mjBIAS_NONE) {
+      const char* name = mj_id2name(m_, mjOBJ_ACTUATOR, i);
+      throw InputError(mjcf_path + ": actuator " + std::to_string(i) + " ('" + (name ? name : "") +
+                       "'): expected a <motor> on joint '" + (i == 0 ? "hip" : "knee") +
+                       "' with gear 1 (ctrl is the joint torque in N m)");
+    }
+  }
+}
+
+void Plant::Rebuild(const InternalJoints& structure) {
+  mjModel* m = nullptr;
+  if (structure.any()) {
+    m = LoadMjcfText(path_, AddInternalJoints(ReadMjcfText(path_), path_, structure), "the model with internal hinges");
+  } else {
+    char err[1000] = "";
+    m = LoadMjcfModel(path_, err, sizeof(err));
+    if (!m) throw InputError(path_ + ": cannot load MJCF model: " + err);
+  }
+  mj_deleteData(d_);
+  mj_deleteData(d_inv_);
+  mj_deleteModel(m_);
+  m_ = m;
+  d_ = mj_makeData(m_);
+  d_inv_ = mj_makeData(m_);
+  structure_ = structure;
+  BindModel();
+  ApplyFreedom();
 }
 
 Plant::~Plant() {
@@ -203,13 +251,53 @@ void Plant::SetParams(const LegParams& params) {
     throw InputError("L1: expected a thigh length in (0.1, 1.0) m, got " + std::to_string(params.L1));
   if (params.human && human_thigh_ < 0)
     throw InputError(path_ + ": the parameter set has a human: block but the model has no human bodies");
-  SystemRealization exo, human;
-  if (!params.human) {
-    exo = RealizeLumped(params.exo, params.L1, "exo");
-  } else {
-    SplitRealization(params, &exo, &human);
-  }
+  WriteRealization(params);
+  params_ = params;
+  has_params_ = true;
+  mj_forward(m_, d_);
+}
 
+void Plant::WriteRealization(const LegParams& params) {
+  // A rotor body (at its hinge's axis, mass kRotorMass, inertia J_r about the axis) turns with the
+  // measured joint; the exoskeleton's lumped parameters give up what it adds (HJ15 eq. 4: J1, and for
+  // the knee rotor, L1 below the hip, J2 and X1 as well), so that with the internal hinges held the
+  // system is exactly the rigid one (M, gravity).
+  constexpr double kRotorMass = 1e-6;  // kg: MuJoCo needs a mass for a body with a joint
+  LegParams p = params;
+  double rotor[2] = {0, 0};
+  for (int j = 0; j < 2; ++j) {
+    if (structure_.kind[j] != InternalHinge::kRotor) continue;
+    rotor[j] = kRotorInertiaFraction * (j == 0 ? p.exo.J1 : p.exo.J2);
+    if (!structure_.backlash[j]) rotor[j] = std::max(rotor[j], 4 * fx_.compliance[j] * timestep() * timestep());
+  }
+  p.exo.J1 -= rotor[0] + rotor[1] + kRotorMass * (rotor[1] > 0) * params.L1 * params.L1;
+  p.exo.J2 -= rotor[1];
+  p.exo.X1 -= kRotorMass * (rotor[1] > 0) * params.L1;
+  SystemRealization exo, human;
+  auto realize = [&] {
+    if (!p.human) {
+      exo = RealizeLumped(p.exo, p.L1, "exo");
+    } else {
+      SplitRealization(p, &exo, &human);
+    }
+  };
+  try {
+    try {
+      realize();
+    } catch (const InputError&) {
+      // The dynamics depend on the lumped parameters alone: when the exoskeleton's given masses leave
+      // no room for the rotor, its masses are chosen instead (m1 = m2 = 0, sim/realization.h).
+      if ((rotor[0] == 0 && rotor[1] == 0) || (p.exo.m1 == 0 && p.exo.m2 == 0)) throw;
+      p.exo.m1 = p.exo.m2 = 0;
+      realize();
+    }
+  } catch (const InputError& e) {
+    if (rotor[0] == 0 && rotor[1] == 0) throw;
+    std::ostringstream os;
+    os << e.what() << " once the rotor inertia " << rotor[0] << " / " << rotor[1]
+       << " kg m^2 (hip / knee) of the backlash or compliance hinge is taken out of the exoskeleton's segments";
+    throw InputError(os.str());
+  }
   m_->opt.gravity[0] = m_->opt.gravity[1] = 0.0;
   m_->opt.gravity[2] = -params.g;
   SetThighLength(m_, params.L1);
@@ -222,20 +310,24 @@ void Plant::SetParams(const LegParams& params) {
     WriteBody(m_, human_thigh_, params.human ? human.thigh : none);
     WriteBody(m_, human_shank_, params.human ? human.lower_leg : none);
   }
+  for (int j = 0; j < 2; ++j) {
+    rotor_inertia_[j] = rotor[j];
+    if (rotor_body_[j] >= 0) WriteBody(m_, rotor_body_[j], {kRotorMass, 0.0, 0.0, rotor[j]});
+  }
   mj_setConst(m_, d_);
-  params_ = params;
-  mj_forward(m_, d_);
 }
 
 Eigen::Vector2d Plant::InverseDynamics(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
                                        const Eigen::Vector2d& qdd) {
   mjData* d = d_inv_;
-  d->qpos[0] = q[0];
-  d->qpos[1] = q[1];
-  d->qvel[0] = qd[0];
-  d->qvel[1] = qd[1];
-  d->qacc[0] = qdd[0];
-  d->qacc[1] = qdd[1];
+  // Internal hinges held at 0 (a dead band's centre, a strap unloaded): the rigid system.
+  for (int j = 0; j < 2; ++j) {
+    const int v = j == 0 ? hip_dof_ : knee_dof_;
+    d->qpos[q_adr_[j]] = q[j];
+    d->qvel[v] = qd[j];
+    d->qacc[v] = qdd[j];
+    if (in_jnt_[j] >= 0) d->qpos[in_q_[j]] = d->qvel[in_v_[j]] = d->qacc[in_v_[j]] = 0.0;
+  }
   const int saved = m_->opt.disableflags;
   m_->opt.disableflags |= mjDSBL_CONSTRAINT;  // rigid-body inverse dynamics, no limit forces
   mj_inverse(m_, d);
@@ -252,7 +344,59 @@ Eigen::Vector2d Plant::InverseDynamics(const Eigen::Vector2d& q, const Eigen::Ve
 }
 
 void Plant::CarryEffects(const PlantEffects& fx) {
-  if (!fx_.link_empty() || !fx.link_empty()) {
+  const InternalJoints structure = InternalJointsOf(fx);
+  if (structure.any() && !has_params_)
+    throw std::logic_error("Plant::CarryEffects: backlash or series compliance before SetParams");
+  const PlantEffects before = fx_;
+  fx_ = fx;
+  try {
+    const bool rebuilt = !(structure == structure_);
+    if (rebuilt) Rebuild(structure);
+    if ((rebuilt || structure.any()) && has_params_) WriteRealization(params_);
+    for (int j = 0; j < 2; ++j) {
+      if (in_jnt_[j] < 0) continue;
+      const int jnt = in_jnt_[j], dof = in_v_[j];
+      if (structure_.backlash[j]) {
+        // The dead band's flanks: limit constraints with MuJoCo's solref time constant at its safe
+        // minimum, 2 steps (as frictionloss), critically damped (MuJoCo XML reference, solref/solimp).
+        m_->jnt_range[2 * jnt] = -0.5 * fx.backlash[j];
+        m_->jnt_range[2 * jnt + 1] = 0.5 * fx.backlash[j];
+        m_->jnt_solref[mjNREF * jnt] = 2 * m_->opt.timestep;
+        m_->jnt_solref[mjNREF * jnt + 1] = 1.0;
+        // A hard flank: impedance 0.99 .. 0.999 (MuJoCo's default 0.9 .. 0.95 lets the load press the
+        // link 5x deeper past the flank, ~2.6e-4 rad on the development rig's knee at rest).
+        m_->jnt_solimp[mjNIMP * jnt] = 0.99;
+        m_->jnt_solimp[mjNIMP * jnt + 1] = 0.999;
+        continue;
+      }
+      // The strap: stiffness k about springref 0, damped at kStrapDampingRatio of its mode's critical
+      // damping 2 sqrt(k J), J the reduced inertia of the two sides (the rotor against the chain; the
+      // exoskeleton's against the human's lower leg).
+      const double k = fx.compliance[j];
+      double J = rotor_inertia_[j];
+      if (structure_.kind[j] == InternalHinge::kHuman) {
+        const double Je = params_.exo.J2, Jh = params_.human->J2;
+        J = Je * Jh / (Je + Jh);
+      }
+      const double omega = std::sqrt(k / J);
+      if (omega * m_->opt.timestep > 0.5) {
+        std::ostringstream os;
+        os << path_ << ": a series compliance of " << k << " N m/rad at the " << (j == 0 ? "hip" : "knee")
+           << " oscillates at " << omega << " rad/s against " << J << " kg m^2: too fast for the "
+           << m_->opt.timestep << " s step (expected at most " << 0.5 / m_->opt.timestep << " rad/s)";
+        throw InputError(os.str());
+      }
+      m_->jnt_stiffness[jnt] = k;
+      m_->qpos_spring[in_q_[j]] = 0.0;
+      m_->dof_damping[dof] = 2 * kStrapDampingRatio * std::sqrt(k * J);
+      if (structure_.kind[j] == InternalHinge::kHuman)  // the hinge at the knee: human_shank's origin
+        for (int c = 0; c < 3; ++c) m_->jnt_pos[3 * jnt + c] = -m_->body_pos[3 * human_shank_ + c];
+    }
+  } catch (...) {
+    fx_ = before;
+    throw;
+  }
+  if (!before.link_empty() || !fx.link_empty()) {
     for (int j = 0; j < 2; ++j) {
       const int dof = j == 0 ? hip_dof_ : knee_dof_, jnt = j == 0 ? hip_jnt_ : knee_jnt_;
       m_->dof_frictionloss[dof] = base_frictionloss_[j] + fx.frictionloss[j];
@@ -270,12 +414,27 @@ void Plant::CarryEffects(const PlantEffects& fx) {
       }
     }
   }
-  fx_ = fx;
+  if (structure_.any()) mj_setConst(m_, d_);
   mj_forward(m_, d_);
 }
 
 void Plant::FreeJointsAndTorque() {
-  m_->opt.disableflags |= mjDSBL_LIMIT | mjDSBL_CLAMPCTRL;
+  free_ = true;
+  ApplyFreedom();
+}
+
+void Plant::ApplyFreedom() {
+  if (!free_) return;
+  m_->opt.disableflags |= mjDSBL_CLAMPCTRL;
+  // The measured joints' limits off; a dead band's limits stay.
+  m_->jnt_limited[hip_jnt_] = m_->jnt_limited[knee_jnt_] = 0;
+}
+
+Eigen::Vector2d Plant::internal_q() const {
+  Eigen::Vector2d x = Eigen::Vector2d::Zero();
+  for (int j = 0; j < 2; ++j)
+    if (in_q_[j] >= 0) x[j] = d_->qpos[in_q_[j]];
+  return x;
 }
 
 void Plant::HoldHip() {
@@ -288,10 +447,22 @@ void Plant::HoldHip() {
 
 void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t) {
   mj_resetData(m_, d_);
-  d_->qpos[0] = q[0];
-  d_->qpos[1] = q[1];
-  d_->qvel[0] = qd[0];
-  d_->qvel[1] = qd[1];
+  for (int j = 0; j < 2; ++j) {
+    d_->qpos[q_adr_[j]] = q[j];
+    d_->qvel[j == 0 ? hip_dof_ : knee_dof_] = qd[j];
+  }
+  if (structure_.any()) {
+    LegParams rigid = params_;
+    rigid.effects.clear();
+    const Eigen::Vector2d tau = ActuatorTorque(rigid, q, qd, Eigen::Vector2d::Zero());
+    for (int j = 0; j < 2; ++j) {
+      if (in_q_[j] < 0) continue;
+      d_->qpos[in_q_[j]] =
+          structure_.backlash[j]
+              ? -0.5 * fx_.backlash[j] * std::tanh(tau[j] / kBacklashTorqueWidth)
+              : CompliantAngle(rigid, j, fx_.compliance[j], q, qd, Eigen::Vector2d::Zero())[j] - q[j];
+    }
+  }
   if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;
   d_->time = t;
   mj_forward(m_, d_);
@@ -302,8 +473,11 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   if (!std::isfinite(tau_R[0]) || !std::isfinite(tau_R[1]) || !std::isfinite(tau_ext[0]) ||
       !std::isfinite(tau_ext[1]))
     throw SimulationError(d_->time, "non-finite torque command");
+  // On the part behind the internal hinges (at the followers' angles q + internal_q): tau_ext and P.
   Eigen::Vector2d applied = tau_ext;
-  if (params_.human) applied -= PassiveElasticTorque(params_.passive, q());
+  if (params_.human) applied -= PassiveElasticTorque(params_.passive, structure_.any() ? q() + internal_q() : q());
+  for (int j = 0; j < 2; ++j)
+    if (in_v_[j] >= 0) d_->qfrc_applied[in_v_[j]] = applied[j];
   if (!fx_.applied.empty()) applied += fx_.AppliedForce(q());
   d_->qfrc_applied[hip_dof_] = applied[0];
   d_->qfrc_applied[knee_dof_] = applied[1];
@@ -329,9 +503,9 @@ void Plant::CheckDivergence(const char* where) {
       throw SimulationError(d_->time, std::string("non-finite state in ") + where);
 }
 
-Eigen::Vector2d Plant::q() const { return {d_->qpos[0], d_->qpos[1]}; }
-Eigen::Vector2d Plant::qd() const { return {d_->qvel[0], d_->qvel[1]}; }
-Eigen::Vector2d Plant::qdd() const { return {d_->qacc[0], d_->qacc[1]}; }
+Eigen::Vector2d Plant::q() const { return {d_->qpos[q_adr_[0]], d_->qpos[q_adr_[1]]}; }
+Eigen::Vector2d Plant::qd() const { return {d_->qvel[hip_dof_], d_->qvel[knee_dof_]}; }
+Eigen::Vector2d Plant::qdd() const { return {d_->qacc[hip_dof_], d_->qacc[knee_dof_]}; }
 double Plant::time() const { return d_->time; }
 double Plant::timestep() const { return m_->opt.timestep; }
 

@@ -9,6 +9,7 @@
 
 #include "core/error.h"  // SimulationError, thrown by Plant
 #include "model/lumped_params.h"
+#include "sim/internal_joints.h"
 #include "sim/plant_effects.h"
 #include "sim/realization.h"
 
@@ -26,7 +27,8 @@ std::string ExowheelMjcfPath(bool with_human);
 
 // Writes the thigh length L1 (m) into one leg of `m` (the leg's names end in `suffix`, "" for the
 // MJCF's own): body exo_shank<suffix> sits at z = -L1 in its parent, and the thigh geoms
-// human_thigh_geom<suffix> and exo_thigh_bar<suffix> (those present; visual only) span 0..-L1.
+// human_thigh_geom<suffix> and exo_thigh_bar<suffix> (those present; visual only) span 0..-L1. When
+// a rotor body holds the knee hinge (sim/internal_joints.h), the rotor is placed there instead.
 // Throws InputError if the model has no body exo_shank<suffix>. Call mj_setConst afterwards when
 // the model simulates.
 void SetThighLength(mjModel_* m, double L1, const std::string& suffix = "");
@@ -50,7 +52,20 @@ class Plant {
   // frictionloss, damping, armature, stiffness/springref, and an applied force for gravity_error and
   // torque_ripple), replacing those carried before. Sensor effects are for the reader of tau_S.
   // Without effects (fx.link_empty()) the model is the MJCF's, bit for bit.
+  // Backlash and series compliance rebuild the model with internal hinges (sim/internal_joints.h);
+  // SetParams must have been called (the rotor's inertia comes out of the exoskeleton's segment).
+  // Their numbers (sim/plant.cc): a rotor body of inertia kRotorInertiaFraction x the exoskeleton's J of that joint
+  // (at least 4 k dt^2 behind a strap: its mode at most 0.5 / dt rad/s), taken out of the segment so
+  // that with the internal hinge held the plant is the rigid one; a dead band's flanks are limit
+  // constraints with MuJoCo's solref time constant 2 dt; a strap has stiffness k, springref 0 and
+  // damping kStrapDampingRatio of its mode's critical value (sim/plant.cc). Throws InputError when the rotor cannot
+  // be taken out of the segment (no realization left) or a strap's mode is too fast for the step;
+  // after such a throw the plant is to be discarded.
   void CarryEffects(const PlantEffects& fx);
+  const InternalJoints& internal_joints() const { return structure_; }
+  // Internal hinge angle of joint j (rad; 0 without one): the followers' angle is q + internal_q.
+  Eigen::Vector2d internal_q() const;
+  double rotor_inertia(int j) const { return rotor_inertia_[j]; }
   const PlantEffects& effects() const { return fx_; }
 
   // Disables the joint limits and the actuators' ctrlrange clamp (replay of a foreign rig's record:
@@ -74,10 +89,16 @@ class Plant {
                                   const Eigen::Vector2d& qdd);
 
   // Sets the state (rad, rad/s) and time (s) of the forward simulation; recomputes kinematics.
+  // q, qd are the measured (motor-side) joints. Internal hinges start at rest relative to their
+  // joint: a dead band at the flank the rigid torque at qdd = 0 presses the link against (the inverse
+  // form's -value/2 tanh(tau / kBacklashTorqueWidth)), a strap at its quasi-static deflection at
+  // qdd = 0 (CompliantAngle).
   void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0);
   // Advances one physics step (model timestep) with actuator torque tau_R (N m) and an extra joint
   // torque tau_ext (N m, e.g. muscles or effects) acting on the link. Throws SimulationError on
   // divergence. P(q) is applied automatically when params.human is set, and the carried effects.
+  // tau_ext and P act on the part behind an internal hinge (at the angles q + internal_q); the
+  // carried table effects at the measured joints.
   void Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext = Eigen::Vector2d::Zero());
 
   Eigen::Vector2d q() const;
@@ -92,6 +113,10 @@ class Plant {
  private:
   void CheckDivergence(const char* where);
   int Body(const char* name, bool required) const;
+  void BindModel();                               // ids, addresses and the MJCF's own per-dof values
+  void Rebuild(const InternalJoints& structure);  // recompiles the MJCF with these internal hinges
+  void WriteRealization(const LegParams& params); // bodies, L1, g (+ rotors); validates first
+  void ApplyFreedom();
 
   std::string path_;
   mjModel_* m_ = nullptr;
@@ -106,6 +131,11 @@ class Plant {
   double base_stiffness_[2] = {0, 0}, base_springref_[2] = {0, 0}, base_solref_[2] = {0, 0};
   int hip_jnt_ = -1, knee_jnt_ = -1;
   bool hip_held_ = false;
+  int q_adr_[2] = {0, 1};              // qpos address of the measured hinges
+  int in_jnt_[2] = {-1, -1}, in_q_[2] = {-1, -1}, in_v_[2] = {-1, -1}, rotor_body_[2] = {-1, -1};
+  InternalJoints structure_;
+  double rotor_inertia_[2] = {0, 0};
+  bool has_params_ = false, free_ = false;
 };
 
 }  // namespace exotwin

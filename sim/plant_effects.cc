@@ -1,5 +1,6 @@
 #include "sim/plant_effects.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -7,6 +8,7 @@
 
 #include "core/error.h"
 #include "model/leg_dynamics.h"
+#include "model/passive_torque.h"
 
 namespace exotwin {
 
@@ -21,10 +23,41 @@ double TorqueRippleTorque(const Effect& e, double q_j) {
   return e.value * std::sin(2 * M_PI * e.fields.at("cycles_per_rad") * q_j + e.fields.at("phase"));
 }
 
+Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
+                                    const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
+  if (!params.human) return ActuatorTorque(params, q, qd, qdd);
+  return RigidInverseDynamics(*params.human, params.L1, params.g, q, qd, qdd) +
+         PassiveElasticTorque(params.passive, q);
+}
+
+Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
+                               const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
+  // Newton on f(x) = x - q_j + tau_C,j(x)/k with a central-difference slope (1e-6 rad).
+  Eigen::Vector2d qc = q;
+  for (int it = 0; it < 6; ++it) {
+    const double f = qc[j] - q[j] + CompliantPartTorque(params, qc, qd, qdd)[j] / k;
+    Eigen::Vector2d a = qc, b = qc;
+    a[j] += 1e-6;
+    b[j] -= 1e-6;
+    const double slope = 1.0 + (CompliantPartTorque(params, a, qd, qdd)[j] -
+                                CompliantPartTorque(params, b, qd, qdd)[j]) / (2e-6 * k);
+    const double step = f / std::max(slope, 0.1);  // a slope <= 0 would be a buckling strap
+    qc[j] -= step;
+    if (std::abs(step) < 1e-12) break;
+  }
+  return qc;
+}
+
 bool PlantEffects::link_empty() const {
   for (int j = 0; j < 2; ++j)
-    if (frictionloss[j] != 0 || damping[j] != 0 || armature[j] != 0 || stiffness[j] != 0) return false;
+    if (frictionloss[j] != 0 || damping[j] != 0 || armature[j] != 0 || stiffness[j] != 0 || backlash[j] != 0 ||
+        compliance[j] != 0)
+      return false;
   return applied.empty();
+}
+
+bool PlantEffects::has_internal_joints() const {
+  return backlash[0] != 0 || backlash[1] != 0 || compliance[0] != 0 || compliance[1] != 0;
 }
 
 bool PlantEffects::empty() const { return link_empty() && sensor[0].empty() && sensor[1].empty(); }
@@ -63,6 +96,7 @@ double SmallestInertiaEigenvalue(const LegParams& params, const double armature[
 PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) {
   PlantEffects fx;
   fx.g = params.g;
+  fx.compliant_human = params.human.has_value();
   for (size_t i = 0; i < params.effects.size(); ++i) {
     const Effect& e = params.effects[i];
     const int j = e.joint == "hip" ? 0 : 1;
@@ -87,12 +121,29 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
       if (e.name == "sensor_delay" && e.value < 0)
         throw InputError(where + ": expected a delay >= 0 s");
       fx.sensor[j].push_back({e.name, e.value});
+    } else if (e.name == "backlash" || e.name == "series_compliance") {
+      if (fx.backlash[j] != 0 || fx.compliance[j] != 0)
+        throw InputError(where + ": a second backlash or series_compliance at this joint; the plant carries one "
+                         "internal hinge per joint");
+      if (e.name == "backlash") {
+        if (!(e.value > 0 && e.value <= 0.1))
+          throw InputError(where + ": a dead band of " + std::to_string(e.value) + " rad; expected 0 < value <= 0.1");
+        fx.backlash[j] = e.value;
+      } else {
+        if (!(e.value > 0))
+          throw InputError(where + ": a strap stiffness of " + std::to_string(e.value) + " N m/rad; expected > 0");
+        if (j == 0 && params.human)
+          throw InputError(where + ": the forward plant cannot carry a series compliance at the hip of a model "
+                           "with a human (the human leg would turn about the hip while its knee follows the "
+                           "exoskeleton's: a closed chain); carried at the knee, or at the hip without a human");
+        fx.compliance[j] = e.value;
+      }
     } else {
-      throw InputError(where + ": the forward plant cannot carry this effect (" +
-                       (e.name == "muscle_activity" ? std::string("no muscles in the plant of a measured record")
-                                                    : std::string("no dead band or compliant strap in the MJCF")) +
-                       "); carried: coulomb_friction, viscous_friction, inertia_error, joint_stiffness, "
-                       "gravity_error, torque_ripple, sensor_offset, sensor_gain, sensor_delay");
+      throw InputError(where + ": the forward plant cannot carry this effect (no muscles in the plant of a "
+                       "measured record: muscle_activity is the subject's EMG, an input the record carries, not a "
+                       "property of the plant); carried: coulomb_friction, viscous_friction, inertia_error, "
+                       "joint_stiffness, gravity_error, torque_ripple, backlash, series_compliance, sensor_offset, "
+                       "sensor_gain, sensor_delay");
     }
   }
   for (int j = 0; j < 2; ++j)

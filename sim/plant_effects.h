@@ -21,8 +21,15 @@
 //  - torque_ripple     -> an applied generalized force -value sin(2 pi k q + phase).
 //  - sensor_offset, sensor_gain, sensor_delay act where the reading tau_S is formed, not on the
 //    link: PlantEffects::sensor holds them for that reader (diagnosis/replay.h inverts them).
-//  - backlash, series_compliance, muscle_activity: not carried (no dead band or strap in the MJCF,
-//    no muscles on the exoskeleton-only plant): ToPlantEffects refuses them (InputError).
+//  - backlash and series_compliance: an internal hinge in the MJCF (Plant::CarryEffects rebuilds the
+//    model, sim/internal_joints.h) between the driven, measured joint and the part behind it, which
+//    the inverse forms below (diagnosis/effects.h) evaluate at the link angle:
+//    backlash: a limited relative hinge of total width value (a hard dead band whose flanks are MuJoCo
+//    limit constraints); the whole chain is behind it and the motor side is a rotor body.
+//    series_compliance: a relative hinge with stiffness value, springref 0: behind it the human limb
+//    (a model with a human, at the knee) or the whole chain (no human, behind a rotor body).
+//  - muscle_activity: not carried (the subject's EMG is an input of the record, not a property of the
+//    plant): ToPlantEffects refuses it (InputError).
 #pragma once
 #include <string>
 #include <vector>
@@ -49,24 +56,43 @@ struct SensorEffect {
   double value = 0;
 };
 
+// Transition width of the backlash flank selection s(tau) = tanh(tau / width), N m (the inverse form:
+// diagnosis/effects.h).
+constexpr double kBacklashTorqueWidth = 0.1;
+
+// Torque (N m) the series-compliant part needs: human rigid dynamics + P(q) when params.human,
+// else the whole chain's actuator torque (HJ15 eq. 5-7).
+Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
+                                    const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
+
+// Link angle of joint j under a strap of stiffness k (N m/rad): solves q_c,j = q_j - tau_C,j(q_c)/k
+// (quasi-static: the deflection's own rates neglected).
+Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
+                               const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd);
+
 struct PlantEffects {
   double frictionloss[2] = {0, 0};  // N m
   double damping[2] = {0, 0};       // N m s/rad
   double armature[2] = {0, 0};      // kg m^2
   double stiffness[2] = {0, 0};     // N m/rad
   double springref[2] = {0, 0};     // rad
+  double backlash[2] = {0, 0};      // rad, total dead-band width (0: none)
+  double compliance[2] = {0, 0};    // N m/rad, strap stiffness (0: none)
+  bool compliant_human = false;     // the part behind a strap is the human limb (else the whole chain)
   std::vector<Effect> applied;      // gravity_error and torque_ripple: qfrc_applied each step
   std::vector<SensorEffect> sensor[2];
   double g = 9.81;                  // for gravity_error
   bool empty() const;
   bool link_empty() const;          // no effect on the link (only sensor effects, or none)
+  bool has_internal_joints() const; // backlash or series_compliance: the MJCF gains hinges
   // The generalized force (N m) of `applied` at q: minus the torques the actuator needs for them.
   Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q) const;
 };
 
 // Sorts `params.effects` into the plant's form. Throws InputError naming `source`, the effect
-// (effects[i], its name and joint) and why, for an effect the plant cannot carry (backlash,
-// series_compliance, muscle_activity) and for a negative inertia_error that leaves M + diag(armature)
+// (effects[i], its name and joint) and why, for an effect the plant cannot carry (muscle_activity;
+// series_compliance at the hip of a model with a human; a second backlash or compliance at one joint;
+// a backlash outside 0 .. 0.1 rad or a stiffness <= 0) and for a negative inertia_error that leaves M + diag(armature)
 // not positive definite at some knee angle (checked on the closed form, HJ15 eq. 5).
 PlantEffects ToPlantEffects(const LegParams& params, const std::string& source);
 

@@ -101,8 +101,8 @@ TEST_F(ReplayCli, CommandInputWithoutCommandColumns) {
 }
 
 TEST_F(ReplayCli, AnEffectThePlantCannotCarry) {
-  ExpectBadInput(Replay(RigModel("[{name: viscous_friction, joint: hip, value: 0.01}, {name: backlash, joint: knee, value: 0.01}]"), ""),
-                 "m.yaml: effects[1] (backlash, knee): the forward plant cannot carry");
+  ExpectBadInput(Replay(RigModel("[{name: viscous_friction, joint: hip, value: 0.01}, {name: muscle_activity, joint: knee, value: 1, weights: {vl: 0.1}}]"), ""),
+                 "m.yaml: effects[1] (muscle_activity, knee): the forward plant cannot carry");
 }
 
 // A one-joint model file (DESIGN.md "One-joint devices") replays a one-joint record: the embedding's
