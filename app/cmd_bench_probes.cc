@@ -597,15 +597,26 @@ json BenchLink(const BenchConfig& c) {
                              ReadTextFile(out_opt.out_dir + "/measured.csv", "", "CSV") &&
                          ReadTextFile(in_opt.out_dir + "/truth.csv", "", "CSV") ==
                              ReadTextFile(out_opt.out_dir + "/truth.csv", "", "CSV");
+  // The same pair on one CPU (the controller inherits the pin; neither end spins): the hand-over
+  // is then a switch on that CPU instead of a wake-up of the other (the policy of regress's workers).
+  double one_cpu = 0;
+  {
+    const ScopedCpuPin pin(FastestCpu(c.cpus));
+    if (pin.pinned()) one_cpu = BestOf(c.repeat, [&] { RunWithControllerProcess(s, out_opt, bin); });
+  }
   std::vector<BenchRow> rows = {{"lockstep: serve + exotwin-controller, gait_2kmh " + Seconds(duration) +
                                      (identical ? " (logs identical)" : " (logs DIFFER)"),
                                  lockstep / in_process, "x", "the in-process run, same scenario", "<= 3x",
                                  Seconds(lockstep) + " vs " + Seconds(in_process)}};
+  if (one_cpu > 0)
+    rows.push_back({"lockstep, both processes pinned to one CPU, no spin", one_cpu / in_process, "x",
+                    "the in-process run, same scenario", "<= 3x", Seconds(one_cpu) + " vs " + Seconds(in_process)});
   json j{{"status", "ok"},
          {"duration_s", duration},
          {"in_process_s", in_process},
          {"lockstep_s", lockstep},
          {"ratio_lockstep_to_in_process", lockstep / in_process},
+         {"lockstep_one_cpu_s", one_cpu},
          {"logs_identical", identical}};
   if (!c.quick) {  // the whole suite, both ways (about a minute)
     try {
