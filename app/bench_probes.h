@@ -65,6 +65,9 @@ int FastestCpu(const std::vector<BenchCpu>& cpus);
 double SpeedupBoundOfCpus(const std::vector<BenchCpu>& cpus);
 nlohmann::ordered_json CpusJson(const std::vector<BenchCpu>& cpus);
 
+// The CPUs this process may run on (sched_getaffinity), in increasing order; empty if unknown.
+std::vector<int> AllowedCpus();
+
 // Pins the calling thread, and the processes it starts from then on, to one CPU until destroyed,
 // then restores the previous affinity. cpu < 0, or a mask the system refuses: no change.
 class ScopedCpuPin {

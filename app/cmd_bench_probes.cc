@@ -22,6 +22,7 @@
 #include "batch/controller_process.h"
 #include "core/file_text.h"
 #include "core/realtime.h"
+#include "dsp/statistics.h"
 #include "formats/csv_table.h"
 #include "core/data_dir.h"
 #include "batch/fork_pool.h"
@@ -400,10 +401,7 @@ json BenchDiagnosis(const BenchConfig& c) {
 
 std::vector<BenchCpu> MeasureCpus(const BenchConfig& c) {
   std::vector<BenchCpu> cpus;
-  cpu_set_t allowed;
-  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return cpus;
-  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
-    if (!CPU_ISSET(cpu, &allowed)) continue;
+  for (const int cpu : AllowedCpus()) {
     const ScopedCpuPin pin(cpu);
     if (!pin.pinned()) return {};
     cpus.push_back({cpu, BareMjStepSeconds(c.repeat, c.quick ? 2000 : 20000)});
@@ -535,6 +533,47 @@ json RealtimeRun(const BenchConfig& c, const std::string& controller_bin, double
               {"missed_cycles", m.at("link_missed_cycles")}};
 }
 
+// The machine's floor (DeadlineLoopJitter): the real-time runs' tick loop with no twin and no
+// controller, for `duration` s at the controller's 1 kHz, in a child process at kBenchRtPriority (when
+// granted) with its memory locked and the same spin before each deadline as serve's (--rt-spin's
+// default). Late: ticks that started half a period or more after their deadline (the twin's answer
+// window); missed: a whole period or more (the next tick's deadline had passed).
+json FloorRun(const BenchConfig& c, double duration) {
+  constexpr double kPeriod = 1e-3, kSpin = 100e-6;
+  const std::string dir = c.scratch + "/rt_floor";
+  std::filesystem::create_directories(dir);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t run = fork();
+  if (run == 0) {
+    const RealtimeGrant g = RequestRealtime(kBenchRtPriority);
+    std::vector<double> j = DeadlineLoopJitter(kPeriod, duration, kSpin);
+    long late = 0, missed = 0;
+    for (const double x : j) late += x >= 0.5 * kPeriod, missed += x >= kPeriod;
+    std::sort(j.begin(), j.end());
+    const json r{{"scheduling", g.fifo ? "SCHED_FIFO " + std::to_string(g.priority) + (g.memory_locked ? ", memory locked" : "")
+                                       : "normal priority (refused: " + g.refused + ")"},
+                 {"ticks", j.size()},
+                 {"jitter_p50_us", 1e6 * Percentile(j, 0.5)},
+                 {"jitter_p99_us", 1e6 * Percentile(j, 0.99)},
+                 {"jitter_max_us", j.empty() ? 0.0 : 1e6 * j.back()},
+                 {"late_ticks", late},
+                 {"missed_ticks", missed}};
+    try {
+      WriteFileAtomic(dir + "/floor.json", r.dump());
+    } catch (...) {
+      _exit(1);
+    }
+    _exit(0);
+  }
+  int st = 0;
+  waitpid(run, &st, 0);
+  if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) return Unavailable("the floor run failed");
+  json r = json::parse(ReadTextFile(dir + "/floor.json", "floor", "JSON"));
+  r["duration_s"] = duration;
+  return r;
+}
+
 std::string Us(double us) {
   char b[32];
   std::snprintf(b, sizeof b, "%.0f us", us);
@@ -558,15 +597,26 @@ json BenchLink(const BenchConfig& c) {
                              ReadTextFile(out_opt.out_dir + "/measured.csv", "", "CSV") &&
                          ReadTextFile(in_opt.out_dir + "/truth.csv", "", "CSV") ==
                              ReadTextFile(out_opt.out_dir + "/truth.csv", "", "CSV");
+  // The same pair on one CPU (the controller inherits the pin; neither end spins): the hand-over
+  // is then a switch on that CPU instead of a wake-up of the other (the policy of regress's workers).
+  double one_cpu = 0;
+  {
+    const ScopedCpuPin pin(FastestCpu(c.cpus));
+    if (pin.pinned()) one_cpu = BestOf(c.repeat, [&] { RunWithControllerProcess(s, out_opt, bin); });
+  }
   std::vector<BenchRow> rows = {{"lockstep: serve + exotwin-controller, gait_2kmh " + Seconds(duration) +
                                      (identical ? " (logs identical)" : " (logs DIFFER)"),
                                  lockstep / in_process, "x", "the in-process run, same scenario", "<= 3x",
                                  Seconds(lockstep) + " vs " + Seconds(in_process)}};
+  if (one_cpu > 0)
+    rows.push_back({"lockstep, both processes pinned to one CPU, no spin", one_cpu / in_process, "x",
+                    "the in-process run, same scenario", "<= 3x", Seconds(one_cpu) + " vs " + Seconds(in_process)});
   json j{{"status", "ok"},
          {"duration_s", duration},
          {"in_process_s", in_process},
          {"lockstep_s", lockstep},
          {"ratio_lockstep_to_in_process", lockstep / in_process},
+         {"lockstep_one_cpu_s", one_cpu},
          {"logs_identical", identical}};
   if (!c.quick) {  // the whole suite, both ways (about a minute)
     try {
@@ -592,6 +642,15 @@ json BenchLink(const BenchConfig& c) {
                         std::to_string(r.at("late_cycles").get<long>()) + ", missed " +
                         std::to_string(r.at("missed_cycles").get<long>())});
   }
+  const json floor = FloorRun(c, rt_duration);
+  j["realtime_floor"] = floor;
+  if (floor.value("status", "") != "unavailable")
+    rows.push_back({"machine floor: the same deadline loop, no twin, " + Seconds(rt_duration) + ", " +
+                        floor.at("scheduling").get<std::string>(),
+                    floor.at("jitter_p99_us").get<double>(), "us p99", "tick start vs its deadline", "",
+                    "p50 " + Us(floor.at("jitter_p50_us")) + ", max " + Us(floor.at("jitter_max_us")) + ", late " +
+                        std::to_string(floor.at("late_ticks").get<long>()) + ", missed " +
+                        std::to_string(floor.at("missed_ticks").get<long>())});
   j["rows"] = BenchRowsJson(rows);
   return j;
 }

@@ -77,6 +77,16 @@ nlohmann::ordered_json CpusJson(const std::vector<BenchCpu>& cpus) {
   return j;
 }
 
+std::vector<int> AllowedCpus() {
+  std::vector<int> cpus;
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &allowed)) cpus.push_back(cpu);
+  return cpus;
+}
+
 ScopedCpuPin::ScopedCpuPin(int cpu) : saved_() {
   if (cpu < 0 || cpu >= CPU_SETSIZE) return;
   if (sched_getaffinity(0, sizeof saved_, &saved_) != 0) return;

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "formats/csv_table.h"
+#include "app/bench_probes.h"  // ScopedCpuPin
 #include "app/commands.h"
 #include "core/data_dir.h"
 #include "core/error.h"
@@ -58,11 +59,19 @@ CommandRunner RegisterRegress(CLI::App& app) {
     auto dir_of = [&](size_t i) { return o->out + "/" + suite[i].scenario.name; };
 
     for (const SuiteEntry& e : suite) KeepScenarioModel(e.scenario);  // loaded once: the workers inherit it
+    const int workers = o->jobs > 0 ? o->jobs : DefaultWorkers();
+    const std::vector<int> cpus = AllowedCpus();
+    const bool pin_workers = !controller_bin.empty() && workers > 1 && cpus.size() > 1;
     ProgressBar bar(suite.size(), "regress");
     size_t done = 0, failed = 0;
     const auto outcomes = RunForked(
-        suite.size(), o->jobs > 0 ? o->jobs : DefaultWorkers(),
+        suite.size(), workers,
         [&](size_t i) {
+          // --controller-process: each worker, with the controller it starts, on a CPU of its own
+          // (ForkWorkerSlot): the lockstep hand-over between the two processes is then a switch on
+          // one CPU, not a wake-up of another (tens of us on a virtual machine), and two workers'
+          // pairs do not take each other's CPUs.
+          const ScopedCpuPin pin(pin_workers ? cpus[static_cast<size_t>(ForkWorkerSlot()) % cpus.size()] : -1);
           RunOptions opt;
           opt.out_dir = dir_of(i);
           opt.controller_process = controller_bin;

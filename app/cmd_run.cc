@@ -136,7 +136,7 @@ CommandRunner RegisterServe(CLI::App& app) {
     std::string scenario, out = "out", bus, can, clock = "lockstep", can_log;
     uint64_t seed = 0;
     double timeout = 10.0;
-    double link_delay_ms = 0, link_jitter_ms = 0, link_loss = 0, rt_spin_us = 100;
+    double link_delay_ms = 0, link_jitter_ms = 0, link_loss = 0, rt_spin_us = 100, link_spin_us = 1e6 * kDefaultLinkSpin;
     int rt_priority = 0;
   };
   auto o = std::make_shared<Opts>();
@@ -157,11 +157,15 @@ CommandRunner RegisterServe(CLI::App& app) {
   auto* rt_priority = sub->add_option("--rt-priority", o->rt_priority,
                                       "realtime: lock the memory and take SCHED_FIFO priority 1..99 (a refusal: warning)");
   sub->add_option("--rt-spin", o->rt_spin_us, "realtime: us spent spinning before each tick's deadline (default 100)");
+  sub->add_option("--link-spin", o->link_spin_us,
+                  "us a wait for the controller's answer spins before it blocks (adaptive; default 50, 0: block)");
   return [sub, o, seed, rt_priority]() -> int {
     if (!*sub) return -1;
     if (o->bus.empty() && o->can.empty()) throw InputError("serve: --bus ADDR or --can IFACE is required");
     if (!(o->rt_spin_us >= 0 && o->rt_spin_us <= 1e6))
       throw InputError("--rt-spin: expected 0 to 1000000 us, got " + std::to_string(o->rt_spin_us));
+    if (!(o->link_spin_us >= 0 && o->link_spin_us <= 1e6))
+      throw InputError("--link-spin: expected 0 to 1000000 us, got " + std::to_string(o->link_spin_us));
     InstallStopSignalHandlers();
     const Scenario s = ReadScenario(o->scenario);
     const LinkFaults faults = LinkFaultsOf(o->link_delay_ms, o->link_jitter_ms, o->link_loss, *seed ? o->seed : s.seed);
@@ -172,6 +176,7 @@ CommandRunner RegisterServe(CLI::App& app) {
     const OutFolderLock lock(o->out);
     const std::string controller_file = WriteControllerFile(s, o->out, *seed ? o->seed : s.seed);
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
+    if (address.kind != BusKind::kSocketCan) link->SetSpin(1e-6 * o->link_spin_us);
     const ServeClock clock = o->clock == "realtime" ? ServeClock::kRealtime : ServeClock::kLockstep;
     if (*rt_priority) {
       const RealtimeGrant g = RequestRealtime(o->rt_priority);

@@ -1,5 +1,6 @@
 #include "batch/controller_process.h"
 
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -75,8 +76,8 @@ class LinkDir {
 };
 
 pid_t StartController(const std::string& bin, const std::string& config, const std::string& bus,
-                      const std::string& log) {
-  std::vector<std::string> args = {bin, "--config", config, "--bus", bus};
+                      const std::string& log, double spin_s) {
+  std::vector<std::string> args = {bin, "--config", config, "--bus", bus, "--spin", std::to_string(1e6 * spin_s)};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -113,7 +114,14 @@ RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std:
   const std::string config = WriteControllerScenario(s, dir.path() + "/scenario.yaml");
   const BusAddress address = ParseBusAddress("unix:" + dir.path() + "/bus");
   std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
-  const pid_t pid = StartController(controller_bin, config, address.text, opt.out_dir + "/controller.log");
+  // Both ends spin before they block only when they may run on different CPUs: the controller
+  // inherits this process's CPUs, and on a single one a spinning end holds the CPU its peer needs.
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  const bool one_cpu = ::sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) == 1;
+  const double spin = one_cpu ? 0.0 : kDefaultLinkSpin;
+  link->SetSpin(spin);
+  const pid_t pid = StartController(controller_bin, config, address.text, opt.out_dir + "/controller.log", spin);
   RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, timeout_s);
   opt.remote = &remote;
   RunResult r;

@@ -29,7 +29,9 @@ std::string DefaultControllerBinary();
 // Runs `s` as RunScenario does (any device and protocol), the controller being `controller_bin` started
 // on the scenario's device and controller part (WriteControllerScenario: it downloads each run's
 // controller file from the twin) on a private Unix link (its log in opt.out_dir/controller.log) and
-// stopped at the end (NMT stop; killed if still there 5 s later), in lockstep (or `clock`). The run
+// stopped at the end (NMT stop; killed if still there 5 s later), in lockstep (or `clock`). The link
+// spins kDefaultLinkSpin before it blocks, on both ends, unless this process may run on one CPU only
+// (the controller inherits its affinity: both ends then block at once). The run
 // fails (a check result "controller_link" failed) when the controller was lost. Throws InputError when
 // the link cannot be set up.
 RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,

@@ -28,8 +28,11 @@ struct Report {
   uint64_t alive;
 };
 
+int g_worker_slot = -1;  // ForkWorkerSlot
+
 struct Worker {
   pid_t pid = -1;
+  int slot = 0;            // ForkWorkerSlot in the worker
   int to = -1, from = -1;  // parent's ends: job indices to the worker, reports from it
   long job = -1;           // the job it runs, -1 idle
   Clock::time_point started;
@@ -80,6 +83,8 @@ bool WriteAll(int fd, const void* p, size_t n) {
 
 }  // namespace
 
+int ForkWorkerSlot() { return g_worker_slot; }
+
 int DefaultWorkers() {
   const unsigned n = std::thread::hardware_concurrency();
   return n > 0 ? static_cast<int>(n) : 1;
@@ -124,12 +129,15 @@ std::vector<JobOutcome> RunForked(size_t n, int workers, const std::function<int
     }
     std::fflush(stdout);
     std::fflush(stderr);
+    int slot = 0;  // the lowest slot no live worker holds
+    while (std::any_of(pool.begin(), pool.end(), [&](const Worker& k) { return k.slot == slot; })) ++slot;
     const pid_t pid = fork();
     if (pid < 0) {
       close(down[0]), close(down[1]), close(up[0]), close(up[1]);
       return false;
     }
     if (pid == 0) {
+      g_worker_slot = slot;
       std::signal(SIGPIPE, SIG_DFL);
       for (const Worker& k : pool) close(k.to), close(k.from);
       close(down[1]);
@@ -140,6 +148,7 @@ std::vector<JobOutcome> RunForked(size_t n, int workers, const std::function<int
     close(up[1]);
     Worker k;
     k.pid = pid;
+    k.slot = slot;
     k.to = down[1];
     k.from = up[0];
     pool.push_back(k);

@@ -26,6 +26,10 @@ struct JobOutcome {
 std::vector<JobOutcome> RunForked(size_t n, int workers, const std::function<int(size_t)>& job,
                                   const std::function<void(size_t, const JobOutcome&)>& on_done = {});
 
+// In a worker of RunForked: its slot, 0..workers-1, unique among the live workers (a worker that
+// replaces a dead one takes its slot), e.g. to give each worker its own CPU. -1 outside a worker.
+int ForkWorkerSlot();
+
 // Default worker count: std::thread::hardware_concurrency(), at least 1.
 int DefaultWorkers();
 

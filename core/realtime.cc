@@ -66,4 +66,16 @@ double WaitUntil(double deadline_s, double spin_s) {
   return now;
 }
 
+std::vector<double> DeadlineLoopJitter(double period_s, double duration_s, double spin_s) {
+  const long ticks = std::lround(duration_s / period_s);
+  std::vector<double> jitter;
+  jitter.reserve(static_cast<size_t>(std::max(0L, ticks)));  // no allocation in the loop
+  const double t0 = MonotonicSeconds() + period_s;
+  for (long k = 0; k < ticks; ++k) {
+    const double due = t0 + static_cast<double>(k) * period_s;
+    jitter.push_back(WaitUntil(due, spin_s) - due);
+  }
+  return jitter;
+}
+
 }  // namespace exotwin

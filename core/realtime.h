@@ -3,6 +3,7 @@
 // and the kernel allows; and the wait for an absolute deadline of CLOCK_MONOTONIC.
 #pragma once
 #include <string>
+#include <vector>
 
 namespace exotwin {
 
@@ -31,5 +32,11 @@ void DropRealtimePriority();
 // `spin_s`, then spins until the deadline (the sleep's wake-up latency taken off the tick's start);
 // returns the time reached (>= deadline_s; later when the deadline had already passed).
 double WaitUntil(double deadline_s, double spin_s);
+
+// The machine's floor for a tick loop (`exotwin bench`'s row beside the twin's real-time runs, as
+// rt-tests' cyclictest): ticks on the absolute deadlines t0 + k period_s for duration_s, each waited
+// for as the twin's (WaitUntil with spin_s), with no work in between; returns each tick's start minus
+// its deadline (s), in tick order. Runs at the calling thread's priority.
+std::vector<double> DeadlineLoopJitter(double period_s, double duration_s, double spin_s);
 
 }  // namespace exotwin

@@ -1,6 +1,7 @@
-// exotwin-controller --config FILE.yaml (--bus ADDR | --can IFACE): the deployable controller
+// exotwin-controller --config FILE.yaml (--bus ADDR | --can IFACE) [--spin US]: the deployable controller
 // (DESIGN.md "Command line"). Exit 0 at the end of the run (NMT stop) or after SIGINT / SIGTERM (zero
 // torque commanded first); 2 on bad input (the file, key or address named on stderr).
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <stdexcept>
@@ -16,8 +17,10 @@
 
 namespace {
 
-constexpr const char* kUsage = "usage: exotwin-controller --config FILE.yaml (--bus ADDR | --can IFACE)\n"
-                               "  ADDR: unix:PATH | udp:HOST:PORT | can:IFACE";
+constexpr const char* kUsage = "usage: exotwin-controller --config FILE.yaml (--bus ADDR | --can IFACE) [--spin US]\n"
+                               "  ADDR: unix:PATH | udp:HOST:PORT | can:IFACE\n"
+                               "  --spin US: a wait for the twin's next frames spins up to US us before it blocks\n"
+                               "             (adaptive; default 50; 0: block at once)";
 
 int Usage(const std::string& why) {
   std::cerr << "exotwin-controller: " << why << "\n" << kUsage << std::endl;
@@ -29,14 +32,22 @@ int Usage(const std::string& why) {
 int main(int argc, char** argv) {
   using namespace exotwin;
   std::string config, bus, what = "--bus";
+  double spin_us = 1e6 * kDefaultLinkSpin;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") {
       std::cout << kUsage << std::endl;
       return 0;
     }
-    if ((a == "--config" || a == "--bus" || a == "--can") && i + 1 >= argc) return Usage(a + ": expected a value");
+    if ((a == "--config" || a == "--bus" || a == "--can" || a == "--spin") && i + 1 >= argc)
+      return Usage(a + ": expected a value");
     if (a == "--config") config = argv[++i];
+    else if (a == "--spin") {
+      char* end = nullptr;
+      spin_us = std::strtod(argv[++i], &end);
+      if (end == argv[i] || *end != '\0' || !(spin_us >= 0 && spin_us <= 1e6))
+        return Usage(std::string("--spin: expected 0 to 1000000 us, got '") + argv[i] + "'");
+    }
     else if (a == "--bus" || a == "--can") {
       if (!bus.empty()) return Usage("give one of --bus, --can");
       what = a;
@@ -70,6 +81,7 @@ int main(int argc, char** argv) {
       throw InputError(config + ": " + e.what());
     }
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kController);
+    if (address.kind != BusKind::kSocketCan) link->SetSpin(1e-6 * spin_us);
     InstallStopSignalHandlers();
     if (scenario) {
       ControllerNode node(scenario_controller, hal3, config, link.get(), std::cerr);

@@ -145,8 +145,10 @@ int ControllerNode::Run() {
       Summary("stopped");
       return 0;
     }
-    link_->WaitInput(0.1);
-    while (!done_ && link_->Receive(&f) == CanStatus::kOk) Handle(f);
+    // The frames of the datagrams read; the next datagram is read by the next wait (a read of an
+    // empty socket here would cost a system call per cycle).
+    if (!link_->WaitInput(0.1)) continue;
+    while (!done_ && link_->Queued() > 0 && link_->Receive(&f) == CanStatus::kOk) Handle(f);
   }
   Summary(exit_code_ ? "configuration refused" : "run over (NMT stop)");
   return exit_code_;

@@ -1,7 +1,6 @@
 #include "protocol/can_link.h"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <linux/can.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -10,6 +9,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -31,6 +31,9 @@ struct CanLink::Impl {
   bool held = false;
   std::vector<can_frame> out;  // held frames (Hold .. Flush)
   std::deque<CanFrame> in;     // valid frames of received datagrams, not yet returned by Receive
+  double rcv_timeout = -1;     // s, the SO_RCVTIMEO set on fd (-1: none set yet)
+  double spin_max = 0, spin = 0;  // s, SetSpin's budget and the current one
+  int spin_skip = 0;              // waits left that block at once
   ~Impl() {
     if (fd >= 0) ::close(fd);
     if (!local_path.empty()) ::unlink(local_path.c_str());
@@ -40,6 +43,8 @@ struct CanLink::Impl {
 namespace {
 
 constexpr double kSendWait = 0.1;  // s
+// Waits at least this long (s) block in a receive with SO_RCVTIMEO; shorter ones in ppoll.
+constexpr double kLongWait = 0.02;
 
 [[noreturn]] void Fail(const BusAddress& a, const std::string& socket, const std::string& what, int err) {
   throw InputError("--bus " + a.text + ": " + socket + ": " + what + (err ? std::string(": ") + std::strerror(err) : ""));
@@ -78,7 +83,7 @@ void BindUnix(const BusAddress& a, const std::string& path, CanLink::Impl* impl)
     if (UnixSocketInUse(path)) Fail(a, path, "in use by another process", 0);
     ::unlink(path.c_str());  // stale: left by a process that died
   }
-  impl->fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  impl->fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);  // blocking: see WaitInput
   if (impl->fd < 0) Fail(a, path, "cannot create a Unix datagram socket", errno);
   const sockaddr_un u = UnixAddress(path);
   const mode_t old = ::umask(0177);  // the socket file is created mode 0600
@@ -91,7 +96,7 @@ void BindUnix(const BusAddress& a, const std::string& path, CanLink::Impl* impl)
 }
 
 void BindUdp(const BusAddress& a, const std::string& local, CanLink::Impl* impl) {
-  impl->fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  impl->fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);  // blocking: see WaitInput
   if (impl->fd < 0) Fail(a, local, "cannot create a UDP socket", errno);
   const sockaddr_in in = InetAddress(local);
   if (::bind(impl->fd, reinterpret_cast<const sockaddr*>(&in), sizeof in) != 0)
@@ -140,6 +145,7 @@ std::unique_ptr<CanLink> CanLink::Open(const BusAddress& a, LinkEnd end) {
       break;
     }
   }
+  impl->spin_max = impl->spin = a.kind == BusKind::kSocketCan ? 0.0 : kDefaultLinkSpin;
   return std::unique_ptr<CanLink>(new CanLink(a, end, std::move(impl)));
 }
 
@@ -183,7 +189,7 @@ CanStatus CanLink::SendQueued() {
   // of a live peer is waited for, up to kSendWait s, before the datagram is refused (kQueueFull).
   ssize_t n;
   const double give_up = MonotonicSeconds() + kSendWait;
-  while ((n = ::sendto(impl_->fd, impl_->out.data(), bytes, MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&impl_->peer),
+  while ((n = ::sendto(impl_->fd, impl_->out.data(), bytes, MSG_NOSIGNAL | MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&impl_->peer),
                        impl_->peer_len)) < 0 &&
          (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS) && MonotonicSeconds() < give_up) {
     const timespec pause{0, 20000};
@@ -213,7 +219,7 @@ CanStatus CanLink::Receive(CanFrame* out) {
     if (st == CanStatus::kOk) ++stats_.received;
     return st;
   }
-  while (impl_->in.empty() && ReceiveDatagram()) {
+  while (impl_->in.empty() && ReceiveDatagram() == 1) {
   }
   if (impl_->in.empty()) return CanStatus::kNoFrame;
   *out = impl_->in.front();
@@ -222,25 +228,27 @@ CanStatus CanLink::Receive(CanFrame* out) {
   return CanStatus::kOk;
 }
 
-bool CanLink::ReceiveDatagram() {
+int CanLink::ReceiveDatagram(bool block) {
   can_frame buf[kMaxFramesPerDatagram + 1];  // one frame more: a longer datagram is seen as such
   sockaddr_storage from{};
   socklen_t from_len = sizeof from;
-  const ssize_t n = ::recvfrom(impl_->fd, buf, sizeof buf, MSG_TRUNC, reinterpret_cast<sockaddr*>(&from), &from_len);
+  const ssize_t n = ::recvfrom(impl_->fd, buf, sizeof buf, MSG_TRUNC | (block ? 0 : MSG_DONTWAIT),
+                               reinterpret_cast<sockaddr*>(&from), &from_len);
   if (n < 0) {
-    if (errno == EAGAIN || errno == EWOULDBLOCK) return false;
-    if (errno == ECONNREFUSED || errno == EINTR) return true;  // UDP: a refused earlier send
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return 0;
+    if (errno == EINTR) return block ? -1 : 1;
+    if (errno == ECONNREFUSED) return 1;  // UDP: a refused earlier send
     ++stats_.malformed;
-    return false;
+    return 0;
   }
   if (!SamePeer(from, from_len, *impl_)) {
     ++stats_.foreign;
-    return true;
+    return 1;
   }
   const size_t frames = static_cast<size_t>(n) / sizeof(can_frame);
   if (n == 0 || static_cast<size_t>(n) % sizeof(can_frame) != 0 || frames > static_cast<size_t>(kMaxFramesPerDatagram)) {
     ++stats_.malformed;
-    return true;
+    return 1;
   }
   const double now = MonotonicSeconds();
   for (size_t i = 0; i < frames; ++i) {
@@ -256,20 +264,84 @@ bool CanLink::ReceiveDatagram() {
     f.t = now;
     impl_->in.push_back(f);
   }
-  return true;
+  return 1;
 }
 
 bool CanLink::PeerAlive() const {
   return address_.kind != BusKind::kUnix || UnixSocketInUse(address_.PeerName(end_));
 }
 
+size_t CanLink::Queued() const { return impl_->in.size(); }
+
+double CanLink::spin_budget() const {
+  return impl_->spin_skip > 1 || impl_->spin_max <= 0 ? 0.0 : (impl_->spin > 0 ? impl_->spin : impl_->spin_max);
+}
+
+void CanLink::SetSpin(double max_spin_s) {
+  impl_->spin_max = impl_->spin = std::max(0.0, max_spin_s);
+  impl_->spin_skip = 0;
+}
+
+bool CanLink::SpinForInput(double timeout_s) {
+  Impl& m = *impl_;
+  if (m.spin_max <= 0) return false;
+  if (m.spin_skip > 0 && --m.spin_skip > 0) return false;
+  if (m.spin <= 0) m.spin = m.spin_max;  // the probe after kSpinProbe waits that blocked at once
+  const double end = MonotonicSeconds() + std::min(m.spin, timeout_s);
+  do {
+    if (ReceiveDatagram() == 1 && !m.in.empty()) {
+      m.spin = m.spin_max;
+      return true;
+    }
+  } while (MonotonicSeconds() < end);
+  m.spin *= 0.5;
+  if (m.spin < 1e-6) m.spin = 0, m.spin_skip = kSpinProbe;
+  return false;
+}
+
 bool CanLink::WaitInput(double timeout_s) {
   if (!impl_->in.empty()) return true;
-  pollfd p{};
-  p.fd = impl_->can ? impl_->can->fd() : impl_->fd;
-  p.events = POLLIN;
-  const int ms = timeout_s <= 0 ? 0 : static_cast<int>(std::ceil(timeout_s * 1e3));
-  return ::poll(&p, 1, ms) > 0 && (p.revents & POLLIN);
+  auto wait_poll = [&](int fd, double seconds) {  // ppoll: a timer of its own, as exact as the kernel's
+    pollfd p{};
+    p.fd = fd;
+    p.events = POLLIN;
+    timespec ts{};
+    ts.tv_sec = static_cast<time_t>(seconds);
+    ts.tv_nsec = static_cast<long>((seconds - std::floor(seconds)) * 1e9);
+    return ::ppoll(&p, 1, &ts, nullptr) > 0 && (p.revents & POLLIN);
+  };
+  if (impl_->can) return wait_poll(impl_->can->fd(), std::max(0.0, timeout_s));
+  auto take = [&] {  // the datagrams waiting, until one brings frames
+    while (impl_->in.empty() && ReceiveDatagram() == 1) {
+    }
+    return !impl_->in.empty();
+  };
+  if (timeout_s <= 0) return take();
+  const double end = MonotonicSeconds() + timeout_s;
+  if (SpinForInput(timeout_s)) return true;
+  for (;;) {  // foreign and malformed datagrams are dropped on the way
+    const double left = end - MonotonicSeconds();
+    if (left <= 0) return take();
+    if (left < kLongWait) {  // short: ppoll's timer (SO_RCVTIMEO counts whole kernel ticks)
+      if (!wait_poll(impl_->fd, left)) return take();
+      if (take()) return true;
+      continue;
+    }
+    // Long (a give-up guard): one blocking receive, the wait of a cycle costing one system call. The
+    // timeout, whole ms (the kernel may round it up to its tick), is set only when it changes.
+    const double timeout = std::floor(left * 1e3) * 1e-3;
+    if (timeout != impl_->rcv_timeout) {
+      timeval tv{};
+      tv.tv_sec = static_cast<time_t>(timeout);
+      tv.tv_usec = static_cast<suseconds_t>(std::lround((timeout - std::floor(timeout)) * 1e6));
+      if (tv.tv_usec >= 1000000) ++tv.tv_sec, tv.tv_usec -= 1000000;
+      ::setsockopt(impl_->fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+      impl_->rcv_timeout = timeout;
+    }
+    const int got = ReceiveDatagram(true);
+    if (take()) return true;
+    if (got < 0) return false;  // a signal
+  }
 }
 
 }  // namespace exotwin

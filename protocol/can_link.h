@@ -21,6 +21,10 @@
 
 namespace exotwin {
 
+// The spin budget of a link's waits unless set (CanLink::SetSpin; `serve --link-spin`,
+// `exotwin-controller --spin`): s.
+constexpr double kDefaultLinkSpin = 50e-6;
+
 // The most frames one datagram carries (1024 bytes: one Ethernet frame with its UDP header).
 constexpr int kMaxFramesPerDatagram = 64;
 
@@ -59,13 +63,27 @@ class CanLink : public CanBus {
   // kOk with the oldest valid frame from the peer (out->t: CLOCK_MONOTONIC, s); kNoFrame when none
   // is waiting (foreign and malformed datagrams are dropped on the way, and counted).
   CanStatus Receive(CanFrame* out) override;
-  // Blocks in poll(2) until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if
-  // input waits. It does not spin: on a loaded machine a spinning end takes the CPU its peer needs to
-  // answer.
+  // Waits until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if input waits.
+  // Unix and UDP: first spins (non-blocking reads) for up to the adaptive spin budget (SetSpin), then
+  // blocks in one receive with the remaining time as timeout (SO_RCVTIMEO), so a wait that blocks
+  // costs one system call, not a poll and a read. SocketCAN: poll(2).
   bool WaitInput(double timeout_s);
+  // The most a wait spins before it blocks (s; kDefaultLinkSpin unless set; 0: it blocks at once;
+  // SocketCAN never spins). A peer running on
+  // another CPU answers within microseconds, sooner than a blocked process is woken (a cross-CPU
+  // wake-up costs tens of microseconds on a virtual machine); a peer that is not running (a loaded
+  // machine, one CPU) cannot answer while this end spins. So the budget adapts: a wait that blocks
+  // halves it, one answered while spinning restores it; once below 1 us the waits block at once, and
+  // every kSpinProbe-th wait tries the whole budget again.
+  void SetSpin(double max_spin_s);
+  double spin_budget() const;  // s, what the next wait spins at most (0: it blocks at once)
+  static constexpr int kSpinProbe = 64;
   // False when the peer is known to be gone: a Unix peer whose socket no live process holds (the file
   // of a killed process stays behind). True otherwise (UDP and SocketCAN cannot tell).
   bool PeerAlive() const;
+  // The frames already read from the socket and not yet returned by Receive (Receive reads the
+  // socket only when there are none).
+  size_t Queued() const;
   const CanLinkStatistics& statistics() const { return stats_; }
   const BusAddress& address() const { return address_; }
   // "unix:PATH (peer PATH.ctl)" and the like, for logs.
@@ -76,7 +94,11 @@ class CanLink : public CanBus {
  private:
   CanLink(BusAddress address, LinkEnd end, std::unique_ptr<Impl> impl);
   CanStatus SendQueued();   // the held frames as one datagram
-  bool ReceiveDatagram();   // one datagram's valid frames into the input queue; false when none waits
+  // One datagram's valid frames into the input queue: 1 when a datagram was read (its frames may all
+  // have been dropped), 0 when none waits (or, blocking, none came within the receive timeout), -1
+  // when a signal interrupted a blocking read.
+  int ReceiveDatagram(bool block = false);
+  bool SpinForInput(double timeout_s);  // the spin phase of WaitInput
   BusAddress address_;
   LinkEnd end_;
   std::unique_ptr<Impl> impl_;

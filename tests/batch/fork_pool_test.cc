@@ -1,5 +1,5 @@
 // RunForked (batch/fork_pool.h): exit codes by index, a crashing job recorded with its signal while
-// the other jobs go on, exceptions as 70, jobs sharing a few long-lived workers.
+// the other jobs go on, exceptions as 70, jobs sharing a few long-lived workers, each in its slot.
 #include "batch/fork_pool.h"
 
 #include <gtest/gtest.h>
@@ -80,6 +80,25 @@ TEST(RunForked, JobsShareLongLivedWorkers) {  // the parent forks `workers` proc
     pids.insert(pid);
   }
   EXPECT_LE(pids.size(), 2u);
+}
+
+// ForkWorkerSlot: 0..workers-1 in a worker (a worker replacing a dead one takes its slot), -1 outside.
+TEST(RunForked, EachWorkerHasASlotBelowTheWorkerCount) {
+  EXPECT_EQ(ForkWorkerSlot(), -1);
+  const auto out = RunForked(12, 3, [](size_t i) {
+    if (i == 4) std::raise(SIGKILL);  // its worker dies: the next one takes its slot
+    return ForkWorkerSlot();
+  });
+  std::set<int> slots;
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (i == 4) continue;
+    EXPECT_GE(out[i].exit_code, 0) << i;
+    EXPECT_LT(out[i].exit_code, 3) << i;
+    slots.insert(out[i].exit_code);
+  }
+  EXPECT_GE(slots.size(), 1u);
+  EXPECT_EQ(out[4].signal, SIGKILL);
+  EXPECT_EQ(ForkWorkerSlot(), -1);
 }
 
 TEST(RunForked, NoJobsNoWorkers) { EXPECT_TRUE(RunForked(0, 4, [](size_t) { return 0; }).empty()); }

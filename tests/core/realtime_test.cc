@@ -22,6 +22,18 @@ TEST(Realtime, WaitUntilReachesTheDeadlineAndNotEarlier) {
   EXPECT_LT(reached - before, 0.1);
 }
 
+// The floor loop: one figure per tick of the duration, none before its deadline; ticks on absolute
+// deadlines, so the loop's own time does not add up (a 50-tick loop takes 50 periods, not more).
+TEST(Realtime, DeadlineLoopJitterOneTickPerPeriodNoneEarly) {
+  const double t0 = MonotonicSeconds();
+  const std::vector<double> j = DeadlineLoopJitter(1e-3, 0.05, 100e-6);
+  const double took = MonotonicSeconds() - t0;
+  ASSERT_EQ(j.size(), 50u);
+  for (const double x : j) EXPECT_GE(x, 0.0);
+  EXPECT_GE(took, 0.05);
+  EXPECT_LT(took, 0.05 + 1e-3 + j.back() + 0.01);  // the last tick's lateness and the set-up, no drift
+}
+
 TEST(Realtime, PriorityOutsideOneTo99IsAnInputError) {
   EXPECT_THROW(RequestRealtime(0), InputError);
   EXPECT_THROW(RequestRealtime(100), InputError);

@@ -90,6 +90,11 @@ TEST(ControllerExecutable, BadInputExitsTwoNamingFileKeyOrAddress) {
   EXPECT_NE(out.find("nosuchcan7"), std::string::npos) << out;
   out = Shell(bin + " --config " + dir.path() + "/ok.yaml", &rc);
   EXPECT_EQ(rc, 2);
+  for (const char* spin : {"-1", "2e6", "fast"}) {
+    out = Shell(bin + " --config " + dir.path() + "/ok.yaml" + bus + " --spin " + spin, &rc);
+    EXPECT_EQ(rc, 2) << spin;
+    EXPECT_NE(out.find(std::string("--spin: expected 0 to 1000000 us, got '") + spin + "'"), std::string::npos) << out;
+  }
   // A second controller on the same link: the address is in use.
   auto first = CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/bus"), LinkEnd::kController);
   out = Shell(bin + " --config " + dir.path() + "/ok.yaml" + bus, &rc);

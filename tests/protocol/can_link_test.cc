@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/realtime.h"
 #include "protocol/link_frames.h"
 #include "tests/temp_dir.h"
 
@@ -147,6 +148,70 @@ TEST(CanLink, HeldFramesLeaveAsOneDatagramOfUpTo64) {
   EXPECT_EQ(twin->Receive(&f), CanStatus::kNoFrame);  // the other two, queued already, dropped
   EXPECT_EQ(twin->statistics().received, 73u);
   EXPECT_EQ(twin->statistics().malformed, 3u);
+}
+
+// A wait blocks in one receive for its whole timeout (not less, whatever the spin), returns at once
+// when a datagram is there, and goes on waiting after a foreign datagram (dropped, counted).
+TEST(CanLink, WaitBlocksForItsTimeoutAndWakesOnADatagram) {
+  testing::ScopedTempDir dir("canlink");
+  const BusAddress a = ParseBusAddress("unix:" + dir.path() + "/bus");
+  auto twin = CanLink::Open(a, LinkEnd::kTwin);
+  auto ctl = CanLink::Open(a, LinkEnd::kController);
+  for (const double spin : {0.0, 50e-6}) {
+    twin->SetSpin(spin);
+    double t0 = MonotonicSeconds();
+    EXPECT_FALSE(twin->WaitInput(0.03)) << spin;
+    const double waited = MonotonicSeconds() - t0;
+    EXPECT_GE(waited, 0.03) << spin;
+    EXPECT_LT(waited, 0.5) << spin;
+    ASSERT_EQ(ctl->Send(Frame(0x100, 3)), CanStatus::kOk);
+    t0 = MonotonicSeconds();
+    EXPECT_TRUE(twin->WaitInput(5.0)) << spin;
+    EXPECT_LT(MonotonicSeconds() - t0, 1.0) << spin;
+    EXPECT_EQ(twin->Queued(), 1u);
+    CanFrame f;
+    ASSERT_EQ(twin->Receive(&f), CanStatus::kOk);
+    EXPECT_TRUE(SamePayload(f, Frame(0x100, 3)));
+  }
+  can_frame cf{};
+  cf.can_id = 0x100;
+  cf.can_dlc = 1;
+  SendRawUnix(dir.path() + "/intruder", dir.path() + "/bus", &cf, sizeof cf);
+  const double t0 = MonotonicSeconds();
+  EXPECT_FALSE(twin->WaitInput(0.03));
+  EXPECT_GE(MonotonicSeconds() - t0, 0.03);
+  EXPECT_EQ(twin->statistics().foreign, 1u);
+}
+
+// CanLink::SetSpin: a wait that blocks halves the budget; below 1 us the waits block at once, and the
+// kSpinProbe-th one spins the whole budget again; a wait answered while spinning restores it. (A wait
+// of timeout 0 is a read and leaves the budget alone.)
+TEST(CanLink, SpinBudgetHalvesWhenWaitsBlockAndComesBackOnAnAnswer) {
+  testing::ScopedTempDir dir("canlink");
+  const BusAddress a = ParseBusAddress("unix:" + dir.path() + "/bus");
+  auto twin = CanLink::Open(a, LinkEnd::kTwin);
+  auto ctl = CanLink::Open(a, LinkEnd::kController);
+  EXPECT_EQ(twin->spin_budget(), kDefaultLinkSpin);
+  twin->SetSpin(40e-6);
+  std::vector<double> budgets;
+  for (int i = 0; i < 6; ++i) {
+    twin->WaitInput(1e-4);
+    budgets.push_back(twin->spin_budget());
+  }
+  EXPECT_EQ(budgets, (std::vector<double>{20e-6, 10e-6, 5e-6, 2.5e-6, 1.25e-6, 0.0}));
+  for (int i = 1; i < CanLink::kSpinProbe - 1; ++i) {
+    twin->WaitInput(1e-5);
+    ASSERT_EQ(twin->spin_budget(), 0.0) << i;
+  }
+  twin->WaitInput(1e-5);  // the last one that blocks at once: the next spins again
+  EXPECT_EQ(twin->spin_budget(), 40e-6);
+  twin->WaitInput(1e-4);
+  EXPECT_EQ(twin->spin_budget(), 20e-6);
+  ASSERT_EQ(ctl->Send(Frame(0x100, 1)), CanStatus::kOk);  // there before the wait: found while spinning
+  EXPECT_TRUE(twin->WaitInput(1.0));
+  EXPECT_EQ(twin->spin_budget(), 40e-6);
+  twin->SetSpin(0);
+  EXPECT_EQ(twin->spin_budget(), 0.0);
 }
 
 TEST(CanLink, PeerAbsentIsAStatusNotACrash) {
