@@ -223,7 +223,9 @@ TEST(ServeCli, RealtimeRunsToTheEndAndReportsJitter) {  // 2 s of gait: 2000 tic
   EXPECT_EQ(total, 2000.0);
   const double max_us = r["metrics"]["link_jitter_max_us"];
   EXPECT_GE(max_us, edges[last]);
-  if (last + 1 < edges.size()) EXPECT_LT(max_us, edges[last + 1]);
+  if (last + 1 < edges.size()) {
+    EXPECT_LT(max_us, edges[last + 1]);
+  }
 }
 
 TEST(ServeCli, ControllerStartedBeforeTheTwinAndTwinRestartedUnderIt) {
