@@ -18,15 +18,15 @@ TEST(Table5Cli, BadPlantInputIsExit2BeforeAnyRun) {
   const testing::ScopedTempDir tmp("table5_cli");
   const std::string out = tmp.path() + "/out";
   const std::string plants = std::string(EXOTWIN_SOURCE_DIR) + "/data/plants/";
-  const std::string backlash = tmp.path() + "/backlash.yaml";
-  WriteText(backlash, "L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
-                      "effects:\n  - {name: backlash, joint: knee, value: 0.01}\n");
+  const std::string muscles = tmp.path() + "/muscles.yaml";
+  WriteText(muscles, "L1: 0.41\nexo: {J1: 3.02, J2: 0.74, X1: 3.85, X2: 1.74, Y1: 0.15, Y2: 0.16}\n"
+                      "effects:\n  - {name: muscle_activity, joint: knee, value: 1, weights: {vl: 0.1}}\n");
   struct Case {
     std::string args, expect;
   } cases[] = {
       {"--realistic --plant " + plants + "exowheel_realistic.yaml", "--realistic: names its own plant files"},
       {"--plant " + tmp.path() + "/missing.yaml", "missing.yaml"},
-      {"--plant-worn " + backlash, "effects[0]"},
+      {"--plant-worn " + muscles, "effects[0]"},  // EMG is a record's input, not the plant's
   };
   for (const Case& c : cases) {
     const auto r = RunExotwin("table5 --subjects S1 --out " + out + " " + c.args);
