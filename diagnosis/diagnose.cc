@@ -13,6 +13,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <Eigen/Cholesky>
 
@@ -322,7 +323,7 @@ std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& b
       if (kNonNegative.count(c.name)) sign[static_cast<size_t>(c.cols[0])] = 1;
     // The normal equations of the columns this record moves (a column of zeros, e.g. a held hip's,
     // stays at 0), diagonal regularized by 1e-6 of itself: collinear candidates (the kitchen sink of
-    // one record, up to ~50 columns) pass SolveSigned's conditioning test (1e-8 of the largest
+    // one record) pass SolveSigned's conditioning test (1e-8 of the largest
     // eigenvalue of the unit-diagonal Gram) at a cost of the order of 1e-6 of the fit.
     std::vector<int> live;
     for (Eigen::Index k = 0; k < b.X.cols(); ++k)
@@ -337,8 +338,12 @@ std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& b
     }
     G.diagonal() += 1e-6 * G.diagonal();
     Eigen::VectorXd x_live, x = Eigen::VectorXd::Zero(b.X.cols());
+    // With the ridge the unit-diagonal Gram's smallest eigenvalue is >= 1e-6 and its largest <= its
+    // column count, so SolveSigned's test passes for up to 100 columns; beyond that a ceiling of 0 %
+    // would be a false bound, so it is an error, not a score.
     if (!live.empty() && !SolveSigned(G, h, live_sign, &x_live))
-      continue;  // columns this record cannot tell apart: no ceiling (scores stay 0, "not measured")
+      throw std::logic_error("diagnose: the ceiling of record " + std::to_string(r) + " (" +
+                             std::to_string(live.size()) + " candidate columns) is too ill-conditioned to solve");
     for (size_t a = 0; a < live.size(); ++a) x[live[a]] = x_live[static_cast<Eigen::Index>(a)];
     const Eigen::VectorXd e = b.r - b.X * x;
     const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
