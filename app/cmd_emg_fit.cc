@@ -88,6 +88,11 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
                   jn[j], d.steps.back().model.figures[j].r2_cv, d.steps.front().model.figures[j].r2_cv,
                   d.steps.back().model.figures[j].r2_heldout_trim, d.steps.back().model.figures[j].r2_heldout,
                   d.steps.front().model.figures[j].r2_heldout_trim, d.steps.front().model.figures[j].r2_heldout);
+    for (int j = 0; j < 2; ++j)
+      std::printf("%s: the estimate holds all but %g %% of its variance below %.1f Hz; the measured moment has %.1f %% of "
+                  "its variance above (the estimate %.2f %%): R^2 cannot pass %.3f in that band\n",
+                  jn[j], 100 * kBandResidue, d.ceiling[j].band_hz, 100 * d.ceiling[j].share_above,
+                  100 * d.ceiling[j].estimate_share, d.ceiling[j].r2);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "emg-fit: wrote %s in %s s\n", o->out.c_str(), NumberText(secs, 3).c_str());
     return 0;

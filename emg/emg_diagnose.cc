@@ -6,6 +6,7 @@
 #include <map>
 
 #include "diagnosis/diagnose_select.h"
+#include "dsp/butterworth.h"
 #include "formats/number_text.h"
 #include "core/error.h"
 
@@ -369,6 +370,72 @@ double ChannelCorrelation(const EmgRecording& r, Muscle mu) {
 
 }  // namespace
 
+EmgBandCeiling BandCeiling(const EmgTorqueModel& model, const std::vector<const EmgRecording*>& recs, int joint) {
+  struct Series {
+    double fs;
+    std::vector<double> pred, meas;
+    std::vector<size_t> scored;
+  };
+  std::vector<Series> ser;
+  for (const EmgRecording* r : recs) {
+    const size_t n = r->size();
+    if (n < 50 || !r->has_moments() || !(r->t.back() > r->t.front()))
+      throw InputError(r->source + ": the band ceiling needs a recording with moments of at least 50 samples");
+    Series s{static_cast<double>(n - 1) / (r->t.back() - r->t.front()), PredictMoment(model, *r, joint), r->tau[joint],
+             WithinSpikeLimit(r->tau[joint], 0, n)};
+    // Spikes bridged linearly between their scored neighbours (they are not scored; their ringing
+    // through the filter would be).
+    std::vector<char> in(n, 0);
+    for (size_t i : s.scored) in[i] = 1;
+    for (size_t i = 0; i < n; ++i) {
+      if (in[i]) continue;
+      size_t a = i, b = i;
+      while (a > 0 && !in[a]) --a;
+      while (b + 1 < n && !in[b]) ++b;
+      const double ya = in[a] ? s.meas[a] : s.meas[b], yb = in[b] ? s.meas[b] : ya;
+      const double f = b > a ? static_cast<double>(i - a) / static_cast<double>(b - a) : 0.0;
+      s.meas[i] = ya + f * (yb - ya);
+    }
+    ser.push_back(std::move(s));
+  }
+  // Energy above f of the estimate (on every sample, or on the scored ones) and of the measured
+  // moment (scored), and the measured sum of squares about its mean, pooled.
+  struct Energy {
+    double pred_all = 0, var_pred = 0, pred = 0, meas = 0, sst = 0;
+  };
+  auto energy = [&](double f, bool measured) {
+    Energy e;
+    for (const Series& s : ser) {
+      const auto hp = dsp::DesignButterworth(4, dsp::BandType::kHighPass, s.fs, f);
+      const std::vector<double> hpred = dsp::FiltFilt(hp, s.pred);
+      double mp = 0;
+      for (double v : s.pred) mp += v / static_cast<double>(s.pred.size());
+      for (size_t i = 0; i < s.pred.size(); ++i) e.pred_all += hpred[i] * hpred[i], e.var_pred += (s.pred[i] - mp) * (s.pred[i] - mp);
+      if (!measured) continue;
+      const std::vector<double> hmeas = dsp::FiltFilt(hp, s.meas);
+      double mm = 0;
+      for (size_t i : s.scored) mm += s.meas[i] / static_cast<double>(s.scored.size());
+      for (size_t i : s.scored)
+        e.pred += hpred[i] * hpred[i], e.meas += hmeas[i] * hmeas[i], e.sst += (s.meas[i] - mm) * (s.meas[i] - mm);
+    }
+    return e;
+  };
+  double nyquist = 1e300;
+  for (const Series& s : ser) nyquist = std::min(nyquist, s.fs / 2);
+  EmgBandCeiling c;
+  c.band_hz = 0.5;
+  for (;; c.band_hz += 0.5) {
+    const Energy e = energy(c.band_hz, false);
+    if (!(e.pred_all > kBandResidue * e.var_pred) || c.band_hz + 0.5 >= 0.9 * nyquist) break;
+  }
+  const Energy e = energy(c.band_hz, true);
+  if (!(e.sst > 0)) return c;
+  c.share_above = e.meas / e.sst, c.estimate_share = e.pred / e.sst;
+  const double d = std::sqrt(c.share_above) - std::sqrt(c.estimate_share);
+  c.r2 = d > 0 ? 1 - d * d : 1.0;
+  return c;
+}
+
 EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const EmgDiagnoseOptions& opt) {
   if (recs.empty()) throw InputError("emg-fit: no recording");
   if (recs.size() < 2 && opt.blocks < 2)
@@ -646,6 +713,7 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     d.measured[j] = r.tau[j];
     d.linear[j] = PredictMoment(d.steps.front().model, r, j);
     d.final_[j] = PredictMoment(d.steps.back().model, r, j);
+    d.ceiling[j] = BandCeiling(d.calibration, recs, j);
   }
   return d;
 }

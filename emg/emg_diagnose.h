@@ -36,6 +36,27 @@
 
 namespace exotwin {
 
+// What of a measured joint moment lies beyond the band an EMG-driven estimate occupies. The
+// estimate is made of envelopes (low-passed) through the muscle twitch and of the angles, so it has
+// almost no content above some frequency; what the measured moment has there (inverse dynamics'
+// noise and impact transients, Bisseling & Hof 2006, J Biomech 39:2438-2444; Kristianslund,
+// Krosshaug & van den Bogert 2012, J Biomech 45:666-671) is error for any estimate of that band,
+// whatever its causes. band_hz: the lowest frequency (0.5 Hz steps) above which the estimate holds
+// at most kBandResidue of its variance (zero-phase 4th-order Butterworth high-pass H, |H| <= 1);
+// share_above = |H m|^2 / SST and estimate_share = |H p|^2 / SST, with m the measured moment, p the
+// estimate, SST the measured variance, on the samples within kSpikeMads of the median (the scored
+// ones; the samples beyond are bridged linearly before filtering), pooled over the recordings.
+// Since SSE >= |H (m - p)|^2 >= (|H m| - |H p|)^2, R^2 <= r2 = 1 - (sqrt(share_above) -
+// sqrt(estimate_share))^2 (1 when the estimate holds more above the band than the moment).
+constexpr double kBandResidue = 0.001;
+struct EmgBandCeiling {
+  double band_hz = 0;
+  double share_above = 0, estimate_share = 0;
+  double r2 = 1;
+};
+// Of `model`'s estimate at `joint` on `recs` (with moments; sampled uniformly, >= 50 samples each).
+EmgBandCeiling BandCeiling(const EmgTorqueModel& model, const std::vector<const EmgRecording*>& recs, int joint);
+
 struct EmgStep {
   std::string added;  // "linear form (HJ15 eq. 26)" for the first step
   std::string why;    // the gates' figures, in words
@@ -65,6 +86,7 @@ struct EmgDiagnosis {
   // (the held-out part starts at `split`), estimated by the fits on the first 70 %.
   std::vector<double> t, measured[2], linear[2], final_[2];
   size_t split = 0;
+  EmgBandCeiling ceiling[2];  // of the calibration (BandCeiling)
 };
 
 struct EmgDiagnoseOptions {

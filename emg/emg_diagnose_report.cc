@@ -102,7 +102,11 @@ std::string EmgDiagnosisJson(const EmgDiagnosis& d) {
                               {"r2_before", first.figures[k].r2_heldout_trim},
                               {"r2_after", last.figures[k].r2_heldout_trim},
                               {"r2_before_all_samples", first.figures[k].r2_heldout},
-                              {"r2_after_all_samples", last.figures[k].r2_heldout}};
+                              {"r2_after_all_samples", last.figures[k].r2_heldout},
+                              {"band_hz", d.ceiling[k].band_hz},
+                              {"moment_share_above_band", d.ceiling[k].share_above},
+                              {"estimate_share_above_band", d.ceiling[k].estimate_share},
+                              {"r2_ceiling_band", d.ceiling[k].r2}};
   }
   j["validation"] = {{"method", Validation(d)},
                      {"holdout_fraction", d.holdout_fraction},

@@ -549,5 +549,39 @@ TEST(EmgSyntheticLaw, NoDelayInTheLawNoDelayNamed) {
   for (int j = 0; j < 2; ++j) EXPECT_GE(R2(b.tau[j], PredictMoment(d.calibration, b, j)), 0.97);
 }
 
+// The band ceiling (emg_diagnose.h BandCeiling) against the closed form of white noise: the law's
+// own moment lies below the estimate's band, white noise of variance s^2 spreads evenly up to fs/2,
+// so the measured share above band_hz is s^2 (1 - band_hz / (fs/2)) / var(tau) (the law's residue
+// above the band, at most kBandResidue of its variance, within the tolerance). The estimate's own
+// R^2 does not pass the ceiling; without noise the ceiling is 1 to within the residue.
+TEST(EmgSyntheticLaw, BandCeilingIsTheWhiteNoiseAboveTheEstimatesBand) {
+  for (double noise : {0.01, 4.0}) {
+    Law law;
+    law.noise = noise;
+    const EmgRecording a = GaitTrial(law, 31);
+    EmgModelSpec spec;
+    spec.common_delay = law.delay;
+    const EmgTorqueModel m = FitEmgModel(spec, {&a}, EmgFitOptions{1.0});
+    for (int j = 0; j < 2; ++j) {
+      const EmgBandCeiling c = BandCeiling(m, {&a}, j);
+      double mean = 0, var = 0;
+      for (double v : a.tau[j]) mean += v / static_cast<double>(a.size());
+      for (double v : a.tau[j]) var += (v - mean) * (v - mean) / static_cast<double>(a.size());
+      const double expected = noise * noise * (1 - c.band_hz / 50.0) / var;
+      const double r2 = R2(a.tau[j], PredictMoment(m, a, j));
+      std::printf("  noise %g N m, %s: band %.1f Hz, share above %.4f (white noise: %.4f), ceiling %.4f, R^2 %.4f\n",
+                  noise, j ? "knee" : "hip", c.band_hz, c.share_above, expected, c.r2, r2);
+      EXPECT_GT(c.band_hz, 0.5);
+      EXPECT_LT(c.band_hz, 10.0);
+      EXPECT_NEAR(c.share_above, expected, 0.002 + 0.1 * expected);
+      EXPECT_LE(c.estimate_share, 1.2 * kBandResidue);
+      EXPECT_LE(r2, c.r2 + 1e-9);
+      if (noise < 0.1) {
+        EXPECT_GT(c.r2, 1 - kBandResidue);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace exotwin
