@@ -163,7 +163,13 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
       << NumberText(F[1].r2_heldout_trim, 3) << "</td><td>" << NumberText(F[1].rms_heldout_trim, 3) << "</td><td>"
       << NumberText(F[0].r2_heldout, 3) << " / " << NumberText(F[1].r2_heldout, 3) << "</td></tr>";
   }
-  o << "</table><h2>Named causes (fitted on every sample)</h2><table><tr><th>cause</th><th>joint</th><th>value</th>"
+  o << "</table><p>Band ceiling (the final model on every sample): ";
+  for (int k = 0; k < 2; ++k)
+    o << (k ? "; " : "") << kJoint[k] << ": the estimate holds all but " << NumberText(100 * kBandResidue, 2)
+      << " % of its variance below " << NumberText(d.ceiling[k].band_hz, 3) << " Hz, the measured moment has "
+      << NumberText(100 * d.ceiling[k].share_above, 3) << " % of its variance above, so R&sup2; cannot pass "
+      << NumberText(d.ceiling[k].r2, 3) << " in that band";
+  o << ".</p><h2>Named causes (fitted on every sample)</h2><table><tr><th>cause</th><th>joint</th><th>value</th>"
        "<th>95 % interval</th></tr>";
   for (const auto& e : Effects(d)) {
     o << "<tr><td>" << HtmlEscape(e["name"].get<std::string>()) << (e.contains("muscle") ? " " + e["muscle"].get<std::string>() : "")
