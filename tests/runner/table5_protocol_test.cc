@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace exotwin {
@@ -68,6 +69,20 @@ TEST(Table5Protocol, TwoSubjectsShortTrialsRecoverTruthAndBeatAnthropometry) {
   }
 }
 
+// The run passed its checks, its identified RMS error lies in (lo, hi) per joint (N m) and below both
+// anthropometric tables.
+void ExpectIdentifiedIn(const Table5SubjectRun& run, std::pair<double, double> hip, std::pair<double, double> knee,
+                        const std::string& what) {
+  EXPECT_TRUE(run.failed_checks.empty()) << (run.failed_checks.empty() ? "" : run.failed_checks[0]);
+  const Table5Entry& e = run.entry;
+  EXPECT_GT(e.hip.identified, hip.first) << what;
+  EXPECT_LT(e.hip.identified, hip.second) << what;
+  EXPECT_GT(e.knee.identified, knee.first) << what;
+  EXPECT_LT(e.knee.identified, knee.second) << what;
+  ExpectPattern(e.hip, what + " hip");
+  ExpectPattern(e.knee, what + " knee");
+}
+
 // S1 with short trials (1 x 20 s per step, 4 strides) through the realistic EXOwheel's sensor
 // (data/plants/exowheel_realistic.yaml) and the worn file `worn` of data/plants/, diagnosed.
 Table5Options RealisticS1Options(const std::string& worn, const std::string& out_dir) {
@@ -92,14 +107,7 @@ TEST(Table5Protocol, RealisticPlantRaisesTheErrorAndDiagnoseNamesItsDamping) {
   const testing::ScopedTempDir tmp("table5_realistic");
   const Table5Options opt = RealisticS1Options("relaxed_leg.yaml", tmp.path());
   const Table5SubjectRun run = RunTable5Subject("S1", opt);
-  EXPECT_TRUE(run.failed_checks.empty()) << (run.failed_checks.empty() ? "" : run.failed_checks[0]);
-  const Table5Entry& e = run.entry;
-  EXPECT_GT(e.hip.identified, 0.20);
-  EXPECT_LT(e.hip.identified, 0.38);
-  EXPECT_GT(e.knee.identified, 0.11);
-  EXPECT_LT(e.knee.identified, 0.21);
-  ExpectPattern(e.hip, "realistic hip");
-  ExpectPattern(e.knee, "realistic knee");
+  ExpectIdentifiedIn(run, {0.20, 0.38}, {0.11, 0.21}, "realistic");
 
   ASSERT_EQ(run.diagnoses.size(), 2u);
   const Table5Diagnosis& gait = run.diagnoses[0];
@@ -157,14 +165,7 @@ TEST(Table5Protocol, SubjectEffectsDrawsTheCvPerSubject) {
 TEST(Table5Protocol, HumanSideRaisesTheErrorAndDiagnoseNamesThePassiveMoment) {
   const testing::ScopedTempDir tmp("table5_human_side");
   const Table5SubjectRun run = RunTable5Subject("S1", RealisticS1Options("human_side.yaml", tmp.path()));
-  EXPECT_TRUE(run.failed_checks.empty()) << (run.failed_checks.empty() ? "" : run.failed_checks[0]);
-  const Table5Entry& e = run.entry;
-  EXPECT_GT(e.hip.identified, 0.77);
-  EXPECT_LT(e.hip.identified, 1.43);
-  EXPECT_GT(e.knee.identified, 0.27);
-  EXPECT_LT(e.knee.identified, 0.50);
-  ExpectPattern(e.hip, "human side hip");
-  ExpectPattern(e.knee, "human side knee");
+  ExpectIdentifiedIn(run, {0.77, 1.43}, {0.27, 0.50}, "human side");
   double drawn = 0;
   for (const Effect& fx : run.plant_worn)
     if (fx.name == "passive_moment" && fx.joint == "hip") drawn = fx.value;
