@@ -122,6 +122,9 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
     } else if (e.name == "gravity_error" || e.name == "torque_ripple") {
       fx.applied.push_back(e);
     } else if (e.name == "passive_moment") {
+      if (params.one_joint)
+        throw InputError(where + ": Riener & Edrich's curves are the two-joint leg's (hip and knee angles of HJ15); "
+                         "a one-joint model cannot carry a passive_moment");
       if (!(e.value > -1 && e.value <= kMaxPassiveScale - 1))
         throw InputError(where + ": a passive moment " + std::to_string(1 + e.value) +
                          " times Riener & Edrich's; expected -1 < value <= " + std::to_string(kMaxPassiveScale - 1));

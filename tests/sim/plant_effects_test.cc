@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "tests/real_rig_model.h"
 #include "model/leg_dynamics.h"
+#include "model/one_joint.h"
 #include "model/passive_torque.h"
 #include "sim/plant.h"
 
@@ -131,6 +132,12 @@ TEST(PlantEffects, PassiveMomentIsAFactorOnRienerEdrich) {
     p.effects = {MakeEffect("passive_moment", "hip", v)};
     EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError) << v;
   }
+  // A one-joint device's knee is not HJ15's two-joint leg: refused.
+  OneJointModel one;
+  one.device = {0.2, 1.5};
+  one.human = OneJointLink{0.43, 11.0};
+  const LegParams embedded = EmbedOneJointModel(one, 9.81, {MakeEffect("passive_moment", "knee", 0.2)});
+  EXPECT_THROW(ToPlantEffects(embedded, "m.yaml"), InputError);
 }
 
 TEST(PlantEffects, RefusesWhatThePlantCannotCarryNamingTheEffect) {
