@@ -1,5 +1,5 @@
 // `exotwin table5 [--subjects S1,...] [--strides 10] [--out DIR] [--trials N] [--trial-duration S]
-//  [--plant FILE] [--plant-worn FILE | --realistic] [--diagnose]`:
+//  [--plant FILE] [--plant-worn FILE | --realistic] [--seed N] [--diagnose]`:
 // Hwang & Jeon 2015 Tables 3-5 reproduced by the twin, side by side with the paper (identification
 // steps 1-4 and relaxed gait through the closed loop, per subject; runner/table5_protocol.h), optionally
 // through a plant with effects (the realistic EXOwheel of data/plants/) and with diagnose on the
@@ -36,6 +36,7 @@ CommandRunner RegisterTable5(CLI::App& app) {
   struct Opts {
     std::string subjects = "S1,S2,S3,S4,S5,S6,S7,S8,S9,S10", out = "out/table5", scenarios, plant, plant_worn;
     int strides = 10, trials = 5;
+    uint64_t seed = 1;
     double trial_duration = 40.0;
     bool drop_logs = false, realistic = false, diagnose = false;
   };
@@ -56,6 +57,8 @@ CommandRunner RegisterTable5(CLI::App& app) {
   sub->add_flag("--realistic", o->realistic,
                 "the shipped realistic EXOwheel: --plant data/plants/exowheel_realistic.yaml --plant-worn "
                 "data/plants/relaxed_leg.yaml");
+  sub->add_option("--seed", o->seed,
+                  "seed of the per-subject draws of a plant effect with a cv field (passive_moment; default 1)");
   sub->add_flag("--diagnose", o->diagnose,
                 "diagnose the gait and the steps 3-4 records with the identified rigid model (a section of the output)");
   return [sub, o]() -> int {
@@ -76,6 +79,7 @@ CommandRunner RegisterTable5(CLI::App& app) {
     opt.plant_worn_file = o->realistic ? DataPath("data/plants/relaxed_leg.yaml") : o->plant_worn;
     Table5PlantEffects(opt, true);  // reads both files up front: a bad file is exit 2 before any run
     opt.diagnose = o->diagnose;
+    opt.seed = o->seed;
     opt.log = [](const std::string& line) { std::fprintf(stderr, "table5: %s\n", line.c_str()); };
     const auto wall0 = std::chrono::steady_clock::now();
     std::vector<Table5Entry> entries;

@@ -181,6 +181,13 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       add("gravity_error", {j == 0 ? AddJointColumn(b, w, 0, G) : AddBothJointsColumn(b, w, G)}, axis);
     }
     add("joint_stiffness", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.q[j][i]; }), off});
+    // The subject's passive moment off Riener & Edrich's curves by a factor: Delta tau_S = -value P_j(q)
+    // (a two-joint model with a human only: the curves are a human leg's in HJ15's two-joint angles).
+    if (params.human && !params.one_joint) {
+      Effect unit_passive;
+      unit_passive.joint = j == 0 ? "hip" : "knee", unit_passive.value = 1.0;
+      add("passive_moment", {AddJointColumn(b, w, j, [&](size_t i) { return -PassiveMomentTorque(unit_passive, Q(i)); })});
+    }
     // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b).
     add("backlash", {AddColumn(b, w, [&](size_t i) {
           Eigen::Vector2d qa = Q(i), qb = Q(i);

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "formats/number_text.h"
+#include "model/passive_torque.h"
 
 namespace exotwin {
 namespace {
@@ -266,7 +267,8 @@ DiagnosedEffect ToEffect(const Candidate& c, const Fit& f) {
       {"coulomb_friction", "N m"}, {"viscous_friction", "N m s/rad"}, {"inertia_error", "kg m^2"},
       {"gravity_error", "kg m"}, {"joint_stiffness", "N m/rad"}, {"backlash", "rad"},
       {"series_compliance", "N m/rad"}, {"torque_ripple", "N m"}, {"sensor_offset", "N m"},
-      {"sensor_gain", "relative"}, {"sensor_delay", "s"}, {"muscle_activity", "-"}};
+      {"sensor_gain", "relative"}, {"sensor_delay", "s"}, {"muscle_activity", "-"},
+      {"passive_moment", "relative"}};
   e.unit = units.at(c.name);
   if (c.name == "joint_stiffness") {
     e.fields["q0"] = std::abs(v) > 0 ? CoefOf(f, c.cols[1]) / v : 0.0;
@@ -321,6 +323,8 @@ bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* wh
   if (e.name == "sensor_offset" && !(std::abs(v) <= 0.5 * s.tau_max[j])) no = "offset beyond half the largest torque";
   if (e.name == "sensor_gain" && !(v >= -0.25 && v <= 0.25)) no = "gain error outside -25 % .. +25 %";
   if (e.name == "sensor_delay" && !(v > 0 && v <= 0.05)) no = "delay outside (0, 50] ms";
+  if (e.name == "passive_moment" && !(v > -1 && v <= kMaxPassiveScale - 1))
+    no = "passive moment " + Num(1 + v) + " times Riener & Edrich's, outside (0, " + Num(kMaxPassiveScale) + "]";
   if (why) *why = no;
   return no.empty();
 }

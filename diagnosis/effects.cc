@@ -74,6 +74,8 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
       for (size_t i = 0; i < n; ++i) tr[i] += e.value * (kin.q[j][i] - q0);
     } else if (e.name == "torque_ripple") {
       for (size_t i = 0; i < n; ++i) tr[i] += TorqueRippleTorque(e, kin.q[j][i]);
+    } else if (e.name == "passive_moment") {
+      for (size_t i = 0; i < n; ++i) tr[i] += PassiveMomentTorque(e, At(kin.q, i));
     } else if (e.name == "gravity_error") {
       for (size_t i = 0; i < n; ++i) {
         const Eigen::Vector2d dG = GravityErrorTorque(e, params.g, At(kin.q, i));

@@ -1,7 +1,7 @@
 // Model extensions (DESIGN.md "Effects") applied on top of the rigid twin's torques.
 //
 // Physical models (the same code is the truth in `generate` and the extended twin in `predict`):
-//  - coulomb/viscous friction, inertia_error, joint_stiffness, torque_ripple: the DESIGN formulas
+//  - coulomb/viscous friction, inertia_error, joint_stiffness, torque_ripple, passive_moment: the DESIGN formulas
 //    added to tau_R of that joint (MuJoCo frictionloss / damping / armature / stiffness analogues).
 //  - gravity_error: HJ15 eq. 7 with the distal segment's lumped X (or Y) changed by value.
 //  - backlash (dead band of total width b): the encoder sits on the motor side; under load the link

@@ -9,6 +9,7 @@
 #include "dsp/butterworth.h"
 #include "formats/number_text.h"
 #include "core/error.h"
+#include "model/passive_torque.h"
 
 namespace exotwin {
 namespace {
@@ -37,9 +38,8 @@ constexpr double kAStep = 0.25;
 // flexors change by up to about a factor 2 over 0-90 deg of flexion (Herzog & Read 1993, J Anat
 // 182:213-230); beyond 3 the term is no moment arm.
 constexpr double kMaxMomentArmRatio = 3.0;
-// Passive moment: Riener & Edrich 1999's population curves scaled by s_P; a subject's passive
-// moment within (0, 3] times theirs (a stated bound: they report a wide spread between subjects).
-constexpr double kMaxPassiveScale = 3.0;
+// Passive moment: Riener & Edrich 1999's population curves scaled by s_P within (0, kMaxPassiveScale]
+// (model/passive_torque.h).
 
 std::string Num(double v) { return NumberText(v, 4); }
 

@@ -50,6 +50,7 @@ const std::vector<EffectSpec>& EffectSpecs() {
       {"backlash", "rad", 0.0, 0.5, {}},
       {"series_compliance", "N m/rad", 1.0, 1e6, {}},
       {"torque_ripple", "N m", 0.0, 100.0, {"cycles_per_rad", "phase"}},
+      {"passive_moment", "relative", -1.0, 10.0, {}},
       {"sensor_offset", "N m", -100.0, 100.0, {}},
       {"sensor_gain", "relative", -0.9, 10.0, {}},
       {"sensor_delay", "s", 0.0, 1.0, {}},
@@ -74,6 +75,7 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
   std::set<std::string> allowed = {"name", "joint", "value", "unit", "ci95", "explained_pct"};
   allowed.insert(spec->fields.begin(), spec->fields.end());
   if (e.name == "gravity_error") allowed.insert("axis");
+  if (e.name == "passive_moment") allowed.insert("cv");
   if (e.name == "muscle_activity") allowed.insert({"weights", "channels"});
   YamlCheckKeys(c, n, key, allowed);
   if (!n["joint"] || !n["joint"].IsScalar() ||
@@ -93,6 +95,8 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
     e.axis = n["axis"] ? n["axis"].Scalar() : "X";
     if (e.axis != "X" && e.axis != "Y") c.Fail(key + ".axis", "expected X or Y");
   }
+  // passive_moment's optional inter-subject coefficient of variation (table5 draws each subject's value).
+  if (e.name == "passive_moment" && n["cv"]) e.fields["cv"] = YamlNumber(c, n["cv"], key + ".cv", 0.0, 2.0, "");
   if (e.name == "muscle_activity" && n["weights"]) {
     if (!n["weights"].IsMap()) c.Fail(key + ".weights", "expected a mapping channel: N m per V");
     for (const auto& kv : n["weights"]) {

@@ -20,4 +20,9 @@ double RienerKneeMoment(double A_deg, double K_deg, double H_deg);
 // coordinate. Ankle held at 0 (the lower leg is one rigid segment). N m. kNone gives zero.
 Eigen::Vector2d PassiveElasticTorque(PassiveModel model, const Eigen::Vector2d& q);
 
+// A subject's passive moment as a multiple of Riener & Edrich's population curves lies in (0, this]:
+// a stated bound (they and later studies report a wide spread between healthy subjects, none beyond
+// a few times the mean curve); the emg loop's passive scale and the passive_moment effect share it.
+constexpr double kMaxPassiveScale = 3.0;
+
 }  // namespace exotwin

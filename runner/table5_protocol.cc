@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -15,6 +16,8 @@
 #include "formats/csv_table.h"
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "core/rng.h"
+#include "model/passive_torque.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
 #include "sim/paper_tables.h"
@@ -107,6 +110,21 @@ Table5Diagnosis DiagnoseRecords(const std::string& what, const LegParams& model,
 
 std::string ShippedScenarioDir() { return DataPath("scenarios"); }
 
+std::vector<Effect> SubjectEffects(std::vector<Effect> fx, const std::string& subject, uint64_t seed) {
+  for (Effect& e : fx) {
+    const auto cv = e.fields.find("cv");
+    if (cv == e.fields.end()) continue;
+    uint64_t h = 1469598103934665603ull;  // FNV-1a, 64 bit
+    for (char ch : subject + "/" + e.name + "/" + e.joint) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+    NormalRng<NormalPolar> z(MixSeed(seed ^ MixSeed(h)));
+    const double sd = std::sqrt(std::log(1.0 + cv->second * cv->second));
+    const double factor = (1.0 + e.value) * std::exp(sd * z.Normal() - 0.5 * sd * sd);
+    e.value = std::min(factor, kMaxPassiveScale) - 1.0;
+    e.fields.erase(cv);
+  }
+  return fx;
+}
+
 std::vector<Effect> Table5PlantEffects(const Table5Options& opt, bool worn) {
   std::vector<Effect> fx;
   for (const std::string* path : {&opt.plant_file, &opt.plant_worn_file}) {
@@ -123,9 +141,11 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   if (!(opt.trial_duration >= 5.0)) throw InputError("table5: --trial-duration: expected at least 5 s");
   if (opt.strides < 1) throw InputError("table5: --strides: expected at least 1");
   const Subject preset = PresetSubject(subject);  // throws InputError listing the valid names
-  const std::vector<Effect> device_fx = Table5PlantEffects(opt, false), worn_fx = Table5PlantEffects(opt, true);
+  const std::vector<Effect> device_fx = SubjectEffects(Table5PlantEffects(opt, false), subject, opt.seed),
+                            worn_fx = SubjectEffects(Table5PlantEffects(opt, true), subject, opt.seed);
   const auto wall0 = std::chrono::steady_clock::now();
   Table5SubjectRun run;
+  run.plant_worn = worn_fx;
   Table5Entry& e = run.entry;
   e.subject = subject;
   const std::string base = opt.out_dir + "/" + subject;
@@ -216,8 +236,17 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
          (opt.plant_worn_file.empty() ? std::string("none") : opt.plant_worn_file) + ".\n\n";
     s += "| effect | joint | value | unit | scenarios |\n| --- | --- | --- | --- | --- |\n";
     for (size_t i = 0; i < worn.size(); ++i)
-      s += "| " + worn[i].name + " | " + worn[i].joint + " | " + FormatNumber("%g", worn[i].value) + " | " + worn[i].unit +
-           " | " + (i < device.size() ? "steps 1-4, gait" : "steps 3-4, gait") + " |\n";
+      s += "| " + worn[i].name + " | " + worn[i].joint + " | " + FormatNumber("%g", worn[i].value) +
+           (worn[i].fields.count("cv") ? ", cv " + FormatNumber("%g", worn[i].fields.at("cv")) + ": drawn per subject" : "") +
+           " | " + worn[i].unit + " | " + (i < device.size() ? "steps 1-4, gait" : "steps 3-4, gait") + " |\n";
+    // The per-subject draws (SubjectEffects), as each subject's plant carried them.
+    for (size_t i = 0; i < worn.size(); ++i) {
+      if (!worn[i].fields.count("cv")) continue;
+      s += "\nDrawn " + worn[i].name + " (" + worn[i].joint + ", seed " + std::to_string(opt.seed) + "):";
+      for (const Table5SubjectRun& r : runs)
+        if (i < r.plant_worn.size()) s += " " + r.entry.subject + " " + FormatNumber("%+.3f", r.plant_worn[i].value);
+      s += ".\n";
+    }
   }
   bool any = false;
   for (const Table5SubjectRun& r : runs) any = any || !r.diagnoses.empty();
@@ -228,7 +257,7 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
        "identified twin -> the extended twin.\n\n";
   s += "| subject | records | named | hip held-out | knee held-out | paper's identified hip / knee (Table 5) |\n"
        "| --- | --- | --- | --- | --- | --- |\n";
-  struct Acc { double sum = 0; int n = 0; };
+  struct Acc { double sum = 0, abs_dev = 0; int n = 0; };  // abs_dev: sum of |named - that subject's set value|
   std::vector<std::pair<std::string, Acc>> named_gait;  // "name(joint)" -> gait values
   for (const Table5SubjectRun& r : runs)
     for (const Table5Diagnosis& d : r.diagnoses) {
@@ -247,7 +276,7 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
         s += (i ? "; " : "") + e.name + " (" + e.joint + ") " + FormatNumber("%.3g", e.value) + " [" +
              FormatNumber("%.3g", d.ci[i].first) + ", " + FormatNumber("%.3g", d.ci[i].second) + "]";
         double set = 0;
-        if (SetValue(worn, e.name, e.joint, &set) && set != 0)
+        if (SetValue(r.plant_worn, e.name, e.joint, &set) && set != 0)
           s += " (" + FormatNumber("%+.0f", 100.0 * (e.value - set) / set) + " % of the plant's " + FormatNumber("%g", set) + ")";
         else
           s += " (not in the plant)";
@@ -256,6 +285,7 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
           auto it = std::find_if(named_gait.begin(), named_gait.end(), [&](const auto& p) { return p.first == key; });
           if (it == named_gait.end()) it = named_gait.insert(named_gait.end(), {key, Acc{}});
           it->second.sum += e.value;
+          it->second.abs_dev += std::abs(e.value - set);
           ++it->second.n;
         }
       }
@@ -273,14 +303,21 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
     seen.push_back(key);
     double set = 0;
     SetValue(worn, e.name, e.joint, &set);
+    // A value drawn per subject: its set value differs by subject; the deviation is then the mean
+    // |named - that subject's value| over the subjects that named it.
+    const bool drawn = e.fields.count("cv") > 0;
+    const std::string set_text = drawn ? "drawn per subject" : FormatNumber("%g", set);
     auto it = std::find_if(named_gait.begin(), named_gait.end(), [&](const auto& p) { return p.first == key; });
     if (it == named_gait.end()) {
-      s += "| " + key + " | " + FormatNumber("%g", set) + " | 0 | - | not named |\n";
+      s += "| " + key + " | " + set_text + " | 0 | - | not named |\n";
       continue;
     }
     const double mean = it->second.sum / it->second.n;
-    s += "| " + key + " | " + FormatNumber("%g", set) + " | " + std::to_string(it->second.n) + " | " + FormatNumber("%.3g", mean) +
-         " | " + (set != 0 ? FormatNumber("%+.1f %%", 100.0 * (mean - set) / set) : std::string("-")) + " |\n";
+    std::string dev = "-";
+    if (drawn) dev = "mean \\|named - set\\| " + FormatNumber("%.3g", it->second.abs_dev / it->second.n);
+    else if (set != 0) dev = FormatNumber("%+.1f %%", 100.0 * (mean - set) / set);
+    s += "| " + key + " | " + set_text + " | " + std::to_string(it->second.n) + " | " + FormatNumber("%.3g", mean) +
+         " | " + dev + " |\n";
   }
   for (const auto& [key, acc] : named_gait)
     if (std::find(seen.begin(), seen.end(), key) == seen.end())

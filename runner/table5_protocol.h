@@ -28,6 +28,9 @@ struct Table5Options {
   std::string plant_file;       // the device's: every scenario (steps 1-4 and gait); "" = none
   std::string plant_worn_file;  // the worn leg's: where the subject wears the exoskeleton (steps 3-4, gait)
   bool diagnose = false;        // diagnose the gait and the steps 3-4 records with the identified model
+  // Seed of the per-subject draws: an effect with a `cv` field (passive_moment) takes, for each subject,
+  // a value drawn from (seed, subject name) (SubjectEffects).
+  uint64_t seed = 1;
   std::function<void(const std::string&)> log;  // progress lines (may be empty)
 };
 
@@ -49,6 +52,7 @@ struct Table5SubjectRun {
   Table5Entry entry;
   std::vector<std::string> failed_checks;
   std::vector<Table5Diagnosis> diagnoses;  // opt.diagnose: gait, then steps 3-4
+  std::vector<Effect> plant_worn;          // the effects this subject's worn scenarios carried (drawn)
   double wall_s = 0;
 };
 
@@ -61,8 +65,16 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
 // missing or bad file, or an effect the plant cannot carry: sim/plant_effects.h).
 std::vector<Effect> Table5PlantEffects(const Table5Options& opt, bool worn);
 
-// Markdown of the plant's effects against what diagnose named per subject (value, % of the set value
-// at that joint and name), the held-out errors of the identified and the extended twin beside the
+// `fx` with every effect that has a `cv` field (the inter-subject coefficient of variation of a
+// passive_moment) drawn for `subject`: the subject's factor on Riener & Edrich's curves,
+// 1 + value' = (1 + value) exp(s z - s^2 / 2), s = sqrt(ln(1 + cv^2)), z standard normal (Marsaglia
+// polar, core/rng.h) from MixSeed(seed ^ MixSeed(FNV-1a of "subject/name/joint")): a log-normal
+// factor of mean 1 + value and that coefficient of variation, positive; capped at kMaxPassiveScale
+// (model/passive_torque.h). The `cv` field is dropped from the drawn effect. Same seed, same bits.
+std::vector<Effect> SubjectEffects(std::vector<Effect> fx, const std::string& subject, uint64_t seed);
+
+// Markdown of the plant's effects against what diagnose named per subject (value, % of the value that
+// subject's plant carried at that joint and name; the drawn values per subject where a file has a cv), the held-out errors of the identified and the extended twin beside the
 // paper's Table 5, and the candidates said not identifiable.
 std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<Table5SubjectRun>& runs);
 

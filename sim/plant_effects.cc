@@ -23,6 +23,10 @@ double TorqueRippleTorque(const Effect& e, double q_j) {
   return e.value * std::sin(2 * M_PI * e.fields.at("cycles_per_rad") * q_j + e.fields.at("phase"));
 }
 
+double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q) {
+  return e.value * PassiveElasticTorque(PassiveModel::kRiener1999, q)[e.joint == "hip" ? 0 : 1];
+}
+
 Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
                                     const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
   if (!params.human) return ActuatorTorque(params, q, qd, qdd);
@@ -67,6 +71,8 @@ Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q) const {
   for (const Effect& e : applied) {
     if (e.name == "gravity_error") {
       f -= GravityErrorTorque(e, g, q);
+    } else if (e.name == "passive_moment") {
+      f[e.joint == "hip" ? 0 : 1] -= PassiveMomentTorque(e, q);
     } else {
       const int j = e.joint == "hip" ? 0 : 1;
       f[j] -= TorqueRippleTorque(e, q[j]);
@@ -115,6 +121,14 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
       fx.springref[j] = e.fields.at("q0");
     } else if (e.name == "gravity_error" || e.name == "torque_ripple") {
       fx.applied.push_back(e);
+    } else if (e.name == "passive_moment") {
+      if (params.one_joint)
+        throw InputError(where + ": Riener & Edrich's curves are the two-joint leg's (hip and knee angles of HJ15); "
+                         "a one-joint model cannot carry a passive_moment");
+      if (!(e.value > -1 && e.value <= kMaxPassiveScale - 1))
+        throw InputError(where + ": a passive moment " + std::to_string(1 + e.value) +
+                         " times Riener & Edrich's; expected -1 < value <= " + std::to_string(kMaxPassiveScale - 1));
+      fx.applied.push_back(e);
     } else if (e.name == "sensor_offset" || e.name == "sensor_gain" || e.name == "sensor_delay") {
       if (e.name == "sensor_gain" && !(e.value > -1))
         throw InputError(where + ": a sensor gain of " + std::to_string(e.value) + " reads no torque; expected > -1");
@@ -142,8 +156,8 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
       throw InputError(where + ": the forward plant cannot carry this effect (no muscles in the plant of a "
                        "measured record: muscle_activity is the subject's EMG, an input the record carries, not a "
                        "property of the plant); carried: coulomb_friction, viscous_friction, inertia_error, "
-                       "joint_stiffness, gravity_error, torque_ripple, backlash, series_compliance, sensor_offset, "
-                       "sensor_gain, sensor_delay");
+                       "joint_stiffness, gravity_error, torque_ripple, passive_moment, backlash, series_compliance, "
+                       "sensor_offset, sensor_gain, sensor_delay");
     }
   }
   for (int j = 0; j < 2; ++j)

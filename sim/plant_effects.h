@@ -19,6 +19,9 @@
 //    segment's inertia and its coupling terms (L1 X2 cos th2) too, which the effect's form (HJ15 eq. 7
 //    with X or Y changed) does not carry; the applied force keeps forward and inverse one model.
 //  - torque_ripple     -> an applied generalized force -value sin(2 pi k q + phase).
+//  - passive_moment    -> an applied generalized force -value P_j(q) (PassiveMomentTorque): the subject's
+//    passive moment off Riener & Edrich's population curves by the factor 1 + value, at the measured
+//    joint's angles (with a knee strap, not at the human's: they differ by the strap's deflection).
 //  - sensor_offset, sensor_gain, sensor_delay act where the reading tau_S is formed, not on the
 //    link: PlantEffects::sensor holds them for that reader (diagnosis/replay.h inverts them).
 //  - backlash and series_compliance: an internal hinge in the MJCF (Plant::CarryEffects rebuilds the
@@ -48,6 +51,11 @@ Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vecto
 // The torque (N m) the actuator needs in addition at the effect's joint for a torque_ripple effect
 // (fields cycles_per_rad, phase): value sin(2 pi cycles_per_rad q_j + phase).
 double TorqueRippleTorque(const Effect& e, double q_j);
+
+// The torque (N m) the actuator needs in addition at the effect's joint for a passive_moment effect:
+// value P_j(q), P the passive elastic torque of Riener & Edrich 1999 (model/passive_torque.h; HJ15 eq. 1,
+// 12), whatever passive model the twin itself subtracts.
+double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q);
 
 // Torque-sensor effects of one joint, in the order the model file lists them (DESIGN.md: tau_S +=
 // offset, tau_S *= 1 + gain, tau_S(t) = true reading at t - delay).
@@ -79,7 +87,7 @@ struct PlantEffects {
   double backlash[2] = {0, 0};      // rad, total dead-band width (0: none)
   double compliance[2] = {0, 0};    // N m/rad, strap stiffness (0: none)
   bool compliant_human = false;     // the part behind a strap is the human limb (else the whole chain)
-  std::vector<Effect> applied;      // gravity_error and torque_ripple: qfrc_applied each step
+  std::vector<Effect> applied;      // gravity_error, torque_ripple, passive_moment: qfrc_applied each step
   std::vector<SensorEffect> sensor[2];
   double g = 9.81;                  // for gravity_error
   bool empty() const;

@@ -12,6 +12,8 @@
 #include "core/error.h"
 #include "tests/real_rig_model.h"
 #include "model/leg_dynamics.h"
+#include "model/one_joint.h"
+#include "model/passive_torque.h"
 #include "sim/plant.h"
 
 namespace exotwin {
@@ -44,6 +46,9 @@ Eigen::Vector2d ClosedFormAcceleration(const LegParams& p, const Eigen::Vector2d
     if (e.name == "joint_stiffness") f[j] -= e.value * (q[j] - e.fields.at("q0"));
     if (e.name == "gravity_error") f -= GravityErrorTorque(e, p.g, q);
     if (e.name == "torque_ripple") f[j] -= TorqueRippleTorque(e, q[j]);
+    // Riener & Edrich 1999 in degrees, mapped as model/passive_torque.h states: P1 = -M_H, P2 = +M_K.
+    const double H = q[0] * 180.0 / M_PI, K = -q[1] * 180.0 / M_PI;
+    if (e.name == "passive_moment") f[j] -= e.value * (j == 0 ? -RienerHipMoment(H, K) : RienerKneeMoment(0, K, H));
   }
   return M.ldlt().solve(f);
 }
@@ -63,7 +68,8 @@ TEST(PlantEffects, EachCarriedEffectMatchesTheClosedForm) {
       {MakeEffect("inertia_error", "hip", 0.01)},    {MakeEffect("inertia_error", "knee", 0.0028)},
       {MakeEffect("inertia_error", "knee", -0.005)}, {stiff},
       {grav},                                {gravy},
-      {ripple},                              {MakeEffect("coulomb_friction", "hip", 0.15), MakeEffect("coulomb_friction", "knee", 0.12)}};
+      {ripple},                              {MakeEffect("coulomb_friction", "hip", 0.15), MakeEffect("coulomb_friction", "knee", 0.12)},
+      {MakeEffect("passive_moment", "hip", 0.004)}, {MakeEffect("passive_moment", "knee", -0.003)}};
   const Eigen::Vector2d q(0.7, -1.1), qd(1.5, -2.0), tau(0.4, -0.3);
   for (const auto& fx : cases) {
     LegParams p = RealRigModel();
@@ -110,6 +116,28 @@ TEST(PlantEffects, InverseDynamicsStaysTheRigidTwins) {
   carried.CarryEffects(ToPlantEffects(p, "test"));
   const Eigen::Vector2d q(0.4, -0.9), qd(1.2, -0.7), qdd(3.0, -5.0);
   EXPECT_LT((rigid.InverseDynamics(q, qd, qdd) - carried.InverseDynamics(q, qd, qdd)).norm(), 1e-12);
+}
+
+// passive_moment's torque pinned to Riener & Edrich's magnitudes (../shared/papers/README.md: hip 0 and
+// knee 0 give M_K = +10.4 N m, M_H = +8.6 N m): value P_j(q), P1 = -M_H, P2 = +M_K.
+TEST(PlantEffects, PassiveMomentIsAFactorOnRienerEdrich) {
+  const Eigen::Vector2d q0(0.0, 0.0);
+  EXPECT_NEAR(PassiveMomentTorque(MakeEffect("passive_moment", "knee", 0.5), q0), 0.5 * 10.4, 0.03);
+  EXPECT_NEAR(PassiveMomentTorque(MakeEffect("passive_moment", "hip", -0.3), q0), -0.3 * -8.6, 0.03);
+  // The plant carries it as an applied force of minus that torque; out of (0, 3] times Riener's: refused.
+  LegParams p = RealRigModel();
+  p.effects = {MakeEffect("passive_moment", "knee", 0.5)};
+  EXPECT_NEAR(ToPlantEffects(p, "m.yaml").AppliedForce(q0)[1], -5.2, 0.03);
+  for (double v : {-1.0, 2.5}) {
+    p.effects = {MakeEffect("passive_moment", "hip", v)};
+    EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError) << v;
+  }
+  // A one-joint device's knee is not HJ15's two-joint leg: refused.
+  OneJointModel one;
+  one.device = {0.2, 1.5};
+  one.human = OneJointLink{0.43, 11.0};
+  const LegParams embedded = EmbedOneJointModel(one, 9.81, {MakeEffect("passive_moment", "knee", 0.2)});
+  EXPECT_THROW(ToPlantEffects(embedded, "m.yaml"), InputError);
 }
 
 TEST(PlantEffects, RefusesWhatThePlantCannotCarryNamingTheEffect) {
