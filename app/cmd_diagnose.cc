@@ -58,9 +58,11 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     const Diagnosis d = Diagnose(params, std::move(data), opt);
     WriteDiagnosis(d, o->out, o->params, names);
     std::printf("diagnose: derivative cutoff %s\n", d.cutoff.why.c_str());
-    for (const auto& e : d.effects)
+    for (const auto& e : d.effects) {
       std::printf("diagnose: %s (%s) = %g %s [%g, %g]\n", e.effect.name.c_str(), e.effect.joint.c_str(),
                   e.effect.value, e.effect.unit.c_str(), e.ci_lo, e.ci_hi);
+      for (const EffectAlias& a : e.aliases) std::printf("diagnose:   alias: %s\n", AliasText(a).c_str());
+    }
     if (d.effects.empty()) std::printf("diagnose: no effect named\n");
     if (params.one_joint) {  // its one joint
       std::printf("diagnose: held-out rmse knee %.4f -> %.4f N m; report %s/report.html\n", d.joints[1].rmse_before,

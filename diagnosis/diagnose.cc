@@ -590,6 +590,67 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
   return refine_ratio;
 }
 
+// Stage 5b: each named effect's aliases (DiagnosedEffect::aliases). With the other named effects
+// (rest) fitted alongside, the effect lowers the fit rows' weighted error by drop = sse(rest) -
+// sse(chosen). A set A of candidates (one, or two neither of which qualifies alone) is an alias when,
+// with A fitted in its place, the effect would add at most kAliasLeft of that drop: sse(rest + A) -
+// sse(rest + A + effect) <= kAliasLeft drop, i.e. its column lies in the span of A's (and the
+// rest's) to within that share. A then reaches at least 1 - kAliasLeft of the drop itself (more is
+// possible: a pair has a parameter more; whether that pays is the selection's judgement). Listed in
+// range first, singles before pairs, then by reach. Fits on the train Grams only (no leave-one-out):
+// a few thousand small solves per named effect.
+void FindAliases(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale, const std::vector<int>& chosen,
+                 const Fit& chosen_fit, Diagnosis* D) {
+  const int C = static_cast<int>(bank.candidates.size());
+  for (size_t k = 0; k < chosen.size(); ++k) {
+    std::vector<int> rest = chosen;
+    rest.erase(rest.begin() + static_cast<long>(k));
+    const Fit f_rest = FitCols(g, ColumnsOf(bank, rest), false);
+    const double drop = f_rest.sse_tr - chosen_fit.sse_tr;
+    if (!f_rest.ok || !(drop > 0)) continue;
+    std::vector<EffectAlias> found;
+    // Whether `alias` (candidate indices) is an alias; if so, its values and scores into *a.
+    auto IsAlias = [&](const std::vector<int>& alias, EffectAlias* a) {
+      std::vector<int> set = rest;
+      set.insert(set.end(), alias.begin(), alias.end());
+      const Fit f = FitCols(g, ColumnsOf(bank, set), false);
+      if (!f.ok) return false;
+      set.push_back(chosen[k]);
+      const Fit with = FitCols(g, ColumnsOf(bank, set), false);
+      // Singular with the effect added: its column is in the alias's span (exactly).
+      const double left = with.ok ? std::max(0.0, f.sse_tr - with.sse_tr) / drop : 0.0;
+      if (left > kAliasLeft) return false;
+      a->reach_pct = 100 * (f_rest.sse_tr - f.sse_tr) / drop;
+      a->left_pct = 100 * left;
+      for (int c : alias) {
+        const DiagnosedEffect e = ToEffect(bank.candidates[static_cast<size_t>(c)], f);
+        a->plausible = a->plausible && Plausible(e, scale);
+        a->effects.push_back(e.effect);
+      }
+      return true;
+    };
+    auto Named = [&](int c) { return std::find(chosen.begin(), chosen.end(), c) != chosen.end(); };
+    std::vector<bool> alone(static_cast<size_t>(C), false);
+    for (int c = 0; c < C; ++c) {
+      EffectAlias a;
+      if (!Named(c) && IsAlias({c}, &a)) alone[static_cast<size_t>(c)] = true, found.push_back(a);
+    }
+    for (int c1 = 0; c1 < C; ++c1)
+      for (int c2 = c1 + 1; c2 < C; ++c2) {
+        if (Named(c1) || Named(c2) || alone[static_cast<size_t>(c1)] || alone[static_cast<size_t>(c2)]) continue;
+        EffectAlias a;
+        if (IsAlias({c1, c2}, &a)) found.push_back(a);
+      }
+    std::stable_sort(found.begin(), found.end(), [](const EffectAlias& a, const EffectAlias& b) {
+      if (a.plausible != b.plausible) return a.plausible;
+      if (a.effects.size() != b.effects.size()) return a.effects.size() < b.effects.size();
+      return a.reach_pct > b.reach_pct;
+    });
+    if (found.size() > kMaxAliases) found.resize(kMaxAliases);
+    D->effects[k].aliases = std::move(found);
+  }
+}
+
 // Stage 6: the extended twin (predict with D->extended) on every record's held-out part: the scores
 // per record and pooled (D->records, D->joints) and the first record's plot series; with several
 // records, each whole record predicted by the effects fitted on the others (D->left_out).
@@ -892,6 +953,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("selection");
 
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
+  FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);

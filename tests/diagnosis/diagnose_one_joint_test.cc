@@ -204,6 +204,61 @@ TEST(OneJointHiddenEffect, NothingIsNamedOnCleanRecords) {
   }
 }
 
+// Aliases (DiagnosedEffect::aliases). A sensor gain g of a frictionless one-joint device scales its
+// torque I qdd + mgl sin q: exactly an inertia correction g I plus a gravity correction g mgl / g0 (the
+// columns qdd and g0 sin q), so that pair stands in the gain's place, leaving it nothing. With the
+// device's R thd + C sgn(thd) in the twin (HAL-3), the gain's column holds friction too: the pair is
+// no longer an alias.
+const EffectAlias* AliasOf(const DiagnosedEffect& e, const std::vector<std::string>& names) {
+  for (const EffectAlias& a : e.aliases) {
+    std::vector<std::string> got;
+    for (const Effect& f : a.effects) got.push_back(f.name + (f.axis.empty() ? "" : "." + f.axis));
+    if (got == names) return &a;
+  }
+  return nullptr;
+}
+
+GeneratedData GainRecord(const LegParams& base, uint64_t seed) {
+  GenerateOptions g;
+  g.seed = seed;
+  g.effects = 1;
+  g.allowed = {"sensor_gain"};
+  g.duration = 20;
+  g.rate = 500;
+  return GenerateMeasured(base, g);
+}
+
+TEST(OneJointAliases, AFrictionlessJointsSensorGainIsExactlyAnInertiaAndGravityCorrection) {
+  const LegParams base = ReadModelFile(kSrc + "/examples/real_rig/simple_pendulum/model.yaml");
+  const GeneratedData data = GainRecord(base, 31);
+  const double gain = data.truth.effects.back().value;
+  const Diagnosis d = Diagnose(base, data.data, TorqueOnly());
+  ASSERT_EQ(d.effects.size(), 1u);
+  const DiagnosedEffect& e = d.effects[0];
+  ASSERT_EQ(e.effect.name, "sensor_gain");
+  for (const EffectAlias& a : e.aliases) std::printf("  sensor_gain %.4g: alias %s\n", gain, AliasText(a).c_str());
+  const EffectAlias* a = AliasOf(e, {"inertia_error", "gravity_error.X"});
+  ASSERT_TRUE(a);
+  EXPECT_LT(a->left_pct, 1e-3);
+  EXPECT_GE(a->reach_pct, 99.99);
+  EXPECT_TRUE(a->plausible);
+  // The closed form: g I and g mgl / g0, within the fit's noise (2 %).
+  const OneJointModel& m = *base.one_joint;
+  EXPECT_NEAR(a->effects[0].value, gain * m.device.I, 0.02 * std::abs(gain * m.device.I));
+  EXPECT_NEAR(a->effects[1].value, gain * m.device.mgl / base.g, 0.02 * std::abs(gain * m.device.mgl / base.g));
+  EXPECT_NE(DiagnosisJson(d).find("\"left_pct\""), std::string::npos);
+}
+
+TEST(OneJointAliases, WithTheDevicesFrictionInTheTwinTheGainHasNoSuchAlias) {
+  const LegParams base = Hal3Knee();
+  const GeneratedData data = GainRecord(base, 31);
+  const Diagnosis d = Diagnose(base, data.data, TorqueOnly());
+  ASSERT_EQ(d.effects.size(), 1u);
+  ASSERT_EQ(d.effects[0].effect.name, "sensor_gain");
+  for (const EffectAlias& a : d.effects[0].aliases) std::printf("  alias %s\n", AliasText(a).c_str());
+  EXPECT_FALSE(AliasOf(d.effects[0], {"inertia_error", "gravity_error.X"}));
+}
+
 // The real simple pendulum (shared/data/real_rig/dfki_simple_pendulum, README there) against the
 // makers' nominal point mass (examples/real_rig/simple_pendulum/model.yaml: I 0.169 kg m^2, mgl
 // 3.31 N m, no friction). The README's careful fit: I 0.177, Coulomb 0.15, viscous 0.002, mgl 3.53.
