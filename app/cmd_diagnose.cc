@@ -68,13 +68,13 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
       std::printf("diagnose: held-out rmse knee %.4f -> %.4f N m; report %s/report.html\n", d.joints[1].rmse_before,
                   d.joints[1].rmse_after, o->out.c_str());
       for (const RecordScore& r : d.records)
-        std::printf("diagnose: %s: held-out %.4f -> %.4f N m (%.1f %%)%s, ceiling %.1f %%\n", r.source.c_str(),
+        std::printf("diagnose: %s: held-out %.4f -> %.4f N m (%.1f %%)%s, ceiling %.1f %% (null %.1f %%)\n", r.source.c_str(),
                     r.split[1].rmse_before, r.split[1].rmse_after, r.split[1].gain_pct,
                     d.leave_one_out ? (", left out " + NumberText(r.left_out[1].rmse_before) + " -> " +
                                        NumberText(r.left_out[1].rmse_after) + " N m (" +
                                        NumberText(r.left_out[1].gain_pct) + " %)").c_str()
                                     : "",
-                    r.ceiling[1].gain_pct);
+                    r.ceiling[1].gain_pct, r.ceiling_null[1].gain_pct);
       return 0;
     }
     std::printf("diagnose: held-out rmse hip %.4f -> %.4f N m, knee %.4f -> %.4f N m; report %s/report.html\n",

@@ -91,6 +91,12 @@ struct RecordScore {
   // sample: the least error any combination of the candidate effects, in their columns' linear form
   // and at any values, reaches on it. Bounds the left-out gain (effects fitted on the other records).
   JointScore ceiling[2];
+  // The ceiling under the null hypothesis that the residual is no function of the motion: the same
+  // fit against this record's residual shifted circularly in time (its spectrum kept; five shifts,
+  // the after-error averaged). A ceiling near it holds nothing the effects could carry to other
+  // records. What a shift reproduces is no test: a constant (an offset is no function of the motion
+  // either) or a motion periodic over the shift.
+  JointScore ceiling_null[2];
   std::vector<Effect> left_out_effects;  // the model's effects and those (>= 2 records)
   // Simulated angle, rigid (before) vs extended (after) twin, rad: the held-out part, and the whole
   // record with left_out_effects; windows 0 where the part is shorter than the horizon.

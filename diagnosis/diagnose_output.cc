@@ -83,6 +83,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
       x["split"][names[k]] = score(r.split[k]);
       if (d.leave_one_out) x["left_out"][names[k]] = score(r.left_out[k]);
       x["ceiling"][names[k]] = score(r.ceiling[k]);
+      x["ceiling_null"][names[k]] = score(r.ceiling_null[k]);
     }
     j["records"].push_back(x);
   }
