@@ -58,21 +58,23 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     const Diagnosis d = Diagnose(params, std::move(data), opt);
     WriteDiagnosis(d, o->out, o->params, names);
     std::printf("diagnose: derivative cutoff %s\n", d.cutoff.why.c_str());
-    for (const auto& e : d.effects)
+    for (const auto& e : d.effects) {
       std::printf("diagnose: %s (%s) = %g %s [%g, %g]\n", e.effect.name.c_str(), e.effect.joint.c_str(),
                   e.effect.value, e.effect.unit.c_str(), e.ci_lo, e.ci_hi);
+      for (const EffectAlias& a : e.aliases) std::printf("diagnose:   alias: %s\n", AliasText(a).c_str());
+    }
     if (d.effects.empty()) std::printf("diagnose: no effect named\n");
     if (params.one_joint) {  // its one joint
       std::printf("diagnose: held-out rmse knee %.4f -> %.4f N m; report %s/report.html\n", d.joints[1].rmse_before,
                   d.joints[1].rmse_after, o->out.c_str());
       for (const RecordScore& r : d.records)
-        std::printf("diagnose: %s: held-out %.4f -> %.4f N m (%.1f %%)%s, ceiling %.1f %%\n", r.source.c_str(),
+        std::printf("diagnose: %s: held-out %.4f -> %.4f N m (%.1f %%)%s, ceiling %.1f %% (null %.1f %%)\n", r.source.c_str(),
                     r.split[1].rmse_before, r.split[1].rmse_after, r.split[1].gain_pct,
                     d.leave_one_out ? (", left out " + NumberText(r.left_out[1].rmse_before) + " -> " +
                                        NumberText(r.left_out[1].rmse_after) + " N m (" +
                                        NumberText(r.left_out[1].gain_pct) + " %)").c_str()
                                     : "",
-                    r.ceiling[1].gain_pct);
+                    r.ceiling[1].gain_pct, r.ceiling_null[1].gain_pct);
       return 0;
     }
     std::printf("diagnose: held-out rmse hip %.4f -> %.4f N m, knee %.4f -> %.4f N m; report %s/report.html\n",

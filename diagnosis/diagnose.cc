@@ -311,11 +311,18 @@ std::vector<Eigen::VectorXd> KitchenSinkResiduals(const std::vector<ColumnBank>&
 // backlash, series_compliance's 1/k, sensor_delay, joint_stiffness >= 0; the others free: a
 // relaxation of DESIGN.md's ranges, so the ceiling bounds any in-range combination), scored on its
 // fit rows against the residual of the model given (weights undone; a joint of weight 0, a
-// one-joint device's held hip, scores 0).
-std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]) {
+// one-joint device's held hip, scores 0). Also its null level (RecordScore::ceiling_null): the same
+// fit against the residual shifted circularly in time by kNullShifts of the record's rows (every
+// joint alike), the after-error's sum of squares averaged over the shifts: a circular-shift
+// permutation test of "the residual is no function of the motion", its spectrum kept.
+struct CeilingScores {
+  JointScore ceiling[2], null[2];
+};
+constexpr double kNullShifts[] = {0.2, 0.35, 0.5, 0.65, 0.8};
+std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]) {
   static const std::set<std::string> kNonNegative = {"coulomb_friction", "viscous_friction", "backlash",
                                                      "series_compliance", "sensor_delay", "joint_stiffness"};
-  std::vector<std::array<JointScore, 2>> out(banks.size());
+  std::vector<CeilingScores> out(banks.size());
   for (size_t r = 0; r < banks.size(); ++r) {
     const ColumnBank& b = banks[r];
     std::vector<int> sign(static_cast<size_t>(b.X.cols()), 0);
@@ -347,11 +354,27 @@ std::vector<std::array<JointScore, 2>> Ceilings(const std::vector<ColumnBank>& b
     for (size_t a = 0; a < live.size(); ++a) x[live[a]] = x_live[static_cast<Eigen::Index>(a)];
     const Eigen::VectorXd e = b.r - b.X * x;
     const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
+    // The null level: the same normal equations against the shifted residual.
+    double null_sse[2] = {0, 0};
+    for (double shift : kNullShifts) {
+      const Eigen::Index k = static_cast<Eigen::Index>(shift * static_cast<double>(m));
+      Eigen::VectorXd rs(b.r.size());
+      for (Eigen::Index j = 0; j < 2; ++j)
+        for (Eigen::Index i = 0; i < m; ++i) rs[j * m + i] = b.r[j * m + (i + k) % m];
+      Eigen::VectorXd hs(live.size()), xs_live, xs = Eigen::VectorXd::Zero(b.X.cols());
+      for (size_t a = 0; a < live.size(); ++a) hs[a] = b.X.col(live[a]).dot(rs);
+      if (!live.empty() && !SolveSigned(G, hs, live_sign, &xs_live))
+        throw std::logic_error("diagnose: the null ceiling of record " + std::to_string(r) + " is too ill-conditioned to solve");
+      for (size_t a = 0; a < live.size(); ++a) xs[live[a]] = xs_live[static_cast<Eigen::Index>(a)];
+      const Eigen::VectorXd es = rs - b.X * xs;
+      for (int j = 0; j < 2; ++j) null_sse[j] += es.segment(j * m, m).squaredNorm() / std::size(kNullShifts);
+    }
     for (int j = 0; j < 2; ++j) {
       if (!(w[j] > 0) || m == 0) continue;
       const double before = b.r.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
       const double after = e.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
-      out[r][j] = ScoreOf(before, after, static_cast<double>(m));
+      out[r].ceiling[j] = ScoreOf(before, after, static_cast<double>(m));
+      out[r].null[j] = ScoreOf(before, null_sse[j] / (w[j] * w[j]), static_cast<double>(m));
     }
   }
   return out;
@@ -588,6 +611,67 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
     D->effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
   }
   return refine_ratio;
+}
+
+// Stage 5b: each named effect's aliases (DiagnosedEffect::aliases). With the other named effects
+// (rest) fitted alongside, the effect lowers the fit rows' weighted error by drop = sse(rest) -
+// sse(chosen). A set A of candidates (one, or two neither of which qualifies alone) is an alias when,
+// with A fitted in its place, the effect would add at most kAliasLeft of that drop: sse(rest + A) -
+// sse(rest + A + effect) <= kAliasLeft drop, i.e. its column lies in the span of A's (and the
+// rest's) to within that share. A then reaches at least 1 - kAliasLeft of the drop itself (more is
+// possible: a pair has a parameter more; whether that pays is the selection's judgement). Listed in
+// range first, singles before pairs, then by reach. Fits on the train Grams only (no leave-one-out):
+// a few thousand small solves per named effect.
+void FindAliases(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale, const std::vector<int>& chosen,
+                 const Fit& chosen_fit, Diagnosis* D) {
+  const int C = static_cast<int>(bank.candidates.size());
+  for (size_t k = 0; k < chosen.size(); ++k) {
+    std::vector<int> rest = chosen;
+    rest.erase(rest.begin() + static_cast<long>(k));
+    const Fit f_rest = FitCols(g, ColumnsOf(bank, rest), false);
+    const double drop = f_rest.sse_tr - chosen_fit.sse_tr;
+    if (!f_rest.ok || !(drop > 0)) continue;
+    std::vector<EffectAlias> found;
+    // Whether `alias` (candidate indices) is an alias; if so, its values and scores into *a.
+    auto IsAlias = [&](const std::vector<int>& alias, EffectAlias* a) {
+      std::vector<int> set = rest;
+      set.insert(set.end(), alias.begin(), alias.end());
+      const Fit f = FitCols(g, ColumnsOf(bank, set), false);
+      if (!f.ok) return false;
+      set.push_back(chosen[k]);
+      const Fit with = FitCols(g, ColumnsOf(bank, set), false);
+      // Singular with the effect added: its column is in the alias's span (exactly).
+      const double left = with.ok ? std::max(0.0, f.sse_tr - with.sse_tr) / drop : 0.0;
+      if (left > kAliasLeft) return false;
+      a->reach_pct = 100 * (f_rest.sse_tr - f.sse_tr) / drop;
+      a->left_pct = 100 * left;
+      for (int c : alias) {
+        const DiagnosedEffect e = ToEffect(bank.candidates[static_cast<size_t>(c)], f);
+        a->plausible = a->plausible && Plausible(e, scale);
+        a->effects.push_back(e.effect);
+      }
+      return true;
+    };
+    auto Named = [&](int c) { return std::find(chosen.begin(), chosen.end(), c) != chosen.end(); };
+    std::vector<bool> alone(static_cast<size_t>(C), false);
+    for (int c = 0; c < C; ++c) {
+      EffectAlias a;
+      if (!Named(c) && IsAlias({c}, &a)) alone[static_cast<size_t>(c)] = true, found.push_back(a);
+    }
+    for (int c1 = 0; c1 < C; ++c1)
+      for (int c2 = c1 + 1; c2 < C; ++c2) {
+        if (Named(c1) || Named(c2) || alone[static_cast<size_t>(c1)] || alone[static_cast<size_t>(c2)]) continue;
+        EffectAlias a;
+        if (IsAlias({c1, c2}, &a)) found.push_back(a);
+      }
+    std::stable_sort(found.begin(), found.end(), [](const EffectAlias& a, const EffectAlias& b) {
+      if (a.plausible != b.plausible) return a.plausible;
+      if (a.effects.size() != b.effects.size()) return a.effects.size() < b.effects.size();
+      return a.reach_pct > b.reach_pct;
+    });
+    if (found.size() > kMaxAliases) found.resize(kMaxAliases);
+    D->effects[k].aliases = std::move(found);
+  }
 }
 
 // Stage 6: the extended twin (predict with D->extended) on every record's held-out part: the scores
@@ -876,7 +960,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   FilterMeasured(&recs);
   UseSecantDelayColumns(recs, w, &banks);
   if (params.one_joint) KeepJointCandidates(1, &banks);
-  const std::vector<std::array<JointScore, 2>> ceilings = Ceilings(banks, w);
+  const std::vector<CeilingScores> ceilings = Ceilings(banks, w);
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
   for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
@@ -892,11 +976,12 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("selection");
 
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
+  FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
   for (size_t r = 0; r < R; ++r)
-    for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r][j];
+    for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r].ceiling[j], D.records[r].ceiling_null[j] = ceilings[r].null[j];
   // Effects in order of what they explain.
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
     return a.explained_pct > b.explained_pct;

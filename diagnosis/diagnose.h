@@ -39,11 +39,29 @@
 
 namespace exotwin {
 
+// A set of candidates that can stand in a named effect's place: with it fitted (and the other named
+// effects), the effect would add almost nothing (its column lies nearly in the set's span), so the
+// data cannot tell them apart (e.g. a sensor gain and an inertia + gravity correction of a one-joint
+// device, whose columns I qdd + mgl sin q are the twin's torque itself).
+struct EffectAlias {
+  std::vector<Effect> effects;  // the candidates at the values fitted in its place
+  double reach_pct = 0;         // the set's drop of the fit rows' error, % of the named effect's
+  double left_pct = 0;          // what the named effect would still add to the set, % of its drop
+  bool plausible = true;        // every value inside its physical range
+};
+
 struct DiagnosedEffect {
   Effect effect;
   double ci_lo = 0, ci_hi = 0;  // 95 % interval of effect.value
   double explained_pct = 0;     // % of the held-out residual sum of squares this effect removes
+  // Single candidates, and pairs of which neither alone qualifies, with left_pct <= 100 kAliasLeft
+  // (diagnose.cc FindAliases); those in range first, singles before pairs, then the most reaching;
+  // at most kMaxAliases.
+  std::vector<EffectAlias> aliases;
 };
+
+constexpr double kAliasLeft = 0.01;  // an alias leaves the named effect at most 1 % of its drop of the fit error
+constexpr size_t kMaxAliases = 6;
 
 struct UnexplainedStructure {
   std::string joint;
@@ -73,6 +91,12 @@ struct RecordScore {
   // sample: the least error any combination of the candidate effects, in their columns' linear form
   // and at any values, reaches on it. Bounds the left-out gain (effects fitted on the other records).
   JointScore ceiling[2];
+  // The ceiling under the null hypothesis that the residual is no function of the motion: the same
+  // fit against this record's residual shifted circularly in time (its spectrum kept; five shifts,
+  // the after-error averaged). A ceiling near it holds nothing the effects could carry to other
+  // records. What a shift reproduces is no test: a constant (an offset is no function of the motion
+  // either) or a motion periodic over the shift.
+  JointScore ceiling_null[2];
   std::vector<Effect> left_out_effects;  // the model's effects and those (>= 2 records)
   // Simulated angle, rigid (before) vs extended (after) twin, rad: the held-out part, and the whole
   // record with left_out_effects; windows 0 where the part is shorter than the horizon.
@@ -147,6 +171,10 @@ inline Diagnosis Diagnose(const LegParams& params, const MeasuredData& data, con
 
 // diagnosis.json text (DESIGN.md format plus `signature` fields in unexplained).
 std::string DiagnosisJson(const Diagnosis& d);
+
+// An alias in words, e.g. "inertia_error (knee) = 0.0135 kg m^2 + gravity_error.X (knee) = 0.0274 kg m
+// (reaches 100 % of its fit)", " [outside its range]" appended when implausible.
+std::string AliasText(const EffectAlias& a);
 
 // Writes DIR/diagnosis.json, DIR/extended.yaml and DIR/report.html (creates DIR). measured_path
 // names the record(s), for the report.

@@ -10,9 +10,19 @@
 #include "diagnosis/diagnose.h"
 #include "diagnosis/diagnose_report.h"
 #include "formats/model_file.h"
+#include "formats/number_text.h"
 #include "core/error.h"
 
 namespace exotwin {
+
+std::string AliasText(const EffectAlias& a) {
+  std::string s;
+  for (const Effect& e : a.effects)
+    s += (s.empty() ? "" : " + ") + e.name + (e.axis.empty() ? "" : "." + e.axis) + " (" + e.joint + ") = " +
+         NumberText(e.value, 4) + " " + e.unit;
+  return s + " (reaches " + NumberText(a.reach_pct, 4) + " % of its fit, leaves it " + NumberText(a.left_pct, 2) + " %)" +
+         (a.plausible ? "" : " [outside its range]");
+}
 
 std::string DiagnosisJson(const Diagnosis& d) {
   using nlohmann::json;
@@ -25,6 +35,16 @@ std::string DiagnosisJson(const Diagnosis& d) {
     for (const auto& f : e.effect.fields) {
       if (f.first.rfind("w_", 0) == 0) x["weights"][f.first.substr(2)] = f.second;
       else x[f.first] = f.second;
+    }
+    x["aliases"] = json::array();
+    for (const EffectAlias& a : e.aliases) {
+      json ja = {{"reach_pct", a.reach_pct}, {"left_pct", a.left_pct}, {"plausible", a.plausible}, {"effects", json::array()}};
+      for (const Effect& f : a.effects) {
+        json jf = {{"name", f.name}, {"joint", f.joint}, {"value", f.value}, {"unit", f.unit}};
+        if (!f.axis.empty()) jf["axis"] = f.axis;
+        ja["effects"].push_back(jf);
+      }
+      x["aliases"].push_back(ja);
     }
     j["effects"].push_back(x);
   }
@@ -63,6 +83,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
       x["split"][names[k]] = score(r.split[k]);
       if (d.leave_one_out) x["left_out"][names[k]] = score(r.left_out[k]);
       x["ceiling"][names[k]] = score(r.ceiling[k]);
+      x["ceiling_null"][names[k]] = score(r.ceiling_null[k]);
     }
     j["records"].push_back(x);
   }

@@ -83,6 +83,13 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
         << " %</td></tr>";
     }
     o << "</table>";
+    for (const auto& e : d.effects) {
+      if (e.aliases.empty()) continue;
+      o << "<p>The data cannot tell <b>" << e.effect.name << " (" << e.effect.joint
+        << ")</b> from these, fitted in its place with the other named effects:</p><ul>";
+      for (const EffectAlias& a : e.aliases) o << "<li>" << HtmlEscape(AliasText(a)) << "</li>";
+      o << "</ul>";
+    }
   }
   o << "<h2>Gain of the extended twin (held-out " << NumberText(100 * d.holdout_fraction, 3) << " %)</h2>"
     << "<table><tr><th>joint</th><th>rmse before (N m)</th><th>rmse after (N m)</th><th>gain</th>"

@@ -94,7 +94,7 @@ Grams MakeGrams(const std::vector<ColumnBank>& banks) {
   return g;
 }
 
-Fit FitCols(const Grams& g, std::vector<int> cols) {
+Fit FitCols(const Grams& g, std::vector<int> cols, bool leave_one_out) {
   std::sort(cols.begin(), cols.end());
   cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
   Fit f;
@@ -127,7 +127,7 @@ Fit FitCols(const Grams& g, std::vector<int> cols) {
   const double s2 = f.sse_tr / (g.n_tr - p) * (g.n_tr / g.n_eff);
   f.se = (Ainv.diagonal() * s2).cwiseMax(0).cwiseSqrt();
   f.bic = g.n_eff * std::log(f.sse_tr / g.n_tr) + p * std::log(g.n_eff);
-  if (R >= 2) {
+  if (R >= 2 && leave_one_out) {
     for (size_t k = 0; k < R; ++k) {
       const Eigen::VectorXd x = FitLeavingOut(g, cols, k);
       if (x.size() == 0) return f;  // not ok: a record's absence makes the set unidentifiable

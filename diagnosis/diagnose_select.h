@@ -59,9 +59,9 @@ struct Fit {
 Grams MakeGrams(const std::vector<ColumnBank>& banks);
 
 // Fits `cols` on the train rows (sse_tr, coefficients, standard errors, BIC), scores the held-out
-// rows (sse_te) and, with two records or more, leave-one-record-out (sse_loo: each record scored by
-// the fit on all rows of the others). !ok when the normalized Gram is nearly singular.
-Fit FitCols(const Grams& g, std::vector<int> cols);
+// rows (sse_te) and, with two records or more and `leave_one_out`, leave-one-record-out (sse_loo: each
+// record scored by the fit on all rows of the others). !ok when the normalized Gram is nearly singular.
+Fit FitCols(const Grams& g, std::vector<int> cols, bool leave_one_out = true);
 
 // Coefficients of `cols` fitted on all rows of every record but `left_out` (leave-one-record-out).
 Eigen::VectorXd FitLeavingOut(const Grams& g, const std::vector<int>& cols, size_t left_out);
