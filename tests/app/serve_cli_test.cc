@@ -89,17 +89,20 @@ struct Pair {
   std::string serve_log, controller_log;
 };
 
-// serve SCENARIO --bus unix:DIR/bus --out OUT (+ extra), then the controller on OUT/controller.yaml.
-// config: the controller's --config (default: the controller file serve writes).
+// serve SCENARIO --bus BUS --out OUT (+ extra), then the controller on OUT/controller.yaml.
+// config: the controller's --config (default: the controller file serve writes); bus: default
+// unix:DIR/bus.
 Pair ServeWithController(const std::string& dir, const std::string& scenario, const std::string& out,
-                         std::vector<std::string> extra = {}, double seconds = 120, std::string config = "") {
-  std::vector<std::string> args = {"serve", scenario, "--bus", "unix:" + dir + "/bus", "--out", out};
+                         std::vector<std::string> extra = {}, double seconds = 120, std::string config = "",
+                         std::string bus = "") {
+  if (bus.empty()) bus = "unix:" + dir + "/bus";
+  std::vector<std::string> args = {"serve", scenario, "--bus", bus, "--out", out};
   args.insert(args.end(), extra.begin(), extra.end());
   Pair p;
   const pid_t serve = testing::StartProgram(testing::ExotwinBin(), args, dir + "/serve.log");
   EXPECT_TRUE(WaitForFile(out + "/controller.yaml", 30));
   const pid_t ctl = testing::StartProgram(
-      testing::ControllerBin(), {"--config", config.empty() ? out + "/controller.yaml" : config, "--bus", "unix:" + dir + "/bus"},
+      testing::ControllerBin(), {"--config", config.empty() ? out + "/controller.yaml" : config, "--bus", bus},
       dir + "/ctl.log");
   p.serve = WaitFor(serve, seconds);
   p.controller = WaitFor(ctl, 30);
@@ -108,12 +111,17 @@ Pair ServeWithController(const std::string& dir, const std::string& scenario, co
   return p;
 }
 
-TEST(ServeCli, LockstepWritesTheSameMeasuredCsvAsRun) {
+// Over each transport between two processes on one host: unix:DIR/bus and shm:NAME.
+class ServeCliTransport : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ServeCliTransport, LockstepWritesTheSameMeasuredCsvAsRun) {
   testing::ScopedTempDir dir("serve");
   const std::string scenario = GaitScenario(dir.path(), 4.0);
   const auto run = testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run");
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve");
+  const std::string bus = GetParam() == "unix" ? "unix:" + dir.path() + "/bus"
+                                               : "shm:exotwin_serve_test_" + std::to_string(::getpid());
+  const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve", {}, 120, "", bus);
   ASSERT_EQ(p.serve, 0) << p.serve_log;
   EXPECT_EQ(p.controller, 0) << p.controller_log;
   const std::string a = ReadText(dir.path() + "/run/measured.csv"), b = ReadText(dir.path() + "/serve/measured.csv");
@@ -125,7 +133,14 @@ TEST(ServeCli, LockstepWritesTheSameMeasuredCsvAsRun) {
   EXPECT_EQ(r["metrics"]["link_frames_foreign"], 0.0);
   EXPECT_EQ(r["metrics"]["tracking_rms_hip_deg"], Result(dir.path() + "/run")["metrics"]["tracking_rms_hip_deg"]);
   EXPECT_NE(p.controller_log.find("run over (NMT stop): 4000 ticks"), std::string::npos) << p.controller_log;
+  EXPECT_NE(p.serve_log.find("link " + GetParam() + ":"), std::string::npos) << p.serve_log;
+  if (GetParam() == "shm") {
+    EXPECT_FALSE(std::filesystem::exists("/dev/shm/" + bus.substr(4)));  // removed when both ends left
+  }
 }
+
+INSTANTIATE_TEST_SUITE_P(, ServeCliTransport, ::testing::Values("unix", "shm"),
+                         [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 // DESIGN.md: `exotwin-controller --config SCENARIO.yaml`: the scenario's controller part, the
 // feed-forward model and reference downloaded from the twin (link::kIdConfigRequest): the same bytes.
