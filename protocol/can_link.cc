@@ -330,12 +330,13 @@ bool CanLink::SpinForInput(double timeout_s) {
   if (m.spin_skip > 0 && --m.spin_skip > 0) return false;
   if (m.spin <= 0) m.spin = m.spin_max;  // the probe after kSpinProbe waits that blocked at once
   const double end = MonotonicSeconds() + std::min(m.spin, timeout_s);
+  const bool yield = m.shm && (m.yield || m.shm->PeerOnThisCpu());
   do {
     if (ReceiveDatagram() == 1 && !m.in.empty()) {
       m.spin = m.spin_max;
       return true;
     }
-    if (m.shm) SpinPause(m.yield);  // (a socket's read is a system call: no pause needed)
+    if (m.shm) SpinPause(yield);  // (a socket's read is a system call: no pause needed)
   } while (MonotonicSeconds() < end);
   m.spin *= 0.5;
   if (m.spin < 1e-6) m.spin = 0, m.spin_skip = kSpinProbe;

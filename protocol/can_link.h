@@ -70,8 +70,9 @@ class CanLink : public CanBus {
   // Unix and UDP: first spins (non-blocking reads) for up to the adaptive spin budget (SetSpin), then
   // blocks in one receive with the remaining time as timeout (SO_RCVTIMEO), so a wait that blocks
   // costs one system call, not a poll and a read. Shared memory: spins on the mailbox (the CPU's
-  // pause between looks; sched_yield instead when this process may run on one CPU only, OnOneCpu:
-  // the peer then needs this CPU to answer), then sleeps on its futex. SocketCAN: poll(2).
+  // pause between looks; sched_yield instead when this process may run on one CPU only, OnOneCpu, or
+  // the peer last waited on this end's CPU, ShmLink::PeerOnThisCpu: the peer then needs this CPU to
+  // answer), then sleeps on its futex. SocketCAN: poll(2).
   bool WaitInput(double timeout_s);
   // The most a wait spins before it blocks (s; kDefaultLinkSpin unless set; 0: it blocks at once;
   // SocketCAN never spins). A peer running on

@@ -37,6 +37,7 @@ struct ShmLink::Segment {
   };
   std::atomic<uint32_t> magic;  // kMagic once opened
   uint32_t layout;              // sizeof(Segment) of the opener
+  std::atomic<uint32_t> cpu[2];  // 1 + the CPU end i last waited on (0: not known yet)
   alignas(64) Mailbox to[2];    // to[i]: the mailbox end i reads (0 the twin, 1 the controller)
 };
 
@@ -222,6 +223,13 @@ int ShmLink::BlockForInput(double timeout_s) {
   }
   m.sleeping.store(0, std::memory_order_relaxed);
   return InputWaiting() ? 1 : result;
+}
+
+bool ShmLink::PeerOnThisCpu() {
+  const int cpu = ::sched_getcpu();  // a read of the thread's rseq area: about 2 ns
+  if (cpu < 0) return false;
+  seg_->cpu[Index(end_)].store(static_cast<uint32_t>(cpu) + 1, std::memory_order_relaxed);
+  return seg_->cpu[1 - Index(end_)].load(std::memory_order_relaxed) == static_cast<uint32_t>(cpu) + 1;
 }
 
 bool ShmLink::PeerAlive() const { return LockedElsewhere(fd_, 1 - Index(end_)); }

@@ -58,6 +58,9 @@ class ShmLink {
   // Sleeps on the futex until a datagram from the peer waits, `timeout_s` (s) passed or a signal
   // arrived: 1 when one waits, 0 on time-out, -1 on a signal.
   int BlockForInput(double timeout_s);
+  // Records the CPU this end runs on (it is about to wait) and returns true when the peer last waited
+  // on the same CPU: the peer then most likely needs this CPU to answer (sched_getcpu, no system call).
+  bool PeerOnThisCpu();
   // True when the peer's end is held by a live process (one fcntl).
   bool PeerAlive() const;
   // "/dev/shm/NAME".
