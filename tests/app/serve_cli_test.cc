@@ -112,15 +112,19 @@ Pair ServeWithController(const std::string& dir, const std::string& scenario, co
 }
 
 // Over each transport between two processes on one host: unix:DIR/bus and shm:NAME.
-class ServeCliTransport : public ::testing::TestWithParam<std::string> {};
+class ServeCliTransport : public ::testing::TestWithParam<std::string> {
+ protected:
+  static std::string Bus(const std::string& dir) {
+    return GetParam() == "unix" ? "unix:" + dir + "/bus" : "shm:exotwin_serve_test_" + std::to_string(::getpid());
+  }
+};
 
 TEST_P(ServeCliTransport, LockstepWritesTheSameMeasuredCsvAsRun) {
   testing::ScopedTempDir dir("serve");
   const std::string scenario = GaitScenario(dir.path(), 4.0);
   const auto run = testing::RunExotwin("run " + scenario + " --out " + dir.path() + "/run");
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const std::string bus = GetParam() == "unix" ? "unix:" + dir.path() + "/bus"
-                                               : "shm:exotwin_serve_test_" + std::to_string(::getpid());
+  const std::string bus = Bus(dir.path());
   const Pair p = ServeWithController(dir.path(), scenario, dir.path() + "/serve", {}, 120, "", bus);
   ASSERT_EQ(p.serve, 0) << p.serve_log;
   EXPECT_EQ(p.controller, 0) << p.controller_log;
@@ -138,9 +142,6 @@ TEST_P(ServeCliTransport, LockstepWritesTheSameMeasuredCsvAsRun) {
     EXPECT_FALSE(std::filesystem::exists("/dev/shm/" + bus.substr(4)));  // removed when both ends left
   }
 }
-
-INSTANTIATE_TEST_SUITE_P(, ServeCliTransport, ::testing::Values("unix", "shm"),
-                         [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 // DESIGN.md: `exotwin-controller --config SCENARIO.yaml`: the scenario's controller part, the
 // feed-forward model and reference downloaded from the twin (link::kIdConfigRequest): the same bytes.
@@ -174,15 +175,13 @@ TEST(ServeCli, ControllerOnAnotherScenarioRefusesTheTwinsFile) {
   EXPECT_EQ(p.serve, 1) << p.serve_log;  // no controller answered: the run fails, logs kept
 }
 
-TEST(ServeCli, ControllerKilledMidGaitWatchdogCutsTheTorque) {
+TEST_P(ServeCliTransport, ControllerKilledMidGaitWatchdogCutsTheTorque) {
   testing::ScopedTempDir dir("serve");
-  const std::string scenario = GaitScenario(dir.path(), 6.0), out = dir.path() + "/serve";
-  const pid_t serve = testing::StartProgram(testing::ExotwinBin(),
-                                            {"serve", scenario, "--bus", "unix:" + dir.path() + "/bus", "--out", out},
+  const std::string scenario = GaitScenario(dir.path(), 6.0), out = dir.path() + "/serve", bus = Bus(dir.path());
+  const pid_t serve = testing::StartProgram(testing::ExotwinBin(), {"serve", scenario, "--bus", bus, "--out", out},
                                             dir.path() + "/serve.log");
   ASSERT_TRUE(WaitForFile(out + "/controller.yaml", 30));
-  const pid_t ctl = testing::StartProgram(testing::ControllerBin(),
-                                          {"--config", out + "/controller.yaml", "--bus", "unix:" + dir.path() + "/bus"});
+  const pid_t ctl = testing::StartProgram(testing::ControllerBin(), {"--config", out + "/controller.yaml", "--bus", bus});
   // Mid-gait: once the twin has logged past 2.5 s (simulated) the controller is killed.
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < end && Lines(out + "/measured.csv") < 2500)
@@ -243,12 +242,12 @@ TEST(ServeCli, RealtimeRunsToTheEndAndReportsJitter) {  // 2 s of gait: 2000 tic
   }
 }
 
-TEST(ServeCli, ControllerStartedBeforeTheTwinAndTwinRestartedUnderIt) {
+TEST_P(ServeCliTransport, ControllerStartedBeforeTheTwinAndTwinRestartedUnderIt) {
   testing::ScopedTempDir dir("serve");
-  const std::string bus = "unix:" + dir.path() + "/bus";
+  const std::string bus = Bus(dir.path());
   const std::string scenario = GaitScenario(dir.path(), 1.0), longer = GaitScenario(dir.path(), 600, "long.yaml");
   // A controller file from a first lockstep pair.
-  const Pair first = ServeWithController(dir.path(), scenario, dir.path() + "/first");
+  const Pair first = ServeWithController(dir.path(), scenario, dir.path() + "/first", {}, 120, "", bus);
   ASSERT_EQ(first.serve, 0) << first.serve_log;
   // The controller first, then a twin that dies (SIGKILL) mid-run, then a new twin: the controller
   // starts a fresh loop for it and the second run is the in-process run.
@@ -270,6 +269,9 @@ TEST(ServeCli, ControllerStartedBeforeTheTwinAndTwinRestartedUnderIt) {
   EXPECT_TRUE(ReadText(dir.path() + "/first/measured.csv") == ReadText(dir.path() + "/again/measured.csv"));
   EXPECT_EQ(Result(dir.path() + "/again")["metrics"]["link_deterministic"], 1.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(, ServeCliTransport, ::testing::Values("unix", "shm"),
+                         [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 TEST(ServeCli, NoControllerWithinTheTimeoutRunsOnSafely) {
   testing::ScopedTempDir dir("serve");
