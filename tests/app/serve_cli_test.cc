@@ -177,7 +177,9 @@ TEST(ServeCli, ControllerOnAnotherScenarioRefusesTheTwinsFile) {
 
 TEST_P(ServeCliTransport, ControllerKilledMidGaitWatchdogCutsTheTorque) {
   testing::ScopedTempDir dir("serve");
-  const std::string scenario = GaitScenario(dir.path(), 6.0), out = dir.path() + "/serve", bus = Bus(dir.path());
+  // 30 s: long enough (0.1 s of wall clock at least, over shm at the in-process speed) for the kill to
+  // come before the end.
+  const std::string scenario = GaitScenario(dir.path(), 30.0), out = dir.path() + "/serve", bus = Bus(dir.path());
   const pid_t serve = testing::StartProgram(testing::ExotwinBin(), {"serve", scenario, "--bus", bus, "--out", out},
                                             dir.path() + "/serve.log");
   ASSERT_TRUE(WaitForFile(out + "/controller.yaml", 30));
@@ -185,7 +187,7 @@ TEST_P(ServeCliTransport, ControllerKilledMidGaitWatchdogCutsTheTorque) {
   // Mid-gait: once the twin has logged past 2.5 s (simulated) the controller is killed.
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < end && Lines(out + "/measured.csv") < 2500)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   ::kill(ctl, SIGKILL);
   EXPECT_EQ(WaitFor(ctl, 10), 128 + SIGKILL);
   const int rc = WaitFor(serve, 60);
@@ -194,15 +196,15 @@ TEST_P(ServeCliTransport, ControllerKilledMidGaitWatchdogCutsTheTorque) {
   EXPECT_EQ(r["metrics"]["link_deterministic"], 0.0);
   const double t_lost = r["metrics"]["link_controller_lost_s"];
   EXPECT_GT(t_lost, 2.0);
-  EXPECT_LT(t_lost, 5.9);
+  EXPECT_LT(t_lost, 29.9);
   bool event = false;
   for (const auto& e : r["events"]) event |= e.get<std::string>().find("controller_lost") != std::string::npos;
   EXPECT_TRUE(event) << r["events"];
   // Every log whole; from 50 ms after the loss on (watchdog 20 ms), no actuator torque (truth.csv tau_R_hip, tau_R_knee).
   // ReadCsv (the project's reader) refuses a row with a missing field: every row is whole.
   const CsvTable truth = ReadCsv(out + "/truth.csv"), measured = ReadCsv(out + "/measured.csv");
-  ASSERT_EQ(truth.rows(), 6000u);
-  ASSERT_EQ(measured.rows(), 6000u);
+  ASSERT_EQ(truth.rows(), 30000u);
+  ASSERT_EQ(measured.rows(), 30000u);
   const int t = truth.Find("t"), hip = truth.Find("tau_R_hip"), knee = truth.Find("tau_R_knee");
   ASSERT_TRUE(t >= 0 && hip >= 0 && knee >= 0);
   double before = 0, after = 0;
