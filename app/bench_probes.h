@@ -122,9 +122,10 @@ nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 nlohmann::ordered_json BenchSweep(const BenchConfig& c);
 
 // The controller across the process boundary (DESIGN.md "The CAN transport between processes").
-// Rows: lockstep serve + exotwin-controller on gait_2kmh (60 s; quick: 5 s) against the same run in
-// this process (goal <= 3x; logs_identical: measured.csv and truth.csv the same bytes); regress
-// --controller-process of the shipped suite against regress (not quick; <= 3x); real time (60 s;
+// Rows: lockstep serve + exotwin-controller on gait_2kmh (60 s; quick: 5 s) over unix: and over shm:,
+// each unpinned and with both processes pinned to one CPU, against the same run in this process, all
+// measured in this call (goal <= 3x; logs_identical: measured.csv and truth.csv the same bytes); regress
+// --controller-process of the shipped suite (over shm:) against regress (not quick; <= 3x); real time (60 s;
 // quick: 2 s) with no added load and with one core kept busy by a spinning process, SCHED_FIFO 50 asked (the row
 // says whether granted): tick-start jitter p99 (goal <= 100 us), p50, max (<= 1 ms), late, missed.
 nlohmann::ordered_json BenchLink(const BenchConfig& c);

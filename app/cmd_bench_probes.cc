@@ -592,39 +592,49 @@ json BenchLink(const BenchConfig& c) {
   in_opt.out_dir = c.scratch + "/link_in_process";
   out_opt.out_dir = c.scratch + "/link_lockstep";
   const double in_process = BestOf(c.repeat, [&] { RunScenario(s, in_opt); });
-  const double lockstep = BestOf(c.repeat, [&] { RunWithControllerProcess(s, out_opt, bin); });
-  const bool identical = ReadTextFile(in_opt.out_dir + "/measured.csv", "", "CSV") ==
-                             ReadTextFile(out_opt.out_dir + "/measured.csv", "", "CSV") &&
-                         ReadTextFile(in_opt.out_dir + "/truth.csv", "", "CSV") ==
-                             ReadTextFile(out_opt.out_dir + "/truth.csv", "", "CSV");
-  // The same pair on one CPU (the controller inherits the pin; neither end spins): the hand-over
-  // is then a switch on that CPU instead of a wake-up of the other (the policy of regress's workers).
-  double one_cpu = 0;
-  {
-    const ScopedCpuPin pin(FastestCpu(c.cpus));
-    if (pin.pinned()) one_cpu = BestOf(c.repeat, [&] { RunWithControllerProcess(s, out_opt, bin); });
+  auto identical = [&] {  // the lockstep run's logs are the in-process run's
+    return ReadTextFile(in_opt.out_dir + "/measured.csv", "", "CSV") == ReadTextFile(out_opt.out_dir + "/measured.csv", "", "CSV") &&
+           ReadTextFile(in_opt.out_dir + "/truth.csv", "", "CSV") == ReadTextFile(out_opt.out_dir + "/truth.csv", "", "CSV");
+  };
+  json j{{"status", "ok"}, {"duration_s", duration}, {"in_process_s", in_process}};
+  std::vector<BenchRow> rows;
+  // Each transport unpinned (the ends spin, on the CPUs the scheduler gives them), then both processes
+  // pinned to one CPU (the controller inherits the pin): the hand-over is then a switch on that CPU
+  // instead of a wake-up of the other (the placement of regress's workers); over unix: neither end
+  // spins, over shm: the waits yield the CPU.
+  for (const BusKind transport : {BusKind::kUnix, BusKind::kShm}) {
+    const std::string scheme = transport == BusKind::kShm ? "shm" : "unix";
+    const double lockstep = BestOf(c.repeat, [&] {
+      RunWithControllerProcess(s, out_opt, bin, 10.0, ServeClock::kLockstep, transport);
+    });
+    const bool same = identical();
+    double one_cpu = 0;
+    {
+      const ScopedCpuPin pin(FastestCpu(c.cpus));
+      if (pin.pinned())
+        one_cpu = BestOf(c.repeat, [&] { RunWithControllerProcess(s, out_opt, bin, 10.0, ServeClock::kLockstep, transport); });
+    }
+    rows.push_back({"lockstep over " + scheme + ": serve + exotwin-controller, gait_2kmh " + Seconds(duration) +
+                        (same && identical() ? " (logs identical)" : " (logs DIFFER)"),
+                    lockstep / in_process, "x", "the in-process run, same scenario", "<= 3x",
+                    Seconds(lockstep) + " vs " + Seconds(in_process)});
+    if (one_cpu > 0)
+      rows.push_back({"lockstep over " + scheme + ", both processes pinned to one CPU" +
+                          (transport == BusKind::kShm ? ", waits yield" : ", no spin"),
+                      one_cpu / in_process, "x", "the in-process run, same scenario", "<= 3x",
+                      Seconds(one_cpu) + " vs " + Seconds(in_process)});
+    j[scheme] = json{{"lockstep_s", lockstep},
+                     {"ratio_lockstep_to_in_process", lockstep / in_process},
+                     {"lockstep_one_cpu_s", one_cpu},
+                     {"logs_identical", same && identical()}};
   }
-  std::vector<BenchRow> rows = {{"lockstep: serve + exotwin-controller, gait_2kmh " + Seconds(duration) +
-                                     (identical ? " (logs identical)" : " (logs DIFFER)"),
-                                 lockstep / in_process, "x", "the in-process run, same scenario", "<= 3x",
-                                 Seconds(lockstep) + " vs " + Seconds(in_process)}};
-  if (one_cpu > 0)
-    rows.push_back({"lockstep, both processes pinned to one CPU, no spin", one_cpu / in_process, "x",
-                    "the in-process run, same scenario", "<= 3x", Seconds(one_cpu) + " vs " + Seconds(in_process)});
-  json j{{"status", "ok"},
-         {"duration_s", duration},
-         {"in_process_s", in_process},
-         {"lockstep_s", lockstep},
-         {"ratio_lockstep_to_in_process", lockstep / in_process},
-         {"lockstep_one_cpu_s", one_cpu},
-         {"logs_identical", identical}};
   if (!c.quick) {  // the whole suite, both ways (about a minute)
     try {
       const double regress = BestOf(1, [&] { RunSelf({"regress", "--out", c.scratch + "/regress_in"}); });
       const double remote = BestOf(1, [&] { RunSelf({"regress", "--controller-process", "--out", c.scratch + "/regress_out"}); });
       j["regress_s"] = regress;
       j["regress_controller_process_s"] = remote;
-      rows.push_back({"regress --controller-process (the shipped suite)", remote / regress, "x", "regress, in-process",
+      rows.push_back({"regress --controller-process (the shipped suite, over shm)", remote / regress, "x", "regress, in-process",
                       "<= 3x", Seconds(remote) + " vs " + Seconds(regress)});
     } catch (const std::exception& e) {
       j["regress"] = Unavailable(e.what());

@@ -142,7 +142,7 @@ CommandRunner RegisterServe(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("serve", "Run a scenario's twin for a controller in another process");
   sub->add_option("scenario", o->scenario, "scenario YAML (any device and protocol)")->required();
-  auto* bus = sub->add_option("--bus", o->bus, "unix:PATH | udp:HOST:PORT | can:IFACE");
+  auto* bus = sub->add_option("--bus", o->bus, "unix:PATH | udp:HOST:PORT | can:IFACE | shm:NAME");
   auto* can = sub->add_option("--can", o->can, "SocketCAN interface (same as --bus can:IFACE)");
   bus->excludes(can);
   sub->add_option("--clock", o->clock, "lockstep (default) or realtime")->check(CLI::IsMember({"lockstep", "realtime"}));

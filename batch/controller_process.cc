@@ -1,6 +1,5 @@
 #include "batch/controller_process.h"
 
-#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,6 +15,7 @@
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "protocol/can_link.h"
+#include "protocol/shm_link.h"
 #include "runner/exowheel_setup.h"
 #include "runner/hal_setup.h"
 #include "runner/remote_controller.h"
@@ -57,7 +57,8 @@ std::string DefaultControllerBinary() {
 
 namespace {
 
-// A private folder for the link's sockets (short enough for sockaddr_un), removed with them.
+// A private folder for the controller's scenario and the link's sockets (short enough for sockaddr_un),
+// removed with them; its unique name also names the private shared-memory segment.
 class LinkDir {
  public:
   LinkDir() {
@@ -107,19 +108,20 @@ void Reap(pid_t pid, double seconds) {
 }  // namespace
 
 RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,
-                                   double timeout_s, ServeClock clock) {
+                                   double timeout_s, ServeClock clock, BusKind transport) {
   if (controller_bin.empty() || ::access(controller_bin.c_str(), X_OK) != 0)
     throw InputError("exotwin-controller: '" + controller_bin + "' is not an executable");
   const LinkDir dir;
   const std::string config = WriteControllerScenario(s, dir.path() + "/scenario.yaml");
-  const BusAddress address = ParseBusAddress("unix:" + dir.path() + "/bus");
+  if (transport != BusKind::kShm && transport != BusKind::kUnix)
+    throw InputError("the controller process's link is shm: or unix:");
+  const BusAddress address = ParseBusAddress(transport == BusKind::kShm ? "shm:" + fs::path(dir.path()).filename().string()
+                                                                        : "unix:" + dir.path() + "/bus");
   std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
-  // Both ends spin before they block only when they may run on different CPUs: the controller
-  // inherits this process's CPUs, and on a single one a spinning end holds the CPU its peer needs.
-  cpu_set_t cpus;
-  CPU_ZERO(&cpus);
-  const bool one_cpu = ::sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) == 1;
-  const double spin = one_cpu ? 0.0 : kDefaultLinkSpin;
+  // Over a socket both ends spin before they block only when they may run on different CPUs: the
+  // controller inherits this process's CPUs, and on a single one a spinning end holds the CPU its peer
+  // needs. Over shared memory the waits yield that CPU instead (CanLink::WaitInput): both spin.
+  const double spin = transport == BusKind::kUnix && OnOneCpu() ? 0.0 : kDefaultLinkSpin;
   link->SetSpin(spin);
   const pid_t pid = StartController(controller_bin, config, address.text, opt.out_dir + "/controller.log", spin);
   RemoteController remote(link.get(), clock, 1.0 / s.controller.rate_hz, timeout_s);

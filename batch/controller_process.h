@@ -1,10 +1,11 @@
 // A scenario run with its controller in another process: the twin of `exotwin serve` and
-// the deployable controller (exotwin-controller) on a private Unix link, in lockstep, so the result is
+// the deployable controller (exotwin-controller) on a private shared-memory link, in lockstep, so the result is
 // the in-process run's (the regression gate's `regress --controller-process`).
 #pragma once
 #include <cstdint>
 #include <string>
 
+#include "protocol/bus_address.h"
 #include "runner/remote_controller.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
@@ -28,13 +29,15 @@ std::string DefaultControllerBinary();
 
 // Runs `s` as RunScenario does (any device and protocol), the controller being `controller_bin` started
 // on the scenario's device and controller part (WriteControllerScenario: it downloads each run's
-// controller file from the twin) on a private Unix link (its log in opt.out_dir/controller.log) and
-// stopped at the end (NMT stop; killed if still there 5 s later), in lockstep (or `clock`). The link
-// spins kDefaultLinkSpin before it blocks, on both ends, unless this process may run on one CPU only
-// (the controller inherits its affinity: both ends then block at once). The run
-// fails (a check result "controller_link" failed) when the controller was lost. Throws InputError when
-// the link cannot be set up.
+// controller file from the twin) on a private link (its log in opt.out_dir/controller.log) and
+// stopped at the end (NMT stop; killed if still there 5 s later), in lockstep (or `clock`). The link is
+// `transport`: kShm (a private segment, shm:exotwin_link_XXXXXX) or kUnix (sockets in a private
+// folder). Its waits spin kDefaultLinkSpin before they block, on both ends; over kUnix only when this
+// process may run on more than one CPU (the controller inherits its affinity: both ends then block at
+// once), over kShm always (on one CPU the spin yields it). The run fails (a check result
+// "controller_link" failed) when the controller was lost. Throws InputError when the link cannot be set up.
 RunResult RunWithControllerProcess(const Scenario& s, RunOptions opt, const std::string& controller_bin,
-                                   double timeout_s = 10.0, ServeClock clock = ServeClock::kLockstep);
+                                   double timeout_s = 10.0, ServeClock clock = ServeClock::kLockstep,
+                                   BusKind transport = BusKind::kShm);
 
 }  // namespace exotwin

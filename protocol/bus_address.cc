@@ -11,7 +11,7 @@
 namespace exotwin {
 namespace {
 
-constexpr const char* kExpected = ", expected unix:PATH, udp:HOST:PORT or can:IFACE";
+constexpr const char* kExpected = ", expected unix:PATH, udp:HOST:PORT, can:IFACE or shm:NAME";
 constexpr const char* kControllerSuffix = ".ctl";
 
 }  // namespace
@@ -26,6 +26,7 @@ std::string BusAddress::LocalName(LinkEnd end) const {
     case BusKind::kUnix: return end == LinkEnd::kTwin ? path : path + kControllerSuffix;
     case BusKind::kUdp: return host + ":" + std::to_string(end == LinkEnd::kTwin ? port : port + 1);
     case BusKind::kSocketCan: return interface;
+    case BusKind::kShm: return "/dev/shm/" + path + (end == LinkEnd::kTwin ? " (twin end)" : " (controller end)");
   }
   return "";
 }
@@ -65,6 +66,12 @@ BusAddress ParseBusAddress(const std::string& text, const std::string& what) {
     a.interface = rest;
     if (rest.empty() || rest.size() >= IFNAMSIZ)
       fail("expected an interface name of 1.." + std::to_string(IFNAMSIZ - 1) + " characters");
+  } else if (scheme == "shm") {
+    a.kind = BusKind::kShm;
+    a.path = rest;
+    if (rest.empty() || rest.size() > 200 || rest[0] == '.' ||
+        rest.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") != std::string::npos)
+      fail("expected a segment name of 1..200 characters A-Z a-z 0-9 . _ -, not starting with '.'");
   } else {
     fail("unknown scheme '" + scheme + "'");
   }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "protocol/shm_link.h"
 #include "protocol/socketcan_bus.h"
 
 namespace exotwin {
@@ -25,6 +26,8 @@ namespace exotwin {
 struct CanLink::Impl {
   int fd = -1;
   std::unique_ptr<SocketCanBus> can;  // kSocketCan
+  std::unique_ptr<ShmLink> shm;       // kShm
+  bool yield = false;                 // kShm: waits yield the CPU instead of spinning (OnOneCpu)
   std::string local_path;             // kUnix: unlinked on close
   sockaddr_storage peer{};
   socklen_t peer_len = 0;
@@ -45,6 +48,7 @@ namespace {
 constexpr double kSendWait = 0.1;  // s
 // Waits at least this long (s) block in a receive with SO_RCVTIMEO; shorter ones in ppoll.
 constexpr double kLongWait = 0.02;
+static_assert(sizeof(can_frame) * kMaxFramesPerDatagram == kShmDatagramBytes, "a slot holds the largest datagram");
 
 [[noreturn]] void Fail(const BusAddress& a, const std::string& socket, const std::string& what, int err) {
   throw InputError("--bus " + a.text + ": " + socket + ": " + what + (err ? std::string(": ") + std::strerror(err) : ""));
@@ -144,6 +148,10 @@ std::unique_ptr<CanLink> CanLink::Open(const BusAddress& a, LinkEnd end) {
       impl->peer_len = sizeof in;
       break;
     }
+    case BusKind::kShm:
+      impl->shm = ShmLink::Open(a, end);
+      impl->yield = OnOneCpu();
+      break;
   }
   impl->spin_max = impl->spin = a.kind == BusKind::kSocketCan ? 0.0 : kDefaultLinkSpin;
   return std::unique_ptr<CanLink>(new CanLink(a, end, std::move(impl)));
@@ -151,6 +159,9 @@ std::unique_ptr<CanLink> CanLink::Open(const BusAddress& a, LinkEnd end) {
 
 std::string CanLink::Describe() const {
   if (address_.kind == BusKind::kSocketCan) return "can:" + address_.interface;
+  if (address_.kind == BusKind::kShm)
+    return "shm:" + address_.path + " (" + impl_->shm->Path() + ", " + (end_ == LinkEnd::kTwin ? "twin" : "controller") +
+           " end)";
   const std::string scheme = address_.kind == BusKind::kUnix ? "unix:" : "udp:";
   return scheme + address_.LocalName(end_) + " (peer " + address_.PeerName(end_) + ")";
 }
@@ -185,6 +196,24 @@ CanStatus CanLink::Flush() {
 
 CanStatus CanLink::SendQueued() {
   const size_t frames = impl_->out.size(), bytes = frames * sizeof(can_frame);
+  if (impl_->shm) {  // a full mailbox of a live peer is waited for as a full Unix queue
+    const double give_up = MonotonicSeconds() + kSendWait;
+    while (!impl_->shm->TryPut(impl_->out.data(), bytes)) {
+      const bool alive = impl_->shm->PeerAlive();
+      if (!alive || MonotonicSeconds() >= give_up) {
+        impl_->out.clear();
+        stats_.last_send_errno = alive ? EAGAIN : ECONNREFUSED;
+        (alive ? stats_.send_failures : stats_.peer_absent) += frames;
+        return alive ? CanStatus::kQueueFull : CanStatus::kError;
+      }
+      const timespec pause{0, 20000};
+      ::nanosleep(&pause, nullptr);
+    }
+    impl_->out.clear();
+    stats_.sent += frames;
+    ++stats_.datagrams_sent;
+    return CanStatus::kOk;
+  }
   // A Unix datagram queue holds few datagrams (net.unix.max_dgram_qlen, 10 by default): a full queue
   // of a live peer is waited for, up to kSendWait s, before the datagram is refused (kQueueFull).
   ssize_t n;
@@ -230,6 +259,12 @@ CanStatus CanLink::Receive(CanFrame* out) {
 
 int CanLink::ReceiveDatagram(bool block) {
   can_frame buf[kMaxFramesPerDatagram + 1];  // one frame more: a longer datagram is seen as such
+  if (impl_->shm) {  // (blocking waits are WaitInput's)
+    size_t n = 0;
+    if (!impl_->shm->TryTake(buf, &n)) return 0;
+    TakeDatagram(buf, n);
+    return 1;
+  }
   sockaddr_storage from{};
   socklen_t from_len = sizeof from;
   const ssize_t n = ::recvfrom(impl_->fd, buf, sizeof buf, MSG_TRUNC | (block ? 0 : MSG_DONTWAIT),
@@ -245,10 +280,16 @@ int CanLink::ReceiveDatagram(bool block) {
     ++stats_.foreign;
     return 1;
   }
-  const size_t frames = static_cast<size_t>(n) / sizeof(can_frame);
-  if (n == 0 || static_cast<size_t>(n) % sizeof(can_frame) != 0 || frames > static_cast<size_t>(kMaxFramesPerDatagram)) {
+  TakeDatagram(buf, static_cast<size_t>(n));
+  return 1;
+}
+
+void CanLink::TakeDatagram(const void* datagram, size_t n) {
+  const can_frame* buf = static_cast<const can_frame*>(datagram);
+  const size_t frames = n / sizeof(can_frame);
+  if (n == 0 || n % sizeof(can_frame) != 0 || frames > static_cast<size_t>(kMaxFramesPerDatagram)) {
     ++stats_.malformed;
-    return 1;
+    return;
   }
   const double now = MonotonicSeconds();
   for (size_t i = 0; i < frames; ++i) {
@@ -264,10 +305,10 @@ int CanLink::ReceiveDatagram(bool block) {
     f.t = now;
     impl_->in.push_back(f);
   }
-  return 1;
 }
 
 bool CanLink::PeerAlive() const {
+  if (impl_->shm) return impl_->shm->PeerAlive();
   return address_.kind != BusKind::kUnix || UnixSocketInUse(address_.PeerName(end_));
 }
 
@@ -280,6 +321,7 @@ double CanLink::spin_budget() const {
 void CanLink::SetSpin(double max_spin_s) {
   impl_->spin_max = impl_->spin = std::max(0.0, max_spin_s);
   impl_->spin_skip = 0;
+  if (impl_->shm) impl_->yield = OnOneCpu();
 }
 
 bool CanLink::SpinForInput(double timeout_s) {
@@ -288,11 +330,13 @@ bool CanLink::SpinForInput(double timeout_s) {
   if (m.spin_skip > 0 && --m.spin_skip > 0) return false;
   if (m.spin <= 0) m.spin = m.spin_max;  // the probe after kSpinProbe waits that blocked at once
   const double end = MonotonicSeconds() + std::min(m.spin, timeout_s);
+  const bool yield = m.shm && (m.yield || m.shm->PeerOnThisCpu());
   do {
     if (ReceiveDatagram() == 1 && !m.in.empty()) {
       m.spin = m.spin_max;
       return true;
     }
+    if (m.shm) SpinPause(yield);  // (a socket's read is a system call: no pause needed)
   } while (MonotonicSeconds() < end);
   m.spin *= 0.5;
   if (m.spin < 1e-6) m.spin = 0, m.spin_skip = kSpinProbe;
@@ -319,6 +363,16 @@ bool CanLink::WaitInput(double timeout_s) {
   if (timeout_s <= 0) return take();
   const double end = MonotonicSeconds() + timeout_s;
   if (SpinForInput(timeout_s)) return true;
+  if (impl_->shm) {  // then sleep on the mailbox's futex
+    for (;;) {
+      if (take()) return true;
+      const double left = end - MonotonicSeconds();
+      if (left <= 0) return false;
+      const int got = impl_->shm->BlockForInput(left);
+      if (take()) return true;
+      if (got < 0) return false;  // a signal
+    }
+  }
   for (;;) {  // foreign and malformed datagrams are dropped on the way
     const double left = end - MonotonicSeconds();
     if (left <= 0) return take();

@@ -1,7 +1,8 @@
 // A CAN link between two processes (DESIGN.md "The CAN transport between processes"): datagrams of 1
 // to kMaxFramesPerDatagram frames, each frame SocketCAN's 16-byte `struct can_frame` (can_id: 11-bit
-// identifier, no flags; can_dlc 0..8; 3 padding bytes zero; data[8]), over a Unix datagram socket or
-// UDP, or the frames of a SocketCAN interface (one frame at a time: a real bus). Implements CanBus,
+// identifier, no flags; can_dlc 0..8; 3 padding bytes zero; data[8]), over a Unix datagram socket,
+// UDP or the mailboxes of a shared-memory segment (protocol/shm_link.h), or the frames of a SocketCAN
+// interface (one frame at a time: a real bus). Implements CanBus,
 // non-blocking, plus a wait for input. Frames sent between Hold() and Flush() leave as one datagram
 // (a controller cycle's frames: one system call per direction and cycle instead of one per frame).
 //
@@ -9,7 +10,9 @@
 // from the other end's configured address (BusAddress::PeerName), never from any other sender; those
 // are dropped and counted (foreign), as are datagrams that are not a classic 11-bit data frame of 16
 // bytes (malformed). Unix sockets are created with mode 0600. UDP binds where ADDR says (loopback
-// unless the user names another address).
+// unless the user names another address). A shared-memory segment is mode 0600 and each of its two
+// ends is held by one live process (ShmLink), so its datagrams come from the peer by construction;
+// they are checked as a socket's (malformed).
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -55,7 +58,7 @@ class CanLink : public CanBus {
   // While held (Hold), a valid frame is queued (kOk) and leaves at Flush, or as soon as
   // kMaxFramesPerDatagram are queued.
   CanStatus Send(const CanFrame& frame) override;
-  // From now on Send queues its frames for one datagram (Unix and UDP; SocketCAN sends at once).
+  // From now on Send queues its frames for one datagram (Unix, UDP, shared memory; SocketCAN sends at once).
   void Hold();
   // Sends the queued frames as one datagram and ends the hold: the status as Send's (kOk when none
   // were queued; the frames of a refused datagram count as send failures or peer_absent).
@@ -66,7 +69,10 @@ class CanLink : public CanBus {
   // Waits until input is waiting or `timeout_s` (s) passed (or a signal arrived); true if input waits.
   // Unix and UDP: first spins (non-blocking reads) for up to the adaptive spin budget (SetSpin), then
   // blocks in one receive with the remaining time as timeout (SO_RCVTIMEO), so a wait that blocks
-  // costs one system call, not a poll and a read. SocketCAN: poll(2).
+  // costs one system call, not a poll and a read. Shared memory: spins on the mailbox (the CPU's
+  // pause between looks; sched_yield instead when this process may run on one CPU only, OnOneCpu, or
+  // the peer last waited on this end's CPU, ShmLink::PeerOnThisCpu: the peer then needs this CPU to
+  // answer), then sleeps on its futex. SocketCAN: poll(2).
   bool WaitInput(double timeout_s);
   // The most a wait spins before it blocks (s; kDefaultLinkSpin unless set; 0: it blocks at once;
   // SocketCAN never spins). A peer running on
@@ -79,7 +85,8 @@ class CanLink : public CanBus {
   double spin_budget() const;  // s, what the next wait spins at most (0: it blocks at once)
   static constexpr int kSpinProbe = 64;
   // False when the peer is known to be gone: a Unix peer whose socket no live process holds (the file
-  // of a killed process stays behind). True otherwise (UDP and SocketCAN cannot tell).
+  // of a killed process stays behind), a shared-memory peer whose end no live process holds. True
+  // otherwise (UDP and SocketCAN cannot tell).
   bool PeerAlive() const;
   // The frames already read from the socket and not yet returned by Receive (Receive reads the
   // socket only when there are none).
@@ -98,6 +105,9 @@ class CanLink : public CanBus {
   // have been dropped), 0 when none waits (or, blocking, none came within the receive timeout), -1
   // when a signal interrupted a blocking read.
   int ReceiveDatagram(bool block = false);
+  // A datagram's `n` bytes checked (a whole number, 1..64, of frames; each an 11-bit data frame) and
+  // its valid frames queued; the rest counted malformed.
+  void TakeDatagram(const void* datagram, size_t n);
   bool SpinForInput(double timeout_s);  // the spin phase of WaitInput
   BusAddress address_;
   LinkEnd end_;

@@ -95,11 +95,37 @@ TEST(ControllerExecutable, BadInputExitsTwoNamingFileKeyOrAddress) {
     EXPECT_EQ(rc, 2) << spin;
     EXPECT_NE(out.find(std::string("--spin: expected 0 to 1000000 us, got '") + spin + "'"), std::string::npos) << out;
   }
+  for (const char* priority : {"0", "100", "high"}) {
+    out = Shell(bin + " --config " + dir.path() + "/ok.yaml" + bus + " --rt-priority " + priority, &rc);
+    EXPECT_EQ(rc, 2) << priority;
+    EXPECT_NE(out.find(std::string("--rt-priority: expected 1 to 99, got '") + priority + "'"), std::string::npos) << out;
+  }
+  out = Shell(bin + " --config " + dir.path() + "/ok.yaml --bus shm:a/b", &rc);
+  EXPECT_EQ(rc, 2);
+  EXPECT_NE(out.find("'shm:a/b'"), std::string::npos) << out;
   // A second controller on the same link: the address is in use.
   auto first = CanLink::Open(ParseBusAddress("unix:" + dir.path() + "/bus"), LinkEnd::kController);
   out = Shell(bin + " --config " + dir.path() + "/ok.yaml" + bus, &rc);
   EXPECT_EQ(rc, 2);
   EXPECT_NE(out.find("in use"), std::string::npos) << out;
+}
+
+// --rt-priority that the kernel refuses (CAP_SYS_NICE dropped by setpriv): a warning naming what was
+// refused, and the controller runs on (here until SIGTERM from timeout(1): exit 0).
+TEST(ControllerExecutable, RefusedRealtimePriorityWarnsAndRunsOn) {
+  int rc = 0;
+  if (Shell("setpriv --version", &rc).find("setpriv") == std::string::npos) GTEST_SKIP() << "no setpriv (util-linux)";
+  testing::ScopedTempDir dir("ctl");
+  testing::WriteText(dir.path() + "/ok.yaml", kConfig);
+  const std::string out = Shell("timeout --preserve-status -s TERM 0.3 setpriv --bounding-set -sys_nice --inh-caps -sys_nice " +
+                                    testing::ControllerBin() + " --config " + dir.path() + "/ok.yaml --bus unix:" +
+                                    dir.path() + "/bus --rt-priority 50",
+                                &rc);
+  EXPECT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("warning: real-time request refused by the kernel: SCHED_FIFO 50: Operation not permitted"),
+            std::string::npos) << out;
+  EXPECT_NE(out.find("the controller runs on at normal priority"), std::string::npos) << out;
+  EXPECT_NE(out.find("waiting for NMT start"), std::string::npos) << out;
 }
 
 TEST(ControllerExecutable, TicksOnSyncAndCommandsZeroTorqueOnSigterm) {

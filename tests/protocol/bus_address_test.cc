@@ -7,7 +7,7 @@
 namespace exotwin {
 namespace {
 
-TEST(BusAddress, ParsesTheThreeSchemes) {
+TEST(BusAddress, ParsesTheFourSchemes) {
   const BusAddress u = ParseBusAddress("unix:/tmp/x.sock");
   EXPECT_EQ(u.kind, BusKind::kUnix);
   EXPECT_EQ(u.LocalName(LinkEnd::kTwin), "/tmp/x.sock");
@@ -25,11 +25,18 @@ TEST(BusAddress, ParsesTheThreeSchemes) {
   const BusAddress c = ParseBusAddress("can:can0");
   EXPECT_EQ(c.kind, BusKind::kSocketCan);
   EXPECT_EQ(c.interface, "can0");
+
+  const BusAddress m = ParseBusAddress("shm:exotwin-1_a.b");
+  EXPECT_EQ(m.kind, BusKind::kShm);
+  EXPECT_EQ(m.path, "exotwin-1_a.b");
+  EXPECT_EQ(m.LocalName(LinkEnd::kTwin), "/dev/shm/exotwin-1_a.b (twin end)");
+  EXPECT_EQ(m.PeerName(LinkEnd::kTwin), "/dev/shm/exotwin-1_a.b (controller end)");
 }
 
 TEST(BusAddress, BadAddressesNameTheAddress) {
   for (const char* bad : {"", "x", "tcp:1", "unix:", "udp:127.0.0.1", "udp:127.0.0.1:0", "udp:127.0.0.1:65535",
-                          "udp:no.such.host:5", "udp:127.0.0.1:12x", "can:", "can:abcdefghijklmnopq"}) {
+                          "udp:no.such.host:5", "udp:127.0.0.1:12x", "can:", "can:abcdefghijklmnopq", "shm:", "shm:a/b", "shm:.hidden", "shm:a b",
+                          "shm:/x"}) {
     try {
       ParseBusAddress(bad);
       ADD_FAILURE() << bad;
