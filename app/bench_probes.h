@@ -112,6 +112,12 @@ nlohmann::ordered_json BenchIdentification(const BenchConfig& c);
 // friction and armature, 0.5 s windows, vs a bare mj_step loop of the same model over the same time.
 nlohmann::ordered_json BenchReplay(const BenchConfig& c);
 
+// The Python module (python/exotwin/bench.py, run by the interpreter it is built for, $EXOTWIN_PYTHON
+// else /usr/bin/python3): exotwin.run vs `exotwin run` (<= 1.05x), a Python PD controller on Twin.step
+// vs the UDP example (<= 0.25x), the binding's cost per step (no-op controller vs exotwin.run); gait_2kmh
+// (quick: 6 s of it). {"status": "unavailable"} when the module is not built.
+nlohmann::ordered_json BenchPython(const BenchConfig& c);
+
 // Diagnosis of 60 s of 1 kHz data with one hidden effect (quick: 20 s): data seconds per wall second.
 nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 

@@ -329,6 +329,31 @@ GenerateOptions BenchFrictionRecord(double duration_s) {
   return g;
 }
 
+json BenchPython(const BenchConfig& c) {
+  // The module as laid out next to this program: P/bin/exotwin -> P/lib/python3/dist-packages/exotwin
+  // (the build tree: build/app/exotwin -> build/lib/python3/dist-packages; python/CMakeLists.txt).
+  const std::string self = ExecutablePath();
+  if (self.empty()) return Unavailable("/proc/self/exe unreadable");
+  const std::filesystem::path prefix = std::filesystem::path(self).parent_path().parent_path();
+  const std::string pythonpath = (prefix / "lib" / "python3" / "dist-packages").string();
+  if (!std::filesystem::exists(pythonpath + "/exotwin/__init__.py"))
+    return Unavailable("the Python module is not built (" + pythonpath + "/exotwin)");
+  const char* env_python = std::getenv("EXOTWIN_PYTHON");
+  const std::string python = env_python && *env_python ? env_python : "/usr/bin/python3";  // Debian's (numpy)
+  const std::string out = c.scratch + "/python_bench.json";
+  const char* old = std::getenv("PYTHONPATH");
+  const std::string saved = old ? old : "";
+  setenv("PYTHONPATH", (pythonpath + (saved.empty() ? "" : ":" + saved)).c_str(), 1);
+  std::vector<std::string> args = {python, "-m", "exotwin.bench", "--exotwin", self, "--repeat",
+                                   std::to_string(c.repeat), "--json", out};
+  if (c.quick) args.push_back("--quick");
+  const bool ok = SpawnAndWait(args);
+  if (old) setenv("PYTHONPATH", saved.c_str(), 1);
+  else unsetenv("PYTHONPATH");
+  if (!ok) return Unavailable(python + " -m exotwin.bench failed (run it by hand to see why)");
+  return json::parse(ReadTextFile(out, "python bench", "JSON"));
+}
+
 json BenchReplay(const BenchConfig& c) {
   // The DFKI rig's model (examples/real_rig/model.yaml) with the effects diagnose names there.
   LegParams p = ReadModelFile(DataPath("examples/real_rig/model.yaml"));

@@ -16,7 +16,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
 endif()
 
 set(EXOTWIN_LAYERS core model dsp protocol controller deploy sim hwsim formats identification diagnosis emg render
-                   runner batch app)
+                   runner batch app python)
 set(EXOTWIN_GUARDED_LIBS mujoco opencv2)
 
 # What each layer's sources may include besides the layer itself.
@@ -39,6 +39,8 @@ set(EXOTWIN_ALLOWED_batch core model dsp protocol controller sim hwsim formats i
                           runner mujoco)
 set(EXOTWIN_ALLOWED_app core model dsp protocol controller sim hwsim formats identification diagnosis emg render
                         runner batch mujoco)
+set(EXOTWIN_ALLOWED_python core model dsp protocol controller sim hwsim formats identification diagnosis emg render
+                           runner batch app mujoco)
 
 # Fails (FATAL_ERROR) listing every forbidden include in the layer folders under `root`.
 function(exotwin_check_layer_includes root)
@@ -78,6 +80,8 @@ endfunction()
 function(_exotwin_layer_targets layer out)
   if(layer STREQUAL "app")
     set(${out} exotwin_cli PARENT_SCOPE)
+  elseif(layer STREQUAL "python")
+    set(${out} exotwin_python PARENT_SCOPE)
   elseif(layer STREQUAL "render")
     set(${out} exotwin_render exotwin_render_gl exotwin_render_plugin PARENT_SCOPE)
   else()

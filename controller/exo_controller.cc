@@ -17,7 +17,7 @@ ExoController::ExoController(const ExoControllerConfig& cfg,
   tel_.tau_sensor[0] = tel_.tau_sensor[1] = std::numeric_limits<double>::quiet_NaN();
 }
 
-void ExoController::Tick(double t) {
+void ExoController::Tick(double t, const double* command) {
   tel_.t = t;
   new_sample_[0] = new_sample_[1] = false;
   CanFrame f;
@@ -63,6 +63,7 @@ void ExoController::Tick(double t) {
   double cmd[2] = {0, 0};
   pd_.Update(tel_.ref[0], tel_.ref[1], tel_.est[0].q, tel_.est[0].qd, tel_.est[1].q, tel_.est[1].qd,
              ff[0], ff[1], &cmd[0], &cmd[1]);
+  if (command) cmd[0] = command[0], cmd[1] = command[1];
 
   SafetyInput in;
   JointSafetyInput* js[2] = {&in.hip, &in.knee};

@@ -44,8 +44,11 @@ class ExoController {
   // trajectory: the reference, sampled at t - t_start; bus: this node's endpoint (not owned).
   ExoController(const ExoControllerConfig& cfg, std::shared_ptr<const LegTrajectory> trajectory,
                 CanBus* bus, double t_start = 0.0);
-  // One control period at time t (s): read frames, estimate, control, supervise, send.
-  void Tick(double t);
+  // One control period at time t (s): read frames, estimate, control, supervise, send. `command`
+  // (N m, hip then knee; may be null): the control law's output given from outside (a controller
+  // written in Python stepping the twin, python/) in place of PD + feed-forward; the reference is still
+  // sampled (telemetry) and the safety supervisor still vetoes and limits it.
+  void Tick(double t, const double* command = nullptr);
   const ControllerTelemetry& telemetry() const { return tel_; }
   SafetyState state() const { return tel_.safety.state; }
 

@@ -38,15 +38,33 @@ hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed) {
   return c;
 }
 
+TrialLog::TrialLog(const std::string& path, const std::vector<std::string>& columns,
+                   const std::vector<std::string>& comments, CapturedLog* capture)
+    : csv_(path, columns, comments), capture_(capture) {}
+
+void TrialLog::Row(const double* values, size_t n) {
+  csv_.Row(values, n);
+  if (!capture_) return;
+  const size_t columns = capture_->columns.size();
+  capture_->values.insert(capture_->values.end(), values, values + std::min(n, columns));
+  if (n < columns) capture_->values.insert(capture_->values.end(), columns - n, 0.0);
+}
+
 TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
                         const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
-                        std::vector<std::string>* files) {
+                        std::vector<std::string>* files, LogCapture* capture) {
   const std::string suffix = trials > 1 ? "_trial" + std::to_string(trial + 1) : "";
+  const std::string measured = "measured" + suffix + ".csv", truth = "truth" + suffix + ".csv";
+  CapturedLog* captured[2] = {nullptr, nullptr};
+  if (capture) {
+    captured[0] = &capture->emplace_back(CapturedLog{measured, measured_columns, {}});
+    captured[1] = &capture->emplace_back(CapturedLog{truth, truth_columns, {}});
+  }
   TrialLogs logs;
-  logs.measured = std::make_unique<CsvStreamWriter>(dir + "/measured" + suffix + ".csv", measured_columns, comments);
-  logs.truth = std::make_unique<CsvStreamWriter>(dir + "/truth" + suffix + ".csv", truth_columns, comments);
-  files->push_back("measured" + suffix + ".csv");
-  files->push_back("truth" + suffix + ".csv");
+  logs.measured = std::make_unique<TrialLog>(dir + "/" + measured, measured_columns, comments, captured[0]);
+  logs.truth = std::make_unique<TrialLog>(dir + "/" + truth, truth_columns, comments, captured[1]);
+  files->push_back(measured);
+  files->push_back(truth);
   return logs;
 }
 
@@ -67,12 +85,28 @@ void CosimRig::AttachEmg(CanBus* endpoint, const MuscleModel* muscles, Synthetic
 
 double CosimRig::Run(const CosimSchedule& sc, CosimDevice& device, const std::function<void(double)>& tick,
                      const CosimProgress& progress) {
-  const double dt = sc.dt;
-  double t = 0.0;
+  Begin(sc, device);
+  Advance(sc.steps, tick, progress);
+  return t_;
+}
+
+void CosimRig::Begin(const CosimSchedule& sc, CosimDevice& device) {
+  schedule_ = sc;
+  device_ = &device;
+  t_ = 0.0;
   stopped_by_ = 0;
   steps_run_ = 0;
-  device.SampleNodes(t);
-  for (long k = 0; k < sc.steps; ++k) {
+  device.SampleNodes(t_);
+}
+
+long CosimRig::Advance(long steps, const std::function<void(double)>& tick, const CosimProgress& progress) {
+  const CosimSchedule& sc = schedule_;
+  CosimDevice& device = *device_;
+  const double dt = sc.dt;
+  double t = t_;
+  const long first = steps_run_;
+  const long end = steps >= sc.steps - first ? sc.steps : first + std::max(0L, steps);  // no overflow for LONG_MAX
+  for (long k = first; k < end && stopped_by_ == 0; ++k) {
     device.BeginStep(t);
     const double plant_clock = device.StepPlant(t);
     device.SampleStepStart(t);
@@ -83,6 +117,7 @@ double CosimRig::Run(const CosimSchedule& sc, CosimDevice& device, const std::fu
     bus_.AdvanceTo(t + 0.999 * dt);
     device.LatchDrivers(t + dt, dt);
     t = sc.clock == CosimClock::kGrid ? static_cast<double>(k + 1) * dt : plant_clock;
+    t_ = t;
     device.SampleNodes(t);
     if (emg_node_) {  // the amplifier samples the electrodes at 1 kHz and sends one frame
       const MuscleVec v = electrodes_->Sample(muscles_->electrical_activation());
@@ -94,12 +129,9 @@ double CosimRig::Run(const CosimSchedule& sc, CosimDevice& device, const std::fu
     if (k % sc.log_every == 0) device.LogSample(t);
     if (progress.bar && k % kProgressEvery == 0) progress.bar->Update(progress.done + static_cast<size_t>(k));
     steps_run_ = k + 1;
-    if (const int sig = StopSignal(); sig != 0 && k + 1 < sc.steps) {  // step 8
-      stopped_by_ = sig;
-      break;
-    }
+    if (const int sig = StopSignal(); sig != 0 && k + 1 < sc.steps) stopped_by_ = sig;  // step 8
   }
-  return t;
+  return steps_run_ - first;
 }
 
 }  // namespace exotwin

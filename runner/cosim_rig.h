@@ -32,6 +32,7 @@
 #include "hwsim/virtual_can_bus.h"
 #include "protocol/candump.h"
 #include "runner/progress_bar.h"
+#include "runner/runner.h"
 #include "runner/scenario.h"
 #include "sim/muscles.h"
 #include "sim/synthetic_emg.h"
@@ -79,15 +80,29 @@ CosimSchedule ScheduleOf(const Scenario& s, double dt, CosimClock clock = CosimC
 // The virtual CAN bus of a scenario's hardware (bitrate, latency, jitter, drop rate) with `seed`.
 hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed);
 
+// One log of a trial: its CSV file (CsvStreamWriter) and, with a capture, its copy in memory.
+class TrialLog {
+ public:
+  TrialLog(const std::string& path, const std::vector<std::string>& columns, const std::vector<std::string>& comments,
+           CapturedLog* capture);
+  // Appends one row: values[0..n), missing columns 0 (CsvStreamWriter::Row).
+  void Row(const double* values, size_t n);
+
+ private:
+  CsvStreamWriter csv_;
+  CapturedLog* capture_;
+};
+
 // The two logs of trial `trial` (0-based) of `trials`: DIR/measured[_trialN].csv (the rig's view) and
 // DIR/truth[_trialN].csv (the plant's), N = trial + 1 when trials > 1, each with `comments`; their
-// names are appended to *files. Throws InputError if a file cannot be opened.
+// names are appended to *files, and with `capture` (may be null) their copies in memory to it. Throws
+// InputError if a file cannot be opened.
 struct TrialLogs {
-  std::unique_ptr<CsvStreamWriter> measured, truth;
+  std::unique_ptr<TrialLog> measured, truth;
 };
 TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
                         const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
-                        std::vector<std::string>* files);
+                        std::vector<std::string>* files, LogCapture* capture = nullptr);
 
 // Progress of a run over several trials: Run() reports done + k steps to `bar` (may be null).
 struct CosimProgress {
@@ -115,13 +130,24 @@ class CosimRig {
 
   // Runs schedule.steps steps from t = 0 (the plant and nodes set up at t = 0) in the order of the
   // file comment, fewer if a stop request arrives (step 8); `tick(t)` is the controller's tick at t (s).
-  // Returns the time of the last step's end.
+  // Returns the time of the last step's end. Begin + Advance(schedule.steps) in one call.
   double Run(const CosimSchedule& schedule, CosimDevice& device, const std::function<void(double)>& tick,
              const CosimProgress& progress = {});
-  // The stop signal that ended the last Run() before its schedule's end (2 SIGINT, 15 SIGTERM), 0 when
-  // it ran every step.
+  // The same run in parts (the Python module's steppable twin): Begin takes the start instant's samples
+  // (t = 0); each Advance runs up to `steps` more steps of the schedule (fewer at its end or on a stop
+  // request) and returns the steps it ran; finished() once the schedule ended or a stop request ended
+  // it. Run() and Begin + Advance in any parts run the same steps with the same bits. `device` outlives
+  // the run.
+  void Begin(const CosimSchedule& schedule, CosimDevice& device);
+  long Advance(long steps, const std::function<void(double)>& tick, const CosimProgress& progress = {});
+  bool finished() const { return steps_run_ >= schedule_.steps || stopped_by_ != 0; }
+  // The time of the last step's end (0 before the first step).
+  double time() const { return t_; }
+  const CosimSchedule& schedule() const { return schedule_; }
+  // The stop signal that ended the run before its schedule's end (2 SIGINT, 15 SIGTERM), 0 when it ran
+  // every step so far.
   int stopped_by() const { return stopped_by_; }
-  // The steps the last Run() ran (schedule.steps unless stopped).
+  // The steps run so far (schedule.steps at the end unless stopped).
   long steps_run() const { return steps_run_; }
 
  private:
@@ -129,6 +155,9 @@ class CosimRig {
   std::unique_ptr<hwsim::EmgNode> emg_node_;
   const MuscleModel* muscles_ = nullptr;
   SyntheticEmg* electrodes_ = nullptr;
+  CosimSchedule schedule_;
+  CosimDevice* device_ = nullptr;
+  double t_ = 0.0;
   int stopped_by_ = 0;
   long steps_run_ = 0;
 };

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -54,9 +55,10 @@ struct ExowheelTotals {
 // (muscles, behaviour, surface EMG), faults, logs and the metrics' accumulation.
 class ExowheelTrial : public CosimDevice {
  public:
-  ExowheelTrial(const Scenario& s, const RunOptions& opt, const LegParams& truth, Plant& plant, int trial,
-                CandumpWriter* can_log, RunResult* result, ExowheelTotals* totals)
-      : s_(s), opt_(opt), plant_(plant), result_(result), totals_(totals), trial_(trial),
+  ExowheelTrial(const Scenario& s, const RunOptions& opt, const LegParams& truth, Plant& plant,
+                const CosimSchedule& schedule, int trial, CandumpWriter* can_log, RunResult* result,
+                ExowheelTotals* totals)
+      : s_(s), opt_(opt), plant_(plant), schedule_(schedule), result_(result), totals_(totals), trial_(trial),
         seed_(result->seed * 7919ull + static_cast<uint64_t>(trial)),
         trajectory_(BuildTrajectory(s, trial)),
         rig_(BusConfigOf(s.hardware, seed_), can_log, trial * (s.protocol.duration + 1.0)),  // trials follow each other
@@ -89,12 +91,24 @@ class ExowheelTrial : public CosimDevice {
     events_seen_ = result->events.size();
   }
 
-  // Runs the trial on the rig and adds its bus statistics and final state to the totals; returns the
-  // stop request that ended it early (its trial field left to the caller), if any.
-  std::optional<RunInterruption> Run(const CosimSchedule& schedule, const CosimProgress& progress) {
+  // The trial in parts (ExowheelSession): Begin sets the rig at t = 0; Advance runs up to `steps`
+  // physics steps, the controller's ticks in them given `command` (hip, knee N m; null: its own law);
+  // once the rig finished, Conclude adds the bus statistics and the final state to the totals and
+  // returns the stop request that ended the trial early (its trial field left to the caller), if any.
+  void Begin() {
     if (opt_.remote) opt_.remote->BeginTrial(trial_, ctrl_ep_, &result_->events);
-    const double t_end = rig_.Run(
-        schedule, *this, [this](double t) { opt_.remote ? opt_.remote->Tick(t) : ctrl_.Tick(t); }, progress);
+    rig_.Begin(schedule_, *this);
+  }
+  long Advance(long steps, const double* command, const CosimProgress& progress) {
+    command_ = command;
+    const long ran = rig_.Advance(
+        steps, [this](double t) { opt_.remote ? opt_.remote->Tick(t) : ctrl_.Tick(t, command_); }, progress);
+    command_ = nullptr;
+    return ran;
+  }
+  bool finished() const { return rig_.finished(); }
+  std::optional<RunInterruption> Conclude() {
+    const double t_end = rig_.time();
     if (video_) {
       video_->Finish(t_end);
       result_->files.push_back(opt_.video_path);
@@ -108,6 +122,35 @@ class ExowheelTrial : public CosimDevice {
     if (!rig_.stopped_by()) return std::nullopt;
     return RunInterruption{rig_.stopped_by(), t_end, 0};
   }
+
+  // The columns of measured.csv and truth.csv, and their rows at the last step's end (t).
+  std::vector<std::string> MeasuredColumns() const {
+    std::vector<std::string> c = {"t",       "q_hip",    "q_knee",  "tau_hip",  "tau_knee",
+                                  "cmd_hip", "cmd_knee", "ref_hip", "ref_knee", "state"};
+    if (emg_on_) c.insert(c.end(), {"emg_GMAX", "emg_VM", "emg_RF", "emg_ST", "emg_GAS"});
+    return c;
+  }
+  static std::vector<std::string> TruthColumns() {
+    return {"t", "q_hip", "q_knee", "qd_hip", "qd_knee", "tau_R_hip", "tau_R_knee", "tau_M_hip", "tau_M_knee"};
+  }
+  size_t MeasuredRow(double t, double* row) const {
+    const auto& tel = Telemetry();
+    const double r[] = {t, tel.est[0].q, tel.est[1].q, tel.tau_sensor[0], tel.tau_sensor[1],
+                        tel.tau_cmd[0], tel.tau_cmd[1], tel.ref[0].q, tel.ref[1].q,
+                        static_cast<double>(tel.safety.state), tel.emg[0], tel.emg[1], tel.emg[2],
+                        tel.emg[3], tel.emg[4]};
+    const size_t n = emg_on_ ? 15 : 10;
+    std::copy(r, r + n, row);
+    return n;
+  }
+  size_t TruthRow(double t, double* row) const {
+    const Eigen::Vector2d qd = plant_.qd();
+    const double r[] = {t, q_[0], q_[1], qd[0], qd[1], applied_[0], applied_[1], tau_M_[0], tau_M_[1]};
+    std::copy(r, r + 9, row);
+    return 9;
+  }
+  double time() const { return rig_.time(); }
+  controller::SafetyState safety_state() const { return Telemetry().safety.state; }
 
   void BeginStep(double t) override {
     ApplyFaults(faults_, t, modules_, rig_.bus(), ctrl_ep_, s_.hardware, &result_->events);
@@ -161,17 +204,11 @@ class ExowheelTrial : public CosimDevice {
   }
 
   void LogSample(double t) override {
-    const auto& tel = Telemetry();
     ++totals_->samples;
     if (logs_.measured) {
-      const double row[] = {t, tel.est[0].q, tel.est[1].q, tel.tau_sensor[0], tel.tau_sensor[1],
-                            tel.tau_cmd[0], tel.tau_cmd[1], tel.ref[0].q, tel.ref[1].q,
-                            static_cast<double>(tel.safety.state), tel.emg[0], tel.emg[1], tel.emg[2],
-                            tel.emg[3], tel.emg[4]};
-      logs_.measured->Row(row, emg_on_ ? 15 : 10);
-      const Eigen::Vector2d qd = plant_.qd();
-      const double trow[] = {t, q_[0], q_[1], qd[0], qd[1], applied_[0], applied_[1], tau_M_[0], tau_M_[1]};
-      logs_.truth->Row(trow, 9);
+      double row[15], trow[9];
+      logs_.measured->Row(row, MeasuredRow(t, row));
+      logs_.truth->Row(trow, TruthRow(t, trow));
     }
     if (video_) AddVideoSample(t);
     if (opt_.on_sample) {
@@ -189,15 +226,11 @@ class ExowheelTrial : public CosimDevice {
   // measured[_trialN].csv and truth[_trialN].csv (logs.measured_csv).
   void OpenLogs(const LegParams& truth, int trial) {
     if (!s_.log_measured_csv) return;
-    std::vector<std::string> measured = {"t",       "q_hip",    "q_knee",  "tau_hip",  "tau_knee",
-                                         "cmd_hip", "cmd_knee", "ref_hip", "ref_knee", "state"};
-    if (emg_on_) measured.insert(measured.end(), {"emg_GMAX", "emg_VM", "emg_RF", "emg_ST", "emg_GAS"});
     logs_ = OpenTrialLogs(
-        opt_.out_dir, trial, s_.protocol.trials, measured,
-        {"t", "q_hip", "q_knee", "qd_hip", "qd_knee", "tau_R_hip", "tau_R_knee", "tau_M_hip", "tau_M_knee"},
+        opt_.out_dir, trial, s_.protocol.trials, MeasuredColumns(), TruthColumns(),
         {"exotwin run " + s_.name + " trial " + std::to_string(trial + 1) + " seed " + std::to_string(result_->seed),
          "subject truth: L1 " + std::to_string(truth.L1) + (truth.human ? " with human" : " exo only")},
-        &result_->files);
+        &result_->files, opt_.capture);
   }
 
   void AddVideoSample(double t) {
@@ -223,6 +256,7 @@ class ExowheelTrial : public CosimDevice {
   const Scenario& s_;
   const RunOptions& opt_;
   Plant& plant_;
+  const CosimSchedule schedule_;
   RunResult* result_;
   ExowheelTotals* totals_;
   const int trial_;
@@ -245,6 +279,7 @@ class ExowheelTrial : public CosimDevice {
   std::unique_ptr<VideoSink> video_;
   std::vector<dsp::SosFilter> envelope_;
   size_t events_seen_ = 0;
+  const double* command_ = nullptr;  // the command of Advance's ticks (null: the controller's own law)
   double tau_[2] = {0, 0};      // the drivers' output at t (at t = 0: no command yet)
   double applied_[2] = {0, 0};  // the drivers' output held over the last step
   Eigen::Vector2d tau_M_ = Eigen::Vector2d::Zero();  // muscle torque of the last step
@@ -253,41 +288,117 @@ class ExowheelTrial : public CosimDevice {
 
 }  // namespace
 
-RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
+// The run's state between Advance calls (exowheel_runner.h).
+struct ExowheelSession::State {
+  State(const Scenario& scenario, const RunOptions& options)
+      : s(scenario), opt(options), truth(ResolveSubject(s)),
+        plant(ExowheelMjcfPath(s.device != Device::kExowheelExoOnly)) {}
+  const Scenario s;
+  const RunOptions opt;
   RunResult result;
+  const LegParams truth;
+  Plant plant;
+  CosimSchedule schedule;
+  std::unique_ptr<CandumpWriter> can_log;
+  ExowheelTotals totals;
+  std::chrono::steady_clock::time_point wall0;
+  std::unique_ptr<ProgressBar> bar;
+  std::unique_ptr<ExowheelTrial> trial;  // the trial running; null once the run ended
+  int trial_index = 0;
+  bool finished = false;
+
+  void StartTrial() {
+    trial = std::make_unique<ExowheelTrial>(s, opt, truth, plant, schedule, trial_index, can_log.get(), &result,
+                                            &totals);
+    trial->Begin();
+  }
+};
+
+ExowheelSession::ExowheelSession(const Scenario& s, const RunOptions& opt) {
+  RunResult& result = (st_ = std::make_unique<State>(s, opt))->result;
   result.scenario = s.name;
   result.seed = opt.seed ? *opt.seed : s.seed;
   std::filesystem::create_directories(opt.out_dir);
 
-  const LegParams truth = ResolveSubject(s);
-  Plant plant(ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
-  plant.SetParams(truth);
+  Plant& plant = st_->plant;
+  plant.SetParams(st_->truth);
   if (!s.plant_effects.empty()) {  // the scenario's plant: the rigid twin plus the effects it carries
-    LegParams carried = truth;
+    LegParams carried = st_->truth;
     carried.effects = s.plant_effects;
     plant.CarryEffects(ToPlantEffects(carried, s.plant_effects_source));  // sensor effects: the joint modules
   }
-  const CosimSchedule schedule = ScheduleOf(s, plant.timestep());
+  st_->schedule = ScheduleOf(s, plant.timestep());
 
-  std::unique_ptr<CandumpWriter> can_log;
-  if (!opt.can_log.empty()) can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
+  if (!opt.can_log.empty()) st_->can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
 
   if (opt.remote)  // the controller in another process runs the scenario's controller file (ControllerNode)
     opt.remote->SetConfiguration(controller::ControllerFileYaml(
-        ControllerFileOf(s, truth), "the controller file of " + s.source + " (" + s.name + ")"));
-  ExowheelTotals totals;
-  const auto wall0 = std::chrono::steady_clock::now();
-  ProgressBar bar(static_cast<size_t>(s.protocol.trials * schedule.steps), s.name, opt.progress);
-  for (int trial = 0; trial < s.protocol.trials; ++trial) {
-    ExowheelTrial run(s, opt, truth, plant, trial, can_log.get(), &result, &totals);
-    if ((result.interrupted = run.Run(schedule, {&bar, static_cast<size_t>(trial * schedule.steps)}))) {
-      result.interrupted->trial = trial + 1;
-      break;  // the trial's logs are closed (flushed) with it
+        ControllerFileOf(s, st_->truth), "the controller file of " + s.source + " (" + s.name + ")"));
+  st_->wall0 = std::chrono::steady_clock::now();
+  st_->bar = std::make_unique<ProgressBar>(static_cast<size_t>(s.protocol.trials * st_->schedule.steps), s.name,
+                                           opt.progress);
+  if (s.protocol.trials > 0) st_->StartTrial();
+  else st_->finished = true;
+}
+
+ExowheelSession::~ExowheelSession() = default;
+
+long ExowheelSession::Advance(long steps, const double* command) {
+  State& st = *st_;
+  long ran = 0;
+  while (ran < steps && !st.finished) {
+    if (st.trial->finished()) {  // concluded at its last step's end (its rows stay readable till now)
+      st.trial.reset();          // closes (flushes) the trial's logs before the next trial opens its own
+      ++st.trial_index;
+      st.StartTrial();
+    }
+    ran += st.trial->Advance(steps - ran, command,
+                             {st.bar.get(), static_cast<size_t>(st.trial_index * st.schedule.steps)});
+    if (!st.trial->finished()) continue;
+    if ((st.result.interrupted = st.trial->Conclude())) {
+      st.result.interrupted->trial = st.trial_index + 1;
+      st.finished = true;
+    } else {
+      st.finished = st.trial_index + 1 >= st.s.protocol.trials;
     }
   }
-  if (!result.interrupted) bar.Update(static_cast<size_t>(s.protocol.trials * schedule.steps));
-  bar.Finish();
+  return ran;
+}
 
+bool ExowheelSession::done() const { return st_->finished; }
+
+int ExowheelSession::steps_per_tick() const { return st_->schedule.steps_per_tick; }
+
+int ExowheelSession::trial() const { return st_->trial_index; }
+
+double ExowheelSession::time() const { return st_->trial ? st_->trial->time() : 0.0; }
+
+std::vector<std::string> ExowheelSession::MeasuredColumns() const {
+  return st_->trial ? st_->trial->MeasuredColumns() : std::vector<std::string>{};
+}
+
+std::vector<std::string> ExowheelSession::TruthColumns() const { return ExowheelTrial::TruthColumns(); }
+
+size_t ExowheelSession::MeasuredRow(double* row) const {
+  return st_->trial ? st_->trial->MeasuredRow(st_->trial->time(), row) : 0;
+}
+
+size_t ExowheelSession::TruthRow(double* row) const {
+  return st_->trial ? st_->trial->TruthRow(st_->trial->time(), row) : 0;
+}
+
+int ExowheelSession::safety_state() const {
+  return st_->trial ? static_cast<int>(st_->trial->safety_state()) : st_->totals.final_state;
+}
+
+RunResult ExowheelSession::Finish() {
+  State& st = *st_;
+  st.trial.reset();
+  if (!st.result.interrupted) st.bar->Update(static_cast<size_t>(st.s.protocol.trials * st.schedule.steps));
+  st.bar->Finish();
+
+  const ExowheelTotals& totals = st.totals;
+  RunResult& result = st.result;
   auto& m = result.metrics;
   m["samples"] = static_cast<double>(totals.samples);
   m["tracking_rms_hip_deg"] = totals.track[0].rms();
@@ -310,11 +421,18 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   m["torque_max_50ms_after_fault"] = totals.torque_after_fault;
   m["safe_state_entered"] = safe_time >= 0 ? 1.0 : 0.0;
   m["final_state"] = totals.final_state;
-  if (opt.remote) opt.remote->AddMetrics(&m);
-  m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (st.opt.remote) st.opt.remote->AddMetrics(&m);
+  m["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - st.wall0).count();
 
-  FinishRun(s, result, opt.out_dir + "/result.json");
+  FinishRun(st.s, result, st.opt.out_dir + "/result.json");
   return result;
+}
+
+
+RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
+  ExowheelSession session(s, opt);
+  session.Advance(std::numeric_limits<long>::max(), nullptr);
+  return session.Finish();
 }
 
 }  // namespace exotwin

@@ -4,6 +4,7 @@
 // device runner for a scenario.
 #pragma once
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <optional>
@@ -18,6 +19,18 @@
 namespace exotwin {
 
 class RemoteController;  // runner/remote_controller.h
+
+// A log of a run kept in memory as it is written (RunOptions::capture; the Python module's results):
+// the numbers of the rows its CSV file holds (the file's text reads back to these doubles bit for bit,
+// AppendNumber), row-major.
+struct CapturedLog {
+  std::string file;                  // the CSV file's name in the run's folder: measured.csv, truth_trial2.csv
+  std::vector<std::string> columns;  // its header
+  std::vector<double> values;        // rows * columns.size(), row-major
+  size_t rows() const { return columns.empty() ? 0 : values.size() / columns.size(); }
+};
+// The logs of a run in the order they were opened (a deque: a log keeps its address while more are added).
+using LogCapture = std::deque<CapturedLog>;
 
 struct RunOptions {
   std::string out_dir = "out";
@@ -34,6 +47,9 @@ struct RunOptions {
   // RunScenarioJob (scenario_job.h) only: the exotwin-controller executable to run the scenario's
   // controller in another process (RunWithControllerProcess, controller_process.h); "" = in-process.
   std::string controller_process;
+  // The logs kept in memory too (measured and truth of every trial, as their CSV files hold them; the
+  // Python module's results); null: files only.
+  LogCapture* capture = nullptr;
 };
 
 struct CheckResult {

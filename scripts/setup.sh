@@ -19,6 +19,8 @@ PKGS=(
   slurm-wlm munge                     # a one-node Slurm for scripts/test_slurm.sh (the sweep job array)
   file dpkg-dev                       # cpack -G DEB: dpkg-shlibdeps computes the dependencies, `file` finds the ELF files
   python3                             # examples/python_controller (a controller from outside the project; its serve test)
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module (python/) and its tests (tests/python)
+  python3-matplotlib                  # examples/python (the plots, Agg)
 )
 
 missing=()

@@ -45,4 +45,5 @@ echo "ok: dpkg-deb -c: $(grep -c -v '/$' "$T/contents") files under /usr/bin, /u
 dpkg-deb -x "$DEB" "$T/root"
 no_source_path "$T/root/usr" "$SRC" "$(realpath "$BUILD")" "$BUILD_TYPE"
 run_shipped "$T/root/usr" "$T/a"
+run_python "$T/root/usr" "$T/a" "$BUILD"
 echo "ok: .deb test"

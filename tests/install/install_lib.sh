@@ -11,7 +11,7 @@ no_source_path() {
     Release|MinSizeRel) ;;
     *) echo "skipped: source path check (a $type build names its source files in debug information or assertions)"; return 0 ;;
   esac
-  for f in "$root"/bin/* "$root"/lib/exotwin/*; do
+  for f in "$root"/bin/* "$root"/lib/exotwin/* "$root"/lib/python3/dist-packages/exotwin/*.so; do
     [ -f "$f" ] || continue
     n=$((n + 1))
     for p in "$src" "$build"; do
@@ -41,4 +41,27 @@ run_shipped() {
   [ -f "$work/run/measured.csv" ] || [ -n "$(ls "$work"/run/*.csv 2>/dev/null)" ] || fail "the run wrote no CSV log"
   [ -z "$(ls -A "$work/cwd")" ] || fail "the run wrote into its working directory: $(ls -A "$work/cwd")"
   echo "ok: $root/bin/exotwin run (cwd $work/cwd): exit 0, $(grep -c '"passed": true' "$r") checks passed"
+}
+
+# run_python ROOT WORK BUILD: when BUILD built the Python module (python/CMakeLists.txt), checks that
+# ROOT holds it (ROOT/lib/python3/dist-packages/exotwin) and that Debian's python3 imports it from an
+# unrelated working directory, the data found next to the package, and runs a shipped scenario.
+run_python() {
+  local root=$1 work=$2 build=$3 rc=0 py=/usr/bin/python3
+  if ! ls "$build"/lib/python3/dist-packages/exotwin/_exotwin*.so >/dev/null 2>&1; then
+    echo "skipped: the Python module (not built in $build)"
+    return 0
+  fi
+  ls "$root"/lib/python3/dist-packages/exotwin/_exotwin*.so >/dev/null 2>&1 || fail "$root/lib/python3/dist-packages/exotwin/_exotwin*.so not installed"
+  [ -f "$root/lib/python3/dist-packages/exotwin/__init__.py" ] || fail "$root/lib/python3/dist-packages/exotwin/__init__.py not installed"
+  mkdir -p "$work/pycwd"
+  (cd "$work/pycwd" && env -u EXOTWIN_DATA_DIR PYTHONPATH="$root/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 "$py" -c "
+import exotwin, sys
+r = exotwin.run('$root/share/exotwin/scenarios/faults/sensor_stuck.yaml')
+assert r.scenario == 'fault_sensor_stuck' and len(r.measured['t']) > 0, r
+print('rows', len(r.measured['t']), 'passed', r.passed, 'from', exotwin.__file__)
+" >"$work/py.log" 2>&1) || rc=$?
+  [ $rc -eq 0 ] || { cat "$work/py.log"; fail "$py: import exotwin; exotwin.run from $work/pycwd: exit $rc"; }
+  grep -q "from $root/lib/python3/dist-packages/exotwin/__init__.py" "$work/py.log" || { cat "$work/py.log"; fail "the module imported is not $root's"; }
+  echo "ok: $py imports exotwin from $root/lib/python3/dist-packages and runs a shipped scenario: $(cat "$work/py.log")"
 }

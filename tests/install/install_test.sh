@@ -27,6 +27,7 @@ echo "ok: layout bin/, lib/exotwin/, share/exotwin/{mjcf,data,scenarios (+ basel
 
 no_source_path "$P" "$SRC" "$(realpath "$BUILD")" "$BUILD_TYPE"
 run_shipped "$P" "$T/a"
+run_python "$P" "$T/a" "$BUILD"
 
 # EXOTWIN_DATA_DIR overrides the program's location; a missing data folder is exit 2 naming it.
 mv "$P/share/exotwin" "$T/data_elsewhere"

@@ -1,0 +1,153 @@
+"""The Python module's bench rows (`exotwin bench --only python` runs `python3 -m exotwin.bench`), each
+against a baseline measured in the same run, best of `repeat`:
+
+1. exotwin.run(gait_2kmh) in this interpreter vs `exotwin run gait_2kmh.yaml` (the program, spawned):
+   the same work, both writing both CSV logs (target <= 1.05x wall);
+2. a Python PD controller stepping Twin.step over the 60 s of gait vs the UDP example
+   (examples/python_controller/pd_controller.py against `exotwin serve --bus udp:...`), the same gains
+   (target <= 0.25x wall);
+3. the binding's own cost per step: a no-op controller (Twin.step(None), the shipped controller acting)
+   against exotwin.run of the same scenario (us per controller period).
+
+Usage: python3 -m exotwin.bench --exotwin PATH/exotwin [--repeat N] [--quick] [--json FILE]; prints JSON
+{"status": "ok", "rows": [{work, ratio, unit, baseline, goal, detail}], ...} on stdout.
+"""
+import argparse
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import exotwin
+
+
+def best_of(n, fn):
+    best = float("inf")
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def free_udp_port():
+    # two consecutive ports: the twin's and the controller's (HOST:PORT and HOST:PORT+1)
+    for _ in range(50):
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as a:
+            a.bind(("127.0.0.1", 0))
+            port = a.getsockname()[1]
+            try:
+                with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as b:
+                    b.bind(("127.0.0.1", port + 1))
+                    return port
+            except OSError:
+                continue
+    raise RuntimeError("no two consecutive free UDP ports")
+
+
+def python_pd(twin, kp=(600.0, 400.0), kd=(30.0, 15.0), limit=100.0):
+    """The UDP example's law on the twin's observations: PD on the reference, velocities as
+    difference quotients, clamped to the torque limit. Returns the periods stepped."""
+    obs = twin.reset()
+    dt = twin.period
+    kp, kd = np.array(kp), np.array(kd)
+    q_prev = ref_prev = None
+    cmd = np.zeros(2)
+    n = 0
+    while not twin.done:
+        q = np.array((obs["q_hip"], obs["q_knee"]))
+        ref = np.array((obs["ref_hip"], obs["ref_knee"]))
+        if q_prev is None:
+            qd = ref_d = np.zeros(2)
+        else:
+            qd, ref_d = (q - q_prev) / dt, (ref - ref_prev) / dt
+        np.clip(kp * (ref - q) + kd * (ref_d - qd), -limit, limit, out=cmd)
+        q_prev, ref_prev = q, ref
+        obs = twin.step(cmd)
+        n += 1
+    return n
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--exotwin", required=True, help="the exotwin program (the CLI baseline, exotwin serve)")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="6 s of gait instead of 60")
+    ap.add_argument("--json", help="write the JSON here too")
+    a = ap.parse_args(argv)
+    data = os.environ.get("EXOTWIN_DATA_DIR")
+    scratch = tempfile.mkdtemp(prefix="exotwin_pybench_")
+    try:
+        scenario = os.path.join(data, "scenarios", "gait_2kmh.yaml")
+        if a.quick:
+            text = open(scenario).read().replace("duration: 60,", "duration: 6,")
+            scenario = os.path.join(scratch, "gait_6s.yaml")
+            with open(scenario, "w") as f:
+                f.write(text)
+        seconds = 6.0 if a.quick else 60.0
+        rows = []
+
+        # 1. exotwin.run vs the program
+        cli = best_of(a.repeat, lambda: subprocess.run([a.exotwin, "run", scenario, "--out", os.path.join(scratch, "cli")],
+                                                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        py = best_of(a.repeat, lambda: exotwin.run(scenario, out=os.path.join(scratch, "py")))
+        rows.append({"work": f"exotwin.run gait_2kmh ({seconds:g} s, both CSV logs) from Python", "ratio": py / cli,
+                     "unit": "x", "baseline": "exotwin run, the same scenario (program spawned)", "goal": "<= 1.05x",
+                     "detail": f"{py:.3f} s vs {cli:.3f} s"})
+
+        # 2. Python PD on Twin.step vs the UDP example
+        pd_script = os.path.join(data, "examples", "python_controller", "pd_controller.py")
+        winter = os.path.join(data, "data", "WinterTableA1.txt")
+
+        def udp():
+            port = free_udp_port()
+            serve = subprocess.Popen([a.exotwin, "serve", scenario, "--bus", f"udp:127.0.0.1:{port}", "--out",
+                                      os.path.join(scratch, "serve")], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            ctrl = subprocess.run([sys.executable, pd_script, "--bus", f"udp:127.0.0.1:{port}", "--winter", winter],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            rc = serve.wait(timeout=600)
+            if ctrl.returncode != 0 or rc not in (0, 1):
+                raise RuntimeError(f"the UDP example failed: controller exit {ctrl.returncode}, serve exit {rc}")
+
+        udp_s = best_of(a.repeat, udp)
+        twin = exotwin.Twin(scenario)
+        twin_s = best_of(a.repeat, lambda: python_pd(twin))
+        steps = python_pd(twin)
+        rows.append({"work": f"Python PD controller on Twin.step, gait_2kmh ({seconds:g} s, {steps} periods)",
+                     "ratio": twin_s / udp_s, "unit": "x",
+                     "baseline": "the UDP example: pd_controller.py against exotwin serve --bus udp", "goal": "<= 0.25x",
+                     "detail": f"{twin_s:.3f} s vs {udp_s:.3f} s; tracking RMS knee "
+                               f"{twin.result.metrics['tracking_rms_knee_deg']:.2f} deg"})
+
+        # 3. the binding's cost per step: no-op controller vs the in-process run
+        def noop():
+            twin.reset()
+            while not twin.done:
+                twin.step()
+
+        noop_s = best_of(a.repeat, noop)
+        run_s = best_of(a.repeat, lambda: exotwin.run(scenario))
+        per_step = (noop_s - run_s) / steps
+        rows.append({"work": "binding cost per Twin.step (no-op Python controller, the shipped one acting)",
+                     "ratio": noop_s / run_s, "unit": "x", "baseline": "exotwin.run of the same scenario (in-process)",
+                     "goal": "", "detail": f"{noop_s:.3f} s vs {run_s:.3f} s: {per_step * 1e6:+.2f} us per step "
+                                           f"({steps} steps)"})
+        text = json.dumps({"status": "ok", "quick": a.quick, "repeat": a.repeat, "rows": rows,
+                           "python": sys.executable, "cli_run_s": cli, "py_run_s": py, "udp_s": udp_s,
+                           "twin_pd_s": twin_s, "twin_noop_s": noop_s, "inprocess_run_s": run_s}, indent=2)
+        print(text)
+        if a.json:
+            with open(a.json, "w") as f:
+                f.write(text + "\n")
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

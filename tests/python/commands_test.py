@@ -1,0 +1,97 @@
+# The commands as functions and the readers (python/module_commands.cc, python/exotwin/_api.py):
+# the same numbers as the program's files, the CLI's error text.
+import json
+
+import numpy as np
+import pytest
+
+import exotwin
+from conftest import cli, read_csv, same_bits
+
+
+@pytest.fixture
+def record(tmp):
+    """A 12 s record of S1 with a hidden Coulomb friction at the knee (exotwin generate, seed 3)."""
+    params = exotwin.data_path("examples/S1.yaml")
+    g = exotwin.generate(params, seed=3, out=tmp / "rec.csv", effects=1, effect="coulomb_friction",
+                         joint="knee", duration=12)
+    return params, tmp / "rec.csv", g
+
+
+def test_generate_is_the_programs_record(tmp, record):
+    params, path, g = record
+    cli("generate", "--params", params, "--seed", 3, "--out", tmp / "cli.csv", "--effects", 1, "--effect",
+        "coulomb_friction", "--joint", "knee", "--duration", 12, "--truth", tmp / "truth.yaml")
+    ref = read_csv(tmp / "cli.csv")
+    assert list(g["measured"]) == list(ref) and g["path"] == str(path)
+    for name in ref:
+        assert same_bits(g["measured"][name], ref[name]), name
+    truth = exotwin.read_model(tmp / "truth.yaml")
+    assert g["truth"]["effects"] == truth["effects"]
+    assert [e["name"] for e in truth["effects"]] == ["coulomb_friction"] and truth["effects"][0]["joint"] == "knee"
+
+
+def test_predict_and_replay_are_the_programs(tmp, record):
+    params, path, _ = record
+    p = exotwin.predict(params, path)
+    cli("predict", "--params", params, "--measured", path, "--out", tmp / "pred.csv")
+    ref = read_csv(tmp / "pred.csv")
+    assert list(p) == ["t", "tau_hip", "tau_knee"]
+    assert all(same_bits(p[c], ref[c]) for c in ref)
+
+    r = exotwin.replay(params, [path], horizon=0.5)
+    cli("replay", "--params", params, "--measured", path, "--horizon", 0.5, "--out", tmp / "replay")
+    ref_json = json.loads((tmp / "replay" / "replay.json").read_text())
+    series = r.pop("series")
+    assert r == ref_json
+    ref_csv = read_csv(tmp / "replay" / "replay.csv")
+    assert all(same_bits(series[c], ref_csv[c]) for c in ref_csv)
+
+
+def test_diagnose_names_the_hidden_effect(tmp, record):
+    params, path, g = record
+    d = exotwin.diagnose(params, [path], out=tmp / "d")
+    on_disk = json.loads((tmp / "d" / "diagnosis.json").read_text())
+    assert {k: v for k, v in d.items() if k not in ("extended", "out")} == on_disk
+    assert d["out"] == str(tmp / "d")
+    names = [(e["name"], e["joint"]) for e in d["effects"]]
+    assert ("coulomb_friction", "knee") in names
+    hidden = g["truth"]["effects"][0]["value"]
+    e = d["effects"][names.index(("coulomb_friction", "knee"))]
+    assert e["ci95"][0] <= hidden <= e["ci95"][1] or abs(e["value"] - hidden) < 0.1 * hidden
+    assert d["extended"]["effects"][0]["name"] == "coulomb_friction"
+    assert d["joints"]["knee"]["rmse_after"] < d["joints"]["knee"]["rmse_before"]
+    with pytest.raises(exotwin.InputError, match="fit: expected one of torque, got 'motion'"):
+        exotwin.diagnose(params, [path], fit="motion")
+
+
+def test_readers(tmp, record):
+    params, path, g = record
+    m = exotwin.read_measured(path)
+    c = exotwin.read_csv(path)
+    assert list(m)[:5] == ["t", "q_hip", "q_knee", "tau_hip", "tau_knee"]
+    assert all(same_bits(m[k], c[k]) for k in m)
+    model = exotwin.read_model(params)
+    assert model["exo"]["J1"] == 3.02 and model["human"]["X1"] == 4.54 and model["passive"] == "riener1999"
+    assert model["effects"] == [] and "exo:" in model["yaml"]
+    sto = tmp / "m.sto"
+    cli("run", exotwin.data_path("scenarios/faults/sensor_stuck.yaml"), "--out", tmp / "run", "--sto")
+    s = exotwin.read_sto(tmp / "run" / "measured.sto")
+    ref = read_csv(tmp / "run" / "measured.csv")
+    assert same_bits(s["time"], ref["t"]) and same_bits(s["q_knee"], ref["q_knee"])
+    del sto
+
+
+def test_bad_input_is_the_programs_text(tmp):
+    p = cli("predict", "--params", tmp / "none.yaml", "--measured", tmp / "none.csv", "--out", tmp / "o.csv",
+            check=False)
+    assert p.returncode == 2
+    with pytest.raises(exotwin.InputError) as e:
+        exotwin.predict(tmp / "none.yaml", tmp / "none.csv")
+    assert p.stderr.strip() == "exotwin: error: " + str(e.value)
+    with pytest.raises(exotwin.InputError, match="--horizon"):
+        exotwin.replay(exotwin.data_path("examples/S1.yaml"), [tmp / "none.csv"], horizon=-1)
+    with pytest.raises(exotwin.InputError, match="measured: expected at least one path"):
+        exotwin.diagnose(exotwin.data_path("examples/S1.yaml"), [])
+    with pytest.raises(exotwin.InputError, match="no_such"):
+        exotwin.read_measured(tmp / "no_such.csv")
