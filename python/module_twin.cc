@@ -99,7 +99,27 @@ class Twin {
 
  private:
   // The command's two values (N m, hip then knee) into cmd; TypeError / InputError on a wrong one.
+  // Fast paths (no array made): a float64 array of shape (2,), a tuple or list of two Python floats.
   const double* Command(const py::handle& command, double* cmd) const {
+    bool read = false;
+    if (py::array_t<double>::check_(command)) {  // float64 in the machine's byte order
+      const auto a = py::reinterpret_borrow<py::array>(command);
+      if (a.ndim() == 1 && a.shape(0) == 2) {
+        const char* p = static_cast<const char*>(a.data());
+        cmd[0] = *reinterpret_cast<const double*>(p);
+        cmd[1] = *reinterpret_cast<const double*>(p + a.strides(0));
+        read = true;
+      }
+    } else if ((PyTuple_Check(command.ptr()) || PyList_Check(command.ptr())) && PySequence_Fast_GET_SIZE(command.ptr()) == 2) {
+      PyObject* x = PySequence_Fast_GET_ITEM(command.ptr(), 0);
+      PyObject* y = PySequence_Fast_GET_ITEM(command.ptr(), 1);
+      if (PyFloat_CheckExact(x) && PyFloat_CheckExact(y)) {
+        cmd[0] = PyFloat_AS_DOUBLE(x);
+        cmd[1] = PyFloat_AS_DOUBLE(y);
+        read = true;
+      }
+    }
+    if (read) return Finite(cmd);
     py::array a = py::array::ensure(command);
     if (!a) throw py::type_error("Twin.step: command: expected a numpy array of 2 torques (cmd_hip, cmd_knee, N m) or None");
     const char kind = a.dtype().kind();
@@ -113,13 +133,16 @@ class Twin {
                        (a.ndim() == 1 ? ",)" : ")"));
     }
     const auto d = py::array_t<double, py::array::forcecast>::ensure(a);
+    for (int j = 0; j < 2; ++j) cmd[j] = d.at(j);
+    return Finite(cmd);
+  }
+
+  static const double* Finite(const double* cmd) {
     static const char* kJoint[2] = {"cmd_hip", "cmd_knee"};
-    for (int j = 0; j < 2; ++j) {
-      cmd[j] = d.at(j);
+    for (int j = 0; j < 2; ++j)
       if (!std::isfinite(cmd[j]))
         throw InputError("Twin.step: command: " + std::string(kJoint[j]) + " is " + std::to_string(cmd[j]) +
                          ", expected a finite torque (N m)");
-    }
     return cmd;
   }
 

@@ -22,8 +22,6 @@ import sys
 import tempfile
 import time
 
-import numpy as np
-
 import exotwin
 
 
@@ -52,24 +50,22 @@ def free_udp_port():
 
 
 def python_pd(twin, kp=(600.0, 400.0), kd=(30.0, 15.0), limit=100.0):
-    """The UDP example's law on the twin's observations: PD on the reference, velocities as
-    difference quotients, clamped to the torque limit. Returns the periods stepped."""
+    """The UDP example's law on the twin's observations, in plain Python floats as the example is:
+    PD on the reference, velocities as difference quotients, clamped to the torque limit. Returns the
+    periods stepped."""
     obs = twin.reset()
-    dt = twin.period
-    kp, kd = np.array(kp), np.array(kd)
-    q_prev = ref_prev = None
-    cmd = np.zeros(2)
+    inv_dt = 1.0 / twin.period
+    kp_h, kp_k = kp
+    kd_h, kd_k = kd
+    q_h, q_k, r_h, r_k = obs["q_hip"], obs["q_knee"], obs["ref_hip"], obs["ref_knee"]
     n = 0
+    step = twin.step
     while not twin.done:
-        q = np.array((obs["q_hip"], obs["q_knee"]))
-        ref = np.array((obs["ref_hip"], obs["ref_knee"]))
-        if q_prev is None:
-            qd = ref_d = np.zeros(2)
-        else:
-            qd, ref_d = (q - q_prev) / dt, (ref - ref_prev) / dt
-        np.clip(kp * (ref - q) + kd * (ref_d - qd), -limit, limit, out=cmd)
-        q_prev, ref_prev = q, ref
-        obs = twin.step(cmd)
+        q_h0, q_k0, r_h0, r_k0 = q_h, q_k, r_h, r_k
+        q_h, q_k, r_h, r_k = obs["q_hip"], obs["q_knee"], obs["ref_hip"], obs["ref_knee"]
+        u_h = kp_h * (r_h - q_h) + kd_h * ((r_h - r_h0) - (q_h - q_h0)) * inv_dt
+        u_k = kp_k * (r_k - q_k) + kd_k * ((r_k - r_k0) - (q_k - q_k0)) * inv_dt
+        obs = step((min(max(u_h, -limit), limit), min(max(u_k, -limit), limit)))
         n += 1
     return n
 

@@ -191,6 +191,40 @@ TEST(ExoControllerBus, HeldStateTorqueAddsTheModelFeedForward) {
   }
 }
 
+// A command from outside (the Python twin, python/module_twin.cc) replaces PD + feed-forward: it is
+// sent as given within the supervisor's limit, limited beyond it, and ignored while torque is off.
+TEST(ExoControllerBus, CommandFromOutsideReplacesTheControlLawThroughTheSupervisor) {
+  Rig rig(/*feedforward=*/true);
+  const double none[2] = {0, 0};
+  rig.bus.ClearSent();
+  rig.bus.AdvanceTo(rig.t());
+  rig.ctl->Tick(rig.t(), none);  // nobody has spoken: torque off whatever the command
+  ++rig.k;
+  ExpectTorqueOff(rig.bus.sent());
+  for (int i = 0; i < 3; ++i) rig.Tick();
+  const double given[2] = {3.25, -7.5};
+  for (int j = 0; j < 2; ++j) rig.Status(j);
+  rig.bus.ClearSent();
+  rig.bus.AdvanceTo(rig.t());
+  rig.ctl->Tick(rig.t(), given);
+  ++rig.k;
+  const auto cmd = Commands(rig.bus.sent());
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_EQ(rig.tel().tau_cmd[j], given[j]) << "joint " << j;
+    EXPECT_NEAR(cmd[j].torque, given[j], kCommandLsb / 2 + 1e-12);
+    EXPECT_TRUE(cmd[j].enable);
+  }
+  EXPECT_EQ(rig.tel().ref[0].q, rig.q_ref[0]) << "the reference is still sampled";
+  const double beyond[2] = {1e6, -1e6};
+  for (int j = 0; j < 2; ++j) rig.Status(j);
+  rig.bus.AdvanceTo(rig.t());
+  rig.ctl->Tick(rig.t(), beyond);
+  ++rig.k;
+  EXPECT_LE(std::abs(rig.tel().tau_cmd[0]), rig.cfg.safety.hip.tau_cmd_max);
+  EXPECT_LE(std::abs(rig.tel().tau_cmd[1]), rig.cfg.safety.knee.tau_cmd_max);
+  EXPECT_GT(rig.cfg.safety.knee.tau_cmd_max, 0.0);
+}
+
 // max_age_s = 3 ticks; the counter watchdog alone would trip later.
 TEST(ExoControllerBus, SilentModuleTorqueOffWhenItsFrameIsOlderThanMaxAge) {
   Rig rig;

@@ -53,6 +53,9 @@ def test_python_commands_reach_the_drivers_through_the_supervisor(tmp):
     assert (obs["cmd_hip"], obs["cmd_knee"]) == (1.5, -2.0)
     assert twin.step(np.array([1, 2], dtype=np.int32))["cmd_knee"] == 2.0
     assert twin.step([0.25, 0.5])["cmd_hip"] == 0.25
+    assert twin.step((0.75, 1))["cmd_knee"] == 1.0
+    assert twin.step(np.array([1.0, -3.0], dtype=">f8"))["cmd_knee"] == -3.0  # another byte order
+    assert twin.step(np.array([9.0, 0.5, 7.0, 0.25])[::2])["cmd_knee"] == 7.0  # strided
     # a Python PD law tracks the reference through the virtual hardware
     obs = twin.step()
     err = []
@@ -84,7 +87,9 @@ def test_bad_commands_are_clear_errors_and_change_nothing(tmp):
                              (np.array([np.nan, 0.0]), exotwin.InputError, "cmd_hip is nan"),
                              (np.array([0.0, np.inf]), exotwin.InputError, "cmd_knee is inf"),
                              (object(), TypeError, "expected a"),
-                             (5.0, exotwin.InputError, r"got shape \(\)")]:
+                             (5.0, exotwin.InputError, r"got shape \(\)"),
+                             ([1.0, float("nan")], exotwin.InputError, "cmd_knee is nan"),
+                             ((1.0, 2.0, 3.0), exotwin.InputError, r"got shape \(3,\)")]:
         with pytest.raises(kind, match=match):
             twin.step(bad)
         assert twin.time == t

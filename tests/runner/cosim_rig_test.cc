@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -199,6 +200,33 @@ TEST(CosimRig, EmgNodeSendsOneFrameAtEachStepEndBeforeTheNextTick) {
   ASSERT_NE(toy.rig.emg_node(), nullptr);
   EXPECT_EQ(toy.rig.emg_node()->frames_sent(), static_cast<uint32_t>(n));
   for (long k = 0; k < n; ++k) EXPECT_EQ(toy.ctrl.emg_frames_at_tick[k], k) << "EMG sampled at dt .. k dt";
+}
+
+// Begin + Advance in parts of any size (the Python twin's controller periods) runs the steps Run runs.
+TEST(CosimRig, RunInPartsIsTheRun) {
+  ToyRig whole;
+  const long n = 37;
+  const double t_end = whole.Run(n, 2, 3);
+  ToyRig parts;
+  parts.rig.Begin(Schedule(n, 2, 3), parts.dev);
+  EXPECT_FALSE(parts.rig.finished());
+  const auto tick = [&parts](double t) { parts.ctrl.Tick(t); };
+  long ran = 0;
+  for (long size : {1L, 2L, 5L, 0L, 3L}) {
+    EXPECT_EQ(parts.rig.Advance(size, tick), size);
+    ran += size;
+    EXPECT_EQ(parts.rig.steps_run(), ran);
+    EXPECT_EQ(parts.rig.time(), ran * kDt);
+  }
+  EXPECT_EQ(parts.rig.Advance(std::numeric_limits<long>::max(), tick), n - ran);
+  EXPECT_TRUE(parts.rig.finished());
+  EXPECT_EQ(parts.rig.Advance(5, tick), 0) << "nothing after the schedule's end";
+  EXPECT_EQ(parts.rig.time(), t_end);
+  EXPECT_EQ(parts.trace.calls, whole.trace.calls);
+  EXPECT_EQ(parts.trace.held, whole.trace.held);
+  EXPECT_EQ(parts.trace.log_t, whole.trace.log_t);
+  EXPECT_EQ(parts.trace.log_x, whole.trace.log_x);
+  EXPECT_EQ(parts.ctrl.seen_sample, whole.ctrl.seen_sample);
 }
 
 TEST(CosimRig, ScheduleOfAScenario) {
