@@ -25,12 +25,15 @@ import time
 import exotwin
 
 
-def best_of(n, fn):
-    best = float("inf")
+def best_of_pair(n, a, b):
+    """Best wall time of a and of b over n rounds, a and b alternating (a machine whose load drifts
+    during the bench weighs on both alike)."""
+    best = [float("inf"), float("inf")]
     for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
+        for i, fn in enumerate((a, b)):
+            t0 = time.perf_counter()
+            fn()
+            best[i] = min(best[i], time.perf_counter() - t0)
     return best
 
 
@@ -90,9 +93,10 @@ def main(argv=None):
         rows = []
 
         # 1. exotwin.run vs the program
-        cli = best_of(a.repeat, lambda: subprocess.run([a.exotwin, "run", scenario, "--out", os.path.join(scratch, "cli")],
-                                                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        py = best_of(a.repeat, lambda: exotwin.run(scenario, out=os.path.join(scratch, "py")))
+        cli, py = best_of_pair(
+            a.repeat, lambda: subprocess.run([a.exotwin, "run", scenario, "--out", os.path.join(scratch, "cli")],
+                                             check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL),
+            lambda: exotwin.run(scenario, out=os.path.join(scratch, "py")))
         rows.append({"work": f"exotwin.run gait_2kmh ({seconds:g} s, both CSV logs) from Python", "ratio": py / cli,
                      "unit": "x", "baseline": "exotwin run, the same scenario (program spawned)", "goal": "<= 1.05x",
                      "detail": f"{py:.3f} s vs {cli:.3f} s"})
@@ -111,9 +115,8 @@ def main(argv=None):
             if ctrl.returncode != 0 or rc not in (0, 1):
                 raise RuntimeError(f"the UDP example failed: controller exit {ctrl.returncode}, serve exit {rc}")
 
-        udp_s = best_of(a.repeat, udp)
         twin = exotwin.Twin(scenario)
-        twin_s = best_of(a.repeat, lambda: python_pd(twin))
+        udp_s, twin_s = best_of_pair(a.repeat, udp, lambda: python_pd(twin))
         steps = python_pd(twin)
         rows.append({"work": f"Python PD controller on Twin.step, gait_2kmh ({seconds:g} s, {steps} periods)",
                      "ratio": twin_s / udp_s, "unit": "x",
@@ -122,16 +125,17 @@ def main(argv=None):
                                f"{twin.result.metrics['tracking_rms_knee_deg']:.2f} deg"})
 
         # 3. the binding's cost per step: no-op controller vs the in-process run
-        def noop():
-            twin.reset()
-            while not twin.done:
-                twin.step()
+        logged = exotwin.Twin(scenario, out=os.path.join(scratch, "twin"))  # both CSV logs, as exotwin.run
 
-        noop_s = best_of(a.repeat, noop)
-        run_s = best_of(a.repeat, lambda: exotwin.run(scenario))
+        def noop():
+            logged.reset()
+            while not logged.done:
+                logged.step()
+
+        noop_s, run_s = best_of_pair(a.repeat, noop, lambda: exotwin.run(scenario))
         per_step = (noop_s - run_s) / steps
         rows.append({"work": "binding cost per Twin.step (no-op Python controller, the shipped one acting)",
-                     "ratio": noop_s / run_s, "unit": "x", "baseline": "exotwin.run of the same scenario (in-process)",
+                     "ratio": noop_s / run_s, "unit": "x", "baseline": "exotwin.run of the same scenario (in-process; both write the CSV logs)",
                      "goal": "", "detail": f"{noop_s:.3f} s vs {run_s:.3f} s: {per_step * 1e6:+.2f} us per step "
                                            f"({steps} steps)"})
         text = json.dumps({"status": "ok", "quick": a.quick, "repeat": a.repeat, "rows": rows,

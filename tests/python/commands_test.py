@@ -95,3 +95,22 @@ def test_bad_input_is_the_programs_text(tmp):
         exotwin.diagnose(exotwin.data_path("examples/S1.yaml"), [])
     with pytest.raises(exotwin.InputError, match="no_such"):
         exotwin.read_measured(tmp / "no_such.csv")
+
+
+def test_identify_is_the_programs(tmp):
+    # the exoskeleton alone in the protocol's two configurations (scenarios/identification, cut to 10 s)
+    records = []
+    for step in ("step1_exo_knee", "step2_exo_hip"):
+        text = open(exotwin.data_path(f"scenarios/identification/{step}.yaml")).read()
+        text = text.replace("duration: 40, trials: 5", "duration: 10, trials: 1")
+        assert "duration: 10, trials: 1" in text
+        scenario = tmp / f"{step}.yaml"
+        scenario.write_text(text)
+        exotwin.run(scenario, out=tmp / step)
+        records.append(tmp / step / "measured.csv")
+    m = exotwin.identify(records, out=tmp / "py.yaml", L1=0.41)
+    cli("identify", "--measured", records[0], "--measured", records[1], "--L1", 0.41, "--out", tmp / "cli.yaml")
+    ref = exotwin.read_model(tmp / "cli.yaml")
+    assert m == ref and m["human"] is None
+    assert m["exo"]["J1"] == pytest.approx(3.01, rel=0.05)  # the scenarios' exoskeleton (Table 3 mean)
+    assert (tmp / "py.yaml").read_text() == (tmp / "cli.yaml").read_text()
