@@ -51,4 +51,7 @@ set(CPACK_STRIP_FILES ON)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# The Python module (P/lib/python3/dist-packages/exotwin, python/CMakeLists.txt) needs Debian's python3
+# and numpy, which dpkg-shlibdeps does not see; the programs do not: recommended, not required.
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3, python3-numpy")
 include(CPack)

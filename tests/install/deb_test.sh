@@ -31,6 +31,10 @@ for lib in libc6 libstdc++6 libmujoco libyaml-cpp; do
   grep -q "$lib" <<<"$deps" || fail "Depends: does not name $lib ($deps)"
 done
 echo "ok: dpkg-deb -I: Depends: names libc6, libstdc++6, libmujoco, libyaml-cpp"
+if ls "$BUILD"/lib/python3/dist-packages/exotwin/_exotwin*.so >/dev/null 2>&1; then
+  grep -q '^ Recommends: .*python3-numpy' "$T/info" || fail "Recommends: does not name python3-numpy (the Python module)"
+  echo "ok: dpkg-deb -I: Recommends: $(sed -n 's/^ Recommends: //p' "$T/info")"
+fi
 
 dpkg-deb -c "$DEB" | awk '{print $6}' >"$T/contents"
 for f in ./usr/bin/exotwin ./usr/lib/exotwin/libexotwin_controller.so ./usr/share/exotwin/mjcf/leg_exowheel.xml \
