@@ -11,4 +11,5 @@ PYBIND11_MODULE(_exotwin, m) {
   exotwin::python::BindRun(m);
   exotwin::python::BindTwin(m);
   exotwin::python::BindCommands(m);
+  exotwin::python::BindRender(m);
 }

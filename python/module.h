@@ -41,5 +41,6 @@ py::dict ResultDict(RunResult& r, LogCapture* logs);
 void BindRun(py::module_& m);
 void BindTwin(py::module_& m);
 void BindCommands(py::module_& m);
+void BindRender(py::module_& m);
 
 }  // namespace exotwin::python

@@ -67,4 +67,11 @@ std::unique_ptr<VideoSink> OpenVideo(const mjModel_* m, const std::string& out_p
   return std::unique_ptr<VideoSink>(g_table->open_video(m, out_path, opt));
 }
 
+std::vector<unsigned char> RenderStill(const mjModel_* m, const double* qpos, const RenderOptions& opt) {
+  LoadRenderPlugin();
+  std::vector<unsigned char> rgb;
+  g_table->render_still(m, qpos, opt, &rgb);
+  return rgb;
+}
+
 }  // namespace exotwin

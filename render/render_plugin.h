@@ -37,4 +37,10 @@ void LoadRenderPlugin();
 // OpenGL or the encoder cannot be set up).
 std::unique_ptr<VideoSink> OpenVideo(const mjModel_* m, const std::string& out_path, const RenderOptions& opt);
 
+// A still of model `m` at the pose qpos (m->nq values, as mjData::qpos): the videos' side view without
+// overlays, opt.height rows top-down of opt.width RGB pixels (3 bytes each). Loads the plugin first
+// (LoadRenderPlugin's errors); std::invalid_argument for a bad size, std::runtime_error if OpenGL
+// cannot be set up.
+std::vector<unsigned char> RenderStill(const mjModel_* m, const double* qpos, const RenderOptions& opt);
+
 }  // namespace exotwin

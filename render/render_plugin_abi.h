@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "render/overlay_sample.h"
 #include "render/render_options.h"
@@ -13,7 +14,7 @@ struct mjModel_;
 namespace exotwin {
 
 // Raised whenever the table or a type that crosses the boundary changes meaning.
-inline constexpr int kRenderPluginAbi = 2;  // 2: RenderOptions::legend
+inline constexpr int kRenderPluginAbi = 3;  // 2: RenderOptions::legend; 3: render_still
 inline constexpr char kRenderPluginEntry[] = "exotwin_render_plugin_v1";
 
 struct RenderPluginTable {
@@ -22,6 +23,9 @@ struct RenderPluginTable {
   // A new VideoRenderer (owned by the caller, deleted through VideoSink's virtual destructor);
   // throws as its constructor does.
   VideoSink* (*open_video)(const mjModel_* m, const std::string& out_path, const RenderOptions& opt);
+  // A still of `m` at the pose qpos (m->nq values): SceneRenderer's side view, no overlays, into *rgb
+  // (opt.height rows top-down of opt.width RGB pixels); throws as SceneRenderer.
+  void (*render_still)(const mjModel_* m, const double* qpos, const RenderOptions& opt, std::vector<unsigned char>* rgb);
 };
 
 // The table the loader expects from a plugin of its own build.

@@ -4,9 +4,10 @@ diagnose it, replay the rigid and the extended twin on the record, plot the gain
 
     python3 first_steps.py [--out DIR] [--duration S] [--effect NAME --joint J --value V]
 
-Writes DIR/tracking.png, DIR/diagnosis.png, DIR/replay.png (matplotlib, Agg: no display needed) and
-the commands' files under DIR; prints what it found. --duration shortens the gait (default: the 60 s of
-scenarios/gait_2kmh.yaml). The test suite runs it (tests/python/example_test.py).
+Writes DIR/tracking.png, DIR/frame.png (the leg rendered off-screen), DIR/diagnosis.png,
+DIR/replay.png (matplotlib, Agg: no display needed) and the commands' files under DIR; prints what
+it found. --duration shortens the gait (default: the 60 s of scenarios/gait_2kmh.yaml). The test
+suite runs it (tests/python/example_test.py).
 """
 import argparse
 import os
@@ -58,6 +59,10 @@ def main():
     ax[1].set_xlabel("t (s)")
     fig.suptitle("gait_2kmh: reference and measured angle")
     fig.savefig(os.path.join(a.out, "tracking.png"), dpi=100)
+    # the leg at mid-swing of the last stride, rendered off-screen into a numpy array
+    last = min(2000, len(m["t"]))  # the last stride (2 s at 1 kHz)
+    k = int(np.argmin(m["q_knee"][-last:])) + len(m["t"]) - last
+    plt.imsave(os.path.join(a.out, "frame.png"), exotwin.render_frame(m["q_hip"][k], m["q_knee"][k]))
 
     # 2. A plant with an effect the rigid twin does not know, run with the same controller: its record.
     effect = f"{{name: {a.effect}, joint: {a.joint}, value: {a.value}, unit: \"{a.unit}\"}}"
@@ -117,7 +122,7 @@ def main():
     ax.set_title(f"replay, restarts every {rigid_replay['horizon_s']} s")
     ax.legend()
     fig.savefig(os.path.join(a.out, "replay.png"), dpi=100)
-    print(f"plots: {a.out}/tracking.png, {a.out}/diagnosis.png, {a.out}/replay.png")
+    print(f"plots: {a.out}/tracking.png, {a.out}/frame.png, {a.out}/diagnosis.png, {a.out}/replay.png")
 
 
 if __name__ == "__main__":

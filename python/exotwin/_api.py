@@ -210,6 +210,15 @@ def data_path(rel):
     return os.path.join(_exotwin.data_dir(), rel)
 
 
+def render_frame(q_hip, q_knee, params=None, width=640, height=480):
+    """The leg of a model file (default: subject S1 in the EXOwheel, examples/S1.yaml; the exoskeleton
+    alone for a file without `human:`) at the hip and knee angles (rad), rendered off-screen as the
+    videos show it (side view, no overlays): a (height, width, 3) uint8 RGB array (plt.imshow shows it).
+    Loads the rendering plugin at the first call."""
+    params = data_path("examples/S1.yaml") if params is None else _path(params, "params")
+    return _exotwin._render_frame(float(q_hip), float(q_knee), params, int(width), int(height))
+
+
 def read_csv(path):
     """Any numeric CSV through the project's reader (formats/csv_table.h): {column: float64 array}."""
     return _exotwin._read_csv(_path(path, "path"))
