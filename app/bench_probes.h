@@ -115,7 +115,8 @@ nlohmann::ordered_json BenchReplay(const BenchConfig& c);
 // The Python module (python/exotwin/bench.py, run by the interpreter it is built for, $EXOTWIN_PYTHON
 // else /usr/bin/python3): exotwin.run vs `exotwin run` (<= 1.05x), a Python PD controller on Twin.step
 // vs the UDP example (<= 0.25x), the binding's cost per step (no-op controller vs exotwin.run); gait_2kmh
-// (quick: 6 s of it). {"status": "unavailable"} when the module is not built.
+// (quick: 6 s of it). The in-process pairs run on the fastest CPU (both halves), the UDP pair unpinned.
+// {"status": "unavailable"} when the module is not built.
 nlohmann::ordered_json BenchPython(const BenchConfig& c);
 
 // Diagnosis of 60 s of 1 kHz data with one hidden effect (quick: 20 s): data seconds per wall second.

@@ -347,6 +347,7 @@ json BenchPython(const BenchConfig& c) {
   std::vector<std::string> args = {python, "-m", "exotwin.bench", "--exotwin", self, "--repeat",
                                    std::to_string(c.repeat), "--json", out};
   if (c.quick) args.push_back("--quick");
+  if (const int cpu = FastestCpu(c.cpus); cpu >= 0) args.insert(args.end(), {"--cpu", std::to_string(cpu)});
   const bool ok = SpawnAndWait(args);
   if (old) setenv("PYTHONPATH", saved.c_str(), 1);
   else unsetenv("PYTHONPATH");

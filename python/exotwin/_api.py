@@ -270,7 +270,9 @@ def predict(params, measured, out=None, map=None, side=None, cutoff=None, mjcf=N
         return read_csv(path)
 
 
-_FITS = ("torque",)  # diagnose's fits in this build (DESIGN.md: torque|motion)
+# diagnose's fits in this build (DESIGN.md: torque|motion): `exotwin diagnose --fit` is passed for any
+# but the default, so a build whose CLI has `--fit motion` needs only "motion" added here.
+_FITS = ("torque",)
 
 
 def diagnose(params, measured, fit="torque", out=None, holdout=None, map=None, cutoff=None, max_effects=None,
@@ -283,7 +285,7 @@ def diagnose(params, measured, fit="torque", out=None, holdout=None, map=None, c
     with _Out(out, "diagnose") as d:
         _command(_args("diagnose", [("--params", _path(params, "params")),
                                     ("--measured", _paths(measured, "measured")), ("--out", d),
-                                    ("--holdout", holdout), ("--map", map), ("--cutoff", cutoff),
+                                    ("--fit", None if fit == "torque" else fit), ("--holdout", holdout), ("--map", map), ("--cutoff", cutoff),
                                     ("--max-effects", max_effects), ("--mjcf", mjcf)]))
         result = _json(os.path.join(d, "diagnosis.json"))
         result["extended"] = read_model(os.path.join(d, "extended.yaml"))

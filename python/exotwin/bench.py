@@ -9,7 +9,8 @@ against a baseline measured in the same run, best of `repeat`:
 3. the binding's own cost per step: a no-op controller (Twin.step(None), the shipped controller acting)
    against exotwin.run of the same scenario (us per controller period).
 
-Usage: python3 -m exotwin.bench --exotwin PATH/exotwin [--repeat N] [--quick] [--json FILE]; prints JSON
+Usage: python3 -m exotwin.bench --exotwin PATH/exotwin [--repeat N] [--quick] [--json FILE] [--cpu N];
+prints JSON
 {"status": "ok", "rows": [{work, ratio, unit, baseline, goal, detail}], ...} on stdout.
 """
 import argparse
@@ -79,6 +80,8 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="6 s of gait instead of 60")
     ap.add_argument("--json", help="write the JSON here too")
+    ap.add_argument("--cpu", type=int, help="CPU the in-process comparisons (rows 1 and 3) run on, both halves "
+                    "(and their threads and children): CPUs of a shared machine can differ in speed")
     a = ap.parse_args(argv)
     data = os.environ.get("EXOTWIN_DATA_DIR")
     scratch = tempfile.mkdtemp(prefix="exotwin_pybench_")
@@ -92,7 +95,11 @@ def main(argv=None):
         seconds = 6.0 if a.quick else 60.0
         rows = []
 
+        unpinned = os.sched_getaffinity(0)
+        pinned = {a.cpu} if a.cpu is not None and a.cpu in unpinned else unpinned
+
         # 1. exotwin.run vs the program
+        os.sched_setaffinity(0, pinned)
         cli, py = best_of_pair(
             a.repeat, lambda: subprocess.run([a.exotwin, "run", scenario, "--out", os.path.join(scratch, "cli")],
                                              check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL),
@@ -101,7 +108,9 @@ def main(argv=None):
                      "unit": "x", "baseline": "exotwin run, the same scenario (program spawned)", "goal": "<= 1.05x",
                      "detail": f"{py:.3f} s vs {cli:.3f} s"})
 
-        # 2. Python PD on Twin.step vs the UDP example
+        os.sched_setaffinity(0, unpinned)
+
+        # 2. Python PD on Twin.step vs the UDP example (unpinned: the example's two processes as a user runs them)
         pd_script = os.path.join(data, "examples", "python_controller", "pd_controller.py")
         winter = os.path.join(data, "data", "WinterTableA1.txt")
 
@@ -132,14 +141,16 @@ def main(argv=None):
             while not logged.done:
                 logged.step()
 
+        os.sched_setaffinity(0, pinned)
         noop_s, run_s = best_of_pair(a.repeat, noop, lambda: exotwin.run(scenario))
+        os.sched_setaffinity(0, unpinned)
         per_step = (noop_s - run_s) / steps
         rows.append({"work": "binding cost per Twin.step (no-op Python controller, the shipped one acting)",
                      "ratio": noop_s / run_s, "unit": "x", "baseline": "exotwin.run of the same scenario (in-process; both write the CSV logs)",
                      "goal": "", "detail": f"{noop_s:.3f} s vs {run_s:.3f} s: {per_step * 1e6:+.2f} us per step "
                                            f"({steps} steps)"})
         text = json.dumps({"status": "ok", "quick": a.quick, "repeat": a.repeat, "rows": rows,
-                           "python": sys.executable, "cli_run_s": cli, "py_run_s": py, "udp_s": udp_s,
+                           "python": sys.executable, "pinned_cpus": sorted(pinned), "cli_run_s": cli, "py_run_s": py, "udp_s": udp_s,
                            "twin_pd_s": twin_s, "twin_noop_s": noop_s, "inprocess_run_s": run_s}, indent=2)
         print(text)
         if a.json:
