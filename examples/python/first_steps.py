@@ -5,9 +5,9 @@ diagnose it, replay the rigid and the extended twin on the record, plot the gain
     python3 first_steps.py [--out DIR] [--duration S] [--effect NAME --joint J --value V]
 
 Writes DIR/tracking.png, DIR/frame.png (the leg rendered off-screen), DIR/diagnosis.png,
-DIR/replay.png (matplotlib, Agg: no display needed) and the commands' files under DIR; prints what
-it found. --duration shortens the gait (default: the 60 s of scenarios/gait_2kmh.yaml). The test
-suite runs it (tests/python/example_test.py).
+DIR/replay.png, DIR/ghosts.png (both twins' replayed legs as ghosts) with matplotlib (Agg: no display
+needed) and the commands' files under DIR; prints what it found. --duration shortens the gait
+(default: the 60 s of scenarios/gait_2kmh.yaml). The test suite runs it (tests/python/example_test.py).
 """
 import argparse
 import os
@@ -122,7 +122,18 @@ def main():
     ax.set_title(f"replay, restarts every {rigid_replay['horizon_s']} s")
     ax.legend()
     fig.savefig(os.path.join(a.out, "replay.png"), dpi=100)
-    print(f"plots: {a.out}/tracking.png, {a.out}/frame.png, {a.out}/diagnosis.png, {a.out}/replay.png")
+
+    # The measured leg at the rigid twin's worst replayed instant, with both twins' simulated legs as
+    # ghosts (red: rigid, green: extended), as `exotwin render-replay --sim ... --sim ...` draws them.
+    i = int(np.argmax(np.abs(s_rigid["q_knee_sim"] - s_rigid["q_knee"])))
+    j = int(np.argmin(np.abs(s_ext["t"] - s_rigid["t"][i])))
+    still = exotwin.render_frame(s_rigid["q_hip"][i], s_rigid["q_knee"][i],
+                                 ghosts=[(s_rigid["q_hip_sim"][i], s_rigid["q_knee_sim"][i]),
+                                         (s_ext["q_hip_sim"][j], s_ext["q_knee_sim"][j])],
+                                 ghost_rgba=[(0.95, 0.1, 0.1, 0.45), (0.1, 0.8, 0.2, 0.45)])
+    plt.imsave(os.path.join(a.out, "ghosts.png"), still)
+    print(f"plots: {a.out}/tracking.png, {a.out}/frame.png, {a.out}/diagnosis.png, {a.out}/replay.png, "
+          f"{a.out}/ghosts.png")
 
 
 if __name__ == "__main__":

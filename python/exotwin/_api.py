@@ -210,13 +210,25 @@ def data_path(rel):
     return os.path.join(_exotwin.data_dir(), rel)
 
 
-def render_frame(q_hip, q_knee, params=None, width=640, height=480):
+def render_frame(q_hip, q_knee, params=None, ghosts=(), ghost_rgba=None, width=640, height=480):
     """The leg of a model file (default: subject S1 in the EXOwheel, examples/S1.yaml; the exoskeleton
     alone for a file without `human:`) at the hip and knee angles (rad), rendered off-screen as the
-    videos show it (side view, no overlays): a (height, width, 3) uint8 RGB array (plt.imshow shows it).
-    Loads the rendering plugin at the first call."""
+    videos show it (side view, no overlays), with translucent ghost legs at `ghosts` ((hip, knee) pairs,
+    rad: e.g. a replay's simulated angles, as render-replay draws them; ghost_rgba: one (r, g, b, a) in
+    0..1 per ghost, default translucent red): a (height, width, 3) uint8 RGB array (plt.imshow shows
+    it). Loads the rendering plugin at the first call."""
     params = data_path("examples/S1.yaml") if params is None else _path(params, "params")
-    return _exotwin._render_frame(float(q_hip), float(q_knee), params, int(width), int(height))
+    try:
+        pairs = [(float(h), float(k)) for h, k in ghosts]
+    except (TypeError, ValueError):
+        raise InputError(f"render_frame: ghosts: expected (q_hip, q_knee) pairs in rad, got {ghosts!r}") from None
+    try:
+        colours = [tuple(float(v) for v in c) for c in (ghost_rgba or [])]
+    except (TypeError, ValueError):
+        raise InputError(f"render_frame: ghost_rgba: expected (r, g, b, a) per ghost, got {ghost_rgba!r}") from None
+    if any(len(c) != 4 for c in colours):
+        raise InputError(f"render_frame: ghost_rgba: expected (r, g, b, a) per ghost, got {ghost_rgba!r}")
+    return _exotwin._render_frame(float(q_hip), float(q_knee), params, pairs, colours, int(width), int(height))
 
 
 def read_csv(path):

@@ -17,6 +17,6 @@ def test_first_steps(tmp):
     assert re.search(r"diagnose: coulomb_friction \(knee\) = ", out), out
     rigid, ext = map(float, re.search(r"replay knee: rigid ([0-9.]+) deg, extended ([0-9.]+) deg", out).groups())
     assert ext < rigid, out
-    for png in ("tracking.png", "frame.png", "diagnosis.png", "replay.png"):
+    for png in ("tracking.png", "frame.png", "diagnosis.png", "replay.png", "ghosts.png"):
         with open(tmp / png, "rb") as f:
             assert f.read(8) == b"\x89PNG\r\n\x1a\n", png

@@ -18,6 +18,27 @@ def test_a_still_of_the_leg():
     assert np.array_equal(s1, a)  # the default model is S1's
 
 
+def test_ghost_legs():
+    a = exotwin.render_frame(0.3, -0.6, width=320, height=240)
+    g = exotwin.render_frame(0.3, -0.6, ghosts=[(1.0, -1.4)], width=320, height=240)
+    changed = np.any(a != g, axis=2)
+    assert changed.mean() > 0.005  # the ghost shows
+    px = g[changed].astype(float)
+    assert px[:, 0].mean() > px[:, 1].mean() + 20  # translucent red by default
+    green = exotwin.render_frame(0.3, -0.6, ghosts=[(1.0, -1.4)], ghost_rgba=[(0.1, 0.9, 0.1, 0.5)],
+                                 width=320, height=240)
+    px = green[np.any(a != green, axis=2)].astype(float)
+    assert px[:, 1].mean() > px[:, 0].mean() + 10  # the colour given (the ground shows through: less than red alone)
+    two = exotwin.render_frame(0.3, -0.6, ghosts=[(1.0, -1.4), (0.0, -0.2)], width=320, height=240)
+    assert np.any(np.any(two != g, axis=2))
+    with pytest.raises(exotwin.InputError, match="one colour per ghost"):
+        exotwin.render_frame(0, 0, ghosts=[(0, 0)], ghost_rgba=[(1, 0, 0, 1), (0, 1, 0, 1)])
+    with pytest.raises(exotwin.InputError, match="ghosts: expected"):
+        exotwin.render_frame(0, 0, ghosts=[1.0])
+    with pytest.raises(exotwin.InputError, match="ghost 0"):
+        exotwin.render_frame(0, 0, ghosts=[(float("inf"), 0)])
+
+
 def test_bad_requests():
     with pytest.raises(exotwin.InputError, match="even width and height"):
         exotwin.render_frame(0, 0, width=321, height=240)
