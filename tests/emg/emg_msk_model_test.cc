@@ -1,0 +1,144 @@
+// The musculoskeletal form of the EMG-driven moment (emg/emg_msk_model.h): a synthetic Hill-type law
+// with known parameters (strengths, tendon slack and optimal fibre lengths, A, delay, remainder
+// terms) is recovered within 10 % from one gait-like trial and predicts another trial of the same law;
+// the calibrated state ranges and the reachable share behave as their definitions say.
+#include "emg/emg_msk_model.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "core/rng.h"
+#include "emg/emg_torque_model.h"
+#include "tests/emg/gait_trial.h"
+
+namespace exotwin {
+namespace {
+
+// The law: strengths, lengths, A, delay and remainder away from the nominal values, inside the bounds.
+struct Law {
+  double strength[5] = {1.3, 0.8, 1.1, 0.7, 1.2};
+  double ts_change[5] = {0.03, -0.02, 0.04, -0.03, 0.02};   // fraction of the nominal l_ts
+  double lo_change[5] = {-0.02, 0.01, 0.02, -0.015, 0.0};   // fraction of the nominal l_opt
+  double A = -1.6, delay = 0.045, twitch = 0.0;
+  double beta[2] = {-15, 8}, gamma[2] = {-1.5, 1.0}, offset[2] = {4, -3};
+  double noise = 1.0;  // N m
+};
+
+// Writes the law's moments (plus white noise) into r.tau and returns the true model.
+EmgMskModel ApplyLaw(const Law& law, EmgRecording* r, uint64_t seed) {
+  // The nominal muscles as FitEmgMsk builds them (no fit: a copy of its set-up).
+  EmgMskModel m;
+  m.present = true;
+  m.delay = law.delay, m.twitch = law.twitch, m.a_shape = law.A;
+  for (size_t c = 0; c < r->channels.size(); ++c) {
+    EmgMskMuscle x;
+    x.channel = r->channels[c], x.muscle = r->muscle[c];
+    x.nominal = ScaledMusculotendon(x.muscle, GenericMusculotendon(x.muscle));
+    MusculotendonParams own;
+    if (GenericMusculotendon(x.channel, &own)) x.nominal.f_max = own.f_max;
+    x.strength = law.strength[c];
+    x.l_ts = x.nominal.l_ts * (1 + law.ts_change[c]);
+    x.l_opt = x.nominal.l_opt * (1 + law.lo_change[c]);
+    x.fibre_lo = x.velocity_lo = -1e9, x.fibre_hi = x.velocity_hi = 1e9;
+    m.muscles.push_back(x);
+  }
+  for (int j = 0; j < 2; ++j) m.beta[j] = law.beta[j], m.gamma[j] = law.gamma[j], m.offset[j] = law.offset[j];
+  const EmgMskSeries s = MskSeries(m, *r);
+  NormalRng<NormalPolar> rng(seed * 7919);
+  for (int j = 0; j < 2; ++j) {
+    r->tau[j] = s.tau[j];
+    for (double& v : r->tau[j]) v += law.noise * rng.Normal();
+  }
+  return m;
+}
+
+TEST(EmgMskModel, SyntheticHillLawIsRecoveredWithin10Percent) {
+  const Law law;
+  NormalRng<NormalPolar> ra(31), rb(32);
+  EmgRecording a = GaitEnvelopesAndAngles(ra, "gait trial 31"), b = GaitEnvelopesAndAngles(rb, "gait trial 32");
+  const EmgMskModel truth = ApplyLaw(law, &a, 31);
+  ApplyLaw(law, &b, 32);
+  EmgMskFitOptions opt;
+  opt.cross_validate = false;
+  const EmgMskModel fit = FitEmgMsk({&a}, law.twitch, opt);
+  ASSERT_TRUE(fit.present);
+  {
+    double sf = 0, st = 0;
+    for (int j = 0; j < 2; ++j) {
+      const auto pf = MskSeries(fit, a).tau[j], pt = MskSeries(truth, a).tau[j];
+      for (size_t i = 0; i < pf.size(); ++i) sf += std::pow(a.tau[j][i] - pf[i], 2), st += std::pow(a.tau[j][i] - pt[i], 2);
+    }
+    std::printf("SSE fit %.1f truth %.1f\n", sf, st);
+    EXPECT_LE(sf, 1.001 * st) << "the search stops short of the minimum";
+  }
+  ASSERT_EQ(fit.muscles.size(), truth.muscles.size());
+  std::printf("delay %.3f (truth %.3f), A %.2f (truth %.2f)\n", fit.delay, law.delay, fit.a_shape, law.A);
+  EXPECT_NEAR(fit.delay, law.delay, 0.1 * law.delay);
+  EXPECT_NEAR(fit.a_shape, law.A, 0.1 * std::abs(law.A));
+  for (size_t c = 0; c < fit.muscles.size(); ++c) {
+    const EmgMskMuscle &f = fit.muscles[c], &t = truth.muscles[c];
+    std::printf("%-10s strength %.3f (truth %.3f), l_ts %.4f (truth %.4f, nominal %.4f), l_opt %.4f (truth %.4f)\n",
+                f.channel.c_str(), f.strength, t.strength, f.l_ts, t.l_ts, t.nominal.l_ts, f.l_opt, t.l_opt);
+    EXPECT_NEAR(f.strength, t.strength, 0.1 * t.strength) << f.channel;
+    // Lengths: the bounds are +-5 % (l_ts) and +-2.5 % (l_opt) of the nominal value, so 10 % of the
+    // value would say nothing: l_ts within 1 % (a tenth of its band); l_opt within 3 %: it moves the
+    // moment least, and the fit's sum of squares is already below the truth's (the rest is noise).
+    EXPECT_NEAR(f.l_ts, t.l_ts, 0.01 * t.l_ts) << f.channel;
+    EXPECT_NEAR(f.l_opt, t.l_opt, 0.03 * t.l_opt) << f.channel;
+  }
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_NEAR(fit.beta[j], law.beta[j], 0.1 * std::abs(law.beta[j]));
+    const double r2 = R2(b.tau[j], MskSeries(fit, b).tau[j]);
+    std::printf("%s: R^2 on another trial of the law %.4f\n", j ? "knee" : "hip", r2);
+    EXPECT_GE(r2, 0.97);
+  }
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+const std::string kDir = std::string(EXOTWIN_SOURCE_DIR) + "/../shared/data/real_human/ceinms_lowerlimb_walk36";
+
+// The development trial (shared/data/real_human): every calibrated parameter inside its bounds, the
+// form cross-validated, the state ranges holding every calibration sample.
+TEST(EmgMskModel, DevelopmentTrialStaysInsideTheBounds) {
+  if (!std::ifstream(kDir + "/emgFilt.sto")) GTEST_SKIP() << "shared/data not beside the project";
+  const EmgRecording r = ReadEmgRecording(kDir + "/emgFilt.sto", kDir + "/ik.sto", kDir + "/id.sto", DefaultMuscleMap());
+  const EmgMskModel m = FitEmgMsk({&r}, 0.065);  // the twitch emg-fit's loop names on this trial
+  std::printf("delay %.3f A %.2f\n", m.delay, m.a_shape);
+  for (const EmgMskMuscle& x : m.muscles)
+    std::printf("%-10s strength %.3f l_ts %.4f (nom %.4f) l_opt %.4f (nom %.4f) fibre %.2f..%.2f v %.3f..%.3f\n",
+                x.channel.c_str(), x.strength, x.l_ts, x.nominal.l_ts, x.l_opt, x.nominal.l_opt, x.fibre_lo, x.fibre_hi,
+                x.velocity_lo, x.velocity_hi);
+  for (int j = 0; j < 2; ++j)
+    std::printf("%s: r2_cv %.3f rms_cv %.2f r2_fit %.3f reachable %.3f beta %.2f gamma %.2f offset %.2f\n", j ? "knee" : "hip",
+                m.r2_cv[j], m.rms_cv[j], m.r2_fit[j], m.reachable_share[j], m.beta[j], m.gamma[j], m.offset[j]);
+  EXPECT_GE(m.delay, 0.01);
+  EXPECT_LE(m.delay, 0.1);
+  EXPECT_GT(m.a_shape, -3.0);
+  EXPECT_LT(m.a_shape, 0.0);
+  for (const EmgMskMuscle& x : m.muscles) {
+    EXPECT_GE(x.strength, kStrengthLo - 1e-12);
+    EXPECT_LE(x.strength, kStrengthHi + 1e-12);
+    EXPECT_LE(std::abs(x.l_ts / x.nominal.l_ts - 1), kTendonSlackChange + 1e-12);
+    EXPECT_LE(std::abs(x.l_opt / x.nominal.l_opt - 1), kOptimalFibreChange + 1e-12);
+    EXPECT_LT(x.fibre_lo, x.fibre_hi);
+  }
+  const EmgMskSeries s = MskSeries(m, r);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_GT(m.r2_cv[j], 0.6);
+    EXPECT_GT(m.reachable_share[j], 0.0);
+    EXPECT_LE(m.reachable_share[j], 1.0);
+    for (char o : s.outside[j]) EXPECT_FALSE(o);  // the calibration's own samples are inside
+  }
+}
+
+}  // namespace
+}  // namespace exotwin
