@@ -1,6 +1,7 @@
 #include "emg/emg_msk_model.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -413,6 +414,7 @@ EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec) {
 
 EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitch, const EmgMskFitOptions& opt) {
   if (recs.empty()) throw InputError("emg fit: no recording");
+  const auto start = std::chrono::steady_clock::now();
   EmgMskModel model;
   model.twitch = twitch;
   const EmgRecording& r0 = *recs[0];
@@ -523,6 +525,7 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     double rms;
     ScoreSamples(meas[j], pred[j], idx, &model.r2_fit[j], &rms);
   }
+  model.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return model;
 }
 

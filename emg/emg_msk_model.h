@@ -59,6 +59,7 @@ struct EmgMskModel {
   // scored samples of min(|tau|, M) / sum |tau|, M the moment of every muscle pulling in tau's
   // direction at full activation and kStrengthHi F_max (the others silent).
   double reachable_share[2] = {0, 0};
+  double seconds = 0;  // run time of the calibration (cross-validation included)
 };
 
 // Time series of a calibrated model on a recording.

@@ -13,7 +13,9 @@
 
 #include "core/rng.h"
 #include "emg/emg_torque_model.h"
+#include "core/error.h"
 #include "tests/emg/gait_trial.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
@@ -96,6 +98,88 @@ TEST(EmgMskModel, SyntheticHillLawIsRecoveredWithin10Percent) {
     std::printf("%s: R^2 on another trial of the law %.4f\n", j ? "knee" : "hip", r2);
     EXPECT_GE(r2, 0.97);
   }
+}
+
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  std::fwrite(text.data(), 1, text.size(), f);
+  std::fclose(f);
+}
+
+// A calibration of both forms on a trial of the Hill law, the knee in the musculoskeletal form.
+EmgTorqueModel BothForms(const EmgRecording& a) {
+  EmgTorqueModel m = FitEmgModel(EmgModelSpec{}, {&a});
+  EmgMskFitOptions opt;
+  opt.cross_validate = false;
+  m.msk = FitEmgMsk({&a}, 0, opt);
+  m.msk_form[1] = true;
+  return m;
+}
+
+// EMGMODEL.yaml carries the form per joint and every muscle's parameters with bounds and sources; read
+// back, it predicts the same moments.
+TEST(EmgMskModel, ModelFileCarriesTheFormsAndTheMuscles) {
+  const Law law;
+  NormalRng<NormalPolar> ra(41);
+  EmgRecording a = GaitEnvelopesAndAngles(ra, "gait trial 41");
+  ApplyLaw(law, &a, 41);
+  const EmgTorqueModel m = BothForms(a);
+  const testing::ScopedTempDir dir("emgmsk");
+  const std::string path = dir.path() + "/m.yaml";
+  const std::string text = EmgModelYaml(m, {"test"});
+  for (const char* key : {"forms: {hip: linear, knee: musculoskeletal}", "strength: {value:", "bounds: [0.5, 1.5]",
+                          "tendon_slack_length: {value:", "optimal_fibre_length: {value:", "source:", "gait2392 vas_int"})
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+  WriteText(path, text);
+  const EmgTorqueModel back = ReadEmgModel(path);
+  EXPECT_FALSE(back.msk_form[0]);
+  EXPECT_TRUE(back.msk_form[1]);
+  ASSERT_EQ(back.msk.muscles.size(), m.msk.muscles.size());
+  for (size_t c = 0; c < m.msk.muscles.size(); ++c) {
+    EXPECT_NEAR(back.msk.muscles[c].strength, m.msk.muscles[c].strength, 1e-9);
+    EXPECT_NEAR(back.msk.muscles[c].l_ts, m.msk.muscles[c].l_ts, 1e-9);
+  }
+  for (int j = 0; j < 2; ++j) {
+    const std::vector<double> x = PredictMoment(m, a, j), y = PredictMoment(back, a, j);
+    for (size_t i = 0; i < x.size(); i += 37) EXPECT_NEAR(x[i], y[i], 1e-6 * (1 + std::abs(x[i]))) << j;
+  }
+  // A parameter outside its physiological bounds: exit 2 naming the file and the key.
+  std::string bad = text;
+  const size_t at = bad.find("strength: {value: ");
+  bad.replace(at, bad.find(',', at) - at, "strength: {value: 2.5");
+  WriteText(path, bad);
+  try {
+    ReadEmgModel(path);
+    ADD_FAILURE() << "accepted a strength of 2.5 F_max";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("musculoskeletal.muscles[0].strength.value"), std::string::npos) << e.what();
+  }
+}
+
+// Outside the muscles' calibrated states the knee falls back to the linear form, sample by sample, and
+// says how often; inside it is the musculoskeletal form's moment.
+TEST(EmgMskModel, OutsideTheCalibratedStatesTheLinearFormStandsIn) {
+  const Law law;
+  NormalRng<NormalPolar> ra(51), rb(52);
+  EmgRecording a = GaitEnvelopesAndAngles(ra, "gait trial 51"), b = GaitEnvelopesAndAngles(rb, "gait trial 52");
+  ApplyLaw(law, &a, 51);
+  for (size_t i = 0; i < b.size(); ++i) b.q[1][i] = -0.65 + 1.4 * (b.q[1][i] + 0.65), b.qd[1][i] *= 1.4;  // a wider knee
+  ApplyLaw(law, &b, 52);
+  const EmgTorqueModel m = BothForms(a);
+  const EmgPrediction p = PredictMoments(m, b);
+  const std::vector<double> lin = PredictLinearMoment(m, b, 1);
+  const EmgMskSeries s = MskSeries(m.msk, b);
+  EXPECT_GT(p.fallback_share[1], 0.05);
+  EXPECT_LT(p.fallback_share[1], 0.95);
+  EXPECT_EQ(p.fallback_share[0], 0.0);  // the hip is in the linear form
+  for (size_t i = 0; i < b.size(); ++i) {
+    EXPECT_EQ(p.fallback[1][i], s.outside[1][i]);
+    EXPECT_DOUBLE_EQ(p.tau[1][i], s.outside[1][i] ? lin[i] : s.tau[1][i]);
+  }
+  // On the calibration trial itself nothing falls back.
+  EXPECT_EQ(PredictMoments(m, a).fallback_share[1], 0.0);
 }
 
 }  // namespace
