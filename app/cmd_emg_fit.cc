@@ -54,6 +54,7 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
     for (const auto& r : recs) ptrs.push_back(&r);
     EmgDiagnoseOptions opt;
     opt.blocks = o->blocks;
+    opt.strength_bounds = map.strength_bounds;
     if (o->linear) opt.max_steps = 0, opt.robust_candidate = false, opt.signed_alphas = false, opt.musculoskeletal = false;
     const EmgDiagnosis d = DiagnoseEmg(ptrs, opt);
     std::vector<std::string> header = {"exotwin emg-fit: EMG-driven joint moment model (HJ15 eq. 26-27 + discrepancy loop)"};
@@ -94,9 +95,9 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
                   msk.r2_cv[1], "-", "-", msk.rms_cv[0], msk.rms_cv[1]);
       for (int j = 0; j < 2; ++j)
         std::printf("%s: %s form chosen (cross-validated R^2 linear %.3f, musculoskeletal %.3f); the recorded muscles can "
-                    "reach %.1f %% of the calibration moment (full activation, %.1f F_max)\n",
+                    "reach %.1f %% of the calibration moment (full activation, largest strength %.1f F_max)\n",
                     jn[j], d.calibration.msk_form[j] ? "musculoskeletal" : "linear", d.calibration.figures[j].r2_cv,
-                    msk.r2_cv[j], 100 * msk.reachable_share[j], kStrengthHi);
+                    msk.r2_cv[j], 100 * msk.reachable_share[j], kStrengthHi);  // the map may narrow it per channel
     }
     for (int j = 0; j < 2; ++j)
       std::printf("%s: the estimate holds all but %g %% of its variance below %.1f Hz; the measured moment has %.1f %% of "

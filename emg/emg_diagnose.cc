@@ -687,6 +687,7 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
   if (opt.musculoskeletal) {
     EmgMskFitOptions mo;
     mo.blocks = opt.blocks;
+    mo.strength_bounds = opt.strength_bounds;
     d.calibration.msk = FitEmgMsk(recs, d.calibration.spec.twitch, mo);
     const EmgMskModel& m = d.calibration.msk;
     for (int j = 0; j < 2; ++j) {
@@ -698,8 +699,8 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
                             Num(gain) + " %, " + Num(100 * kMinHeldoutGain) + " % needed): " +
                             (d.calibration.msk_form[j] ? "musculoskeletal form" : "linear form"));
       d.notes.push_back(std::string(kJoint[j]) + ": the recorded muscles can reach " + Num(100 * m.reachable_share[j]) +
-                        " % of the calibration moment at full activation and 1.5 F_max (the rest belongs to muscles "
-                        "nobody recorded)");
+                        " % of the calibration moment at full activation and their largest strength (the rest "
+                        "belongs to muscles nobody recorded)");
     }
   }
   // Channels whose fitted alpha contradicts their muscle's action (HJ15 eq. 23-24 signs): crosstalk,

@@ -99,6 +99,7 @@ struct EmgDiagnoseOptions {
   // Calibrate the musculoskeletal form (emg_msk_model.h) too and choose it at a joint where its
   // cross-validated error is lower than the linear calibration's by kMinHeldoutGain (the loop's gate).
   bool musculoskeletal = true;
+  std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
 };
 
 // Runs the loop on recordings with moments (same mapped channels). Throws InputError on unusable input.

@@ -86,16 +86,18 @@ struct Solved {
   double sse = 0;
 };
 
-Solved SolveBounded(const Eigen::MatrixXd& G, const Eigen::VectorXd& b, double rr, int n_bounded) {
+Solved SolveBounded(const Eigen::MatrixXd& G, const Eigen::VectorXd& b, double rr, const std::vector<double>& blo,
+                    const std::vector<double>& bhi) {
+  const int n_bounded = static_cast<int>(blo.size());
   const int C = static_cast<int>(G.rows());
   std::vector<int> state(C, 0);  // 0 free, -1 at the lower bound, +1 at the upper bound
   Eigen::VectorXd x = Eigen::VectorXd::Zero(C);
-  auto bound = [](int s) { return s < 0 ? kStrengthLo : kStrengthHi; };
+  auto bound = [&](int k) { return state[k] < 0 ? blo[k] : bhi[k]; };
   for (int iter = 0; iter < 4 * C + 8; ++iter) {
     std::vector<int> fr;
     for (int k = 0; k < C; ++k)
       if (state[k] == 0) fr.push_back(k);
-      else x[k] = bound(state[k]);
+      else x[k] = bound(k);
     if (!fr.empty()) {
       const int F = static_cast<int>(fr.size());
       Eigen::MatrixXd A(F, F);
@@ -114,12 +116,12 @@ Solved SolveBounded(const Eigen::MatrixXd& G, const Eigen::VectorXd& b, double r
       for (int i = 0; i < F; ++i) {
         const int k = fr[i];
         if (k >= n_bounded) continue;
-        const double v = std::max(kStrengthLo - xf[i], xf[i] - kStrengthHi);
+        const double v = std::max(blo[k] - xf[i], xf[i] - bhi[k]);
         if (v > dv) dv = v, worst = i;
       }
       if (worst >= 0) {
         const int k = fr[worst];
-        state[k] = xf[worst] < kStrengthLo ? -1 : 1;
+        state[k] = xf[worst] < blo[k] ? -1 : 1;
         continue;
       }
       for (int i = 0; i < F; ++i) x[fr[i]] = xf[i];
@@ -192,7 +194,9 @@ class Calibration {
       }
     }
     G = G.selfadjointView<Eigen::Lower>();
-    return SolveBounded(G, b, rr, M);
+    std::vector<double> blo(M), bhi(M);
+    for (int c = 0; c < M; ++c) blo[c] = mus_[c].strength_lo, bhi[c] = mus_[c].strength_hi;
+    return SolveBounded(G, b, rr, blo, bhi);
   }
 
   // The whole search: delay and A on a grid with the nominal lengths (the global step), then a
@@ -426,6 +430,8 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     MusculotendonParams own;
     if (GenericMusculotendon(m.channel, &own)) m.nominal.f_max = own.f_max, m.nominal.name = own.name;
     m.l_opt = m.nominal.l_opt, m.l_ts = m.nominal.l_ts;
+    const auto sb = opt.strength_bounds.find(m.channel);
+    if (sb != opt.strength_bounds.end()) m.strength_lo = sb->second[0], m.strength_hi = sb->second[1];
     model.muscles.push_back(m);
   }
   std::vector<Rec> rs;
@@ -507,12 +513,12 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
         if (!rs[k].spike_ok[j][i]) continue;
         const double tau = recs[k]->tau[j][i];
         meas[j].push_back(tau), pred[j].push_back(ser.tau[j][i]);
-        // Every muscle pulling along tau's direction at full activation and kStrengthHi F_max.
+        // Every muscle pulling along tau's direction at full activation and its largest strength.
         double M_dir = 0;
         for (size_t c = 0; c < model.muscles.size(); ++c) {
           const EmgMskMuscle& m = model.muscles[c];
           const HillState h = RigidTendonState(m.Params(), rs[k].geo.L[c][i], rs[k].geo.Ld[c][i]);
-          const double mom = kStrengthHi * m.nominal.f_max * (h.active + h.passive) * rs[k].geo.r[j][c][i];
+          const double mom = m.strength_hi * m.nominal.f_max * (h.active + h.passive) * rs[k].geo.r[j][c][i];
           if (mom * tau > 0) M_dir += std::abs(mom);
         }
         reach[j] += std::min(std::abs(tau), M_dir), total[j] += std::abs(tau);

@@ -22,6 +22,7 @@
 // A and the common delay (10-100 ms, Cavanagh & Komi 1979) searched on the nominal lengths first.
 #pragma once
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,6 @@
 namespace exotwin {
 
 // Bounds of the calibration (header).
-constexpr double kStrengthLo = 0.5, kStrengthHi = 1.5;      // x F_max
 constexpr double kTendonSlackChange = 0.05;                 // +- fraction of the nominal l_ts
 constexpr double kOptimalFibreChange = 0.025;               // +- fraction of the nominal l_opt
 
@@ -40,6 +40,7 @@ struct EmgMskMuscle {
   Muscle muscle = Muscle::kVM;          // the path (sim/musculotendon.h)
   MusculotendonParams nominal;          // F_max of the channel's actuator, lengths of its path, scaled
   double strength = 1;                  // x F_max
+  double strength_lo = kStrengthLo, strength_hi = kStrengthHi;  // its bounds (a map file may narrow them)
   double l_opt = 0, l_ts = 0;           // m
   // Calibrated range of the muscle's state (emg-predict's fallback): normalized fibre length and
   // velocity over the calibration samples.
@@ -76,6 +77,7 @@ EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec);
 struct EmgMskFitOptions {
   int blocks = 5;          // one recording: contiguous cross-validation blocks
   bool cross_validate = true;
+  std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
 };
 
 // Calibrates the form on recordings with moments (same channels). Channels whose gait2392 actuator

@@ -582,7 +582,7 @@ std::string EmgMskYaml(const EmgTorqueModel& em) {
       << MusculotendonPathSource(x.muscle) << "\"\n      actuator: " << n.name << "\n";
     o << "      max_isometric_force: {value: " << num(n.f_max) << ", unit: N, source: \"gait2392 " << n.name << "\"}\n";
     o << "      pennation: {value: " << num(n.pennation) << ", unit: rad, source: \"gait2392, of the path\"}\n";
-    o << "      strength: {value: " << num(x.strength) << ", bounds: [" << kStrengthLo << ", " << kStrengthHi
+    o << "      strength: {value: " << num(x.strength) << ", bounds: [" << num(x.strength_lo) << ", " << num(x.strength_hi)
       << "], unit: \"x F_max\", source: \"CEINMS-RT calibration bounds\"}\n";
     o << "      tendon_slack_length: {value: " << num(x.l_ts) << ", nominal: " << num(n.l_ts) << ", bounds: ["
       << num((1 - kTendonSlackChange) * n.l_ts) << ", " << num((1 + kTendonSlackChange) * n.l_ts)
@@ -638,7 +638,11 @@ void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em
     // below 45 deg, the calibration's own bounds.
     x.nominal.f_max = YamlNumber(c, e["max_isometric_force"]["value"], key + ".max_isometric_force.value", 10, 6000, "N");
     x.nominal.pennation = YamlNumber(c, e["pennation"]["value"], key + ".pennation.value", 0, 0.7854, "rad");
-    x.strength = YamlNumber(c, e["strength"]["value"], key + ".strength.value", kStrengthLo, kStrengthHi, "x F_max");
+    const YAML::Node sb = e["strength"]["bounds"];
+    if (!sb || !sb.IsSequence() || sb.size() != 2) c.Fail(key + ".strength.bounds", "expected [low, high]" + YamlLine(sb));
+    x.strength_lo = YamlNumber(c, sb[0], key + ".strength.bounds[0]", kStrengthLo, kStrengthHi, "x F_max");
+    x.strength_hi = YamlNumber(c, sb[1], key + ".strength.bounds[1]", x.strength_lo, kStrengthHi, "x F_max");
+    x.strength = YamlNumber(c, e["strength"]["value"], key + ".strength.value", x.strength_lo, x.strength_hi, "x F_max");
     x.nominal.l_ts = YamlNumber(c, e["tendon_slack_length"]["nominal"], key + ".tendon_slack_length.nominal", 0.005, 0.6, "m");
     x.nominal.l_opt = YamlNumber(c, e["optimal_fibre_length"]["nominal"], key + ".optimal_fibre_length.nominal", 0.02, 0.5, "m");
     x.l_ts = YamlNumber(c, e["tendon_slack_length"]["value"], key + ".tendon_slack_length.value",

@@ -182,6 +182,49 @@ TEST(EmgMskModel, OutsideTheCalibratedStatesTheLinearFormStandsIn) {
   EXPECT_EQ(PredictMoments(m, a).fallback_share[1], 0.0);
 }
 
+
+// A map file's musculoskeletal section: the joints a channel's muscle crosses and its strength bounds;
+// a joint its path does not cross, a biarticular muscle given one joint, bounds outside the
+// calibration's, a channel not mapped: exit 2 naming the file and the key. The narrowed bounds hold.
+TEST(EmgMskModel, MapFileBoundsAndJointsAreChecked) {
+  const testing::ScopedTempDir dir("emgmskmap");
+  const std::string path = dir.path() + "/map.yaml";
+  const std::string head = "muscles: {VM: [vas_lat_r], RF: [rect_fem_r], ST: [semimem_r, bifemlh_r], GAS: [med_gas_r]}\n";
+  WriteText(path, head + "musculoskeletal:\n  rect_fem_r: {joints: [hip, knee], strength: [0.9, 1.1]}\n  vas_lat_r: {joints: [knee]}\n");
+  const MuscleMap ok = ReadMuscleMap(path);
+  ASSERT_EQ(ok.strength_bounds.count("rect_fem_r"), 1u);
+  EXPECT_EQ(ok.strength_bounds.at("rect_fem_r")[0], 0.9);
+  const std::pair<std::string, std::string> bad[] = {
+      {"  vas_lat_r: {joints: [hip, knee]}\n", "musculoskeletal.vas_lat_r.joints"},       // the vasti do not cross the hip
+      {"  rect_fem_r: {joints: [knee]}\n", "musculoskeletal.rect_fem_r.joints"},          // RF crosses the hip too
+      {"  rect_fem_r: {strength: [0.2, 1.0]}\n", "musculoskeletal.rect_fem_r.strength[0]"},
+      {"  rect_fem_r: {strength: [1.0, 4.0]}\n", "musculoskeletal.rect_fem_r.strength[1]"},
+      {"  soleus_r: {joints: [knee]}\n", "musculoskeletal.soleus_r"},                     // not mapped
+      {"  vas_lat_r: {joints: [ankle]}\n", "musculoskeletal.vas_lat_r.joints"},
+  };
+  for (const auto& b : bad) {
+    WriteText(path, head + "musculoskeletal:\n" + b.first);
+    try {
+      ReadMuscleMap(path);
+      ADD_FAILURE() << "accepted " << b.first;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(b.second), std::string::npos) << e.what();
+    }
+  }
+  // The narrowed bounds hold in the calibration: the law's vas_lat strength 1.3 held at 1.1.
+  const Law law;
+  NormalRng<NormalPolar> ra(61);
+  EmgRecording a = GaitEnvelopesAndAngles(ra, "gait trial 61");
+  ApplyLaw(law, &a, 61);
+  EmgMskFitOptions opt;
+  opt.cross_validate = false;
+  opt.strength_bounds["vas_lat_r"] = {0.9, 1.1};
+  const EmgMskModel m = FitEmgMsk({&a}, 0, opt);
+  EXPECT_NEAR(m.muscles[0].strength, 1.1, 1e-9);
+  EXPECT_EQ(m.muscles[0].strength_hi, 1.1);
+}
+
 }  // namespace
 }  // namespace exotwin
 
