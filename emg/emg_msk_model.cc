@@ -201,7 +201,7 @@ class Calibration {
 
   // The whole search: delay and A on a grid with the nominal lengths (the global step), then a
   // pattern search (Hooke & Jeeves 1961) of delay, A and every channel's l_ts and l_opt, each in its
-  // bounds, the step halving from half the band to 1/256 of it.
+  // bounds, the step halving from a quarter of the band to 1/128 of it (the Levenberg-Marquardt step refines).
   void Calibrate(double twitch, double* delay, double* A) {
     for (EmgMskMuscle& m : mus_) m.l_ts = m.nominal.l_ts, m.l_opt = m.nominal.l_opt;
     static const double kA[] = {-2.95, -2.5, -2.0, -1.5, -1.0, -0.5, -0.05};
@@ -236,7 +236,7 @@ class Calibration {
     };
     apply(0);
     best = Solve().sse;
-    for (double frac = 0.25; frac >= 1.0 / 512; frac /= 2) {
+    for (double frac = 0.25; frac >= 1.0 / 128; frac /= 2) {
       bool improved = true;
       for (int sweep = 0; sweep < 4 && improved; ++sweep) {
         improved = false;
