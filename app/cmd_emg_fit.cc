@@ -55,6 +55,7 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
     EmgDiagnoseOptions opt;
     opt.blocks = o->blocks;
     opt.strength_bounds = map.strength_bounds;
+    opt.musculoskeletal = !o->linear;
     if (o->linear) opt.max_steps = 0, opt.robust_candidate = false, opt.signed_alphas = false, opt.musculoskeletal = false;
     const EmgDiagnosis d = DiagnoseEmg(ptrs, opt);
     std::vector<std::string> header = {"exotwin emg-fit: EMG-driven joint moment model (HJ15 eq. 26-27 + discrepancy loop)"};

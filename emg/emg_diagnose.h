@@ -98,7 +98,8 @@ struct EmgDiagnoseOptions {
   int blocks = 5;                // one recording: contiguous cross-validation blocks (>= 2)
   // Calibrate the musculoskeletal form (emg_msk_model.h) too and choose it at a joint where its
   // cross-validated error is lower than the linear calibration's by kMinHeldoutGain (the loop's gate).
-  bool musculoskeletal = true;
+  // Off by default (the loop alone, ~4 s less per call); emg-fit turns it on.
+  bool musculoskeletal = false;
   std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
 };
 
