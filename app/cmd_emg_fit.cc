@@ -54,7 +54,9 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
     for (const auto& r : recs) ptrs.push_back(&r);
     EmgDiagnoseOptions opt;
     opt.blocks = o->blocks;
-    if (o->linear) opt.max_steps = 0, opt.robust_candidate = false, opt.signed_alphas = false;
+    opt.strength_bounds = map.strength_bounds;
+    opt.musculoskeletal = !o->linear;
+    if (o->linear) opt.max_steps = 0, opt.robust_candidate = false, opt.signed_alphas = false, opt.musculoskeletal = false;
     const EmgDiagnosis d = DiagnoseEmg(ptrs, opt);
     std::vector<std::string> header = {"exotwin emg-fit: EMG-driven joint moment model (HJ15 eq. 26-27 + discrepancy loop)"};
     std::string files;
@@ -88,13 +90,24 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
                   jn[j], d.steps.back().model.figures[j].r2_cv, d.steps.front().model.figures[j].r2_cv,
                   d.steps.back().model.figures[j].r2_heldout_trim, d.steps.back().model.figures[j].r2_heldout,
                   d.steps.front().model.figures[j].r2_heldout_trim, d.steps.front().model.figures[j].r2_heldout);
+    const EmgMskModel& msk = d.calibration.msk;
+    if (msk.present) {
+      std::printf("%-44s %8.3f %8.3f %9s %9s %8.2f %8.2f\n", "musculoskeletal form (gait2392 + Hill)", msk.r2_cv[0],
+                  msk.r2_cv[1], "-", "-", msk.rms_cv[0], msk.rms_cv[1]);
+      for (int j = 0; j < 2; ++j)
+        std::printf("%s: %s form chosen (cross-validated R^2 linear %.3f, musculoskeletal %.3f); the recorded muscles can "
+                    "reach %.1f %% of the calibration moment (full activation, largest strength %.1f F_max)\n",
+                    jn[j], d.calibration.msk_form[j] ? "musculoskeletal" : "linear", d.calibration.figures[j].r2_cv,
+                    msk.r2_cv[j], 100 * msk.reachable_share[j], kStrengthHi);  // the map may narrow it per channel
+    }
     for (int j = 0; j < 2; ++j)
       std::printf("%s: the estimate holds all but %g %% of its variance below %.1f Hz; the measured moment has %.1f %% of "
                   "its variance above (the estimate %.2f %%): R^2 cannot pass %.3f in that band\n",
                   jn[j], 100 * kBandResidue, d.ceiling[j].band_hz, 100 * d.ceiling[j].share_above,
                   100 * d.ceiling[j].estimate_share, d.ceiling[j].r2);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "emg-fit: wrote %s in %s s\n", o->out.c_str(), NumberText(secs, 3).c_str());
+    std::fprintf(stderr, "emg-fit: wrote %s in %s s (the musculoskeletal form %s s of it)\n", o->out.c_str(),
+                 NumberText(secs, 3).c_str(), NumberText(d.calibration.msk.seconds, 3).c_str());
     return 0;
   };
 }

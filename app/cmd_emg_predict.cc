@@ -50,6 +50,38 @@ void ReportExtrapolation(const EmgTorqueModel& model, const EmgRecording& rec) {
   }
 }
 
+// The musculoskeletal form's muscle states against their calibrated ranges, and where the linear form
+// stands in for it (emg_torque_model.h PredictMoments).
+void ReportMuscleStates(const EmgTorqueModel& model, const EmgRecording& rec, const EmgPrediction& pr) {
+  const char* jn[2] = {"hip", "knee"};
+  if (!model.msk.present) {
+    std::printf("forms: linear at both joints (the model file has no musculoskeletal form)\n");
+    return;
+  }
+  std::printf("forms: hip %s, knee %s\n", model.msk_form[0] ? "musculoskeletal" : "linear",
+              model.msk_form[1] ? "musculoskeletal" : "linear");
+  const double n = static_cast<double>(std::max<size_t>(1, rec.size()));
+  std::printf("muscle states: share of samples outside the calibrated fibre length or velocity\n");
+  for (size_t c = 0; c < model.msk.muscles.size() && c < pr.msk.fibre.size(); ++c) {
+    const EmgMskMuscle& m = model.msk.muscles[c];
+    double out = 0;
+    for (size_t i = 0; i < rec.size(); ++i) {
+      const double l = pr.msk.fibre[c][i], v = pr.msk.velocity[c][i];
+      out += (l < m.fibre_lo || l > m.fibre_hi || v < m.velocity_lo || v > m.velocity_hi) ? 1 : 0;
+    }
+    std::printf("  %-28s %6.1f %%   calibrated fibre %.3g .. %.3g l_opt, velocity %.3g .. %.3g v_max\n",
+                ("muscle " + m.channel).c_str(), 100 * out / n, m.fibre_lo, m.fibre_hi, m.velocity_lo, m.velocity_hi);
+  }
+  for (int j = 0; j < 2; ++j) {
+    if (!model.msk_form[j]) continue;
+    std::printf("%s: the linear form stands in on %.1f %% of the samples (a muscle spanning the joint outside its "
+                "calibrated state)\n", jn[j], 100 * pr.fallback_share[j]);
+    if (pr.fallback_share[j] > kExtrapolationWarn)
+      std::fprintf(stderr, "emg-predict: warning: at the %s, %.1f %% of the samples leave the muscles' calibrated states: "
+                   "predicted by the linear form there\n", jn[j], 100 * pr.fallback_share[j]);
+  }
+}
+
 CommandRunner RegisterEmgPredict(CLI::App& app) {
   struct Opts {
     std::string model, emg, kin, mom, map, out;
@@ -69,9 +101,10 @@ CommandRunner RegisterEmgPredict(CLI::App& app) {
     const EmgRecording rec = ReadEmgRecording(o->emg, o->kin, o->mom, map);
     for (const auto& n : rec.notes) std::fprintf(stderr, "emg-predict: %s: %s\n", rec.source.c_str(), n.c_str());
     ReportExtrapolation(model, rec);
-    std::vector<double> tau[2];
-    for (int j = 0; j < 2; ++j) tau[j] = PredictMoment(model, rec, j);
-    WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&rec.t, &tau[0], &tau[1]},
+    const EmgPrediction pr = PredictMoments(model, rec);
+    const std::vector<double>* tau = pr.tau;
+    ReportMuscleStates(model, rec, pr);
+    WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&rec.t, &pr.tau[0], &pr.tau[1]},
              {"exotwin emg-predict: estimated muscular joint moment (N m, hip flexion +, knee extension +)",
               "model: " + o->model + ", emg: " + o->emg + ", kinematics: " + o->kin});
     if (rec.has_moments()) {

@@ -681,6 +681,28 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     for (int j = 0; j < 2; ++j)
       d.calibration.spec.q_lo[j] = d.calibration.range.q_lo[j], d.calibration.spec.q_hi[j] = d.calibration.range.q_hi[j];
   }
+  // The musculoskeletal form (issue 42), with the twitch the loop named (none: none), cross-validated on
+  // the same folds; chosen at a joint where it gains the loop's kMinHeldoutGain on the linear
+  // calibration's cross-validated error (the same samples scored).
+  if (opt.musculoskeletal) {
+    EmgMskFitOptions mo;
+    mo.blocks = opt.blocks;
+    mo.strength_bounds = opt.strength_bounds;
+    d.calibration.msk = FitEmgMsk(recs, d.calibration.spec.twitch, mo);
+    const EmgMskModel& m = d.calibration.msk;
+    for (int j = 0; j < 2; ++j) {
+      const double lin = 1 - d.calibration.figures[j].r2_cv, msk = 1 - m.r2_cv[j];
+      d.calibration.msk_form[j] = msk <= (1 - kMinHeldoutGain) * lin;
+      const double gain = lin > 0 ? 100 * (1 - msk / lin) : 0;
+      d.selection.push_back(std::string(kJoint[j]) + ": musculoskeletal form cross-validated R^2 " + Num(m.r2_cv[j]) +
+                            " against the linear calibration's " + Num(d.calibration.figures[j].r2_cv) + " (gain " +
+                            Num(gain) + " %, " + Num(100 * kMinHeldoutGain) + " % needed): " +
+                            (d.calibration.msk_form[j] ? "musculoskeletal form" : "linear form"));
+      d.notes.push_back(std::string(kJoint[j]) + ": the recorded muscles can reach " + Num(100 * m.reachable_share[j]) +
+                        " % of the calibration moment at full activation and their largest strength (the rest "
+                        "belongs to muscles nobody recorded)");
+    }
+  }
   // Channels whose fitted alpha contradicts their muscle's action (HJ15 eq. 23-24 signs): crosstalk,
   // a channel standing for a missing muscle, or collinearity. Fitted free of sign, reported; held at
   // zero by the signed fit, reported with the value the same structure gives it free of sign.
@@ -707,6 +729,7 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
   }
   // Plot series of the first recording.
   const EmgRecording& r = *recs[0];
+  if (d.calibration.msk.present) d.first_recording = r;
   d.t = r.t;
   d.split = static_cast<size_t>(std::floor((1 - opt.holdout_fraction) * static_cast<double>(r.size())));
   for (int j = 0; j < 2; ++j) {

@@ -87,6 +87,7 @@ struct EmgDiagnosis {
   std::vector<double> t, measured[2], linear[2], final_[2];
   size_t split = 0;
   EmgBandCeiling ceiling[2];  // of the calibration (BandCeiling)
+  EmgRecording first_recording;  // for the musculoskeletal form's muscle plots (report)
 };
 
 struct EmgDiagnoseOptions {
@@ -95,6 +96,11 @@ struct EmgDiagnoseOptions {
   bool robust_candidate = true;  // consider the robust fit
   bool signed_alphas = true;     // fit every alpha with its muscle's sign (EmgModelSpec::signed_alphas)
   int blocks = 5;                // one recording: contiguous cross-validation blocks (>= 2)
+  // Calibrate the musculoskeletal form (emg_msk_model.h) too and choose it at a joint where its
+  // cross-validated error is lower than the linear calibration's by kMinHeldoutGain (the loop's gate).
+  // Off by default (the loop alone, ~4 s less per call); emg-fit turns it on.
+  bool musculoskeletal = false;
+  std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
 };
 
 // Runs the loop on recordings with moments (same mapped channels). Throws InputError on unusable input.

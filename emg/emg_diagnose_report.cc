@@ -207,6 +207,53 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
                      {t, part(d.linear[j]), "#d62728", "linear form"},
                      {t, part(d.final_[j]), "#1f77b4", "final model"}});
   }
+  // The musculoskeletal form (issue 42): forms, reachable shares, every muscle's parameters and bounds,
+  // and its force and fibre length over the first recording.
+  const EmgMskModel& m = d.calibration.msk;
+  if (m.present && !d.t.empty()) {
+    o << "<h2>Musculoskeletal form</h2><p>Cross-validated R<sup>2</sup>: hip " << NumberText(m.r2_cv[0], 3) << " ("
+      << (d.calibration.msk_form[0] ? "chosen" : "linear form chosen") << "), knee " << NumberText(m.r2_cv[1], 3) << " ("
+      << (d.calibration.msk_form[1] ? "chosen" : "linear form chosen") << "). The recorded muscles can reach "
+      << NumberText(100 * m.reachable_share[0], 3) << " % of the hip's and " << NumberText(100 * m.reachable_share[1], 3)
+      << " % of the knee's calibration moment (full activation, 1.5 F_max). Delay " << NumberText(1e3 * m.delay, 3)
+      << " ms, twitch " << NumberText(1e3 * m.twitch, 3) << " ms, A " << NumberText(m.a_shape, 3) << ".</p>";
+    o << "<table><tr><th>channel</th><th>path</th><th>F_max (N)</th><th>strength (0.5-1.5)</th><th>l_ts (m) [bounds]</th>"
+         "<th>l_opt (m) [bounds]</th><th>force over the trial (N) min / mean / max</th><th>fibre length (l_opt) min / max</th></tr>";
+    const EmgRecording& rec0 = d.first_recording;
+    const EmgMskSeries ser = rec0.size() ? MskSeries(m, rec0) : EmgMskSeries{};
+    for (size_t c = 0; c < m.muscles.size(); ++c) {
+      const EmgMskMuscle& x = m.muscles[c];
+      o << "<tr><td>" << HtmlEscape(x.channel) << "</td><td>" << HtmlEscape(MusculotendonPathSource(x.muscle)) << "</td><td>"
+        << NumberText(x.nominal.f_max, 4) << "</td><td>" << NumberText(x.strength, 3) << "</td><td>" << NumberText(x.l_ts, 4)
+        << " [" << NumberText((1 - kTendonSlackChange) * x.nominal.l_ts, 4) << ", "
+        << NumberText((1 + kTendonSlackChange) * x.nominal.l_ts, 4) << "]</td><td>" << NumberText(x.l_opt, 4) << " ["
+        << NumberText((1 - kOptimalFibreChange) * x.nominal.l_opt, 4) << ", "
+        << NumberText((1 + kOptimalFibreChange) * x.nominal.l_opt, 4) << "]</td>";
+      if (c < ser.force.size() && !ser.force[c].empty()) {
+        const auto f = std::minmax_element(ser.force[c].begin(), ser.force[c].end());
+        double mean = 0;
+        for (double v : ser.force[c]) mean += v / static_cast<double>(ser.force[c].size());
+        o << "<td>" << NumberText(*f.first, 3) << " / " << NumberText(mean, 3) << " / " << NumberText(*f.second, 3)
+          << "</td><td>" << NumberText(x.fibre_lo, 3) << " / " << NumberText(x.fibre_hi, 3) << "</td>";
+      }
+      o << "</tr>";
+    }
+    o << "</table>";
+    if (!ser.force.empty()) {
+      static const char* kColour[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                                      "#7f7f7f", "#bcbd22", "#17becf"};
+      const size_t b = std::min(rec0.size(), static_cast<size_t>(10.0 / std::max(1e-6, rec0.t[1] - rec0.t[0])));
+      const std::vector<double> t(rec0.t.begin(), rec0.t.begin() + static_cast<long>(b));
+      std::vector<SvgSeries> fs, ls;
+      for (size_t c = 0; c < ser.force.size(); ++c) {
+        const char* col = kColour[c % 10];
+        fs.push_back({t, std::vector<double>(ser.force[c].begin(), ser.force[c].begin() + static_cast<long>(b)), col, m.muscles[c].channel});
+        ls.push_back({t, std::vector<double>(ser.fibre[c].begin(), ser.fibre[c].begin() + static_cast<long>(b)), col, m.muscles[c].channel});
+      }
+      o << "<h2>Muscle forces (first 10 s)</h2>" << SvgChart("muscle force", "t (s)", "N", fs)
+        << "<h2>Fibre lengths (first 10 s)</h2>" << SvgChart("fibre length", "t (s)", "l / l_opt", ls);
+    }
+  }
   o << "</body></html>\n";
   return o.str();
 }

@@ -46,7 +46,7 @@ MuscleMap DefaultMuscleMap() {
 MuscleMap ReadMuscleMap(const std::string& path) {
   const YamlContext c{path};
   const YAML::Node root = ParseYaml(ReadYamlText(path, "muscle map"), path);
-  YamlCheckKeys(c, root, "", {"muscles", "coordinates"});
+  YamlCheckKeys(c, root, "", {"muscles", "coordinates", "musculoskeletal"});
   MuscleMap m;
   m.source = path;
   m.from_file = true;
@@ -69,6 +69,41 @@ MuscleMap ReadMuscleMap(const std::string& path) {
       for (const auto& prev : m.channels)
         if (prev.first == name) c.Fail("muscles." + key, "channel '" + name + "' mapped twice" + YamlLine(ch));
       m.channels.push_back({name, muscle});
+    }
+  }
+  if (const YAML::Node ms = root["musculoskeletal"]) {
+    if (!ms.IsMap()) c.Fail("musculoskeletal", "expected a mapping of channels to {joints, strength}" + YamlLine(ms));
+    const char* jn[2] = {"hip", "knee"};
+    for (const auto& kv : ms) {
+      const std::string ch = kv.first.as<std::string>(), key = "musculoskeletal." + ch;
+      const auto it = std::find_if(m.channels.begin(), m.channels.end(), [&](const auto& p) { return p.first == ch; });
+      if (it == m.channels.end()) c.Fail(key, "expected a channel mapped under muscles:" + YamlLine(kv.first));
+      const Muscle mu = it->second;
+      YamlCheckKeys(c, kv.second, key, {"joints", "strength"});
+      if (const YAML::Node js = kv.second["joints"]) {
+        if (!js.IsSequence()) c.Fail(key + ".joints", "expected a list of hip, knee" + YamlLine(js));
+        bool listed[2] = {false, false};
+        for (const auto& j : js) {
+          const std::string s = j.IsScalar() ? j.as<std::string>() : "";
+          const int ji = s == "hip" ? 0 : s == "knee" ? 1 : -1;
+          if (ji < 0) c.Fail(key + ".joints", "expected hip or knee" + YamlLine(j));
+          if (ActionSign(mu, ji) == 0)
+            c.Fail(key + ".joints", std::string(MuscleName(mu)) + "'s path does not cross the " + s +
+                                        " (expected the joints it crosses)" + YamlLine(j));
+          listed[ji] = true;
+        }
+        for (int j = 0; j < 2; ++j)
+          if (ActionSign(mu, j) != 0 && !listed[j])
+            c.Fail(key + ".joints", std::string(MuscleName(mu)) + " crosses the " + jn[j] +
+                                        " too (one force acts at every joint its path crosses)" + YamlLine(js));
+      }
+      if (const YAML::Node sb = kv.second["strength"]) {
+        if (!sb.IsSequence() || sb.size() != 2) c.Fail(key + ".strength", "expected [low, high] (x F_max)" + YamlLine(sb));
+        std::array<double, 2> b;
+        b[0] = YamlNumber(c, sb[0], key + ".strength[0]", kStrengthLo, kStrengthHi, "x F_max (CEINMS-RT's calibration bounds)");
+        b[1] = YamlNumber(c, sb[1], key + ".strength[1]", b[0], kStrengthHi, "x F_max (CEINMS-RT's calibration bounds)");
+        m.strength_bounds[ch] = b;
+      }
     }
   }
   if (const YAML::Node co = root["coordinates"]) {

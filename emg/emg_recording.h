@@ -7,6 +7,7 @@
 // dynamics `<coordinate>_moment`); envelopes as recorded (normalized: fraction of the muscle's
 // maximum).
 #pragma once
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -22,7 +23,13 @@ struct MuscleMap {
   bool from_file = false;                         // every channel a file names must be recorded
   std::vector<std::pair<std::string, Muscle>> channels;  // channel name -> muscle, in map order
   std::string hip_coordinate, knee_coordinate;    // e.g. hip_flexion_r; empty: from the side
+  // Strength bounds of the musculoskeletal form per channel (x F_max), narrowing the calibration's.
+  std::map<std::string, std::array<double, 2>> strength_bounds;
 };
+
+// Strength bounds of the musculoskeletal form's calibration (x F_max; CEINMS-RT's calibration,
+// StrengthCoefficients_ShapeFactor_TendonSlackLength_single): a map file may narrow them per channel.
+constexpr double kStrengthLo = 0.5, kStrengthHi = 1.5;
 
 // OpenSim gait models' names (gait2392 / gait2354 and Rajagopal 2015) of both sides.
 MuscleMap DefaultMuscleMap();
@@ -32,6 +39,10 @@ MuscleMap DefaultMuscleMap();
 //     VM: [vas_med_r, vas_lat_r]
 //     RF: [rect_fem_r]
 //   coordinates: {hip: hip_flexion_r, knee: knee_angle_r}   # optional
+//   musculoskeletal:              # optional, per mapped channel (emg/emg_msk_model.h)
+//     rect_fem_r: {joints: [hip, knee], strength: [0.6, 1.4]}
+// `joints` must be the joints the channel's muscle path crosses (sim/muscles.h ActionSign: one force at
+// each of them); `strength` (x F_max) must lie within [kStrengthLo, kStrengthHi].
 // Throws InputError naming the file and key.
 MuscleMap ReadMuscleMap(const std::string& path);
 

@@ -212,6 +212,29 @@ std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, co
 }
 
 std::vector<double> PredictMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint) {
+  if (!(model.msk.present && model.msk_form[joint])) return PredictLinearMoment(model, rec, joint);
+  return PredictMoments(model, rec).tau[joint];
+}
+
+EmgPrediction PredictMoments(const EmgTorqueModel& model, const EmgRecording& rec) {
+  EmgPrediction p;
+  const bool any = model.msk.present && (model.msk_form[0] || model.msk_form[1]);
+  if (model.msk.present) p.msk = MskSeries(model.msk, rec);  // the muscle states, reported either way
+  for (int j = 0; j < 2; ++j) {
+    p.tau[j] = PredictLinearMoment(model, rec, j);
+    p.fallback[j].assign(rec.size(), 0);
+    if (!(any && model.msk_form[j])) continue;
+    double n = 0;
+    for (size_t i = 0; i < rec.size(); ++i) {
+      if (p.msk.outside[j][i]) p.fallback[j][i] = 1, n += 1;
+      else p.tau[j][i] = p.msk.tau[j][i];
+    }
+    p.fallback_share[j] = rec.size() ? n / static_cast<double>(rec.size()) : 0;
+  }
+  return p;
+}
+
+std::vector<double> PredictLinearMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint) {
   std::vector<double> tau(rec.size(), 0.0);
   for (const EmgTerm& t : model.terms) {
     if (t.joint != joint) continue;
@@ -526,6 +549,120 @@ EmgExtrapolation ExtrapolationOf(const EmgCalibrationRange& g, const EmgRecordin
 
 // ---- EMGMODEL.yaml ----
 
+namespace {
+
+// The musculoskeletal block: the form per joint and every muscle's parameters with bounds and sources.
+std::string EmgMskYaml(const EmgTorqueModel& em) {
+  const EmgMskModel& m = em.msk;
+  std::ostringstream o;
+  auto num = [](double v) { return NumberText(v, 17); };  // read back exactly (the state ranges' ends)
+  auto form = [&](int j) { return em.msk_form[j] ? "musculoskeletal" : "linear"; };
+  o << "# The musculoskeletal form (emg/emg_msk_model.h): per channel one Hill unit (Thelen 2003 curves, rigid\n"
+       "# tendon) on a gait2392 path (Delp et al. 1990), force s F_max (a f_L f_V + f_PE) cos(phi) acting at every\n"
+       "# joint the path crosses with its moment arm -dL/dq; plus beta q + gamma qd + offset per joint. Bounds of\n"
+       "# CEINMS-RT's calibration (strength 0.5-1.5, l_ts +-5 %, l_opt +-2.5 % of the scaled gait2392 values).\n";
+  o << "forms: {hip: " << form(0) << ", knee: " << form(1) << "}\n";
+  o << "musculoskeletal:\n";
+  o << "  activation: {delay: {value: " << num(m.delay) << ", bounds: [0.01, 0.1], unit: s, source: \"Cavanagh & Komi 1979\"}, "
+    << "twitch: {value: " << num(m.twitch) << ", unit: s, source: \"the linear loop's twitch\"}, A_shape: {value: "
+    << num(m.a_shape) << ", bounds: [-3, 0], unit: \"1\", source: \"LB03 eq. 2; CEINMS-RT bounds\"}}\n";
+  o << "  remainder:\n";
+  for (int j = 0; j < 2; ++j)
+    o << "    " << kJointName[j] << ": {beta: " << num(m.beta[j]) << ", gamma: " << num(m.gamma[j]) << ", offset: "
+      << num(m.offset[j]) << ", units: [\"N m/rad\", \"N m s/rad\", \"N m\"]}\n";
+  o << "  reachable_share: {hip: " << NumberText(m.reachable_share[0], 4) << ", knee: " << NumberText(m.reachable_share[1], 4)
+    << "}\n";
+  o << "  fit: {hip: {r2_cv: " << NumberText(m.r2_cv[0], 4) << ", rms_cv: " << NumberText(m.rms_cv[0], 4) << ", r2_fit: "
+    << NumberText(m.r2_fit[0], 4) << "}, knee: {r2_cv: " << NumberText(m.r2_cv[1], 4) << ", rms_cv: "
+    << NumberText(m.rms_cv[1], 4) << ", r2_fit: " << NumberText(m.r2_fit[1], 4) << "}}\n";
+  o << "  muscles:\n";
+  for (const EmgMskMuscle& x : m.muscles) {
+    const MusculotendonParams& n = x.nominal;
+    o << "    - channel: " << x.channel << "\n      muscle: " << MuscleName(x.muscle) << "\n      path: \""
+      << MusculotendonPathSource(x.muscle) << "\"\n      actuator: " << n.name << "\n";
+    o << "      max_isometric_force: {value: " << num(n.f_max) << ", unit: N, source: \"gait2392 " << n.name << "\"}\n";
+    o << "      pennation: {value: " << num(n.pennation) << ", unit: rad, source: \"gait2392, of the path\"}\n";
+    o << "      strength: {value: " << num(x.strength) << ", bounds: [" << num(x.strength_lo) << ", " << num(x.strength_hi)
+      << "], unit: \"x F_max\", source: \"CEINMS-RT calibration bounds\"}\n";
+    o << "      tendon_slack_length: {value: " << num(x.l_ts) << ", nominal: " << num(n.l_ts) << ", bounds: ["
+      << num((1 - kTendonSlackChange) * n.l_ts) << ", " << num((1 + kTendonSlackChange) * n.l_ts)
+      << "], unit: m, source: \"gait2392 scaled to the path (Delp et al. 2007); +-5 % CEINMS-RT\"}\n";
+    o << "      optimal_fibre_length: {value: " << num(x.l_opt) << ", nominal: " << num(n.l_opt) << ", bounds: ["
+      << num((1 - kOptimalFibreChange) * n.l_opt) << ", " << num((1 + kOptimalFibreChange) * n.l_opt)
+      << "], unit: m, source: \"gait2392 scaled to the path (Delp et al. 2007); +-2.5 % CEINMS-RT\"}\n";
+    o << "      calibrated_state: {fibre_length: [" << NumberText(x.fibre_lo, 17) << ", " << NumberText(x.fibre_hi, 17)
+      << "], fibre_velocity: [" << NumberText(x.velocity_lo, 17) << ", " << NumberText(x.velocity_hi, 17)
+      << "], units: [l_opt, \"10 l_opt/s\"]}\n";
+  }
+  return o.str();
+}
+
+// Reads the musculoskeletal block (EmgMskYaml) into m; every parameter inside its bounds.
+void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em) {
+  const YAML::Node f = root["forms"], k = root["musculoskeletal"];
+  if (!f && !k) return;
+  if (!f || !k) c.Fail(f ? "musculoskeletal" : "forms", "expected both forms: and musculoskeletal: (a file written by emg-fit)");
+  for (int j = 0; j < 2; ++j) {
+    const YAML::Node v = f[kJointName[j]];
+    const std::string key = std::string("forms.") + kJointName[j];
+    if (!v || !v.IsScalar() || (v.as<std::string>() != "linear" && v.as<std::string>() != "musculoskeletal"))
+      c.Fail(key, "expected linear or musculoskeletal" + YamlLine(v));
+    em->msk_form[j] = v.as<std::string>() == "musculoskeletal";
+  }
+  EmgMskModel& m = em->msk;
+  const YAML::Node a = k["activation"];
+  m.delay = YamlNumber(c, a["delay"]["value"], "musculoskeletal.activation.delay.value", 0.01, 0.1, "s");
+  m.twitch = YamlNumber(c, a["twitch"]["value"], "musculoskeletal.activation.twitch.value", 0, 1, "s");
+  m.a_shape = YamlNumber(c, a["A_shape"]["value"], "musculoskeletal.activation.A_shape.value", -3, 0, "");
+  for (int j = 0; j < 2; ++j) {
+    const std::string key = std::string("musculoskeletal.remainder.") + kJointName[j];
+    const YAML::Node r = k["remainder"][kJointName[j]];
+    m.beta[j] = YamlNumber(c, r["beta"], key + ".beta", -1e6, 1e6, "N m/rad");
+    m.gamma[j] = YamlNumber(c, r["gamma"], key + ".gamma", -1e6, 1e6, "N m s/rad");
+    m.offset[j] = YamlNumber(c, r["offset"], key + ".offset", -1e6, 1e6, "N m");
+    if (k["reachable_share"]) m.reachable_share[j] = YamlNumber(c, k["reachable_share"][kJointName[j]], "musculoskeletal.reachable_share." + std::string(kJointName[j]), 0, 1, "");
+  }
+  const YAML::Node ms = k["muscles"];
+  if (!ms || !ms.IsSequence() || ms.size() == 0) c.Fail("musculoskeletal.muscles", "expected a list of muscles" + YamlLine(ms));
+  for (size_t i = 0; i < ms.size(); ++i) {
+    const YAML::Node e = ms[i];
+    const std::string key = "musculoskeletal.muscles[" + std::to_string(i) + "]";
+    EmgMskMuscle x;
+    if (!e["channel"] || !e["channel"].IsScalar()) c.Fail(key + ".channel", "expected the EMG channel's name" + YamlLine(e));
+    x.channel = e["channel"].as<std::string>();
+    if (!e["muscle"] || !MuscleByName(e["muscle"].as<std::string>(), &x.muscle))
+      c.Fail(key + ".muscle", "expected GMAX, VM, RF, ST or GAS (a path of sim/musculotendon.h)" + YamlLine(e["muscle"]));
+    x.nominal = ScaledMusculotendon(x.muscle, GenericMusculotendon(x.muscle));
+    x.nominal.name = e["actuator"] ? e["actuator"].as<std::string>() : x.nominal.name;
+    // Physiology: a force of one human muscle (Delp 1990's largest: soleus 3549 N, x 1.5), pennation
+    // below 45 deg, the calibration's own bounds.
+    x.nominal.f_max = YamlNumber(c, e["max_isometric_force"]["value"], key + ".max_isometric_force.value", 10, 6000, "N");
+    x.nominal.pennation = YamlNumber(c, e["pennation"]["value"], key + ".pennation.value", 0, 0.7854, "rad");
+    const YAML::Node sb = e["strength"]["bounds"];
+    if (!sb || !sb.IsSequence() || sb.size() != 2) c.Fail(key + ".strength.bounds", "expected [low, high]" + YamlLine(sb));
+    x.strength_lo = YamlNumber(c, sb[0], key + ".strength.bounds[0]", kStrengthLo, kStrengthHi, "x F_max");
+    x.strength_hi = YamlNumber(c, sb[1], key + ".strength.bounds[1]", x.strength_lo, kStrengthHi, "x F_max");
+    x.strength = YamlNumber(c, e["strength"]["value"], key + ".strength.value", x.strength_lo, x.strength_hi, "x F_max");
+    x.nominal.l_ts = YamlNumber(c, e["tendon_slack_length"]["nominal"], key + ".tendon_slack_length.nominal", 0.005, 0.6, "m");
+    x.nominal.l_opt = YamlNumber(c, e["optimal_fibre_length"]["nominal"], key + ".optimal_fibre_length.nominal", 0.02, 0.5, "m");
+    x.l_ts = YamlNumber(c, e["tendon_slack_length"]["value"], key + ".tendon_slack_length.value",
+                        (1 - kTendonSlackChange) * x.nominal.l_ts * (1 - 1e-9), (1 + kTendonSlackChange) * x.nominal.l_ts * (1 + 1e-9), "m");
+    x.l_opt = YamlNumber(c, e["optimal_fibre_length"]["value"], key + ".optimal_fibre_length.value",
+                         (1 - kOptimalFibreChange) * x.nominal.l_opt * (1 - 1e-9), (1 + kOptimalFibreChange) * x.nominal.l_opt * (1 + 1e-9), "m");
+    const YAML::Node st = e["calibrated_state"];
+    double fl[2], fv[2];
+    for (int b = 0; b < 2; ++b) {
+      fl[b] = YamlNumber(c, st["fibre_length"][b], key + ".calibrated_state.fibre_length[" + std::to_string(b) + "]", 0, 3, "l_opt");
+      fv[b] = YamlNumber(c, st["fibre_velocity"][b], key + ".calibrated_state.fibre_velocity[" + std::to_string(b) + "]", -1, 1, "v_max");
+    }
+    x.fibre_lo = fl[0], x.fibre_hi = fl[1], x.velocity_lo = fv[0], x.velocity_hi = fv[1];
+    m.muscles.push_back(x);
+  }
+  m.present = true;
+}
+
+}  // namespace
+
 std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>& header) {
   std::ostringstream o;
   for (const std::string& h : header) o << "# " << h << "\n";
@@ -581,6 +718,7 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
       << ", unit: rad}\n  velocity: {hip: " << pair(m.range.qd_lo[0], m.range.qd_hi[0])
       << ", knee: " << pair(m.range.qd_lo[1], m.range.qd_hi[1]) << ", unit: rad/s}\n";
   }
+  if (m.msk.present) o << EmgMskYaml(m);
   o << "fit:\n  validation: \"" << (m.folds_are_recordings ? "each recording left out in turn" : "contiguous blocks left out in turn")
     << "\"\n  folds: " << m.sse_fold.size() << "\n";
   for (int j = 0; j < 2; ++j) {
@@ -599,7 +737,7 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
   const YAML::Node root = ParseYaml(ReadYamlText(path, "EMG model"), path);
   YamlCheckKeys(c, root, "",
                 {"model", "activation", "twitch", "delays", "structure", "missing_channels", "autocorrelation_rows",
-                 "parameters", "calibration_range", "fit"});
+                 "parameters", "calibration_range", "fit", "forms", "musculoskeletal"});
   if (!root["model"] || !root["model"].IsScalar() || root["model"].as<std::string>() != "emg_torque_hj15")
     c.Fail("model", "expected 'emg_torque_hj15' (a file written by exotwin emg-fit)" + YamlLine(root["model"]));
   EmgTorqueModel m;
@@ -660,6 +798,7 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
   }
   if (const YAML::Node mc = root["missing_channels"])
     for (const auto& x : mc) m.missing.push_back(x.as<std::string>());
+  ReadEmgMsk(c, root, &m);
   const YAML::Node p = root["parameters"];
   if (!p || !p.IsMap()) c.Fail("parameters", "expected hip: and knee: lists of parameters");
   const std::map<std::string, TermKind> kinds = {{"alpha", TermKind::kAlpha},   {"alpha_q", TermKind::kAlphaQ},

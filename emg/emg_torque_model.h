@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "emg/emg_msk_model.h"
 #include "emg/emg_recording.h"
 
 namespace exotwin {
@@ -143,6 +144,10 @@ struct EmgTorqueModel {
   bool folds_are_recordings = false;
   EmgCalibrationRange range;         // of the recordings fitted
   int nonlinear_parameters() const;  // delays and A
+  // The musculoskeletal form (emg_msk_model.h) beside this linear one, and per joint which of the two
+  // predicts (issue 42: chosen by the same blocked cross-validation; the linear form otherwise).
+  EmgMskModel msk;
+  bool msk_form[2] = {false, false};
 };
 
 // The terms of `spec` for the channels of `rec` (coefficients zero).
@@ -162,8 +167,21 @@ std::vector<double> ChannelEnvelope(const EmgRecording& rec, const std::string& 
 // Throws InputError when the recording lacks the term's channel.
 std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, const EmgRecording& rec);
 
-// Estimated joint moment (N m) at joint j on every sample of `rec`.
+// Estimated joint moment (N m) at joint j on every sample of `rec`: the linear form's, or at a joint in
+// the musculoskeletal form its moment, except on the samples where a muscle spanning the joint leaves
+// its calibrated fibre length or velocity: there the linear form, validated on the same calibration,
+// stands in (PredictMoments says where).
 std::vector<double> PredictMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint);
+
+struct EmgPrediction {
+  std::vector<double> tau[2];       // N m
+  std::vector<char> fallback[2];    // samples predicted by the linear form in place of the musculoskeletal one
+  double fallback_share[2] = {0, 0};
+  EmgMskSeries msk;                 // the musculoskeletal series (empty without msk.present)
+};
+EmgPrediction PredictMoments(const EmgTorqueModel& model, const EmgRecording& rec);
+// The linear form's moment (HJ15 eq. 26 and the loop's terms), whatever the joint's form.
+std::vector<double> PredictLinearMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint);
 
 // Indices of the samples [a, b) of x within kSpikeMads scaled MADs of their median.
 std::vector<size_t> WithinSpikeLimit(const std::vector<double>& x, size_t a, size_t b);

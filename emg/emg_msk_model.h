@@ -1,0 +1,87 @@
+// The musculoskeletal form of the EMG-driven joint moment (issue 42), beside the linear form of
+// emg_torque_model.h, in CEINMS's family (Lloyd & Besier 2003; Pizzolato et al. 2015, CEINMS):
+// each recorded channel drives one musculotendon unit (sim/musculotendon.h) whose force acts at
+// every joint its path crosses through the moment arm of that path (a biarticular muscle: one force,
+// two moments). Per joint j:
+//
+//   tau_j(t) = sum_c s_c F_max,c (a_c(t) f_L(l_c) f_V(v_c) + f_PE(l_c)) cos(phi_c) r_c,j(q)
+//              + beta_j q_j + gamma_j qd_j + offset_j
+//   a_c(t)   = the activation of emg_torque_model.h: A-shape (LB03 eq. 2) of the twitch-filtered
+//              envelope delayed by the electromechanical delay (one common A and delay here)
+//   l_c, v_c = fibre length and velocity of the rigid-tendon unit at the path length L_c(q) and its
+//              rate -sum_j r_c,j qd_j (sim/musculotendon.h RigidTendonState)
+//
+// beta, gamma, offset carry what the recorded muscles do not (the muscles nobody recorded, passive
+// tissues): the terms of the linear form's remainder (HJ15 eq. 26).
+// Calibrated parameters and their bounds (CEINMS-RT's calibration,
+// StrengthCoefficients_ShapeFactor_TendonSlackLength_single: strength 0.5-1.5 x F_max, A in (-3, 0),
+// tendon slack length +-5 % and optimal fibre length +-2.5 % of the subject-scaled model):
+// s_c within [0.5, 1.5] (bounded least squares, with beta, gamma, offset free, rows of both joints
+// weighted by 1/SD of each joint's moment and the contact spikes left out); l_opt,c and l_ts,c within
+// their bounds of the scaled gait2392 values (ScaledMusculotendon), searched channel by channel;
+// A and the common delay (10-100 ms, Cavanagh & Komi 1979) searched on the nominal lengths first.
+#pragma once
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "emg/emg_recording.h"
+#include "sim/musculotendon.h"
+
+namespace exotwin {
+
+// Bounds of the calibration (header).
+constexpr double kTendonSlackChange = 0.05;                 // +- fraction of the nominal l_ts
+constexpr double kOptimalFibreChange = 0.025;               // +- fraction of the nominal l_opt
+
+struct EmgMskMuscle {
+  std::string channel;
+  Muscle muscle = Muscle::kVM;          // the path (sim/musculotendon.h)
+  MusculotendonParams nominal;          // F_max of the channel's actuator, lengths of its path, scaled
+  double strength = 1;                  // x F_max
+  double strength_lo = kStrengthLo, strength_hi = kStrengthHi;  // its bounds (a map file may narrow them)
+  double l_opt = 0, l_ts = 0;           // m
+  // Calibrated range of the muscle's state (emg-predict's fallback): normalized fibre length and
+  // velocity over the calibration samples.
+  double fibre_lo = 0, fibre_hi = 0, velocity_lo = 0, velocity_hi = 0;
+  MusculotendonParams Params() const;   // nominal with the calibrated lengths
+};
+
+struct EmgMskModel {
+  bool present = false;
+  double delay = 0, twitch = 0, a_shape = 0;  // s, s, 1
+  std::vector<EmgMskMuscle> muscles;
+  double beta[2] = {0, 0}, gamma[2] = {0, 0}, offset[2] = {0, 0};
+  // Cross-validation (the folds of the linear form; lengths, A and delay searched again in every fold)
+  // and fit figures per joint, within kSpikeMads of the median moment.
+  double r2_cv[2] = {0, 0}, rms_cv[2] = {0, 0}, r2_fit[2] = {0, 0};
+  // Share of the calibration moment the recorded muscles can reach at all (item 2): sum over the
+  // scored samples of min(|tau|, M) / sum |tau|, M the moment of every muscle pulling in tau's
+  // direction at full activation and kStrengthHi F_max (the others silent).
+  double reachable_share[2] = {0, 0};
+  double seconds = 0;  // run time of the calibration (cross-validation included)
+};
+
+// Time series of a calibrated model on a recording.
+struct EmgMskSeries {
+  std::vector<double> tau[2];                         // N m
+  std::vector<std::vector<double>> force, fibre;      // per muscle: N, l/l_opt
+  std::vector<std::vector<double>> velocity;          // per muscle: v/v_max
+  // Samples where a muscle spanning joint j leaves its calibrated fibre length or velocity range.
+  std::vector<char> outside[2];
+};
+// Throws InputError when the recording lacks a channel of the model.
+EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec);
+
+struct EmgMskFitOptions {
+  int blocks = 5;          // one recording: contiguous cross-validation blocks
+  bool cross_validate = true;
+  std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
+};
+
+// Calibrates the form on recordings with moments (same channels). Channels whose gait2392 actuator
+// is unknown take their twin muscle's path actuator (sim/musculotendon.h GenericMusculotendon).
+EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitch, const EmgMskFitOptions& opt = {});
+
+}  // namespace exotwin
