@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "formats/csv_table.h"
+#include "core/output_path.h"
 #include "controller/exo_controller.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
@@ -257,7 +258,7 @@ RunResult RunExowheelScenario(const Scenario& s, const RunOptions& opt) {
   RunResult result;
   result.scenario = s.name;
   result.seed = opt.seed ? *opt.seed : s.seed;
-  std::filesystem::create_directories(opt.out_dir);
+  CreateOutputFolder(opt.out_dir);
 
   const LegParams truth = ResolveSubject(s);
   Plant plant(ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
