@@ -15,6 +15,7 @@
 #include "formats/csv_table.h"
 #include "app/bench_probes.h"  // ScopedCpuPin
 #include "app/commands.h"
+#include "core/output_path.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "batch/controller_process.h"
@@ -55,9 +56,14 @@ CommandRunner RegisterRegress(CLI::App& app) {
       if (controller_bin.empty() || ::access(controller_bin.c_str(), X_OK) != 0)
         throw InputError("--controller-bin: '" + controller_bin + "': no exotwin-controller executable there");
     }
-    std::filesystem::create_directories(o->out);
+    CreateOutputFolder(o->out);
     auto dir_of = [&](size_t i) { return o->out + "/" + suite[i].scenario.name; };
 
+    for (size_t i = 0; i < suite.size(); ++i) {  // every job's scenario checked before the first job starts
+      RunOptions opt;
+      opt.out_dir = dir_of(i);
+      CheckScenarioRun(suite[i].scenario, opt);
+    }
     for (const SuiteEntry& e : suite) KeepScenarioModel(e.scenario);  // loaded once: the workers inherit it
     const int workers = o->jobs > 0 ? o->jobs : DefaultWorkers();
     const std::vector<int> cpus = AllowedCpus();

@@ -3,15 +3,14 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <sys/stat.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/output_path.h"
 #include "diagnosis/replay.h"
 #include "formats/column_map.h"
 #include "formats/csv_table.h"
@@ -117,8 +116,7 @@ CommandRunner RegisterReplay(CLI::App& app) {
     if (params.one_joint) j["one_joint"] = true;
     for (int k = j0; k < 2; ++k) j["joints"][names[k]] = {{"rmse_rad", total.Rmse(k)}};
 
-    if (mkdir(o->out.c_str(), 0755) != 0 && errno != EEXIST)
-      throw InputError(o->out + ": cannot create the output folder: " + std::strerror(errno));
+    CreateOutputFolder(o->out);
     std::vector<std::string> csv_names = {"t", "q_hip", "q_hip_sim", "q_knee", "q_knee_sim", "window", "record"};
     std::vector<const std::vector<double>*> csv_cols = {&col_t, &col_q[0], &col_sim[0], &col_q[1], &col_sim[1], &col_w, &col_r};
     if (params.one_joint) {  // no hip columns

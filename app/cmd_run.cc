@@ -174,6 +174,12 @@ CommandRunner RegisterServe(CLI::App& app) {
       std::fprintf(stderr, "exotwin serve: note: UDP on %s, not loopback: torque commands cross the network\n",
                    address.host.c_str());
     const OutFolderLock lock(o->out);
+    {  // the scenario's files and outputs checked before the link opens and the controller is awaited
+      RunOptions check;
+      check.out_dir = o->out;
+      check.can_log = o->can_log;
+      CheckScenarioRun(s, check);
+    }
     const std::string controller_file = WriteControllerFile(s, o->out, *seed ? o->seed : s.seed);
     std::unique_ptr<CanLink> link = CanLink::Open(address, LinkEnd::kTwin);
     if (address.kind != BusKind::kSocketCan) link->SetSpin(1e-6 * o->link_spin_us);

@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/file_text.h"
 #include "sim/plant.h"
 
 namespace {
@@ -39,6 +40,12 @@ int main(int argc, char** argv) {
   if (const char* f = std::getenv("EXOTWIN_PEAK_FILE"); f && *f) {
     g_peak_file = f;
     std::atexit(WritePeak);
+  }
+  try {  // every value is valid text before any is used (and later written to JSON, CSV or HTML)
+    exotwin::CheckCommandLine(argc, argv);
+  } catch (const exotwin::InputError& e) {
+    std::fprintf(stderr, "exotwin: error: %s\n", e.what());
+    return 2;
   }
   CLI::App app{"exotwin: digital twin of a leg in a rehabilitation exoskeleton"};
   app.require_subcommand(1);

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "formats/csv_table.h"
+#include "core/output_path.h"
 #include "core/error.h"
 #include "core/file_text.h"
 
@@ -64,7 +65,7 @@ void WriteBaseline(const Baseline& b, const std::string& path) {
     j["tolerance"] = t;
   }
   const auto parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
+  if (!parent.empty()) CreateOutputFolder(parent);
   WriteFileAtomic(path, j.dump(2) + "\n");
 }
 

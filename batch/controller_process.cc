@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "formats/csv_table.h"
+#include "core/output_path.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "protocol/can_link.h"
@@ -25,7 +26,7 @@ namespace fs = std::filesystem;
 
 std::string WriteControllerFile(const Scenario& s, const std::string& dir, uint64_t seed) {
   if (s.emg_calibration) return "";
-  fs::create_directories(dir);
+  CreateOutputFolder(dir);
   const std::string path = dir + "/controller.yaml";
   // Whole or absent (a controller may be started as soon as the file appears).
   WriteFileAtomic(path, s.device == Device::kHal3

@@ -47,6 +47,11 @@ SweepOutcome RunSweep(const SweepOptions& opt) {
   m.seed = opt.seed;
   if (opt.sharded) m.shard = opt.shard;
 
+  for (const Scenario& s : scenarios) {  // every job's scenario checked before the first job starts
+    RunOptions ro;
+    ro.out_dir = opt.out_dir;
+    CheckScenarioRun(WithPopulationSubject(s, opt.seed, 0), ro);
+  }
   for (const Scenario& s : scenarios) KeepScenarioModel(s);  // loaded once: the workers inherit it
   const std::vector<SweepJob> jobs = PlanSweep(scenarios.size(), opt.subjects, opt.shard);
   auto dir_of = [&](const SweepJob& j) {

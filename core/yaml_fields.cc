@@ -1,5 +1,7 @@
 #include "core/yaml_fields.h"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <cmath>
 #include <sstream>
 
@@ -15,6 +17,29 @@ std::string List(const std::set<std::string>& items) {
   for (const auto& a : items) list += (list.empty() ? "" : ", ") + a;
   return list;
 }
+
+// Checks every scalar (keys included) the YAML text gives: a double-quoted string's escapes
+// ("\xC1", "\uD800", "\0", "\e") can make invalid text out of valid text.
+class ScalarCheck : public YAML::EventHandler {
+ public:
+  explicit ScalarCheck(const std::string& source) : source_(source) {}
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+    if (const auto f = FindTextFault(value))
+      throw InputError(source_ + ": line " + std::to_string(mark.line + 1) + ": a string holds " + f->Where() +
+                       " of its value, expected UTF-8 text without control characters (check its escape sequences)");
+  }
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+
+ private:
+  const std::string& source_;
+};
 
 }  // namespace
 
@@ -92,7 +117,15 @@ std::string ReadYamlText(const std::string& path, const std::string& what) {
 }
 
 YAML::Node ParseYaml(const std::string& text, const std::string& source) {
+  CheckText(text, source, "a YAML text");
   try {
+    if (text.find('\\') != std::string::npos) {  // escapes only exist after a backslash
+      std::istringstream in(text);
+      YAML::Parser parser(in);
+      ScalarCheck check(source);
+      while (parser.HandleNextDocument(check)) {
+      }
+    }
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": line " + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);

@@ -9,6 +9,7 @@
 
 #include "controller/controller_config.h"
 #include "core/error.h"
+#include "core/file_text.h"
 #include "core/realtime.h"
 #include "core/stop_signal.h"
 #include "core/yaml_fields.h"
@@ -38,6 +39,11 @@ int main(int argc, char** argv) {
   std::string config, bus, what = "--bus";
   double spin_us = 1e6 * kDefaultLinkSpin;
   int rt_priority = 0;
+  try {
+    CheckCommandLine(argc, argv);
+  } catch (const InputError& e) {
+    return Usage(e.what());
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") {

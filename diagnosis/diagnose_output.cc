@@ -1,9 +1,7 @@
 // diagnosis.json, extended.yaml and the report of a Diagnosis (DESIGN.md "diagnose").
 #include <nlohmann/json.hpp>
 
-#include <sys/stat.h>
 
-#include <cerrno>
 #include <cstring>
 
 #include "formats/csv_table.h"
@@ -12,6 +10,7 @@
 #include "formats/model_file.h"
 #include "formats/number_text.h"
 #include "core/error.h"
+#include "core/output_path.h"
 
 namespace exotwin {
 
@@ -116,8 +115,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
 
 void WriteDiagnosis(const Diagnosis& d, const std::string& dir, const std::string& params_path,
                     const std::string& measured_path) {
-  if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
-    throw InputError(dir + ": cannot create the output folder: " + std::strerror(errno));
+  CreateOutputFolder(dir);
   WriteFileAtomic(dir + "/diagnosis.json", DiagnosisJson(d));
   std::string header = "exotwin diagnose: " + params_path + " extended with the effects found in " +
                        measured_path;

@@ -2,10 +2,8 @@
 // of `exotwin diagnose` (diagnose_output.cc) where the concepts match.
 #include <nlohmann/json.hpp>
 
-#include <sys/stat.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -15,6 +13,7 @@
 #include "formats/number_text.h"
 #include "formats/svg_chart.h"
 #include "core/error.h"
+#include "core/output_path.h"
 
 namespace exotwin {
 namespace {
@@ -259,8 +258,7 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
 }
 
 void WriteEmgDiagnosis(const EmgDiagnosis& d, const std::string& dir) {
-  if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
-    throw InputError(dir + ": cannot create the report folder: " + std::strerror(errno));
+  CreateOutputFolder(dir);
   WriteFileAtomic(dir + "/diagnosis.json", EmgDiagnosisJson(d));
   WriteFileAtomic(dir + "/report.html", EmgDiagnosisHtml(d));
 }

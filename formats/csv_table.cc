@@ -9,11 +9,13 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <stdexcept>
 #include <string_view>
 
 #include "formats/number_rows.h"
 #include "core/error.h"
 #include "core/file_text.h"
+#include "core/output_path.h"
 #include "core/realtime.h"
 
 namespace exotwin {
@@ -317,7 +319,42 @@ CsvTable ReadCsv(const std::string& path) {
   return t;
 }
 
+namespace {
+
+// The comment lines and the header row the writers put first, so that ReadCsv reads back exactly
+// `names` whatever they hold (a foreign column named `note, "raw"` or `#1`): a name holding a comma,
+// a quote, a line break, leading or trailing blanks, or starting with '#' is quoted (RFC 4180,
+// quotes doubled); a comment holding line breaks becomes one '# ' line per line.
+std::string CsvHead(const std::vector<std::string>& comments, const std::vector<std::string>& names) {
+  std::string head;
+  for (const auto& c : comments) {
+    for (size_t b = 0;;) {
+      const size_t e = c.find_first_of("\r\n", b);
+      head += "# " + c.substr(b, e == std::string::npos ? std::string::npos : e - b) + "\n";
+      if (e == std::string::npos) break;
+      b = e + 1;
+    }
+  }
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string& n = names[i];
+    const bool quote = n.find_first_of(",\"\r\n") != std::string::npos || (!n.empty() && (Blank(n.front()) || Blank(n.back()))) ||
+                       (i == 0 && !n.empty() && n[0] == '#');
+    head += i ? "," : "";
+    if (!quote) {
+      head += n;
+      continue;
+    }
+    head += '"';
+    for (char ch : n) head += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    head += '"';
+  }
+  return head + "\n";
+}
+
+}  // namespace
+
 void WriteFileAtomic(const std::string& path, const std::string& text) {
+  CreateParentFolders(path);
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -334,14 +371,17 @@ void WriteCsv(const std::string& path, const std::vector<std::string>& names,
               const std::vector<const std::vector<double>*>& columns,
               const std::vector<std::string>& comments) {
   // Streamed to the temporary file in blocks of about 1 MiB (the text of a long record is never
-  // held whole), then renamed as WriteFileAtomic does.
+  // held whole), then renamed as WriteFileAtomic does. Columns of unequal length are the caller's bug.
+  for (const auto* c : columns)
+    if (columns.size() != names.size() || c->size() != columns[0]->size())
+      throw std::invalid_argument(path + ": WriteCsv: " + std::to_string(names.size()) + " names for " +
+                                  std::to_string(columns.size()) + " columns of unequal length");
+  CreateParentFolders(path);
   const std::string tmp = path + ".tmp";
   std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
   if (!file) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
   std::string out;
-  for (const auto& c : comments) out += "# " + c + "\n";
-  for (size_t i = 0; i < names.size(); ++i) out += (i ? "," : "") + names[i];
-  out += "\n";
+  out += CsvHead(comments, names);
   constexpr size_t kBlock = size_t{1} << 20;
   out.reserve(kBlock + 1024);
   const size_t n = columns.empty() ? 0 : columns[0]->size();
@@ -450,12 +490,11 @@ CsvStreamWriter::CsvStreamWriter(const std::string& path, const std::vector<std:
     : path_(path), columns_(std::max<size_t>(names.size(), 1)), flush_rows_(flush_rows ? flush_rows : 1),
       writer_(std::make_unique<Writer>()) {
   Writer& w = *writer_;
+  CreateParentFolders(path);
   w.fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (w.fd < 0) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
   std::string head = std::string(kStreamMarker) + "\n";
-  for (const auto& c : comments) head += "# " + c + "\n";
-  for (size_t i = 0; i < names.size(); ++i) head += (i ? "," : "") + names[i];
-  head += "\n";
+  head += CsvHead(comments, names);
   const std::string e = w.WriteAll(head.data(), head.size());
   if (!e.empty()) {
     ::close(w.fd);

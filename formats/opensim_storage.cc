@@ -88,6 +88,7 @@ std::vector<double> StorageTable::AngleRad(const std::string& name) const {
 }
 
 StorageTable ParseStorage(const std::string& text, const std::string& source) {
+  CheckText(text, source, "an OpenSim storage (.sto/.mot) text");  // labels are written to CSV and JSON
   StorageTable t;
   t.source = source;
   std::vector<std::string> lines;

@@ -39,7 +39,8 @@ struct StorageTable {
   std::vector<double> AngleRad(const std::string& name) const;
 };
 
-// Parses storage text; `source` names it in messages.
+// Parses storage text; `source` names it in messages. Text that is not valid (core/file_text.h
+// CheckText: UTF-8 without control characters) is an InputError naming its line and byte.
 StorageTable ParseStorage(const std::string& text, const std::string& source);
 // Reads and parses a storage file; throws InputError when it cannot be read.
 StorageTable ReadStorage(const std::string& path);

@@ -16,6 +16,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!f) return 0;
   if (size) std::fwrite(data, 1, size, f);
   std::fclose(f);
-  exotwin::fuzz::MeasuredCsvFile(path);
+  exotwin::fuzz::MeasuredCsvFile(path, tmp.path());
   return 0;
 }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "core/output_path.h"
 
 namespace exotwin {
 namespace {
@@ -60,6 +61,7 @@ std::string FormatCandumpLine(const CanFrame& f, const std::string& interface, i
 
 CandumpWriter::CandumpWriter(const std::string& path, std::string interface, int64_t epoch_s)
     : path_(path), interface_(std::move(interface)), epoch_s_(epoch_s), line_(LineCapacity(interface_), '\0') {
+  CreateParentFolders(path);
   file_ = std::fopen(path.c_str(), "w");
   if (!file_) throw InputError(path + ": cannot create CAN log: " + std::strerror(errno));
 }
@@ -84,6 +86,8 @@ bool CandumpReader::Next(CandumpRecord* out) {
   std::string line;
   while (std::getline(in_, line)) {
     ++line_;
+    if (!text_.Feed(line.data(), line.size()) || (!in_.eof() && !text_.Feed("\n", 1)) || (in_.eof() && !text_.End()))
+      throw InputError(path_ + ": " + text_.fault()->Where() + ", expected a candump log");
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const std::string where = path_ + ":" + std::to_string(line_) + ": ";

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file_text.h"
 #include "protocol/can_frame.h"
 
 namespace exotwin {
@@ -48,7 +49,7 @@ class CandumpReader {
   // Opens path; epoch_s (s) is subtracted from every time stamp. Throws InputError if unreadable.
   explicit CandumpReader(const std::string& path, int64_t epoch_s = 0);
   // Reads the next frame into *out; false at end of file. Empty lines are skipped. Throws
-  // InputError naming the file and line for a malformed line, an extended (29-bit) ID, a remote or
+  // InputError naming the file and line for a line that is not valid text (core/file_text.h), a malformed line, an extended (29-bit) ID, a remote or
   // a CAN FD frame (only classic 11-bit data and error frames are supported).
   bool Next(CandumpRecord* out);
   // Reads every frame of a log (throws like Next).
@@ -57,6 +58,7 @@ class CandumpReader {
  private:
   std::string path_;
   std::ifstream in_;
+  TextCheck text_;
   int64_t epoch_s_;
   int line_ = 0;
 };

@@ -9,6 +9,7 @@
 
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "core/output_path.h"
 #include "render/render_plugin_abi.h"
 
 namespace exotwin {
@@ -64,6 +65,7 @@ void LoadRenderPlugin() {
 
 std::unique_ptr<VideoSink> OpenVideo(const mjModel_* m, const std::string& out_path, const RenderOptions& opt) {
   LoadRenderPlugin();
+  CreateParentFolders(out_path);
   return std::unique_ptr<VideoSink>(g_table->open_video(m, out_path, opt));
 }
 

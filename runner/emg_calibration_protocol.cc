@@ -15,6 +15,7 @@
 #include "formats/measured_data.h"
 #include "dsp/statistics.h"
 #include "controller/muscular_torque.h"
+#include "core/output_path.h"
 #include "core/error.h"
 #include "dsp/emg_envelope.h"
 #include "dsp/mvc.h"
@@ -151,7 +152,7 @@ MuscleVec Normalized(const std::vector<std::vector<double>>& env, size_t k, cons
 // pose, seated) into DIR/mvc/; returns the MVC per muscle (V), adds files and mvc_* metrics to result.
 MuscleVec MvcStage(const Scenario& s, const MuscleParams& mp, const RunOptions& opt, RunResult& result) {
   const EmgCalibrationSpec& cal = *s.emg_calibration;
-  fs::create_directories(opt.out_dir + "/mvc");
+  CreateOutputFolder(opt.out_dir + "/mvc");
   MuscleVec mvc;
   for (int c = 0; c < kNumMuscles; ++c) {
     const Muscle mu = MuscleAt(c);
@@ -415,7 +416,7 @@ RunResult CalibrateOneSubject(const Scenario& s, const RunOptions& opt, uint64_t
   RunResult result;
   result.scenario = s.name;
   result.seed = seed;
-  fs::create_directories(opt.out_dir);
+  CreateOutputFolder(opt.out_dir);
   const std::optional<Subject> subject = ScenarioSubject(s);
   if (!subject) throw InputError(s.source + ": subject: emg_calibration needs preset or random_seed");
   const MuscleParams mp = DrawMuscleParams(s.human.muscle_seed);

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "formats/csv_table.h"
+#include "core/output_path.h"
 #include "controller/exo_controller.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
@@ -318,7 +319,7 @@ ExowheelSession::ExowheelSession(const Scenario& s, const RunOptions& opt) {
   RunResult& result = (st_ = std::make_unique<State>(s, opt))->result;
   result.scenario = s.name;
   result.seed = opt.seed ? *opt.seed : s.seed;
-  std::filesystem::create_directories(opt.out_dir);
+  CreateOutputFolder(opt.out_dir);
 
   Plant& plant = st_->plant;
   plant.SetParams(st_->truth);

@@ -15,6 +15,7 @@
 #include "controller/hal_loop.h"
 #include "hwsim/emg_node.h"
 #include "hwsim/hal3_knee_node.h"
+#include "core/output_path.h"
 #include "core/error.h"
 #include "protocol/candump.h"
 #include "runner/cosim_rig.h"
@@ -311,7 +312,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   RunResult result;
   result.scenario = s.name;
   result.seed = opt.seed ? *opt.seed : s.seed;
-  std::filesystem::create_directories(opt.out_dir);
+  CreateOutputFolder(opt.out_dir);
   std::unique_ptr<CandumpWriter> can_log;
   if (!opt.can_log.empty()) can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
   const auto wall0 = std::chrono::steady_clock::now();

@@ -9,17 +9,16 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/output_path.h"
 
 namespace exotwin {
 
 OutFolderLock::OutFolderLock(const std::string& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw InputError("--out " + dir + ": exists and is not a folder, expected a folder for the run's files "
-                     "(created when missing)");
-  fs::create_directories(dir, ec);
-  if (ec) throw InputError("--out " + dir + ": cannot create the folder (" + ec.message() + ")");
+  try {
+    CreateOutputFolder(dir);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--out ") + e.what());
+  }
   const std::string path = dir + "/" + kOutFolderLockName;
   fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0) throw InputError("--out " + dir + ": cannot create " + path + " (" + std::strerror(errno) + ")");

@@ -1,29 +1,24 @@
-// RunScenario's dispatch to the device runners, the scenario's subject, and the end of a run
-// (checks, result.json): see runner.h.
+// RunScenario's dispatch to the device runners and the scenario's subject: see runner.h. The end of a
+// run (checks, result.json) is in run_result.cc.
 #include "runner/runner.h"
 
-#include <nlohmann/json.hpp>
+#include <filesystem>
+#include <system_error>
 
-#include <algorithm>
-#include <limits>
-
-#include "formats/csv_table.h"
 #include "formats/model_file.h"
 #include "core/error.h"
-#include "core/stop_signal.h"
+#include "core/output_path.h"
 #include "runner/emg_calibration_protocol.h"
 #include "runner/exowheel_runner.h"
+#include "runner/exowheel_setup.h"
 #include "runner/hal_runner.h"
 #include "sim/mjcf_cache.h"
 #include "sim/muscles.h"
 #include "sim/plant.h"
+#include "sim/plant_effects.h"
 #include "sim/subjects.h"
 
 namespace exotwin {
-
-bool RunResult::all_passed() const {
-  return std::all_of(checks.begin(), checks.end(), [](const CheckResult& c) { return c.passed; });
-}
 
 std::optional<Subject> ScenarioSubject(const Scenario& s) {
   if (!s.subject.preset.empty()) return PresetSubject(s.subject.preset);
@@ -63,73 +58,30 @@ void KeepScenarioModel(const Scenario& s) {
                                           : ExowheelMjcfPath(s.device != Device::kExowheelExoOnly));
 }
 
+void CheckScenarioRun(const Scenario& s, const RunOptions& opt) {
+  const LegParams truth = ResolveSubject(s);
+  if (!s.plant_effects.empty()) {  // as RunExowheelScenario hands them to the plant
+    LegParams carried = truth;
+    carried.effects = s.plant_effects;
+    ToPlantEffects(carried, s.plant_effects_source);
+  }
+  if (s.device != Device::kHal3 && !s.emg_calibration && s.protocol.trajectory == TrajectoryKind::kFile)
+    ReferenceOf(s);  // reads the motion file
+  CreateOutputFolder(opt.out_dir);
+  if (!opt.video_path.empty()) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(opt.video_path, ec))
+      throw InputError(opt.video_path + ": is a folder, expected the video file to write (.mp4)");
+    CreateParentFolders(opt.video_path);
+  }
+  if (!opt.can_log.empty()) CreateParentFolders(opt.can_log);
+}
+
 RunResult RunScenario(const Scenario& s, const RunOptions& opt) {
+  CheckScenarioRun(s, opt);
   if (s.device == Device::kHal3) return RunHalScenario(s, opt);
   if (s.emg_calibration) return RunEmgCalibrationScenario(s, opt);
   return RunExowheelScenario(s, opt);
-}
-
-namespace {
-
-// The checks on `m`; a check whose metric is missing is failed with value NaN and named in *unknown.
-std::vector<CheckResult> Checks(const Scenario& s, const std::map<std::string, double>& m,
-                                std::string* unknown) {
-  std::vector<CheckResult> out;
-  for (const CheckSpec& c : s.checks) {
-    CheckResult r;
-    r.name = c.name;
-    r.metric = c.metric;
-    r.op = c.op;
-    r.limit = c.limit;
-    auto it = m.find(c.metric);
-    if (it == m.end()) {
-      if (unknown->empty()) {
-        std::string list;
-        for (const auto& kv : m) list += (list.empty() ? "" : ", ") + kv.first;
-        *unknown = s.source + ": checks: unknown metric '" + c.metric + "', expected one of: " + list;
-      }
-      r.value = std::numeric_limits<double>::quiet_NaN();
-      r.passed = false;
-    } else {
-      r.value = it->second;
-      r.passed = c.op == "<=" ? r.value <= c.limit : r.value >= c.limit;
-    }
-    out.push_back(r);
-  }
-  return out;
-}
-
-}  // namespace
-
-void FinishRun(const Scenario& s, RunResult& result, const std::string& path) {
-  std::string unknown;
-  result.checks = Checks(s, result.metrics, &unknown);
-  if (result.interrupted) {
-    for (CheckResult& c : result.checks) c.passed = false;
-    unknown.clear();
-  }
-  WriteResultJson(result, path);
-  if (!unknown.empty()) throw InputError(unknown + " (the run's metrics are in " + path + ")");
-}
-
-void WriteResultJson(const RunResult& r, const std::string& path) {
-  nlohmann::json j;
-  j["scenario"] = r.scenario;
-  j["seed"] = r.seed;
-  j["checks"] = nlohmann::json::array();
-  for (const CheckResult& c : r.checks)
-    j["checks"].push_back({{"name", c.name}, {"metric", c.metric}, {"op", c.op}, {"passed", c.passed},
-                           {"value", c.value}, {"limit", c.limit}});
-  j["metrics"] = nlohmann::json::object();
-  for (const auto& kv : r.metrics) j["metrics"][kv.first] = kv.second;
-  j["files"] = r.files;
-  j["events"] = r.events;
-  if (r.interrupted)
-    j["interrupted"] = {{"signal", r.interrupted->signal},
-                        {"name", StopSignalName(r.interrupted->signal)},
-                        {"t_s", r.interrupted->t},
-                        {"trial", r.interrupted->trial}};
-  WriteFileAtomic(path, j.dump(2) + "\n");
 }
 
 }  // namespace exotwin

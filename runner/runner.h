@@ -88,10 +88,18 @@ std::optional<Subject> ScenarioSubject(const Scenario& s);
 // run_seed): the runner plays it, and the EMG calibration protocol reads its blocks (s, fraction of MVC).
 ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed);
 
+// Everything the run of `s` with `opt` reads or writes besides the scenario file, checked before
+// anything runs: the subject's model file, the effects the plant carries (as the plant takes them),
+// the recorded trajectory of trajectory: file, an empty or folder video path; the folders of the
+// outputs (out_dir, video, CAN log) are created. Throws InputError. RunScenario calls it first; sweep
+// and regress call it for every job before the first job starts. (The check metrics are checked
+// when the scenario is read: runner/scenario_metrics.h.)
+void CheckScenarioRun(const Scenario& s, const RunOptions& opt);
+
 // Runs the scenario with the runner of its kind: device hal3 -> RunHalScenario (hal_runner.h); an
 // emg_calibration block -> RunEmgCalibrationScenario (emg_calibration_protocol.h); otherwise the
 // EXOwheel closed loop (gait, identification excitation or hold) -> RunExowheelScenario
-// (exowheel_runner.h). Each writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
+// (exowheel_runner.h), after CheckScenarioRun. Each writes DIR/result.json, DIR/measured[_trialN].csv (the rig's view:
 // encoder angles, torque-sensor readings, commands) and DIR/truth[_trialN].csv (plant state and applied
 // torque). Throws InputError on bad scenario content and SimulationError on divergence (the logs
 // written so far stay on disk).

@@ -9,7 +9,9 @@
 
 #include "core/error.h"
 #include "formats/model_file.h"
+#include "formats/number_text.h"
 #include "core/yaml_fields.h"
+#include "runner/scenario_metrics.h"
 #include "sim/subjects.h"
 
 namespace exotwin {
@@ -83,6 +85,11 @@ void ParseEmgCalibration(const YamlContext& r, const YAML::Node& n, Scenario& s)
 void ParseHeader(const YamlContext& r, const YAML::Node& root, Scenario& s) {
   if (!root["name"]) r.Fail("name", "missing, expected the scenario's name");
   s.name = YamlString(r, root["name"], "name");
+  // The name names folders (sweep's runs/<name>/, regress's <name>/) and files: one plain file name.
+  if (s.name.empty() || s.name == "." || s.name == ".." || s.name.find('/') != std::string::npos ||
+      s.name.size() > 200 || s.name.find_first_of("\n\r\t") != std::string::npos)
+    r.Fail("name", "'" + s.name + "' cannot name a folder, expected a non-empty name of at most 200 bytes without '/', "
+                   "tab or line break, other than '.' and '..'" + YamlLine(root["name"]));
   if (root["seed"]) s.seed = static_cast<uint64_t>(YamlNumber(r, root["seed"], "seed", 0, 1e15));
 
   if (!root["device"]) r.Fail("device", "missing, expected exowheel, exowheel_exo_only or hal3");
@@ -327,6 +334,12 @@ Scenario ParseScenarioYaml(const std::string& text, const std::string& source) {
   if (root["checks"] && !root["checks"].IsNull()) ParseChecks(r, root["checks"], s);
   if (s.emg_calibration) CheckEmgCalibration(r, root, s);
   if (root["plant"]) ParsePlant(r, root["plant"], s);
+  // The HAL-3 runner takes its metrics after hal.settle: a run no longer than that has none (and a
+  // sweep's criteria would divide by zero).
+  if (s.device == Device::kHal3 && !(s.protocol.duration > s.hal.settle))
+    r.Fail("protocol.duration", NumberText(s.protocol.duration) + " s leaves no time after hal.settle (" +
+                                    NumberText(s.hal.settle) + " s) for the metrics, expected a run longer than hal.settle");
+  CheckScenarioMetrics(s);  // a check the run cannot judge is refused now, not after the run
   return s;
 }
 

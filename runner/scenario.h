@@ -151,7 +151,8 @@ struct Scenario {
 };
 
 // Reads and validates a scenario file. Throws InputError naming the file, the key and what was
-// expected (unknown keys, wrong types, out-of-range values, unknown names).
+// expected (text that is not UTF-8, unknown keys, wrong types, out-of-range values, unknown names, a
+// check's metric the run cannot report: runner/scenario_metrics.h).
 Scenario ReadScenario(const std::string& path);
 Scenario ParseScenarioYaml(const std::string& text, const std::string& source);
 

@@ -14,6 +14,7 @@
 
 #include "formats/csv_table.h"
 #include "dsp/statistics.h"
+#include "core/output_path.h"
 #include "core/error.h"
 #include "core/file_text.h"
 #include "runner/sweep_plots.h"
@@ -180,7 +181,7 @@ SweepManifest ParseManifestJson(const std::string& text, const std::string& sour
 
 void WriteSweepAggregate(const std::string& dir, const SweepManifest& m, std::vector<SweepRow> rows) {
   SortRows(m, &rows);
-  std::filesystem::create_directories(dir + "/plots");
+  CreateOutputFolder(dir + "/plots");
   WriteFileAtomic(dir + "/sweep.csv", SweepCsv(rows));
   WriteFileAtomic(dir + "/summary.json", SweepSummaryJson(m, rows));
   WriteFileAtomic(dir + "/sweep.json", ManifestJson(m, rows.size()));

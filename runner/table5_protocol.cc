@@ -14,6 +14,7 @@
 #include "formats/model_file.h"
 #include "formats/number_text.h"
 #include "formats/csv_table.h"
+#include "core/output_path.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/rng.h"
@@ -149,7 +150,7 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   Table5Entry& e = run.entry;
   e.subject = subject;
   const std::string base = opt.out_dir + "/" + subject;
-  fs::create_directories(base);
+  CreateOutputFolder(base);
 
   const char* steps[4] = {"identification/step1_exo_knee.yaml", "identification/step2_exo_hip.yaml",
                           "identification/step3_knee.yaml", "identification/step4_hip.yaml"};

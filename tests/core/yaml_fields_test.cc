@@ -56,5 +56,24 @@ TEST(YamlFields, StringsBoolsAndKeys) {
   EXPECT_EQ(MessageOf([] { ParseYaml("a: [1\n", "f.yaml"); }).rfind("f.yaml: line ", 0), 0u);
 }
 
+// Text that is not valid UTF-8 (or holds a control character) is refused before it is parsed, and
+// so is a string whose escapes make such text out of valid text: every string of a parsed node can
+// be written to JSON as it is.
+TEST(YamlFields, InvalidTextAndEscapesAreRefused) {
+  EXPECT_EQ(MessageOf([] { ParseYaml("name: ok\nchecks: [{name: \"a\xc1\"}]\n", "s.yaml"); }),
+            "s.yaml: invalid UTF-8 (byte 0xC1) at line 2, byte 19, expected a YAML text");
+  // yaml-cpp writes the escape \N (U+0085) as the single byte 0x85: valid YAML text, invalid UTF-8 string.
+  EXPECT_EQ(MessageOf([] { ParseYaml("a: 1\nname: \"x\\xC1\\N\"\n", "s.yaml"); }),
+            "s.yaml: line 2: a string holds invalid UTF-8 (byte 0x85) at line 1, byte 4 of its "
+            "value, expected UTF-8 text without control characters (check its escape sequences)");
+  EXPECT_EQ(MessageOf([] { ParseYaml("{\"k\\e\": 1}\n", "s.yaml"); }).rfind("s.yaml: line 1: a string holds control character 0x1B", 0), 0u);
+  EXPECT_EQ(MessageOf([] { ParseYaml("a: \"\\x85\"\n", "s.yaml"); }).rfind("s.yaml: line 1: a string holds control character U+0085 (C1)", 0), 0u);
+  EXPECT_EQ(MessageOf([] { ParseYaml("a: \"\\0\"\n", "s.yaml"); }).rfind("s.yaml: line 1: a string holds binary data (NUL byte)", 0), 0u);
+  // Valid escapes and text pass.
+  const YAML::Node n = ParseYaml("a: \"caf\\xe9 \\u20ac \\t\"\nb: 'x\\y'\nc: |\n  two\n  lines\n", "s.yaml");
+  EXPECT_EQ(n["a"].Scalar(), "caf\xc3\xa9 \xe2\x82\xac \t");
+  EXPECT_EQ(n["b"].Scalar(), "x\\y");
+}
+
 }  // namespace
 }  // namespace exotwin

@@ -342,7 +342,7 @@ TEST(ReadCsv, ANulByteAnywhereComesBeforeAParseError) {
     ReadCsv(path);
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), path + ": binary data (NUL byte), expected a text CSV file");
+    EXPECT_EQ(std::string(e.what()), path + ": binary data (NUL byte) at line 1500003, byte 1, expected a text CSV file");
   }
   Spit(path, std::string(kStreamMarker) + "\n" + text + "4,");
   ::testing::internal::CaptureStderr();

@@ -42,12 +42,27 @@ const char kGood[] = "(1700000000.000000) can0 101#0102\n(1700000000.001000) can
 TEST(CandumpBadInput, TruncatedLastLine) {
   ExpectBad("truncated", std::string(kGood) + "(1700000000.00", ":3:", "missing ')' after the time stamp");
 }
+// Text that is not valid (core/file_text.h: UTF-8 without control characters) is refused before its
+// line is parsed, naming the line and the byte.
+void ExpectBadText(const std::string& tag, const std::string& content, const std::string& fault) {
+  const std::string path = WriteLog(tag, content);
+  try {
+    CandumpReader::ReadAll(path);
+    ADD_FAILURE() << tag << ": accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": " + fault + ", expected a candump log");
+  }
+  std::remove(path.c_str());
+}
+
 TEST(CandumpBadInput, BinaryJunkWithNul) {
-  ExpectBad("junk_nul", std::string("\x01\x02\0\xff\xfe junk\n", 11), ":1:", "missing '(' time stamp");
+  ExpectBadText("junk_nul", std::string("\x01\x02\0\xff\xfe junk\n", 11), "binary data (NUL byte) at line 1, byte 3");
 }
 TEST(CandumpBadInput, BinaryJunkHighBytes) {
-  ExpectBad("junk_high", std::string(kGood) + "(\xc3\x28\xa0\xa1.\xe2\x82) can0 1#\n", ":3:",
-            "time stamp is not sec.usec");
+  ExpectBadText("junk_high", std::string(kGood) + "(\xc3\x28\xa0\xa1.\xe2\x82) can0 1#\n",
+                "invalid UTF-8 (byte 0xC3 followed by 0x28) at line 3, byte 2");
+  ExpectBadText("junk_ctrl", std::string(kGood) + "(1700000000.002000) can\x1b" "0 103#00\n",
+                "control character 0x1B at line 3, byte 24");
 }
 TEST(CandumpBadInput, HugeTimeStamp) {
   ExpectBad("huge_stamp", "(99999999999999999999999.000001) can0 123#00\n", ":1:", "time stamp out of range");

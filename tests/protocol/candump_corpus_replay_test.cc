@@ -3,21 +3,15 @@
 // InputError (fuzz/harness_candump.h); any other exception is a failure.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <filesystem>
 
+#include "fuzz/corpus_files.h"
 #include "fuzz/harness_candump.h"
 
 namespace exotwin {
 namespace {
 
 TEST(CorpusReplay, CandumpReadsOrThrowsInputError) {
-  const std::filesystem::path dir =
-      std::filesystem::path(EXOTWIN_SOURCE_DIR) / "fuzz" / "corpus" / "fuzz_candump";
-  std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir))
-    if (e.is_regular_file()) files.push_back(e.path().string());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = fuzz::CorpusFiles(EXOTWIN_SOURCE_DIR, "fuzz_candump");
   ASSERT_GE(files.size(), 8u);
   int read = 0;
   for (const auto& f : files) {

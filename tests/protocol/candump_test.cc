@@ -119,7 +119,12 @@ TEST(Candump, MalformedLinesThrowWithLineNumber) {
     std::remove(path.c_str());
   }
   EXPECT_THROW(CandumpReader("/nonexistent/dir/x.log"), InputError);
-  EXPECT_THROW(CandumpWriter("/nonexistent/dir/x.log"), InputError);
+  // The writer creates the log's missing folders (core/output_path.h); a file in their way is an InputError.
+  const testing::ScopedTempDir tmp("candump_folders");
+  std::ofstream(tmp.File("f")) << "x";
+  EXPECT_THROW(CandumpWriter(tmp.File("f") + "/x.log"), InputError);
+  { CandumpWriter w(tmp.path() + "/a/b/x.log"); }
+  EXPECT_TRUE(std::ifstream(tmp.path() + "/a/b/x.log").good());
 }
 
 TEST(Candump, Log2AscConvertsOurLog) {

@@ -77,6 +77,11 @@ TEST(Scenario, RejectsBadInput) {
               "controller.kp: expected [hip, knee]");
   ExpectError("name: x\ndevice: exowheel\nsubject: {preset: S1}\nhuman: {outward_gate: -0.5}\n",
               "human.outward_gate: value -0.5 out of range");
+  // Found by the command-line fuzz (issue 43): a HAL sweep shorter than its settle time had no metrics
+  // and died after the run in NormalizeByMax ("internal error").
+  ExpectError("name: x\ndevice: hal3\nsubject: {preset: S1}\nprotocol: {duration: 2}\nhal: {sweep_viscosity: [0, 1]}\n",
+              "protocol.duration: 2 s leaves no time after hal.settle (4 s) for the metrics");
+  ExpectError("name: ../x\ndevice: exowheel\nsubject: {preset: S1}\n", "name: '../x' cannot name a folder");
 }
 
 TEST(Scenario, ExaggeratedGaitOutwardGate) {
