@@ -43,7 +43,7 @@ struct Rec {
   Kinematics kin;
   std::vector<double> taken[2];         // the record's tau_hip, tau_knee when Diagnose took it over
   const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
-  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots)
+  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots; released by stage 6)
   double hz = 0;                        // the parallel low-pass (0: none)
   // The twin: the rigid actuator torque (after stage 2 only on [0, RefineRows)) and the reading
   // with the model's effects (released by stage 6).
@@ -70,6 +70,21 @@ struct Rec {
   std::function<void(std::vector<double>&)> FilterFn() const {
     if (!(hz > 0)) return {};
     return [this](std::vector<double>& x) { x = Filter(std::move(x)); };
+  }
+  // The measured tau_S of joint j on kin.t's samples (raw[j]'s n values), for the last user of raw:
+  // the column taken over, cut in place, else a copy. raw[j] is left null.
+  std::vector<double> TakeRaw(int j) {
+    std::vector<double> v;
+    if (taken[j].empty()) {
+      v.assign(raw[j], raw[j] + n());
+    } else {
+      const size_t off = static_cast<size_t>(raw[j] - taken[j].data());
+      v = std::move(taken[j]);
+      v.erase(v.begin() + static_cast<long>(off + n()), v.end());
+      v.erase(v.begin(), v.begin() + static_cast<long>(off));
+    }
+    raw[j] = nullptr;
+    return v;
   }
 };
 
@@ -712,12 +727,13 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
       rs.split[j] = ScoreOf(b, a, static_cast<double>(std::max<size_t>(1, n - rc.split)));
       sb[j] += b, sa[j] += a;
       if (r == 0) {
-        D.measured[j] = rc.meas[j];
         D.before[j].resize(n);
         for (size_t i = 0; i < n; ++i) D.before[j][i] = rc.meas[j][i] - resid[j][i];
         D.after[j].assign(n, std::nan(""));  // the extended twin is scored on the held-out part only
         for (size_t i = rc.split; i < n; ++i) D.after[j][i] = rc.meas[j][i] - ea[i - warm];
+        D.measured[j] = std::move(rc.meas[j]);  // its last use (a long record's memory)
       }
+      std::vector<double>().swap(rc.meas[j]);
     }
     cnt += static_cast<double>(n - rc.split);
     if (D.leave_one_out) {
@@ -756,8 +772,9 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
 // Stage 6b: the rigid and the extended twin simulated forward (replay.h) on every record's held-out
 // part and, with several records, on every whole record with the effects fitted on the others
 // (D->simulation, RecordScore::sim_*). Needs the records' kinematics and raw torque, D->extended and
-// D->records[r].left_out_effects.
-void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const DiagnoseOptions& opt, Diagnosis* D_out) {
+// D->records[r].left_out_effects. The records' last stage: their measured torque, time and angles are
+// taken into each replay series (not copied) and the time and angles given back.
+void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const DiagnoseOptions& opt, Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   SimulationScores& S = D.simulation;
   S.horizon_s = opt.replay_horizon_s;
@@ -783,39 +800,50 @@ void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const 
     return;
   ReplayScore sb, sa, lb, la;
   for (size_t r = 0; r < recs.size(); ++r) {
-    const Rec& rc = recs[r];
+    Rec& rc = recs[r];
     RecordScore& rs = D.records[r];
     const size_t n = rc.n();
-    const std::vector<double> tau_S[2] = {std::vector<double>(rc.raw[0], rc.raw[0] + n),
-                                          std::vector<double>(rc.raw[1], rc.raw[1] + n)};
-    // One series; its input re-formed for each twin's sensor effects (memory of long records).
-    ReplaySeries series = ReplaySeriesOf(rc.source, rc.kin.t, rc.kin.q, tau_S, rigid_fx, opt.replay_cutoff_hz);
+    const std::vector<double> tau_S[2] = {rc.TakeRaw(0), rc.TakeRaw(1)};
+    // One series; its input re-formed for each twin's sensor effects (memory of long records). The
+    // record's time and angles are moved into it, and back into rc.kin when its replays are done.
+    ReplaySeries series;
+    series.source = rc.source;
+    series.t = std::move(rc.kin.t);
+    for (int j = 0; j < 2; ++j) series.q[j] = std::move(rc.kin.q[j]);
+    struct GiveBack {
+      ReplaySeries& s;
+      Kinematics& kin;
+      ~GiveBack() {
+        kin.t = std::move(s.t);
+        for (int j = 0; j < 2; ++j) kin.q[j] = std::move(s.q[j]);
+      }
+    } give_back{series, rc.kin};
+    CompleteReplaySeries(tau_S, rigid_fx, opt.replay_cutoff_hz, &series);
+    const std::vector<double>& t = series.t;
     auto Score = [](const ReplayScore& b, const ReplayScore& a, JointScore out[2]) {
       for (int j = 0; j < 2; ++j) out[j] = ScoreOf(b.sse[j], a.sse[j], static_cast<double>(std::max<size_t>(1, b.count)));
     };
-    const bool split_long = rc.kin.t.back() - rc.kin.t[rc.split] >= opt.replay_horizon_s;
-    const bool whole_long = D.leave_one_out && rc.kin.t.back() - rc.kin.t.front() >= opt.replay_horizon_s;
+    const bool split_long = t.back() - t[rc.split] >= opt.replay_horizon_s;
+    const bool whole_long = D.leave_one_out && t.back() - t.front() >= opt.replay_horizon_s;
+    const long from = static_cast<long>(rc.split);
     ReplayScore b_split, b_whole;
-    std::vector<double> b_sim[2];
     if (split_long) {
-      ReplayRecord b = Replay(*rigid, series, opt.replay_horizon_s, rc.split, n);
+      const ReplayRecord b = Replay(*rigid, series, opt.replay_horizon_s, rc.split, n);
       b_split = b.score;
       if (r == 0)
-        for (int j = 0; j < 2; ++j) b_sim[j] = std::move(b.sim[j]);
+        for (int j = 0; j < 2; ++j) S.rigid[j].assign(b.sim[j].begin() + from, b.sim[j].end());
     }
     if (whole_long) b_whole = Replay(*rigid, series, opt.replay_horizon_s).score;
     if (split_long) {
-      ActuatorTorqueFromReading(ext_fx, rc.kin.t, tau_S, series.tau_R);
+      ActuatorTorqueFromReading(ext_fx, t, tau_S, series.tau_R);
       const ReplayRecord a = Replay(*ext, series, opt.replay_horizon_s, rc.split, n);
       Score(b_split, a.score, rs.sim_split);
       rs.sim_split_windows = b_split.windows;
       sb.Add(b_split), sa.Add(a.score);
       if (r == 0) {
-        const long from = static_cast<long>(rc.split);
-        S.t.assign(rc.kin.t.begin() + from, rc.kin.t.end());
+        S.t.assign(t.begin() + from, t.end());
         for (int j = 0; j < 2; ++j) {
-          S.measured[j].assign(rc.kin.q[j].begin() + from, rc.kin.q[j].end());
-          S.rigid[j].assign(b_sim[j].begin() + from, b_sim[j].end());
+          S.measured[j].assign(series.q[j].begin() + from, series.q[j].end());
           S.extended[j].assign(a.sim[j].begin() + from, a.sim[j].end());
         }
       }
@@ -826,7 +854,7 @@ void SimulateTwins(const LegParams& params, const std::vector<Rec>& recs, const 
       std::unique_ptr<Plant> loo_plant;
       PlantEffects loo_fx;
       if (!Make(loo, rc.source + " left out", &loo_plant, &loo_fx)) return;
-      ActuatorTorqueFromReading(loo_fx, rc.kin.t, tau_S, series.tau_R);
+      ActuatorTorqueFromReading(loo_fx, t, tau_S, series.tau_R);
       const ReplayScore a = Replay(*loo_plant, series, opt.replay_horizon_s).score;
       Score(b_whole, a, rs.sim_left_out);
       rs.sim_left_out_windows = b_whole.windows;
@@ -980,6 +1008,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("refinement");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)
     for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r].ceiling[j], D.records[r].ceiling_null[j] = ceilings[r].null[j];
   // Effects in order of what they explain.

@@ -47,9 +47,13 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
   s.t = t;
   s.q[0] = q[0];
   s.q[1] = q[1];
-  RestartState(source, cutoff_hz, &s);
-  ActuatorTorqueFromReading(fx, t, tau_S, s.tau_R);
+  CompleteReplaySeries(tau_S, fx, cutoff_hz, &s);
   return s;
+}
+
+void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s) {
+  RestartState(s->source, cutoff_hz, s);
+  ActuatorTorqueFromReading(fx, s->t, tau_S, s->tau_R);
 }
 
 ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, ReplayInput input, double cutoff_hz) {

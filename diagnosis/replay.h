@@ -52,6 +52,9 @@ ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, Re
 // The same from kinematics and a measured reading (diagnose's records).
 ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
                             const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz);
+// The same on a series whose source, t and q the caller filled (e.g. moved in, not copied): the restart
+// state and the input.
+void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s);
 
 struct ReplayScore {
   double sse[2] = {0, 0};  // sum of squared angle errors, rad^2
