@@ -28,7 +28,15 @@ export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/build-asan/lsan.supp:prin
 #   install.*: they check that the installed programs hold no source path; this RelWithDebInfo build
 #   carries the source file names in its debug info (and ASan's global descriptors). The installed and
 #   packaged build is the Release build of scripts/test.sh, where they run.
-EXCLUDE="^install\."
+#   the statistical sweeps below: the same code paths as shorter tests of the suite (one subject or one
+#   effect: Table5Protocol.*, IdentifyCli.*, DiagnoseHiddenEffect.PairsAreFound / OffsetAndFriction...,
+#   OneJointHiddenEffect.*, DiagnoseCli.*), repeated over many subjects, seeds or effects to check a
+#   statistic; they were half of the suite's time under the sanitizers and find no memory error the
+#   short ones miss. They run in the Release suite of scripts/test.sh.
+SWEEPS="IdentificationRecovery\.FiftyRandomSubjects|IdentificationRecovery\.PaperSubjects"
+SWEEPS="$SWEEPS|IdentificationSensitivity\.TableOfErrorGrowth|Excitation\.GainInRecoveryError"
+SWEEPS="$SWEEPS|DiagnoseHiddenEffect\.EverySingleEffectIsNamedMeasuredAndRemoved|DiagnoseHiddenEffect\.NoEffectNamedOnCleanData"
+EXCLUDE="^install\.|^($SWEEPS)\$"
 start=$(date +%s)
 ctest --test-dir build-asan --output-on-failure -j"$JOBS" ${EXCLUDE:+-E "$EXCLUDE"} "$@"
 echo "test_sanitizers: suite took $(( $(date +%s) - start )) s under ASan+UBSan"
