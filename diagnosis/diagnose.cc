@@ -356,7 +356,7 @@ std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const 
     for (size_t a = 0; a < live.size(); ++a) {
       h[a] = b.X.col(live[a]).dot(b.r);
       live_sign[a] = sign[static_cast<size_t>(live[a])];
-      for (size_t c = 0; c < live.size(); ++c) G(a, c) = b.X.col(live[a]).dot(b.X.col(live[c]));
+      for (size_t c = a; c < live.size(); ++c) G(a, c) = G(c, a) = b.X.col(live[a]).dot(b.X.col(live[c]));
     }
     G.diagonal() += 1e-6 * G.diagonal();
     Eigen::VectorXd x_live, x = Eigen::VectorXd::Zero(b.X.cols());

@@ -8,6 +8,7 @@
 #include "diagnosis/effects.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
+#include "model/passive_torque.h"
 
 namespace exotwin {
 
@@ -56,6 +57,65 @@ void FilterColumn(const ColumnBank& b, std::vector<double>& x) {
       b.filter(x);
       return;
     }
+}
+
+// Fills the bank's columns c1 and c2 from f(i, &v1, &v2), two (hip row value, knee row value) of one
+// sample, as AddColumn fills one column from its f(i).
+template <class F>
+void AddColumnPair(ColumnBank& b, const double w[2], int c1, int c2, F f) {
+  const size_t m = b.sample.size();
+  Eigen::Vector2d x1, x2;
+  if (b.filter) {
+    std::vector<double> v1[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
+    std::vector<double> v2[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
+    for (size_t i = 0; i < b.n; ++i) {
+      f(i, &x1, &x2);
+      v1[0][i] = x1[0], v1[1][i] = x1[1], v2[0][i] = x2[0], v2[1][i] = x2[1];
+    }
+    SetColumn(b, c1, w, v1);
+    for (auto& v : v1) std::vector<double>().swap(v);
+    SetColumn(b, c2, w, v2);
+    return;
+  }
+  for (size_t k = 0; k < m; ++k) {
+    f(b.sample[k], &x1, &x2);
+    b.X(k, c1) = w[0] * x1[0], b.X(m + k, c1) = w[1] * x1[1];
+    b.X(k, c2) = w[0] * x2[0], b.X(m + k, c2) = w[1] * x2[1];
+  }
+}
+
+// The actuator torque R[k] = ActuatorTorque(rigid, x_k, qd, qdd) and the compliant part's torque
+// C[k] = CompliantPartTorque(rigid, x_k, qd, qdd) at x_0 = q, x_1 = q + 1e-5 e_j, x_2 = q - 1e-5 e_j,
+// bit for bit, with what they share computed once: each point's passive moment (in both) and, for
+// the hip (j = 0: M and V depend on the knee angle alone), M qdd + V of q. `total`: rigid.Total().
+struct NearTorques {
+  Eigen::Vector2d R[3], C[3];
+};
+NearTorques TorquesNear(const LegParams& rigid, const LumpedParams& total, int j, const Eigen::Vector2d& q,
+                        const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
+  Eigen::Vector2d x[3] = {q, q, q};
+  x[1][j] += 1e-5, x[2][j] -= 1e-5;
+  // RigidInverseDynamics at the three points: (M qdd + V) + G, in its order.
+  auto rigid_id = [&](const LumpedParams& p, Eigen::Vector2d out[3]) {
+    if (j == 0) {
+      const Eigen::Vector2d mv = MassMatrix(p, rigid.L1, q[1]) * qdd + CoriolisCentrifugal(p, rigid.L1, q, qd);
+      for (int k = 0; k < 3; ++k) out[k] = mv + GravityTorque(p, rigid.g, x[k]);
+    } else {
+      for (int k = 0; k < 3; ++k) out[k] = RigidInverseDynamics(p, rigid.L1, rigid.g, x[k], qd, qdd);
+    }
+  };
+  NearTorques t;
+  rigid_id(total, t.R);
+  if (!rigid.human) {  // no human: the compliant part is the whole chain
+    for (int k = 0; k < 3; ++k) t.C[k] = t.R[k];
+    return t;
+  }
+  Eigen::Vector2d passive[3];
+  for (int k = 0; k < 3; ++k) passive[k] = PassiveElasticTorque(rigid.passive, x[k]);
+  for (int k = 0; k < 3; ++k) t.R[k] += passive[k];
+  rigid_id(*rigid.human, t.C);
+  for (int k = 0; k < 3; ++k) t.C[k] = t.C[k] + passive[k];
+  return t;
 }
 
 // Column c from the values x_j of its joint-j rows on the fit rows (the other joint's rows zero),
@@ -152,6 +212,7 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
   for (int j = 0; j < 2; ++j) std::vector<double>().swap(resid[j]);
   LegParams rigid = params;
   rigid.effects.clear();
+  const LumpedParams total = rigid.Total();
   auto Q = [&](size_t i) { return Eigen::Vector2d(kin.q[0][i], kin.q[1][i]); };
   auto QD = [&](size_t i) { return Eigen::Vector2d(kin.qd[0][i], kin.qd[1][i]); };
   auto QDD = [&](size_t i) { return Eigen::Vector2d(kin.qdd[0][i], kin.qdd[1][i]); };
@@ -159,7 +220,9 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
   // The envelope columns are the same at both joints but for the rows they fill: the hip's are kept
   // on the fit rows (filtered, unweighted) for the knee's.
   std::vector<std::vector<double>> envelope_rows;
-  b.X.resize(2 * m, 40);
+  // Its columns per joint: offset, Coulomb, viscous, inertia, gravity X and Y, stiffness, backlash,
+  // strap, gain, delay, [passive moment], one per EMG channel (NewColumn grows X if more).
+  b.X.resize(2 * m, 2 * (11 + (params.human && !params.one_joint ? 1 : 0) + static_cast<long>(kin.emg.size())));
   for (int j = 0; j < 2; ++j) {
     auto add = [&](const std::string& name, std::vector<int> cols, const std::string& axis = "") {
       Candidate c;
@@ -188,23 +251,20 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       unit_passive.joint = j == 0 ? "hip" : "knee", unit_passive.value = 1.0;
       add("passive_moment", {AddJointColumn(b, w, j, [&](size_t i) { return -PassiveMomentTorque(unit_passive, Q(i)); })});
     }
-    // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b).
-    add("backlash", {AddColumn(b, w, [&](size_t i) {
-          Eigen::Vector2d qa = Q(i), qb = Q(i);
-          qa[j] += 1e-5, qb[j] -= 1e-5;
-          const Eigen::Vector2d d = (ActuatorTorque(rigid, qa, QD(i), QDD(i)) -
-                                     ActuatorTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
-          const double tau_R = ActuatorTorque(rigid, Q(i), QD(i), QDD(i))[j];
-          return Eigen::Vector2d(0.5 * std::tanh(tau_R / kBacklashTorqueWidth) * d);
-        })});
-    // Straps: Delta tau_S = (1/k) dtau_C/dq_j tau_C,j (first order in 1/k).
-    add("series_compliance", {AddColumn(b, w, [&](size_t i) {
-          Eigen::Vector2d qa = Q(i), qb = Q(i);
-          qa[j] += 1e-5, qb[j] -= 1e-5;
-          const Eigen::Vector2d d = (CompliantPartTorque(rigid, qa, QD(i), QDD(i)) -
-                                     CompliantPartTorque(rigid, qb, QD(i), QDD(i))) / 2e-5;
-          return Eigen::Vector2d(d * CompliantPartTorque(rigid, Q(i), QD(i), QDD(i))[j]);
-        })});
+    // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b). Straps: Delta tau_S =
+    // (1/k) dtau_C/dq_j tau_C,j (first order in 1/k). Both columns in one pass over the samples.
+    {
+      const int cb = NewColumn(b), cs = NewColumn(b);
+      AddColumnPair(b, w, cb, cs, [&](size_t i, Eigen::Vector2d* backlash, Eigen::Vector2d* strap) {
+        const NearTorques t = TorquesNear(rigid, total, j, Q(i), QD(i), QDD(i));
+        const Eigen::Vector2d d = (t.R[1] - t.R[2]) / 2e-5;
+        *backlash = Eigen::Vector2d(0.5 * std::tanh(t.R[0][j] / kBacklashTorqueWidth) * d);
+        const Eigen::Vector2d dc = (t.C[1] - t.C[2]) / 2e-5;
+        *strap = Eigen::Vector2d(dc * t.C[0][j]);
+      });
+      add("backlash", {cb});
+      add("series_compliance", {cs});
+    }
     add("sensor_offset", {off});
     add("sensor_gain", {AddJointColumn(b, w, j, [&](size_t i) { return tau_S[j][i]; })});
     // Time derivative of the predicted reading (for the delay), central differences on the record.
