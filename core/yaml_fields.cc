@@ -123,8 +123,9 @@ YAML::Node ParseYaml(const std::string& text, const std::string& source) {
       std::istringstream in(text);
       YAML::Parser parser(in);
       ScalarCheck check(source);
-      while (parser.HandleNextDocument(check)) {
-      }
+      // The first document only, as YAML::Load: yaml-cpp 0.7 can loop for ever looking for a next
+      // document after a malformed one (found by fuzz_model_yaml, fuzz/corpus/*/crash_second_document_*).
+      parser.HandleNextDocument(check);
     }
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
