@@ -112,6 +112,11 @@ nlohmann::ordered_json BenchIdentification(const BenchConfig& c);
 // friction and armature, 0.5 s windows, vs a bare mj_step loop of the same model over the same time.
 nlohmann::ordered_json BenchReplay(const BenchConfig& c);
 
+// diagnose --fit motion (diagnosis/motion_fit.h, 2 threads) of a 60 s closed-loop gait record (S1, knee
+// backlash 0.02 rad in the plant; quick: 15 s) against one replay of the record (0.5 s windows, one
+// thread): the number of replays' worth of wall time (goal <= 150).
+nlohmann::ordered_json BenchMotionFit(const BenchConfig& c);
+
 // Diagnosis of 60 s of 1 kHz data with one hidden effect (quick: 20 s): data seconds per wall second.
 nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);
 
