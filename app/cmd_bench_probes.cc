@@ -389,6 +389,7 @@ json BenchMotionFit(const BenchConfig& c) {
   dead_band.name = "backlash", dead_band.joint = "knee", dead_band.value = 0.02, dead_band.unit = "rad";
   s.plant_effects = {dead_band};
   s.plant_effects_source = "bench: plant.effects";
+  s.log_measured_csv = true;  // the record
   RunOptions o;
   o.out_dir = c.scratch + "/motion_fit";
   RunScenario(s, o);
