@@ -118,6 +118,10 @@ nlohmann::ordered_json BenchReplay(const BenchConfig& c);
 // (quick: 6 s of it). The in-process pairs run on the fastest CPU (both halves), the UDP pair unpinned.
 // {"status": "unavailable"} when the module is not built.
 nlohmann::ordered_json BenchPython(const BenchConfig& c);
+// diagnose --fit motion (diagnosis/motion_fit.h, 2 threads) of a 60 s closed-loop gait record (S1, knee
+// backlash 0.02 rad in the plant; quick: 15 s) against one replay of the record (0.5 s windows, one
+// thread): the number of replays' worth of wall time (goal <= 150).
+nlohmann::ordered_json BenchMotionFit(const BenchConfig& c);
 
 // Diagnosis of 60 s of 1 kHz data with one hidden effect (quick: 20 s): data seconds per wall second.
 nlohmann::ordered_json BenchDiagnosis(const BenchConfig& c);

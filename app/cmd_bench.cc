@@ -34,12 +34,12 @@ CommandRunner RegisterBench(CLI::App& app) {
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
   sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                  "predict_long,diagnose_long,link,replay,python");
+                  "predict_long,diagnose_long,link,replay,python,motion_fit");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
     const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep",
-                                          "predict_long", "diagnose_long", "link", "replay", "python"};
+                                          "predict_long", "diagnose_long", "link", "replay", "python", "motion_fit"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -50,7 +50,7 @@ CommandRunner RegisterBench(CLI::App& app) {
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
                            "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                           "predict_long,diagnose_long,link,replay,python");
+                           "predict_long,diagnose_long,link,replay,python,motion_fit");
         selected.push_back(name);
         start = end + 1;
       }
@@ -74,7 +74,8 @@ CommandRunner RegisterBench(CLI::App& app) {
       std::fprintf(stderr, "bench: %s...\n", name.c_str());
       // Single-threaded work runs on the fastest CPU, its baseline too (bench_probes.h BenchCpu); the
       // render (llvmpipe and encoder threads), `run` (its log writer thread) and the sweep use them all.
-      const bool threaded = name == "render" || name == "run" || name == "sweep" || name == "link" || name == "python";
+      const bool threaded = name == "render" || name == "run" || name == "sweep" || name == "link" || name == "python" ||
+                            name == "motion_fit";
       const ScopedCpuPin pin(threaded ? -1 : FastestCpu(c.cpus));
       if (name == "startup") j[name] = BenchStartup(c);
       if (name == "run") j[name] = BenchRunCommand(c);
@@ -88,6 +89,7 @@ CommandRunner RegisterBench(CLI::App& app) {
       if (name == "link") j[name] = BenchLink(c);
       if (name == "replay") j[name] = BenchReplay(c);
       if (name == "python") j[name] = BenchPython(c);
+      if (name == "motion_fit") j[name] = BenchMotionFit(c);
       if (pin.pinned()) j[name]["pinned_cpu"] = FastestCpu(c.cpus);
       for (const BenchRow& r : BenchRowsFromJson(j[name])) rows.push_back(r);
     }

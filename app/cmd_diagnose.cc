@@ -1,6 +1,7 @@
 // `exotwin diagnose`: name what the twin gets wrong on measured data, extend it, measure the gain.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 
 #include "formats/column_map.h"
@@ -9,6 +10,7 @@
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "app/commands.h"
+#include "core/error.h"
 #include "core/heap_policy.h"
 
 namespace exotwin {
@@ -16,7 +18,7 @@ namespace {
 
 CommandRunner RegisterDiagnose(CLI::App& app) {
   struct Opts {
-    std::string params, out, mjcf, map, cutoff = "auto";
+    std::string params, out, mjcf, map, cutoff = "auto", fit = "torque";
     std::vector<std::string> measured;
     double holdout = 0.3;
     int max_effects = 6;
@@ -36,15 +38,21 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
                   "derivative filter cutoff in Hz, the torque filtered alike, or 'auto' (default: "
                   "chosen from the data by held-out prediction error)");
   sub->add_option("--max-effects", o->max_effects, "most effects named together (0..6, default 6)");
+  sub->add_option("--fit", o->fit,
+                  "torque (default: effects sized on the torque residual) or motion (effects fitted by simulating "
+                  "the forward plant on the records, diagnosis/motion_fit.h)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     KeepFreedMemoryForReuse();
+    if (o->fit != "torque" && o->fit != "motion")
+      throw InputError("diagnose --fit: '" + o->fit + "', expected torque or motion");
     const LegParams params = ReadModelFile(o->params);
     DiagnoseOptions opt;
     opt.holdout_fraction = o->holdout;
     opt.mjcf = o->mjcf;
     opt.cutoff_hz = ParseCutoffOption(o->cutoff, "diagnose --cutoff");
     opt.max_effects = o->max_effects;
+    opt.fit = o->fit == "motion" ? DiagnoseFit::kMotion : DiagnoseFit::kTorque;
     std::vector<MeasuredData> data;
     std::string names;
     for (const std::string& m : o->measured) {
@@ -64,6 +72,23 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
       for (const EffectAlias& a : e.aliases) std::printf("diagnose:   alias: %s\n", AliasText(a).c_str());
     }
     if (d.effects.empty()) std::printf("diagnose: no effect named\n");
+    if (d.fit == DiagnoseFit::kMotion) {
+      for (const TorqueOnlyEffect& t : d.torque_only)
+        std::printf("diagnose: torque only: %s (%s) = %g %s%s\n", t.effect.name.c_str(), t.effect.joint.c_str(),
+                    t.effect.value, t.effect.unit.c_str(),
+                    t.simulated ? (": held-out simulated error " + NumberText(t.heldout_change_pct[0], 3) + " % hip, " +
+                                   NumberText(t.heldout_change_pct[1], 3) + " % knee when added").c_str()
+                                : " (not carried by the forward plant)");
+      const int j0 = params.one_joint ? 1 : 0;
+      for (int j = j0; j < 2; ++j)
+        std::printf("diagnose: held-out simulated angle %s %.4f -> %.4f deg%s\n", j == 0 ? "hip" : "knee",
+                    d.joints[j].rmse_before * 180 / M_PI, d.joints[j].rmse_after * 180 / M_PI,
+                    d.leave_one_out ? (", whole records left out " + NumberText(d.left_out[j].rmse_before * 180 / M_PI, 4) +
+                                       " -> " + NumberText(d.left_out[j].rmse_after * 180 / M_PI, 4) + " deg").c_str()
+                                    : "");
+      std::printf("diagnose: report %s/report.html\n", o->out.c_str());
+      return 0;
+    }
     if (params.one_joint) {  // its one joint
       std::printf("diagnose: held-out rmse knee %.4f -> %.4f N m; report %s/report.html\n", d.joints[1].rmse_before,
                   d.joints[1].rmse_after, o->out.c_str());

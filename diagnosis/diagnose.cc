@@ -21,6 +21,7 @@
 #include "diagnosis/diagnose_select.h"
 #include "diagnosis/effects.h"
 #include "diagnosis/generate.h"
+#include "diagnosis/motion_fit.h"
 #include "formats/number_text.h"
 #include "diagnosis/predict.h"
 #include "dsp/statistics.h"
@@ -478,43 +479,12 @@ Grams PooledGrams(const std::vector<Rec>& recs, const std::vector<ColumnBank>& b
   return g;
 }
 
-// Stage 4: the physical scale of the records (angle and torque ranges, mean M_jj, the strap's
-// neglected dynamics J_c w^2, the compliant part's torque) for the plausibility ranges.
+// Stage 4: the physical scale of the records (diagnose_select.h ScaleOf), of their kinematics and
+// the measured torque filtered alike.
 PhysicalScale ScaleOf(const LegParams& params, const std::vector<Rec>& recs) {
-  PhysicalScale scale;
-  const LumpedParams tot = params.Total();
-  const double Xd[2] = {tot.X1, tot.X2}, Yd[2] = {tot.Y1, tot.Y2};
-  LegParams rigid = params;
-  rigid.effects.clear();
-  for (int j = 0; j < 2; ++j) {
-    scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
-    scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
-    // Means over every record (strided): the twin's M_jj, the compliant part's J_c (the human when
-    // there is one, else the whole chain), and the motion's effective angular frequency
-    // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
-    // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
-    const LumpedParams& compliant = params.human ? *params.human : tot;
-    double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
-    for (const Rec& rc : recs) {
-      for (size_t i = 0; i < rc.n(); ++i) {
-        scale.q_min[j] = std::min(scale.q_min[j], rc.kin.q[j][i]);
-        scale.q_max[j] = std::max(scale.q_max[j], rc.kin.q[j][i]);
-        scale.tau_max[j] = std::max(scale.tau_max[j], std::abs(rc.meas[j][i]));
-      }
-      const size_t stride = std::max<size_t>(1, rc.n() / 4000);
-      for (size_t i = 0; i < rc.n(); i += stride) {
-        const Eigen::Vector2d q(rc.kin.q[0][i], rc.kin.q[1][i]), qd(rc.kin.qd[0][i], rc.kin.qd[1][i]),
-            qdd(rc.kin.qdd[0][i], rc.kin.qdd[1][i]);
-        msum += MassMatrix(tot, params.L1, q[1])(j, j);
-        jc += MassMatrix(compliant, params.L1, q[1])(j, j);
-        v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
-        scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
-      }
-    }
-    scale.M_jj[j] = msum / cnt;
-    scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
-  }
-  return scale;
+  std::vector<ScaleRecord> in;
+  for (const Rec& rc : recs) in.push_back({&rc.kin, {&rc.meas[0], &rc.meas[1]}});
+  return exotwin::ScaleOf(params, in);
 }
 
 // The largest magnitude DESIGN.md's physical range allows a one-parameter candidate (0: unbounded or
@@ -947,6 +917,7 @@ namespace {
 // columns are moved into the analysis once the cutoff is chosen instead of copied.
 Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const MeasuredData*>& records,
                           std::vector<MeasuredData>* owned, const DiagnoseOptions& opt) {
+  if (opt.fit == DiagnoseFit::kMotion) return DiagnoseByMotion(params, records, opt);
   const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
   auto clock0 = std::chrono::steady_clock::now();
   auto Lap = [&](const char* what) {

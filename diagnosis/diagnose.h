@@ -117,7 +117,21 @@ struct SimulationScores {
   std::vector<double> t, measured[2], rigid[2], extended[2];
 };
 
+// Which fit sizes and chooses the effects: the torque residual (inverse dynamics, this header's method)
+// or the simulated motion (the forward plant on the records, diagnosis/motion_fit.h).
+enum class DiagnoseFit { kTorque, kMotion };
+
+// The motion fit: an effect the torque fit names that the motion fit does not (it does not lower the
+// held-out simulated error enough, or is not carried by the plant).
+struct TorqueOnlyEffect {
+  Effect effect;                           // as the torque fit sized it
+  bool simulated = false;                  // false: the forward plant cannot carry it (muscle_activity)
+  double heldout_change_pct[2] = {0, 0};   // held-out simulated-angle SSE change per joint when added
+                                           // at that value to the motion fit's effects, % (< 0: lower)
+};
+
 struct Diagnosis {
+  DiagnoseFit fit = DiagnoseFit::kTorque;
   std::vector<DiagnosedEffect> effects;
   std::vector<UnexplainedStructure> unexplained;
   JointScore joints[2];
@@ -143,6 +157,9 @@ struct Diagnosis {
   Kinematics kin;
   std::vector<double> measured[2], before[2], after[2];
   size_t split = 0;
+  // The motion fit only: what the torque fit named (its values), and those the motion fit does not.
+  std::vector<DiagnosedEffect> torque_named;
+  std::vector<TorqueOnlyEffect> torque_only;
 };
 
 struct DiagnoseOptions {
@@ -154,6 +171,9 @@ struct DiagnoseOptions {
   bool simulate = true;          // step 6b (false: the torque analysis alone)
   double replay_horizon_s = 0.5; // step 6b: restart interval of the forward simulation, s
   double replay_cutoff_hz = kReplayCutoffHz;  // step 6b: filter of the restart state
+  DiagnoseFit fit = DiagnoseFit::kTorque;     // kMotion: diagnosis/motion_fit.h (windows of replay_horizon_s,
+                                              // restart state at replay_cutoff_hz)
+  int threads = 0;                            // the motion fit's rollouts in parallel (0: every core)
 };
 
 // Runs the discrepancy analysis. `params` is the twin to confront, `records` the measured records of

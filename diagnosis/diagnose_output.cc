@@ -26,6 +26,7 @@ std::string AliasText(const EffectAlias& a) {
 std::string DiagnosisJson(const Diagnosis& d) {
   using nlohmann::json;
   json j;
+  j["fit"] = d.fit == DiagnoseFit::kMotion ? "motion" : "torque";
   j["effects"] = json::array();
   for (const auto& e : d.effects) {
     json x = {{"name", e.effect.name}, {"joint", e.effect.joint}, {"value", e.effect.value},
@@ -110,6 +111,27 @@ std::string DiagnosisJson(const Diagnosis& d) {
     }
   }
   j["simulation"] = js;
+  if (d.fit == DiagnoseFit::kMotion) {  // what the torque fit would have named, and what it alone names
+    auto effect = [](const Effect& e) {
+      json x = {{"name", e.name}, {"joint", e.joint}, {"value", e.value}, {"unit", e.unit}};
+      if (!e.axis.empty()) x["axis"] = e.axis;
+      return x;
+    };
+    j["torque_fit"] = json::array();
+    for (const auto& e : d.torque_named) {
+      json x = effect(e.effect);
+      x["ci95"] = {e.ci_lo, e.ci_hi};
+      j["torque_fit"].push_back(x);
+    }
+    j["torque_only"] = json::array();
+    for (const auto& t : d.torque_only) {
+      json x = effect(t.effect);
+      x["simulated"] = t.simulated;
+      if (t.simulated)
+        for (int k = k0; k < 2; ++k) x["heldout_change_pct"][names[k]] = t.heldout_change_pct[k];
+      j["torque_only"].push_back(x);
+    }
+  }
   return j.dump(2) + "\n";
 }
 

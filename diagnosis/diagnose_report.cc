@@ -40,10 +40,108 @@ SvgSeries Spectrum(const std::vector<double>& t, const std::vector<double>& x, s
   return s;
 }
 
+// The named effects' table; `explains`: of what explained_pct is the share.
+std::string EffectsTable(const Diagnosis& d, const std::string& explains) {
+  std::ostringstream o;
+  o << "<table><tr><th>effect</th><th>joint</th><th>value</th><th>95 % interval</th><th>extra</th>"
+       "<th>explains (" << explains << ")</th></tr>";
+  for (const auto& e : d.effects) {
+    std::string extra = e.effect.axis.empty() ? "" : "axis " + e.effect.axis + " ";
+    for (const auto& f : e.effect.fields) extra += f.first + " = " + NumberText(f.second, 4) + " ";
+    o << "<tr><td>" << e.effect.name << "</td><td>" << e.effect.joint << "</td><td>" << NumberText(e.effect.value, 4)
+      << " " << HtmlEscape(e.effect.unit) << "</td><td>" << NumberText(e.ci_lo, 4) << " .. " << NumberText(e.ci_hi, 4)
+      << "</td><td>" << HtmlEscape(extra) << "</td><td>" << NumberText(e.explained_pct, 3) << " %</td></tr>";
+  }
+  o << "</table>";
+  return o.str();
+}
+
+// The forward simulation's table: per record (and pooled) the RMS simulated-angle error of the twin
+// given vs the extended twin, held-out and whole records left out.
+std::string SimulationTable(const Diagnosis& d) {
+  const SimulationScores& S = d.simulation;
+  std::ostringstream o;
+  auto deg = [&](const JointScore& s) {
+    return NumberText(s.rmse_before * kDegPerRad, 3) + " / " + NumberText(s.rmse_after * kDegPerRad, 3) + " deg (" +
+           NumberText(s.gain_pct, 3) + " %)";
+  };
+  o << "<table><tr><th>record</th><th>hip: held-out, rigid / extended</th><th>knee: held-out</th>"
+    << (d.leave_one_out ? "<th>hip: whole record left out</th><th>knee: whole record left out</th>" : "") << "</tr>";
+  for (const auto& r : d.records) {
+    o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << deg(r.sim_split[0]) << "</td><td>" << deg(r.sim_split[1]) << "</td>";
+    if (d.leave_one_out) o << "<td>" << deg(r.sim_left_out[0]) << "</td><td>" << deg(r.sim_left_out[1]) << "</td>";
+    o << "</tr>";
+  }
+  o << "<tr><th>all</th><td>" << deg(S.split[0]) << "</td><td>" << deg(S.split[1]) << "</td>";
+  if (d.leave_one_out) o << "<td>" << deg(S.left_out[0]) << "</td><td>" << deg(S.left_out[1]) << "</td>";
+  o << "</tr></table><p>RMS error of the simulated angle against the measured one.</p>";
+  return o.str();
+}
+
+// The motion fit's report (diagnosis/motion_fit.h).
+std::string MotionReportHtml(const Diagnosis& d, const std::string& params_path, const std::string& measured_path) {
+  const char* jn[2] = {"hip", "knee"};
+  const int j0 = d.extended.one_joint ? 1 : 0;
+  const SimulationScores& S = d.simulation;
+  std::ostringstream o;
+  o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>exotwin diagnosis (motion fit)</title>"
+       "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
+       "td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}</style></head><body>\n";
+  o << "<h1>exotwin diagnosis: motion fit</h1><p>Twin: <code>" << HtmlEscape(params_path) << "</code>, measured: <code>"
+    << HtmlEscape(measured_path) << "</code>.</p><p><small>" << HtmlEscape(d.method) << "</small></p>";
+  o << "<h2>What the twin's motion gets wrong, and why</h2>";
+  if (d.effects.empty()) {
+    o << "<p><b>No effect named</b>: no candidate lowers the simulated-motion error enough (information criterion, "
+         "held-out time" << (d.leave_one_out ? ", records left out" : "") << ", significance).</p>";
+  } else {
+    o << EffectsTable(d, "held-out simulated error");
+  }
+  o << "<h2>What the torque fit would have named</h2>";
+  if (d.torque_named.empty()) o << "<p>Nothing.</p>";
+  else {
+    o << "<table><tr><th>effect</th><th>joint</th><th>torque fit's value</th><th>motion fit</th></tr>";
+    for (const auto& e : d.torque_named) {
+      std::string verdict = "named too";
+      for (const TorqueOnlyEffect& t : d.torque_only)
+        if (t.effect.name == e.effect.name && t.effect.joint == e.effect.joint && t.effect.axis == e.effect.axis)
+          verdict = t.simulated ? "torque only: added at this value, the held-out simulated error changes by " +
+                                      NumberText(t.heldout_change_pct[0], 3) + " % (hip), " +
+                                      NumberText(t.heldout_change_pct[1], 3) + " % (knee)"
+                                : "torque only: not carried by the forward plant";
+      o << "<tr><td>" << e.effect.name << (e.effect.axis.empty() ? "" : "." + e.effect.axis) << "</td><td>"
+        << e.effect.joint << "</td><td>" << NumberText(e.effect.value, 4) << " " << HtmlEscape(e.effect.unit)
+        << "</td><td>" << HtmlEscape(verdict) << "</td></tr>";
+    }
+    o << "</table>";
+  }
+  o << "<h2>Forward simulation</h2><p>" << HtmlEscape(S.note) << "</p>" << SimulationTable(d);
+  o << "<p>The torque reading drives the simulation (the twin's sensor reads the motor torque, HJ15 eq. 8), so it is "
+       "no output of the fit: the plots show the angles.</p>";
+  for (int j = j0; j < 2; ++j) {  // the first four windows of the first record's held-out part
+    SvgSeries sm{{}, {}, "#000", "measured"}, sr{{}, {}, "#d62728", "twin given, simulated"},
+        se{{}, {}, "#1f77b4", "motion fit, simulated"};
+    for (size_t i = 0; i < S.t.size() && S.t[i] <= S.t.front() + 4 * S.horizon_s; ++i) {
+      if (std::isnan(S.rigid[j][i])) continue;
+      sm.x.push_back(S.t[i]), sm.y.push_back(S.measured[j][i] * kDegPerRad);
+      sr.x.push_back(S.t[i]), sr.y.push_back(S.rigid[j][i] * kDegPerRad);
+      se.x.push_back(S.t[i]), se.y.push_back(S.extended[j][i] * kDegPerRad);
+    }
+    o << "<h2>" << jn[j] << "</h2>"
+      << SvgChart("measured vs fitted simulated angle (held-out, four windows of " + NumberText(S.horizon_s) + " s)",
+                  "t (s)", "angle (deg)", {sm, sr, se});
+  }
+  o << "<h2>Selection</h2><ol>";
+  for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
+  o << "</ol></body></html>\n";
+  return o.str();
+}
+
+
 }  // namespace
 
 std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_path,
                                 const std::string& measured_path) {
+  if (d.fit == DiagnoseFit::kMotion) return MotionReportHtml(d, params_path, measured_path);
   const auto& k = d.kin;
   const size_t n = k.t.size();
   const char* jn[2] = {"hip", "knee"};
@@ -72,17 +170,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
     o << "<p><b>No effect named</b>: no candidate explanation is supported by the data (information "
          "criterion and held-out error).</p>";
   } else {
-    o << "<table><tr><th>effect</th><th>joint</th><th>value</th><th>95 % interval</th><th>extra</th>"
-         "<th>explains (held-out residual)</th></tr>";
-    for (const auto& e : d.effects) {
-      std::string extra = e.effect.axis.empty() ? "" : "axis " + e.effect.axis + " ";
-      for (const auto& f : e.effect.fields) extra += f.first + " = " + NumberText(f.second, 4) + " ";
-      o << "<tr><td>" << e.effect.name << "</td><td>" << e.effect.joint << "</td><td>"
-        << NumberText(e.effect.value, 4) << " " << HtmlEscape(e.effect.unit) << "</td><td>" << NumberText(e.ci_lo, 4) << " .. "
-        << NumberText(e.ci_hi, 4) << "</td><td>" << HtmlEscape(extra) << "</td><td>" << NumberText(e.explained_pct, 3)
-        << " %</td></tr>";
-    }
-    o << "</table>";
+    o << EffectsTable(d, "held-out residual");
     for (const auto& e : d.effects) {
       if (e.aliases.empty()) continue;
       o << "<p>The data cannot tell <b>" << e.effect.name << " (" << e.effect.joint
@@ -117,22 +205,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<p><small>" << HtmlEscape(d.method) << "</small></p>";
   const SimulationScores& S = d.simulation;
   o << "<h2>Forward simulation</h2><p>" << HtmlEscape(S.note) << "</p>";
-  if (S.done) {
-    auto deg = [&](const JointScore& s) {
-      return NumberText(s.rmse_before * kDegPerRad, 3) + " / " + NumberText(s.rmse_after * kDegPerRad, 3) + " deg (" +
-             NumberText(s.gain_pct, 3) + " %)";
-    };
-    o << "<table><tr><th>record</th><th>hip: held-out, rigid / extended</th><th>knee: held-out</th>"
-      << (d.leave_one_out ? "<th>hip: whole record left out</th><th>knee: whole record left out</th>" : "") << "</tr>";
-    for (const auto& r : d.records) {
-      o << "<tr><td>" << HtmlEscape(r.source) << "</td><td>" << deg(r.sim_split[0]) << "</td><td>" << deg(r.sim_split[1]) << "</td>";
-      if (d.leave_one_out) o << "<td>" << deg(r.sim_left_out[0]) << "</td><td>" << deg(r.sim_left_out[1]) << "</td>";
-      o << "</tr>";
-    }
-    o << "<tr><th>all</th><td>" << deg(S.split[0]) << "</td><td>" << deg(S.split[1]) << "</td>";
-    if (d.leave_one_out) o << "<td>" << deg(S.left_out[0]) << "</td><td>" << deg(S.left_out[1]) << "</td>";
-    o << "</tr></table><p>RMS error of the simulated angle against the measured one.</p>";
-  }
+  if (S.done) o << SimulationTable(d);
   o << "<h2>Selection</h2><ol>";
   for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
   o << "</ol>";

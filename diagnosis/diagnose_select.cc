@@ -9,7 +9,9 @@
 #include <Eigen/Eigenvalues>
 
 #include "formats/number_text.h"
+#include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
+#include "sim/plant_effects.h"
 
 namespace exotwin {
 namespace {
@@ -329,6 +331,45 @@ bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* wh
   return no.empty();
 }
 
+PhysicalScale ScaleOf(const LegParams& params, const std::vector<ScaleRecord>& recs) {
+  PhysicalScale scale;
+  const LumpedParams tot = params.Total();
+  const double Xd[2] = {tot.X1, tot.X2}, Yd[2] = {tot.Y1, tot.Y2};
+  LegParams rigid = params;
+  rigid.effects.clear();
+  for (int j = 0; j < 2; ++j) {
+    scale.q_min[j] = 1e300, scale.q_max[j] = -1e300;
+    scale.distal_moment[j] = std::hypot(Xd[j], Yd[j]);
+    // Means over every record (strided): the twin's M_jj, the compliant part's J_c (the human when
+    // there is one, else the whole chain), and the motion's effective angular frequency
+    // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
+    // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
+    const LumpedParams& compliant = params.human ? *params.human : tot;
+    double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
+    for (const ScaleRecord& rc : recs) {
+      const Kinematics& kin = *rc.kin;
+      const size_t n = kin.t.size();
+      for (size_t i = 0; i < n; ++i) {
+        scale.q_min[j] = std::min(scale.q_min[j], kin.q[j][i]);
+        scale.q_max[j] = std::max(scale.q_max[j], kin.q[j][i]);
+        scale.tau_max[j] = std::max(scale.tau_max[j], std::abs((*rc.tau[j])[i]));
+      }
+      const size_t stride = std::max<size_t>(1, n / 4000);
+      for (size_t i = 0; i < n; i += stride) {
+        const Eigen::Vector2d q(kin.q[0][i], kin.q[1][i]), qd(kin.qd[0][i], kin.qd[1][i]),
+            qdd(kin.qdd[0][i], kin.qdd[1][i]);
+        msum += MassMatrix(tot, params.L1, q[1])(j, j);
+        jc += MassMatrix(compliant, params.L1, q[1])(j, j);
+        v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
+        scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
+      }
+    }
+    scale.M_jj[j] = msum / cnt;
+    scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
+  }
+  return scale;
+}
+
 namespace {
 
 // Significant and plausible inside fit `f`?
@@ -415,7 +456,7 @@ std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const Phy
                           "error at the " + kJoint[j] + " by " + Num(100 * (1 - f.sse_te_j[j] / cur.sse_te_j[j])) +
                           " %" + (loo ? " and on left-out records by " + Num(100 * (1 - f.sse_loo_j[j] / cur.sse_loo_j[j])) + " %" : "") +
                           " (needed: " + Num(100 * kMinHeldoutGain) + " % and (" + Num(100 * kMinTorqueShare) +
-                          " % of the torque RMS)^2)";
+                          " % of the " + g.scale_name + " RMS)^2)";
         continue;
       }
       if (!AllAdmissible(bank, next, f, scale)) continue;

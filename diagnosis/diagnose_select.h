@@ -43,6 +43,7 @@ struct Grams {
   std::vector<Eigen::VectorXd> brec[2];
   std::vector<double> rrrec[2];
   double tt_te[2] = {0, 0};  // weighted sum of squares of the measured torque, held-out rows per joint
+  std::string scale_name = "torque";  // what tt_te measures, for the selection's words
   size_t records() const { return Grec[0].size(); }
 };
 
@@ -103,6 +104,17 @@ struct PhysicalScale {
   double M_jj[2] = {0, 0};                      // kg m^2, the twin's mean diagonal inertia
   double distal_moment[2] = {0, 0};             // kg m, hypot(X, Y) of the segments distal to j
 };
+
+// One record's part of the physical scale: its kinematics and measured torque reading per joint
+// (N m, the samples of kin->t).
+struct ScaleRecord {
+  const Kinematics* kin = nullptr;
+  const std::vector<double>* tau[2] = {nullptr, nullptr};
+};
+
+// The physical scale of the records: angle and torque ranges, the twin's mean M_jj, the compliant
+// part's torque and the strap's neglected dynamics J_c w^2 (strided means over every record).
+PhysicalScale ScaleOf(const LegParams& params, const std::vector<ScaleRecord>& recs);
 
 // The effect a candidate's fitted coefficients stand for (value, 95 % interval, fields).
 DiagnosedEffect ToEffect(const Candidate& c, const Fit& f);

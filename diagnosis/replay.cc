@@ -120,7 +120,7 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
   size_t in = begin;  // input interpolation: t[in] <= time < t[in + 1]
   auto Input = [&](double time) -> Eigen::Vector2d {
     while (in + 1 < t.size() && t[in + 1] <= time) ++in;
-    if (in + 1 >= t.size() || time <= t[in]) return {s.tau_R[0][in], s.tau_R[1][in]};
+    if (s.hold || in + 1 >= t.size() || time <= t[in]) return {s.tau_R[0][in], s.tau_R[1][in]};
     const double a = (time - t[in]) / (t[in + 1] - t[in]);
     return {s.tau_R[0][in] + a * (s.tau_R[0][in + 1] - s.tau_R[0][in]),
             s.tau_R[1][in] + a * (s.tau_R[1][in + 1] - s.tau_R[1][in])};
@@ -128,7 +128,8 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
   while (start < end && t[end - 1] - t[start] >= horizon_s) {
     const double t0 = t[start], t_end = t0 + horizon_s;
     const int w = static_cast<int>(out.score.windows);
-    plant.Reset({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0);
+    const Eigen::Vector2d tau0(s.tau_R[0][start], s.tau_R[1][start]);  // the dead band's flank at the restart
+    plant.Reset({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0, &tau0);
     in = start;
     Eigen::Vector2d q_prev = plant.q();
     double time_prev = t0;

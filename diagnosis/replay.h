@@ -6,10 +6,13 @@
 // Method:
 //  - input: tau_R = -tau_S, the reading with the model's sensor effects inverted (ActuatorTorque
 //    FromReading), or the commanded torque (cmd_* columns); linearly interpolated at the middle of
-//    each physics step (model timestep, 1 ms) and held over the step.
+//    each physics step (model timestep, 1 ms) and held over the step (ReplaySeries::hold: the last
+//    sample at or before that middle).
 //  - restart state: the angle low-passed by the zero-phase 2nd-order Butterworth at the cutoff
 //    (formats/measured_data.h LowPassOnTimeBase) and its velocity (DeriveAngleRates at the same
 //    cutoff), at the window's first sample.
+//    A dead band (backlash) restarts against the flank of the input torque there (Plant::Reset's
+//    `transmitted`).
 //  - windows: from the first sample, each window starts at the first sample at or after the previous
 //    window's start + horizon and is scored on its samples up to start + horizon (its first sample,
 //    the restart, excluded); a last part shorter than the horizon is not run.
@@ -33,6 +36,10 @@ struct ReplaySeries {
   std::vector<double> q[2];              // measured angle, rad (scored)
   std::vector<double> q0[2], qd0[2];     // restart state: filtered angle (rad) and velocity (rad/s)
   std::vector<double> tau_R[2];          // actuator torque input, N m
+  // The input between samples: false, linear interpolation (a rig's continuously sampled torque);
+  // true, each sample held until the next (a zero-order hold: the twin's joint modules log the torque
+  // they apply over the coming step, DESIGN.md "Sampling instant of a joint node").
+  bool hold = false;
 };
 
 // The default cutoff of the restart state's filter, Hz.

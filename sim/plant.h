@@ -92,8 +92,11 @@ class Plant {
   // q, qd are the measured (motor-side) joints. Internal hinges start at rest relative to their
   // joint: a dead band at the flank the rigid torque at qdd = 0 presses the link against (the inverse
   // form's -value/2 tanh(tau / kBacklashTorqueWidth)), a strap at its quasi-static deflection at
-  // qdd = 0 (CompliantAngle).
-  void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0);
+  // qdd = 0 (CompliantAngle). `transmitted` (N m, when given, e.g. the measured actuator torque at t)
+  // chooses the dead band's flank instead of that rigid torque: in motion the motor presses the link
+  // with its own torque, not with the quasi-static one.
+  void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0,
+             const Eigen::Vector2d* transmitted = nullptr);
   // Advances one physics step (model timestep) with actuator torque tau_R (N m) and an extra joint
   // torque tau_ext (N m, e.g. muscles or effects) acting on the link. Throws SimulationError on
   // divergence. P(q) is applied automatically when params.human is set, and the carried effects.

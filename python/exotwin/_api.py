@@ -284,7 +284,7 @@ def predict(params, measured, out=None, map=None, side=None, cutoff=None, mjcf=N
 
 # diagnose's fits in this build (DESIGN.md: torque|motion): `exotwin diagnose --fit` is passed for any
 # but the default, so a build whose CLI has `--fit motion` needs only "motion" added here.
-_FITS = ("torque",)
+_FITS = ("torque", "motion")
 
 
 def diagnose(params, measured, fit="torque", out=None, holdout=None, map=None, cutoff=None, max_effects=None,

@@ -61,8 +61,17 @@ def test_diagnose_names_the_hidden_effect(tmp, record):
     assert e["ci95"][0] <= hidden <= e["ci95"][1] or abs(e["value"] - hidden) < 0.1 * hidden
     assert d["extended"]["effects"][0]["name"] == "coulomb_friction"
     assert d["joints"]["knee"]["rmse_after"] < d["joints"]["knee"]["rmse_before"]
-    with pytest.raises(exotwin.InputError, match="fit: expected one of torque, got 'motion'"):
-        exotwin.diagnose(params, [path], fit="motion")
+    with pytest.raises(exotwin.InputError, match="fit: expected one of torque, motion, got 'inverse'"):
+        exotwin.diagnose(params, [path], fit="inverse")
+
+
+def test_diagnose_motion_fit_is_the_programs(tmp, record):
+    params, path, g = record
+    d = exotwin.diagnose(params, [path], fit="motion", out=tmp / "m")
+    cli("diagnose", "--params", params, "--measured", path, "--fit", "motion", "--out", tmp / "cli")
+    on_disk = json.loads((tmp / "cli" / "diagnosis.json").read_text())
+    assert on_disk["fit"] == "motion"
+    assert {k: v for k, v in d.items() if k not in ("extended", "out")} == on_disk
 
 
 def test_readers(tmp, record):

@@ -1,0 +1,1065 @@
+#include "diagnosis/motion_fit.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <Eigen/Cholesky>
+
+#include "core/error.h"
+#include "diagnosis/replay.h"
+#include "dsp/statistics.h"
+#include "formats/number_text.h"
+#include "model/passive_torque.h"
+#include "sim/mjcf_cache.h"
+#include "sim/plant.h"
+
+namespace exotwin {
+
+namespace {
+
+const char* kJoint[2] = {"hip", "knee"};
+
+constexpr double kNoBacklash = 1e-5;    // rad: a narrower dead band is none (the hinge is not built)
+constexpr double kNoCompliance = 1e-7;  // rad/(N m): a stiffer strap is none
+
+// MuJoCo's XML compiler keeps global state: plants are built one at a time.
+std::mutex& BuildMutex() {
+  static std::mutex m;
+  return m;
+}
+
+// Runs f(0) .. f(n - 1) on up to `threads` std::threads (the calling thread among them); the first
+// exception is rethrown after all have finished.
+thread_local bool tl_in_worker = false;  // inside ParallelFor's work: nested calls run serially
+
+template <class F>
+void ParallelFor(size_t n, int threads, F f) {
+  if (tl_in_worker) {
+    for (size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  std::atomic<size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&] {
+    tl_in_worker = true;
+    for (size_t i; (i = next.fetch_add(1)) < n;) {
+      try {
+        f(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
+    tl_in_worker = false;
+  };
+  const size_t T = std::min(n, static_cast<size_t>(std::max(1, threads)));
+  std::vector<std::thread> pool;
+  for (size_t k = 1; k < T; ++k) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
+  if (error) std::rethrow_exception(error);
+}
+
+int Threads(const DiagnoseOptions& opt) {
+  if (opt.threads > 0) return opt.threads;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+bool AllZero(const std::vector<double>& v) {
+  return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0; });
+}
+
+double RmsAboutMean(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m += x;
+  m /= static_cast<double>(std::max<size_t>(1, v.size()));
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return v.empty() ? 0.0 : std::sqrt(s / static_cast<double>(v.size()));
+}
+
+// The motion fit's checks of one record (motion_fit.h DiagnoseByMotion): returns the split (first
+// held-out sample) and whether the torque reading drives it (else cmd_*).
+size_t CheckMotionRecord(const LegParams& params, const MeasuredData& data, const DiagnoseOptions& opt, bool* by_reading) {
+  const double H = opt.replay_horizon_s;
+  if (!(H > 0)) throw InputError("diagnose --fit motion: window " + NumberText(H) + " s, expected > 0");
+  const int j0 = params.one_joint ? 1 : 0;
+  const std::vector<double>& t = data.t();
+  const size_t n = t.size();
+  const double T = t.back() - t.front();
+  const double t_split = t.front() + (1 - opt.holdout_fraction) * T;
+  const size_t split = static_cast<size_t>(std::lower_bound(t.begin(), t.end(), t_split) - t.begin());
+  const double fit_s = split > 0 ? t[split - 1] - t.front() : 0.0, held_s = t.back() - t[std::min(split, n - 1)];
+  if (fit_s < H || held_s < H)
+    throw InputError(data.source + ": the motion fit's windows of " + NumberText(H) + " s do not fit the record: its fit part is " +
+                     NumberText(fit_s, 4) + " s and its held-out part " + NumberText(held_s, 4) + " s (holdout " +
+                     NumberText(opt.holdout_fraction) + " of " + NumberText(T, 4) +
+                     " s); expected each at least one window (a longer record or a smaller holdout)");
+  // The input: the torque reading where the device's joints have one, else cmd_*.
+  const std::vector<double>* reading[2] = {&data.tau_hip(), &data.tau_knee()};
+  bool has_reading = true, has_cmd = true;
+  for (int j = j0; j < 2; ++j) {
+    has_reading = has_reading && !AllZero(*reading[j]);
+    has_cmd = has_cmd && data.Column(j == 0 ? "cmd_hip" : "cmd_knee") != nullptr;
+  }
+  if (!has_reading && !has_cmd)
+    throw InputError(data.source + ": the motion fit needs the actuator torque that drove the record: its torque reading (" +
+                     std::string(params.one_joint ? "tau_knee" : "tau_hip, tau_knee") +
+                     ") is zero throughout and it has no commanded torque (" +
+                     std::string(params.one_joint ? "cmd_knee" : "cmd_hip, cmd_knee") + "); expected either");
+  *by_reading = has_reading;
+  return split;
+}
+
+// The values of a torque-named effect as the candidate's parameters (into *theta); false if none.
+bool TorqueValues(const MotionProblem& P, const Effect& e, Eigen::VectorXd* theta) {
+  const int c = P.CandidateIndex(e.name, e.joint, e.axis);
+  if (c < 0) return false;
+  const Candidate& cand = P.candidates()[static_cast<size_t>(c)];
+  const double v = e.value;
+  if (e.name == "series_compliance") {
+    (*theta)[cand.cols[0]] = v > 0 ? 1 / v : 0;
+  } else if (e.name == "joint_stiffness") {
+    (*theta)[cand.cols[0]] = v;
+    (*theta)[cand.cols[1]] = v * (e.fields.count("q0") ? e.fields.at("q0") : 0.0);
+  } else if (e.name == "torque_ripple") {
+    const double ph = e.fields.count("phase") ? e.fields.at("phase") : 0.0;
+    (*theta)[cand.cols[0]] = v * std::cos(ph);
+    (*theta)[cand.cols[1]] = v * std::sin(ph);
+  } else {
+    (*theta)[cand.cols[0]] = v;
+  }
+  return true;
+}
+
+}  // namespace
+
+struct MotionProblem::Record {
+  std::string source;
+  ReplaySeries series;              // t, measured q, restart state (tau_R formed per rollout)
+  std::vector<double> reading[2];   // the torque reading tau_S (by_reading)
+  std::vector<double> cmd[2];       // the commanded torque (!by_reading)
+  bool by_reading = true;
+  size_t n = 0, split = 0, samples = 0;
+  std::vector<size_t> rows;         // scored sample indices, ascending (fit part first)
+  size_t fit_rows = 0;
+  Eigen::VectorXd q;                // measured angle on the rows: hip block, knee block
+};
+
+MotionProblem::~MotionProblem() = default;
+
+MotionProblem::MotionProblem(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                             const DiagnoseOptions& opt, const std::vector<DiagnosedEffect>& torque_named)
+    : params_(params), opt_(opt) {
+  if (records.empty()) throw InputError("diagnose --fit motion: no record given");
+  const double H = opt.replay_horizon_s;
+  const int j0 = params.one_joint ? 1 : 0;
+  PlantEffects base_fx = ToPlantEffects(params, "the model given");
+  std::vector<Kinematics> kins;
+  std::vector<ScaleRecord> scale_in;
+  kins.reserve(records.size());
+  for (const MeasuredData* data : records) {
+    auto rec = std::make_unique<Record>();
+    Record& R = *rec;
+    R.source = data->source;
+    R.n = R.samples = data->size();
+    bool has_reading = true;
+    R.split = CheckMotionRecord(params, *data, opt, &has_reading);
+    R.by_reading = has_reading;
+    if (!has_reading) reading_input_ = false;
+    R.series = ReplaySeriesOf(*data, base_fx, has_reading ? ReplayInput::kTorque : ReplayInput::kCommand,
+                              opt.replay_cutoff_hz);
+    for (int j = 0; j < 2; ++j) {
+      if (has_reading) R.reading[j] = j == 0 ? data->tau_hip() : data->tau_knee();
+      else R.cmd[j] = R.series.tau_R[j];
+      std::vector<double>().swap(R.series.tau_R[j]);
+    }
+    kins.push_back(DeriveKinematics(*data));
+    rec_.push_back(std::move(rec));
+  }
+  for (size_t r = 0; r < rec_.size(); ++r) scale_in.push_back({&kins[r], {&records[r]->tau_hip(), &records[r]->tau_knee()}});
+  scale_ = ScaleOf(params, scale_in);
+  // The forward plant simulates the strap's dynamics: the quasi-static form's limit does not apply.
+  scale_.strap_dynamics[0] = scale_.strap_dynamics[1] = 0;
+
+  // Parameters, their boxes (DESIGN.md's ranges) and secant steps.
+  auto Add = [&](const std::string& kind, int j, double lo, double hi, double step, double f = 0) {
+    kind_.push_back(kind), joint_.push_back(j), lo_.push_back(lo), hi_.push_back(hi), step_.push_back(step);
+    ripple_f_.push_back(f);
+    return static_cast<int>(lo_.size()) - 1;
+  };
+  auto Has = [&](const std::string& name, int j) {
+    for (const Effect& e : params.effects)
+      if (e.joint == kJoint[j] &&
+          (e.name == name || ((name == "backlash" || name == "series_compliance") &&
+                              (e.name == "backlash" || e.name == "series_compliance"))))
+        return true;
+    return false;
+  };
+  for (int j = j0; j < 2; ++j) {
+    double qd2 = 0, qdev = 0, cnt = 0;
+    std::vector<double> all_q;
+    for (const Kinematics& k : kins) {
+      for (double v : k.qd[j]) qd2 += v * v, cnt += 1;
+      all_q.insert(all_q.end(), k.q[j].begin(), k.q[j].end());
+    }
+    qdev = std::max(RmsAboutMean(all_q), 1e-3);
+    const double qd_rms = std::max(std::sqrt(qd2 / std::max(cnt, 1.0)), 1e-3);
+    const double tau = std::max(scale_.tau_max[j], 1e-3);
+    const double M = std::max(scale_.M_jj[j], 1e-6);
+    const double grav = 0.5 * scale_.distal_moment[j] + 0.05;
+    const double range = scale_.q_max[j] - scale_.q_min[j];
+    auto Cand = [&](const std::string& name, std::vector<int> cols, const std::string& axis = "") {
+      Candidate c;
+      c.name = name, c.joint = j, c.axis = axis, c.cols = std::move(cols);
+      c.ripple_f = ripple_f_[static_cast<size_t>(c.cols[0])];
+      candidates_.push_back(c);
+    };
+    const int off = Add("offset", j, -0.5 * tau, 0.5 * tau, 0.02 * tau);
+    if (!Has("coulomb_friction", j)) Cand("coulomb_friction", {Add("coulomb_friction", j, 0, 0.5 * tau, 0.02 * tau)});
+    if (!Has("viscous_friction", j))
+      Cand("viscous_friction", {Add("viscous_friction", j, 0, 100 * tau / qd_rms, 0.02 * tau / qd_rms)});
+    if (!Has("inertia_error", j)) Cand("inertia_error", {Add("inertia_error", j, -0.45 * M, M, 0.02 * M)});
+    if (!Has("gravity_error", j)) {
+      Cand("gravity_error", {Add("gravity_error.X", j, -grav, grav, 0.02 * grav)}, "X");
+      Cand("gravity_error", {Add("gravity_error.Y", j, -grav, grav, 0.02 * grav)}, "Y");
+    }
+    if (!Has("joint_stiffness", j))
+      Cand("joint_stiffness", {Add("joint_stiffness", j, 0, 100 * tau / qdev, 0.02 * tau / qdev), off});
+    if (params.human && !params.one_joint && !Has("passive_moment", j))
+      Cand("passive_moment", {Add("passive_moment", j, -0.95, kMaxPassiveScale - 1, 0.05)});
+    if (!Has("backlash", j)) Cand("backlash", {Add("backlash", j, 0, 0.1, 0.005)});
+    if (!Has("series_compliance", j) && !(j == 0 && params.human)) {
+      const double tc = std::max(scale_.tau_C_max[j], 1e-3);
+      Cand("series_compliance", {Add("series_compliance", j, 0, 0.5 * range / tc, 0.005 / tc)});
+    }
+    for (const DiagnosedEffect& d : torque_named)
+      if (d.effect.name == "torque_ripple" && d.effect.joint == kJoint[j] && !Has("torque_ripple", j)) {
+        const double f = d.effect.fields.at("cycles_per_rad");
+        const int a = Add("torque_ripple.sin", j, -0.5 * tau, 0.5 * tau, 0.02 * tau, f);
+        Cand("torque_ripple", {a, Add("torque_ripple.cos", j, -0.5 * tau, 0.5 * tau, 0.02 * tau, f)});
+      }
+    if (reading_input_) {
+      if (!Has("sensor_offset", j)) Cand("sensor_offset", {off});
+      if (!Has("sensor_gain", j)) Cand("sensor_gain", {Add("sensor_gain", j, -0.25, 0.25, 0.02)});
+      if (!Has("sensor_delay", j)) Cand("sensor_delay", {Add("sensor_delay", j, 0, 0.05, 0.002)});
+    }
+  }
+
+  // The scored rows: the given twin's windows (Replay's schedule) on the fit and held-out parts.
+  std::unique_ptr<Plant> plant;
+  {
+    std::lock_guard<std::mutex> lock(BuildMutex());
+    KeepMjcfModel(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);  // rollouts copy it
+    plant = MakeReplayPlant(params, "the model given", opt.mjcf);
+  }
+  for (auto& rp : rec_) {
+    Record& R = *rp;
+    ReplaySeries s = R.series;
+    if (R.by_reading) ActuatorTorqueFromReading(base_fx, s.t, R.reading, s.tau_R);
+    else s.tau_R[0] = R.cmd[0], s.tau_R[1] = R.cmd[1];
+    const ReplayRecord a = Replay(*plant, s, H, 0, R.split);
+    const ReplayRecord b = Replay(*plant, s, H, R.split, R.n);
+    for (size_t i = 0; i < R.n; ++i)
+      if (a.window[i] >= 0 || b.window[i] >= 0) R.rows.push_back(i);
+    R.fit_rows = static_cast<size_t>(std::lower_bound(R.rows.begin(), R.rows.end(), R.split) - R.rows.begin());
+    const size_t m = R.rows.size();
+    R.q.resize(static_cast<Eigen::Index>(2 * m));
+    for (size_t k = 0; k < m; ++k)
+      for (int j = 0; j < 2; ++j) R.q[static_cast<Eigen::Index>(j * m + k)] = R.series.q[j][R.rows[k]];
+  }
+  // The input's hold between samples (ReplaySeries::hold), chosen from the data: the one under which
+  // the given twin follows the fit parts closer.
+  Eigen::VectorXd zero = Eigen::VectorXd::Zero(parameters());
+  w_[0] = w_[1] = 1;
+  // The model given and, where the torque fit names effects the plant carries, with those too (a
+  // delayed reading, say, would otherwise hide which hold fits).
+  Eigen::VectorXd with_torque = zero;
+  for (const DiagnosedEffect& d : torque_named) TorqueValues(*this, d.effect, &with_torque);
+  for (int k = 0; k < parameters(); ++k) with_torque[k] = std::clamp(with_torque[k], lo_[k], hi_[k]);
+  double by_hold[2] = {INFINITY, INFINITY};
+  for (int h = 0; h < 2; ++h) {
+    for (auto& rp : rec_) rp->series.hold = h == 1;
+    for (const Eigen::VectorXd* x : {&zero, &with_torque}) {
+      const Rollout ro = Simulate(*x, Part::kFit);
+      double s2[2];
+      if (ro.ok) Sse(ro, Part::kFit, s2), by_hold[h] = std::min(by_hold[h], s2[0] + s2[1]);
+    }
+  }
+  hold_ = by_hold[1] < by_hold[0];
+  for (auto& rp : rec_) rp->series.hold = hold_;
+  // Output weights: 1 / the given twin's RMS simulated-angle error per joint on the fit parts.
+  const Rollout given = Simulate(zero, Part::kFit);
+  if (!given.ok) throw SimulationError(0, "the model given diverges in the forward simulation of the records");
+  double sse[2];
+  Sse(given, Part::kFit, sse);
+  double count = 0;
+  for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows);
+  for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse[j] / count), 1e-6);
+}
+
+int MotionProblem::CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis) const {
+  for (size_t c = 0; c < candidates_.size(); ++c)
+    if (candidates_[c].name == name && kJoint[candidates_[c].joint] == joint &&
+        (name != "gravity_error" || candidates_[c].axis == axis))
+      return static_cast<int>(c);
+  return -1;
+}
+
+const std::vector<size_t>& MotionProblem::rows(size_t r) const { return rec_[r]->rows; }
+size_t MotionProblem::fit_rows(size_t r) const { return rec_[r]->fit_rows; }
+const Eigen::VectorXd& MotionProblem::measured(size_t r) const { return rec_[r]->q; }
+
+std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const {
+  std::vector<Effect> link, sensor;
+  auto Make = [](const std::string& name, int j, double v, const std::string& unit) {
+    Effect e;
+    e.name = name, e.joint = kJoint[j], e.value = v, e.unit = unit;
+    return e;
+  };
+  for (int k = 0; k < parameters(); ++k) {
+    const double v = theta[k];
+    const int j = joint_[k];
+    const std::string& kind = kind_[k];
+    if (v == 0) continue;
+    if (kind == "coulomb_friction" && v > 0) link.push_back(Make(kind, j, v, "N m"));
+    if (kind == "viscous_friction" && v > 0) link.push_back(Make(kind, j, v, "N m s/rad"));
+    if (kind == "inertia_error") link.push_back(Make(kind, j, v, "kg m^2"));
+    if (kind == "passive_moment") link.push_back(Make(kind, j, v, "relative"));
+    if (kind.rfind("gravity_error", 0) == 0) {
+      Effect e = Make("gravity_error", j, v, "kg m");
+      e.axis = kind.substr(14);
+      link.push_back(e);
+    }
+    if (kind == "joint_stiffness" && v > 0) {  // its constant part k q0 is the offset parameter
+      Effect e = Make(kind, j, v, "N m/rad");
+      e.fields["q0"] = 0;
+      link.push_back(e);
+    }
+    if (kind == "backlash" && v > kNoBacklash) link.push_back(Make(kind, j, v, "rad"));
+    if (kind == "series_compliance" && v > kNoCompliance) link.push_back(Make(kind, j, 1 / v, "N m/rad"));
+    if (kind == "torque_ripple.sin") {
+      const double b = theta[k + 1];
+      Effect e = Make("torque_ripple", j, std::hypot(v, b), "N m");
+      e.fields["cycles_per_rad"] = ripple_f_[k];
+      e.fields["phase"] = std::atan2(b, v);
+      link.push_back(e);
+    }
+    // The input's constant torque: a sensor offset where the reading drives (tau_R = -(reading - offset)).
+    if (kind == "offset" && reading_input_) sensor.push_back(Make("sensor_offset", j, v, "N m"));
+    if (kind == "sensor_gain") sensor.push_back(Make(kind, j, v, "relative"));
+    if (kind == "sensor_delay" && v > 0) sensor.push_back(Make(kind, j, v, "s"));
+  }
+  for (int k = 0; k < parameters(); ++k)  // a ripple whose sine part is 0
+    if (kind_[k] == "torque_ripple.cos" && theta[k] != 0 && theta[k - 1] == 0) {
+      Effect e = Make("torque_ripple", joint_[k], std::abs(theta[k]), "N m");
+      e.fields["cycles_per_rad"] = ripple_f_[k];
+      e.fields["phase"] = std::atan2(theta[k], 0.0);
+      link.push_back(e);
+    }
+  link.insert(link.end(), sensor.begin(), sensor.end());
+  return link;
+}
+
+MotionProblem::Rollout MotionProblem::Simulate(const Eigen::VectorXd& theta, Part part) const {
+  LegParams p = params_;
+  const std::vector<Effect> extra = EffectsOf(theta);
+  p.effects.insert(p.effects.end(), extra.begin(), extra.end());
+  std::unique_ptr<Plant> plant;
+  PlantEffects fx;
+  {
+    std::lock_guard<std::mutex> lock(BuildMutex());
+    try {
+      plant = MakeReplayPlant(p, "motion fit", opt_.mjcf, &fx);
+    } catch (const InputError&) {
+      return {};
+    }
+  }
+  Rollout out;
+  out.ok = true;
+  const double H = opt_.replay_horizon_s;
+  for (const auto& rp : rec_) {
+    const Record& R = *rp;
+    ReplaySeries s = R.series;
+    if (R.by_reading) {
+      ActuatorTorqueFromReading(fx, s.t, R.reading, s.tau_R);
+    } else {
+      s.tau_R[0] = R.cmd[0], s.tau_R[1] = R.cmd[1];
+      for (int k = 0; k < parameters(); ++k)
+        if (kind_[k] == "offset" && theta[k] != 0)
+          for (double& v : s.tau_R[joint_[k]]) v += theta[k];
+    }
+    const size_t m = R.rows.size();
+    Eigen::VectorXd q = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(2 * m), std::nan(""));
+    try {
+      auto Take = [&](const ReplayRecord& rr, size_t k0, size_t k1) {
+        for (size_t k = k0; k < k1; ++k)
+          for (int j = 0; j < 2; ++j) q[static_cast<Eigen::Index>(j * m + k)] = rr.sim[j][R.rows[k]];
+      };
+      if (part != Part::kHeldOut) Take(Replay(*plant, s, H, 0, R.split), 0, R.fit_rows);
+      if (part != Part::kFit) Take(Replay(*plant, s, H, R.split, R.n), R.fit_rows, m);
+    } catch (const SimulationError&) {
+      return {};
+    }
+    for (Eigen::Index i = 0; i < q.size(); ++i)  // a row inside the part the replay missed: not ok
+      if (!std::isfinite(q[i]) && ((i % static_cast<Eigen::Index>(m)) < static_cast<Eigen::Index>(R.fit_rows)
+                                       ? part != Part::kHeldOut
+                                       : part != Part::kFit))
+        return {};
+    out.q.push_back(std::move(q));
+  }
+  return out;
+}
+
+std::vector<MotionProblem::Rollout> MotionProblem::SimulateAll(const std::vector<Eigen::VectorXd>& thetas,
+                                                               Part part) const {
+  std::vector<Rollout> out(thetas.size());
+  ParallelFor(thetas.size(), Threads(opt_), [&](size_t k) { out[k] = Simulate(thetas[k], part); });
+  return out;
+}
+
+Eigen::MatrixXd MotionProblem::Jacobian(const Eigen::VectorXd& theta, const Rollout& at, const std::vector<int>& cols,
+                                        Part part) const {
+  Eigen::Index rows = 0;
+  for (const auto& rp : rec_) rows += static_cast<Eigen::Index>(2 * rp->rows.size());
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, static_cast<Eigen::Index>(cols.size()));
+  std::vector<Eigen::VectorXd> thetas;
+  std::vector<double> h(cols.size());
+  for (size_t c = 0; c < cols.size(); ++c) {
+    const int k = cols[c];
+    h[c] = theta[k] + step_[k] <= hi_[k] ? step_[k] : -step_[k];
+    Eigen::VectorXd x = theta;
+    x[k] += h[c];
+    thetas.push_back(x);
+  }
+  std::vector<Rollout> ro = SimulateAll(thetas, part);
+  for (size_t c = 0; c < cols.size(); ++c) {
+    if (!ro[c].ok) {  // the other way
+      const int k = cols[c];
+      h[c] = -h[c];
+      Eigen::VectorXd x = theta;
+      x[k] = std::clamp(x[k] + h[c], lo_[k], hi_[k]);
+      h[c] = x[k] - theta[k];
+      if (h[c] != 0) ro[c] = Simulate(x, part);
+      if (!ro[c].ok || h[c] == 0) continue;
+    }
+    Eigen::Index off = 0;
+    for (size_t r = 0; r < rec_.size(); ++r) {
+      const Eigen::VectorXd d = (ro[c].q[r] - at.q[r]) / h[c];
+      for (Eigen::Index i = 0; i < d.size(); ++i) J(off + i, static_cast<Eigen::Index>(c)) = std::isfinite(d[i]) ? d[i] : 0.0;
+      off += d.size();
+    }
+  }
+  return J;
+}
+
+void MotionProblem::Sse(const Rollout& ro, Part part, double sse[2]) const {
+  sse[0] = sse[1] = 0;
+  for (size_t r = 0; r < rec_.size(); ++r) {
+    const Record& R = *rec_[r];
+    const size_t m = R.rows.size();
+    const size_t k0 = part == Part::kHeldOut ? R.fit_rows : 0, k1 = part == Part::kFit ? R.fit_rows : m;
+    for (int j = 0; j < 2; ++j)
+      for (size_t k = k0; k < k1; ++k) {
+        const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
+        sse[j] += std::pow(w_[j] * (R.q[i] - ro.q[r][i]), 2);
+      }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The fit (motion_fit.h "Method").
+
+namespace {
+
+using Part = MotionProblem::Part;
+
+double Cost(const MotionProblem& P, const MotionProblem::Rollout& ro, Part part) {
+  if (!ro.ok) return INFINITY;
+  double s[2];
+  P.Sse(ro, part, s);
+  return s[0] + s[1];
+}
+
+// Stacked row indices (records stacked, 2 m each) of a part, rows of weight 0 left out.
+std::vector<Eigen::Index> PartRows(const MotionProblem& P, Part part) {
+  std::vector<Eigen::Index> out;
+  Eigen::Index off = 0;
+  for (size_t r = 0; r < P.records(); ++r) {
+    const size_t m = P.rows(r).size();
+    for (int j = 0; j < 2; ++j) {
+      if (P.weight(j) == 0) continue;
+      const size_t k0 = part == Part::kHeldOut ? P.fit_rows(r) : 0, k1 = part == Part::kFit ? P.fit_rows(r) : m;
+      for (size_t k = k0; k < k1; ++k) out.push_back(off + static_cast<Eigen::Index>(j * m + k));
+    }
+    off += static_cast<Eigen::Index>(2 * m);
+  }
+  return out;
+}
+
+// Weighted residual (measured - simulated) on `idx` of a rollout.
+Eigen::VectorXd WeightedResidual(const MotionProblem& P, const MotionProblem::Rollout& ro,
+                                 const std::vector<Eigen::Index>& idx) {
+  Eigen::VectorXd all;
+  std::vector<double> w;
+  Eigen::Index total = 0;
+  for (size_t r = 0; r < P.records(); ++r) total += P.measured(r).size();
+  all.resize(total);
+  Eigen::VectorXd wv(total);
+  Eigen::Index off = 0;
+  for (size_t r = 0; r < P.records(); ++r) {
+    const Eigen::Index m2 = P.measured(r).size();
+    all.segment(off, m2) = P.measured(r) - ro.q[r];
+    wv.segment(off, m2 / 2).setConstant(P.weight(0));
+    wv.segment(off + m2 / 2, m2 / 2).setConstant(P.weight(1));
+    off += m2;
+  }
+  Eigen::VectorXd e(static_cast<Eigen::Index>(idx.size()));
+  for (size_t k = 0; k < idx.size(); ++k) e[static_cast<Eigen::Index>(k)] = wv[idx[k]] * all[idx[k]];
+  return e;
+}
+
+Eigen::VectorXd RowWeights(const MotionProblem& P) {
+  Eigen::Index total = 0;
+  for (size_t r = 0; r < P.records(); ++r) total += P.measured(r).size();
+  Eigen::VectorXd wv(total);
+  Eigen::Index off = 0;
+  for (size_t r = 0; r < P.records(); ++r) {
+    const Eigen::Index m2 = P.measured(r).size();
+    wv.segment(off, m2 / 2).setConstant(P.weight(0));
+    wv.segment(off + m2 / 2, m2 / 2).setConstant(P.weight(1));
+    off += m2;
+  }
+  return wv;
+}
+
+// Autocorrelation length (rows) of the weighted fit-part residual: the longest over records and
+// joints, at most a window's rows.
+double ResidualAutocorrelation(const MotionProblem& P, const MotionProblem::Rollout& ro, double window_rows) {
+  double tau = 1;
+  for (size_t r = 0; r < P.records(); ++r) {
+    const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
+    for (int j = 0; j < 2; ++j) {
+      if (P.weight(j) == 0 || mf < 8) continue;
+      std::vector<double> e(mf);
+      for (size_t k = 0; k < mf; ++k) {
+        const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
+        e[k] = P.measured(r)[i] - ro.q[r][i];
+      }
+      tau = std::max(tau, AutocorrelationLength(e.data(), e.size()));
+    }
+  }
+  return std::min(tau, std::max(1.0, window_rows));
+}
+
+struct Refined {
+  Eigen::VectorXd theta;
+  double cost = INFINITY;
+  Eigen::MatrixXd J;  // weighted, fit rows x cols, at theta
+  Eigen::VectorXd e;  // weighted residual there
+};
+
+// Projected Levenberg-Marquardt on parameters `cols` (motion_fit.h step 4), from the best of `starts`.
+Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::vector<Eigen::VectorXd>& starts,
+               int iterations = kMotionLmIterations) {
+  const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
+  const Eigen::VectorXd wv = RowWeights(P);
+  auto Clamp = [&](Eigen::VectorXd x) {
+    for (int k : cols) x[k] = std::clamp(x[k], P.lower(k), P.upper(k));
+    return x;
+  };
+  std::vector<Eigen::VectorXd> xs;
+  for (const auto& s : starts) xs.push_back(Clamp(s));
+  std::vector<MotionProblem::Rollout> ro = P.SimulateAll(xs, Part::kFit);
+  size_t best = 0;
+  for (size_t k = 1; k < xs.size(); ++k)
+    if (Cost(P, ro[k], Part::kFit) < Cost(P, ro[best], Part::kFit)) best = k;
+  Refined R;
+  R.theta = xs[best];
+  MotionProblem::Rollout at = ro[best];
+  R.cost = Cost(P, at, Part::kFit);
+  if (!std::isfinite(R.cost)) return R;
+  auto WeightedJ = [&](const MotionProblem::Rollout& a, const Eigen::VectorXd& theta) {
+    const Eigen::MatrixXd Jall = P.Jacobian(theta, a, cols, Part::kFit);
+    Eigen::MatrixXd J(static_cast<Eigen::Index>(idx.size()), Jall.cols());
+    for (size_t k = 0; k < idx.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = wv[idx[k]] * Jall.row(idx[k]);
+    return J;
+  };
+  double lambda = 1e-3;
+  bool fresh = false;
+  for (int it = 0; it < iterations; ++it) {
+    R.J = WeightedJ(at, R.theta);
+    R.e = WeightedResidual(P, at, idx);
+    fresh = true;
+    const Eigen::MatrixXd A = R.J.transpose() * R.J;
+    const Eigen::VectorXd g = R.J.transpose() * R.e;
+    const Eigen::VectorXd D = A.diagonal().cwiseMax(1e-12 * std::max(A.diagonal().maxCoeff(), 1e-300));
+    bool improved = false;
+    const double before = R.cost;
+    for (int trial = 0; trial < 6 && !improved; ++trial) {
+      Eigen::MatrixXd Al = A;
+      Al.diagonal() += lambda * D;
+      const Eigen::VectorXd d = Al.ldlt().solve(g);
+      Eigen::VectorXd x = R.theta;
+      for (size_t c = 0; c < cols.size(); ++c) x[cols[c]] += d[static_cast<Eigen::Index>(c)];
+      x = Clamp(x);
+      if ((x - R.theta).norm() == 0) break;
+      MotionProblem::Rollout rx = P.Simulate(x, Part::kFit);
+      const double cx = Cost(P, rx, Part::kFit);
+      if (cx < R.cost) {
+        R.theta = x, R.cost = cx, at = std::move(rx);
+        lambda = std::max(lambda / 3, 1e-9);
+        improved = true, fresh = false;
+      } else {
+        lambda *= 5;
+      }
+    }
+    if (!improved || before - R.cost < 1e-5 * before) break;
+  }
+  if (!fresh) {
+    R.J = WeightedJ(at, R.theta);
+    R.e = WeightedResidual(P, at, idx);
+  }
+  return R;
+}
+
+std::string Labels(const MotionProblem& P, const std::vector<int>& set) {
+  std::string o;
+  for (int c : set) o += (o.empty() ? "" : " + ") + P.candidates()[static_cast<size_t>(c)].Label();
+  return o.empty() ? "the model given" : o;
+}
+
+JointScore Score(double sse_before, double sse_after, double count) {
+  count = std::max(count, 1.0);
+  return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
+          sse_before > 0 ? 100 * (1 - std::sqrt(sse_after / sse_before)) : 0};
+}
+
+// Unweighted SSE (rad^2) of one record's part per joint, and its rows.
+void RecordSse(const MotionProblem& P, const MotionProblem::Rollout& ro, size_t r, Part part, double sse[2], double* count) {
+  const size_t m = P.rows(r).size();
+  const size_t k0 = part == Part::kHeldOut ? P.fit_rows(r) : 0, k1 = part == Part::kFit ? P.fit_rows(r) : m;
+  sse[0] = sse[1] = 0;
+  for (int j = 0; j < 2; ++j)
+    for (size_t k = k0; k < k1; ++k) {
+      const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
+      sse[j] += std::pow(P.measured(r)[i] - ro.q[r][i], 2);
+    }
+  *count = static_cast<double>(k1 - k0);
+}
+
+}  // namespace
+
+Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                           const DiagnoseOptions& opt) {
+  bool by_reading = true;
+  for (const MeasuredData* data : records) CheckMotionRecord(params, *data, opt, &by_reading);
+  // 1. The torque fit: starting values and what it would name.
+  DiagnoseOptions topt = opt;
+  topt.fit = DiagnoseFit::kTorque;
+  topt.simulate = false;
+  Diagnosis T = Diagnose(params, records, topt);
+
+  const MotionProblem P(params, records, opt, T.effects);
+  const int n_par = P.parameters();
+  const std::vector<Candidate>& cands = P.candidates();
+  const bool loo = records.size() >= 2;
+  ColumnBank cand_bank;  // the candidates alone (ColumnsOf)
+  cand_bank.candidates = cands;
+  std::vector<int> all(static_cast<size_t>(n_par));
+  for (int k = 0; k < n_par; ++k) all[static_cast<size_t>(k)] = k;
+
+  Diagnosis D;
+  D.fit = DiagnoseFit::kMotion;
+  D.holdout_fraction = opt.holdout_fraction;
+  D.leave_one_out = loo;
+  D.torque_named = T.effects;
+  D.cutoff = T.cutoff;
+
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_par);
+  const MotionProblem::Rollout given = P.Simulate(zero, Part::kBoth);
+  if (!given.ok) throw SimulationError(0, "the model given diverges in the forward simulation of the records");
+  double window_rows = 0;
+  {
+    double rows = 0, windows = 0;
+    for (size_t r = 0; r < P.records(); ++r) {
+      const auto& t = records[r]->t();
+      rows += static_cast<double>(P.rows(r).size());
+      windows += std::floor((t.back() - t.front()) / opt.replay_horizon_s);
+    }
+    window_rows = rows / std::max(windows, 1.0);
+  }
+
+  // 2-5. Linearize, select, refine.
+  Eigen::VectorXd theta = zero;
+  MotionProblem::Rollout at = given;
+  std::vector<int> chosen, previous;
+  Grams g_last;
+  double tau_eff = 1;
+  std::vector<std::vector<int>> seen;
+  const Eigen::VectorXd wv = RowWeights(P);
+  // The linear model at theta of Jacobian J (motion_fit.h step 2): one bank per record, their Grams.
+  auto Linearize = [&](const Eigen::MatrixXd& J, std::vector<ColumnBank>* banks_out, Grams* g_out) {
+    std::vector<ColumnBank> banks(P.records());
+    Eigen::Index off = 0;
+    for (size_t r = 0; r < P.records(); ++r) {
+      ColumnBank& b = banks[r];
+      const size_t m = P.rows(r).size();
+      const Eigen::Index m2 = static_cast<Eigen::Index>(2 * m);
+      b.sample = P.rows(r);
+      b.train.resize(m);
+      for (size_t k = 0; k < m; ++k) b.train[k] = k < P.fit_rows(r);
+      b.X = wv.segment(off, m2).asDiagonal() * J.middleRows(off, m2);
+      b.r = wv.segment(off, m2).asDiagonal() * (P.measured(r) - at.q[r] + J.middleRows(off, m2) * theta);
+      b.candidates = cands;
+      b.used = n_par;
+      b.n = records[r]->size();
+      off += m2;
+    }
+    Grams g = MakeGrams(banks);
+    g.n_eff = g.n_tr / tau_eff;
+    g.scale_name = "measured angle";
+    for (size_t r = 0; r < P.records(); ++r) {
+      const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
+      for (int j = 0; j < 2; ++j) {
+        std::vector<double> q;
+        for (size_t k = mf; k < m; ++k) q.push_back(P.measured(r)[static_cast<Eigen::Index>(j * m + k)]);
+        const double s = RmsAboutMean(q) * P.weight(j);
+        g.tt_te[j] += s * s * static_cast<double>(q.size());
+      }
+    }
+    *banks_out = std::move(banks);
+    *g_out = std::move(g);
+  };
+  // Column k of J replaced by the secant (q(x) - q(theta)) / (x_k - theta_k).
+  auto Secant = [&](Eigen::MatrixXd* J, int k, const MotionProblem::Rollout& rx, double dx) {
+    Eigen::Index off = 0;
+    for (size_t r = 0; r < P.records(); ++r) {
+      J->col(k).segment(off, rx.q[r].size()) = (rx.q[r] - at.q[r]) / dx;
+      off += rx.q[r].size();
+    }
+  };
+  for (int round = 0; round < kMotionOuterSteps; ++round) {
+    Eigen::MatrixXd J = P.Jacobian(theta, at, all, Part::kBoth);
+    tau_eff = ResidualAutocorrelation(P, at, window_rows);
+    // The one-parameter effects of the current set: secants from the set without them.
+    std::vector<int> in_set;
+    std::vector<Eigen::VectorXd> without;
+    for (int c : chosen)
+      if (cands[static_cast<size_t>(c)].cols.size() == 1 && theta[cands[static_cast<size_t>(c)].cols[0]] != 0) {
+        in_set.push_back(cands[static_cast<size_t>(c)].cols[0]);
+        without.push_back(theta);
+        without.back()[in_set.back()] = 0;
+      }
+    const std::vector<MotionProblem::Rollout> ro_without = P.SimulateAll(without, Part::kBoth);
+    for (size_t k = 0; k < in_set.size(); ++k)
+      if (ro_without[k].ok) Secant(&J, in_set[k], ro_without[k], -(theta[in_set[k]]));
+    std::vector<ColumnBank> banks;
+    Grams g;
+    Linearize(J, &banks, &g);
+    // Screening (motion_fit.h step 3): every one-parameter candidate whose linear fit on top of the
+    // current set is significant and lowers the BIC is refined alone on the plant (LM, the set held);
+    // its column becomes the secant to that value, so the selection sees its exact single fit.
+    {
+      const Fit f_set = FitCols(g, ColumnsOf(banks[0], chosen), false);
+      std::vector<int> screen;
+      std::vector<Eigen::VectorXd> start;
+      for (size_t c = 0; c < cands.size(); ++c) {
+        const Candidate& cand = cands[c];
+        if (cand.cols.size() != 1 || std::find(chosen.begin(), chosen.end(), static_cast<int>(c)) != chosen.end()) continue;
+        std::vector<int> set = chosen;
+        set.push_back(static_cast<int>(c));
+        const Fit f = FitCols(g, ColumnsOf(banks[0], set), false);
+        const int k = cand.cols[0];
+        if (!f.ok || !(f.bic < f_set.bic) || !(std::abs(CoefOf(f, k)) > kMinT * SeOf(f, k))) continue;
+        Eigen::VectorXd x = theta;
+        x[k] = std::clamp(CoefOf(f, k), P.lower(k), P.upper(k));
+        if (x[k] == theta[k]) continue;
+        screen.push_back(k);
+        start.push_back(x);
+      }
+      std::vector<Refined> refined(screen.size());
+      std::vector<MotionProblem::Rollout> at_refined(screen.size());
+      ParallelFor(screen.size(), Threads(opt), [&](size_t i) {
+        refined[i] = Refine(P, {screen[i]}, {start[i]}, kMotionScreenIterations);
+        if (std::isfinite(refined[i].cost) && refined[i].theta[screen[i]] != theta[screen[i]])
+          at_refined[i] = P.Simulate(refined[i].theta, Part::kBoth);
+      });
+      for (size_t i = 0; i < screen.size(); ++i)
+        if (at_refined[i].ok) Secant(&J, screen[i], at_refined[i], refined[i].theta[screen[i]] - theta[screen[i]]);
+      if (!screen.empty()) Linearize(J, &banks, &g);
+    }
+    Fit lin;
+    SelectionTrace trace;
+    chosen = SelectEffects(banks[0], g, P.scale(), opt.max_effects, loo, &lin, &trace);
+    for (const auto& s : trace.steps)
+      D.selection.push_back("round " + std::to_string(round + 1) + " (linearized at " + Labels(P, previous) + "): " + s);
+    g_last = std::move(g);
+    if (chosen.empty()) {
+      theta = zero, at = given;
+      break;
+    }
+    const std::vector<int> cols = ColumnsOf(banks[0], chosen);
+    Eigen::VectorXd start_lin = zero, start_torque = zero;
+    for (size_t k = 0; k < lin.cols.size(); ++k) start_lin[lin.cols[k]] = lin.coef[static_cast<Eigen::Index>(k)];
+    start_torque = start_lin;
+    bool has_torque = false;
+    for (int c : chosen)
+      for (const DiagnosedEffect& e : T.effects) {
+        const Candidate& cand = cands[static_cast<size_t>(c)];
+        if (e.effect.name == cand.name && e.effect.joint == kJoint[cand.joint] &&
+            (cand.name != "gravity_error" || e.effect.axis == cand.axis))
+          has_torque = TorqueValues(P, e.effect, &start_torque) || has_torque;
+      }
+    std::vector<Eigen::VectorXd> starts = {start_lin};
+    if (has_torque) starts.push_back(start_torque);
+    const Refined rf = Refine(P, cols, starts);
+    if (!std::isfinite(rf.cost)) {
+      D.selection.push_back("round " + std::to_string(round + 1) + ": " + Labels(P, chosen) +
+                            " cannot be simulated at its fitted values; nothing named");
+      chosen.clear();
+      theta = zero, at = given;
+      break;
+    }
+    theta = rf.theta;
+    at = P.Simulate(theta, Part::kBoth);
+    std::ostringstream os;
+    os << "round " << round + 1 << ": refined on the plant:";
+    for (int c : chosen) {
+      const Candidate& cand = cands[static_cast<size_t>(c)];
+      os << " " << cand.Label() << " =";
+      for (int k : cand.cols) os << " " << NumberText(theta[k], 4);
+    }
+    D.selection.push_back(os.str());
+    std::vector<int> key = chosen;
+    std::sort(key.begin(), key.end());
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) break;
+    seen.push_back(key);
+    previous = chosen;
+  }
+
+  // 6. The exact held-out gate.
+  std::vector<double> explained(chosen.size(), 0.0);
+  double sse_given_te[2];
+  P.Sse(given, Part::kHeldOut, sse_given_te);
+  Refined last;
+  bool have_last = false;
+  while (!chosen.empty()) {
+    std::vector<Eigen::VectorXd> thetas = {theta};
+    for (int c : chosen) {
+      Eigen::VectorXd x = theta;
+      for (int k : cands[static_cast<size_t>(c)].cols) x[k] = 0;
+      thetas.push_back(x);
+    }
+    const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(thetas, Part::kHeldOut);
+    double full[2];
+    P.Sse(ro[0], Part::kHeldOut, full);
+    int worst = -1;
+    double worst_gain = INFINITY;
+    explained.assign(chosen.size(), 0.0);
+    for (size_t k = 0; k < chosen.size(); ++k) {
+      const int j = cands[static_cast<size_t>(chosen[k])].joint;
+      double without[2] = {INFINITY, INFINITY};
+      if (ro[k + 1].ok) P.Sse(ro[k + 1], Part::kHeldOut, without);
+      const double gain = without[j] > 0 ? 1 - full[j] / without[j] : 0.0;
+      explained[k] = 100 * ((without[0] + without[1]) - (full[0] + full[1])) /
+                     std::max(sse_given_te[0] + sse_given_te[1], 1e-300);
+      if (gain < worst_gain) worst_gain = gain, worst = static_cast<int>(k);
+    }
+    if (worst_gain >= kMinHeldoutGain) break;
+    const Candidate& wc = cands[static_cast<size_t>(chosen[static_cast<size_t>(worst)])];
+    D.selection.push_back("exact held-out gate: " + wc.Label() + " removed: without it the held-out simulated error at the " +
+                          kJoint[wc.joint] + " is only " + NumberText(100 * worst_gain, 3) + " % higher (needed " +
+                          NumberText(100 * kMinHeldoutGain) + " %)");
+    chosen.erase(chosen.begin() + worst);
+    for (int k : wc.cols) theta[k] = 0;
+    have_last = false;
+    if (chosen.empty()) {
+      theta = zero;
+      break;
+    }
+    const Refined rf = Refine(P, ColumnsOf(cand_bank, chosen), {theta});
+    if (std::isfinite(rf.cost)) theta = rf.theta, last = rf, have_last = true;
+  }
+  at = P.Simulate(theta, Part::kBoth);
+  if (!at.ok) throw SimulationError(0, "the motion fit's extended twin diverges on the records");
+
+  // 7. Values and intervals from the final Jacobian.
+  const std::vector<int> cols = ColumnsOf(cand_bank, chosen);
+  D.tau_eff = ResidualAutocorrelation(P, at, window_rows);
+  if (!chosen.empty()) {
+    if (!have_last) last = Refine(P, cols, {theta});  // no step taken when theta is its own minimum
+    theta = last.theta;
+    at = P.Simulate(theta, Part::kBoth);
+    Fit f;
+    f.ok = true;
+    f.cols = cols;
+    f.coef.resize(static_cast<Eigen::Index>(cols.size()));
+    for (size_t k = 0; k < cols.size(); ++k) f.coef[static_cast<Eigen::Index>(k)] = theta[cols[k]];
+    const double n = static_cast<double>(last.e.size()), p = static_cast<double>(cols.size());
+    const double s2 = last.e.squaredNorm() / std::max(n - p, 1.0) * D.tau_eff;
+    const Eigen::MatrixXd A = last.J.transpose() * last.J;
+    const Eigen::MatrixXd cov = s2 * A.ldlt().solve(Eigen::MatrixXd::Identity(A.rows(), A.cols()));
+    f.se = cov.diagonal().cwiseMax(0).cwiseSqrt();
+    for (size_t k = 0; k < chosen.size(); ++k) {
+      DiagnosedEffect de = ToEffect(cands[static_cast<size_t>(chosen[k])], f);
+      de.explained_pct = explained[k];
+      D.effects.push_back(de);
+    }
+  }
+  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
+    const bool sa = a.effect.name.rfind("sensor_", 0) == 0, sb = b.effect.name.rfind("sensor_", 0) == 0;
+    return sa != sb ? !sa : a.explained_pct > b.explained_pct;
+  });
+  D.extended = params;
+  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  // The sensor effects in the order the rollouts applied them (offset, gain, delay).
+  std::stable_sort(D.extended.effects.begin() + static_cast<long>(params.effects.size()), D.extended.effects.end(),
+                   [](const Effect& a, const Effect& b) {
+                     auto rank = [](const Effect& e) {
+                       return e.name == "sensor_offset" ? 1 : e.name == "sensor_gain" ? 2 : e.name == "sensor_delay" ? 3 : 0;
+                     };
+                     return rank(a) < rank(b);
+                   });
+
+  // Scores: the given vs the extended twin, held-out parts and whole records left out (rad).
+  SimulationScores& S = D.simulation;
+  S.horizon_s = opt.replay_horizon_s;
+  S.cutoff_hz = opt.replay_cutoff_hz;
+  double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
+  std::vector<Eigen::VectorXd> loo_thetas;
+  if (loo)
+    for (size_t r = 0; r < P.records(); ++r) {
+      Eigen::VectorXd x = zero;
+      if (!cols.empty()) {
+        const Eigen::VectorXd v = FitLeavingOut(g_last, cols, r);
+        if (v.size() == 0) throw InputError(records[r]->source + ": without this record the chosen effects are not identifiable");
+        for (size_t k = 0; k < cols.size(); ++k)
+          x[cols[k]] = std::clamp(v[static_cast<Eigen::Index>(k)], P.lower(cols[k]), P.upper(cols[k]));
+      }
+      loo_thetas.push_back(x);
+    }
+  const std::vector<MotionProblem::Rollout> loo_ro = P.SimulateAll(loo_thetas, Part::kBoth);
+  for (size_t r = 0; r < P.records(); ++r) {
+    RecordScore rs;
+    rs.source = records[r]->source;
+    rs.samples = records[r]->size();
+    double b[2], a[2], c;
+    RecordSse(P, given, r, Part::kHeldOut, b, &c);
+    RecordSse(P, at, r, Part::kHeldOut, a, &c);
+    const auto& t = records[r]->t();
+    const size_t split = P.rows(r)[P.fit_rows(r)];
+    rs.sim_split_windows = static_cast<size_t>(std::floor((t.back() - t[split]) / opt.replay_horizon_s + 1e-9));
+    for (int j = 0; j < 2; ++j) {
+      rs.split[j] = rs.sim_split[j] = Score(b[j], a[j], c);
+      sb[j] += b[j], sa[j] += a[j];
+    }
+    cnt += c;
+    if (loo) {
+      double lb_r[2], la_r[2], lc;
+      RecordSse(P, given, r, Part::kBoth, lb_r, &lc);
+      if (!loo_ro[r].ok) throw SimulationError(0, rs.source + ": the effects fitted on the other records diverge on it");
+      RecordSse(P, loo_ro[r], r, Part::kBoth, la_r, &lc);
+      for (int j = 0; j < 2; ++j) {
+        rs.left_out[j] = rs.sim_left_out[j] = Score(lb_r[j], la_r[j], lc);
+        lb[j] += lb_r[j], la[j] += la_r[j];
+      }
+      lcnt += lc;
+      rs.sim_left_out_windows = static_cast<size_t>(std::floor((t.back() - t.front()) / opt.replay_horizon_s));
+      rs.left_out_effects = params.effects;
+      const std::vector<Effect> fx = P.EffectsOf(loo_thetas[r]);
+      rs.left_out_effects.insert(rs.left_out_effects.end(), fx.begin(), fx.end());
+    }
+    if (r == 0) {  // the plotted series: the held-out part, NaN off the scored rows
+      const size_t n = t.size(), m = P.rows(0).size();
+      S.t.assign(t.begin() + static_cast<long>(split), t.end());
+      for (int j = 0; j < 2; ++j) {
+        S.measured[j].assign(n - split, std::nan(""));
+        S.rigid[j] = S.extended[j] = S.measured[j];
+        for (size_t k = P.fit_rows(0); k < m; ++k) {
+          const size_t i = P.rows(0)[k] - split;
+          const Eigen::Index row = static_cast<Eigen::Index>(j * m + k);
+          S.measured[j][i] = P.measured(0)[row];
+          S.rigid[j][i] = given.q[0][row];
+          S.extended[j][i] = at.q[0][row];
+        }
+      }
+    }
+    D.records.push_back(rs);
+  }
+  for (int j = 0; j < 2; ++j) {
+    D.joints[j] = S.split[j] = Score(sb[j], sa[j], cnt);
+    if (loo) D.left_out[j] = S.left_out[j] = Score(lb[j], la[j], lcnt);
+    D.noise[j] = P.weight(j) > 0 ? 1 / P.weight(j) : 0.0;
+  }
+  S.done = true;
+  {
+    std::ostringstream os;
+    os << "the model given and the motion fit's extended twin (their effects in the MuJoCo plant, joint limits off) "
+          "driven by the measured torque, restarted every " << NumberText(opt.replay_horizon_s)
+       << " s from the measured state (angle low-passed at " << NumberText(opt.replay_cutoff_hz)
+       << " Hz, zero-phase 2nd-order Butterworth, and its velocity), on the held-out parts"
+       << (loo ? " and on every whole record with the effects fitted on the others" : "");
+    S.note = os.str();
+  }
+
+  // Torque only: what the torque fit names and the motion fit does not.
+  std::vector<Eigen::VectorXd> tthetas;
+  std::vector<size_t> tidx;
+  for (size_t k = 0; k < T.effects.size(); ++k) {
+    const Effect& e = T.effects[k].effect;
+    bool named = false;
+    for (const auto& de : D.effects)
+      named = named || (de.effect.name == e.name && de.effect.joint == e.joint && de.effect.axis == e.axis);
+    if (named) continue;
+    TorqueOnlyEffect to;
+    to.effect = e;
+    Eigen::VectorXd x = theta;
+    to.simulated = TorqueValues(P, e, &x);
+    if (to.simulated) {
+      for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
+      tthetas.push_back(x);
+      tidx.push_back(D.torque_only.size());
+    }
+    D.torque_only.push_back(to);
+  }
+  const std::vector<MotionProblem::Rollout> tro = P.SimulateAll(tthetas, Part::kHeldOut);
+  double base_te[2];
+  P.Sse(at, Part::kHeldOut, base_te);
+  for (size_t k = 0; k < tro.size(); ++k) {
+    TorqueOnlyEffect& to = D.torque_only[tidx[k]];
+    if (!tro[k].ok) {
+      to.simulated = false;
+      continue;
+    }
+    double s[2];
+    P.Sse(tro[k], Part::kHeldOut, s);
+    for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base_te[j] > 0 ? 100 * (s[j] / base_te[j] - 1) : 0.0;
+  }
+
+  D.kin = std::move(T.kin);
+  D.split = T.split;
+  std::ostringstream m;
+  m << "motion fit: the candidate effects' values fitted by simulating the forward plant on the records (multiple "
+       "shooting: windows of " << NumberText(opt.replay_horizon_s) << " s restarted from the measured state, the angle "
+       "low-passed at " << NumberText(opt.replay_cutoff_hz) << " Hz), driven by the recorded actuator torque ("
+    << (P.hold() ? "each sample held over the step" : "interpolated linearly between samples")
+    << ", the closer of the two for the model given); outputs the "
+       "angles weighted by 1 / the given twin's RMS simulated error per joint (" << NumberText(D.noise[0], 3) << " / "
+    << NumberText(D.noise[1], 3) << " rad); fit on the first " << NumberText(100 * (1 - opt.holdout_fraction), 3)
+    << " % of every record, held out the rest" << (loo ? ", every whole record also left out in turn" : "")
+    << "; selection on the forward-difference Jacobian by the torque fit's gates (BIC margin " << NumberText(kBicMargin)
+    << ", |t| > " << NumberText(kMinT) << ", held-out gain >= " << NumberText(100 * kMinHeldoutGain)
+    << " %, ranges), values refined by projected Levenberg-Marquardt in the box of the ranges, each named effect "
+       "checked on the exact held-out simulation; residual autocorrelation " << NumberText(D.tau_eff, 3) << " rows";
+  D.method = m.str();
+  return D;
+}
+
+}  // namespace exotwin

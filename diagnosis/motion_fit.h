@@ -1,0 +1,159 @@
+// `exotwin diagnose --fit motion` (DESIGN.md "diagnose --fit motion"): the effects that explain where
+// the twin's simulated motion departs from the records, chosen and sized by simulating the forward
+// plant on them. The torque fit (diagnose.h) sees only what a quasi-static inverse-dynamics residual
+// shows; a dead band, a strap or a delay lives in the dynamics and shows in the motion.
+//
+// What is fitted: theta, the values of the candidate effects, minimizing over the fit part of every
+// record
+//     S(theta) = sum_records sum_joints j sum_scored samples i  w_j^2 (q_j(t_i) - qsim_j(t_i; theta))^2
+// where qsim is the angle of the forward plant replay uses (diagnosis/replay.h MakeReplayPlant / Replay:
+// the model given + the candidates' effects, carried as sim/plant_effects.h says), driven by the
+// record's actuator torque (the torque reading with the model's and the candidates' sensor effects
+// inverted, ActuatorTorqueFromReading; the cmd_* columns where the reading is zero throughout) and
+// held between samples or interpolated (ReplaySeries::hold: whichever the model given, alone or with
+// the torque fit's effects, follows closer on the fit parts: a record of the twin's own joint modules
+// is held, MotionProblem::hold),
+// restarted from the measured state (the angle low-passed at DiagnoseOptions::replay_cutoff_hz,
+// zero-phase, and its velocity) every DiagnoseOptions::replay_horizon_s: multiple shooting, each
+// window scored on its samples after the restart. The fit part is the first 1 - holdout_fraction of
+// every record's time, the held-out part the rest; no window straddles the split.
+// The torque reading is the input, so it is no output here (the twin's sensor reads the motor
+// torque, HJ15 eq. 8: the simulated reading would be the input itself); the outputs are the angles.
+// Output weights: w_j = 1 / (the model given's RMS simulated-angle error at joint j on the fit parts,
+// pooled): each joint counts by what the given twin leaves there (a one-joint device's held hip: 0).
+//
+// Candidates (MotionCandidates): every effect the plant carries, at every joint of the device:
+// coulomb_friction, viscous_friction, inertia_error, gravity_error (X, Y), joint_stiffness (two
+// parameters, k and k q0), passive_moment (a two-joint model with a human), backlash,
+// series_compliance (as the compliance 1/k; at the knee with a human, at either joint without),
+// sensor_offset, sensor_gain, sensor_delay (a reading as input), torque_ripple at the frequency the
+// torque fit found (when it names one); not an effect the model given already carries at that joint.
+// Box bounds: DESIGN.md's ranges (PhysicalScale of the records, diagnose_select.h).
+//
+// Method (Gauss-Newton with selection):
+//  1. the torque fit (Diagnose with DiagnoseFit::kTorque, no simulation): starting values of the
+//     effects it names, and what it would have named (Diagnosis::torque_named);
+//  2. at the current theta (first: the model given, theta = 0) one rollout per parameter (forward
+//     differences, each parameter's secant step MotionCandidateStep) gives the Jacobian J of qsim on
+//     every scored sample; J's columns and the residual q - qsim(theta) + J theta form one ColumnBank
+//     per record (rows weighted by w_j), a linear model whose coefficients are the effects' values;
+//  3. screening: each one-parameter candidate whose linear fit on top of the current set is
+//     significant and lowers the BIC is refined alone on the exact plant (Levenberg-Marquardt, the set
+//     held; kMotionScreenIterations) and its column replaced by the secant to that value (the current
+//     set's own one-parameter effects: the secant from the set without them), so that the linear model
+//     holds every candidate's exact single fit (a dead band or a strap is far from linear in its value);
+//     then SelectEffects (diagnose_select.h: the torque fit's gates, shared) chooses the effects on that
+//     model: BIC (effective sample size from the residual's autocorrelation length), held-out error at
+//     the effect's joint (and, with several records, each whole record left out), materiality
+//     (kMinTorqueShare of the measured angle's RMS about its mean), |t| > kMinT from J's covariance,
+//     DESIGN.md's ranges, the simpler explanation preferred;
+//  4. the chosen effects' values are refined on the exact plant: projected Levenberg-Marquardt inside
+//     the box, forward-difference Jacobians, from the linear fit's values and from the torque fit's
+//     where it named the effect (the lower error wins);
+//  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
+//  6. exact held-out gate: every chosen effect, taken out of the refined set, must raise the held-out
+//     simulated error at its joint by at least kMinHeldoutGain of the set's; one that does not is
+//     dropped (the weakest first) and the rest refined again;
+//  7. 95 % intervals from the final Jacobian: cov = s^2 (J'J)^-1, s^2 the fit part's residual variance
+//     inflated by its autocorrelation length; every effect the torque fit names and the motion fit
+//     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings.
+// Rollouts run in parallel on DiagnoseOptions::threads std::threads (one plant per rollout, built under
+// a lock: MuJoCo's compiler is not reentrant), each stored by its index: the result does not depend on
+// the thread count (the same bits).
+//
+// Diagnosis fields of a motion fit: effects (value, ci95), extended, selection, records (split: the
+// simulated angle, rad), joints (the same pooled, rad), simulation (rigid vs extended, held-out and
+// whole records left out), noise (1 / w_j, rad), tau_eff (rows), torque_named, torque_only; cutoff
+// and kin are the torque fit's (the report's header).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "diagnosis/diagnose.h"
+#include "diagnosis/diagnose_columns.h"
+#include "diagnosis/diagnose_select.h"
+
+namespace exotwin {
+
+constexpr int kMotionOuterSteps = 3;     // linearize-select-refine rounds at most
+constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per refinement at most
+constexpr int kMotionScreenIterations = 4;  // the same for a candidate's screening fit
+
+// `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
+// InputError naming the record for a record the motion fit cannot use: neither a torque reading (a
+// reading that is zero throughout at a joint of the device) nor cmd_* columns; a fit or held-out part
+// shorter than one window of replay_horizon_s. SimulationError when the given twin diverges.
+Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                           const DiagnoseOptions& opt);
+
+// The simulated-motion problem of some records: the candidates as columns, rollouts, Jacobians.
+class MotionProblem {
+ public:
+  // `torque_named`: the torque fit's effects (a torque_ripple among them adds its ripple candidate).
+  MotionProblem(const LegParams& params, const std::vector<const MeasuredData*>& records,
+                const DiagnoseOptions& opt, const std::vector<DiagnosedEffect>& torque_named = {});
+  ~MotionProblem();
+
+  // The candidates (Candidate::cols index the parameters) and each parameter's box and step.
+  const std::vector<Candidate>& candidates() const { return candidates_; }
+  int parameters() const { return static_cast<int>(lo_.size()); }
+  double lower(int k) const { return lo_[k]; }
+  double upper(int k) const { return hi_[k]; }
+  double step(int k) const { return step_[k]; }
+  // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
+  int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
+  const PhysicalScale& scale() const { return scale_; }
+  double weight(int j) const { return w_[j]; }
+  size_t records() const { return rec_.size(); }
+  // The input between samples (ReplaySeries::hold): the one under which the model given follows the
+  // records' fit parts closer.
+  bool hold() const { return hold_; }
+
+  // The effects (Effect list appended to the model's) that theta stands for.
+  std::vector<Effect> EffectsOf(const Eigen::VectorXd& theta) const;
+
+  // Simulated angles on every record's scored rows (per record a vector of 2 m: hip rows then knee
+  // rows, each the fit part's samples first; NaN on the part not simulated); ok false when the plant
+  // cannot carry theta's effects or diverges.
+  enum class Part { kFit, kHeldOut, kBoth };
+  struct Rollout {
+    bool ok = false;
+    std::vector<Eigen::VectorXd> q;
+  };
+  Rollout Simulate(const Eigen::VectorXd& theta, Part part) const;
+  // Many rollouts in parallel (the result of k at [k]).
+  std::vector<Rollout> SimulateAll(const std::vector<Eigen::VectorXd>& thetas, Part part) const;
+
+  // Forward-difference Jacobian of the simulated angles (rad per unit of parameter; rows as Simulate's,
+  // records stacked) with respect to parameters `cols` at theta, whose rollout is `at`; a column is
+  // taken backwards where the forward step leaves the box, and is zero where neither rollout runs.
+  Eigen::MatrixXd Jacobian(const Eigen::VectorXd& theta, const Rollout& at, const std::vector<int>& cols,
+                           Part part) const;
+
+  // Per record: scored sample indices, fit-part rows (the first fit_rows of them), measured angles.
+  const std::vector<size_t>& rows(size_t r) const;
+  size_t fit_rows(size_t r) const;
+  const Eigen::VectorXd& measured(size_t r) const;  // measured angle on the rows (rad), Simulate's layout
+  // Weighted SSE of a rollout per joint, on the fit part or the held-out part.
+  void Sse(const Rollout& ro, Part part, double sse[2]) const;
+
+ private:
+  struct Record;
+  LegParams params_;
+  DiagnoseOptions opt_;
+  std::vector<std::unique_ptr<Record>> rec_;
+  std::vector<Candidate> candidates_;
+  std::vector<double> lo_, hi_, step_;
+  std::vector<std::string> kind_;  // per parameter: what it is (e.g. "coulomb_friction", "offset")
+  std::vector<int> joint_;         // per parameter
+  std::vector<double> ripple_f_;   // per parameter (torque_ripple)
+  PhysicalScale scale_;
+  double w_[2] = {1, 1};
+  bool reading_input_ = true;      // every record driven by its torque reading
+  bool hold_ = false;              // ReplaySeries::hold of every record
+};
+
+}  // namespace exotwin

@@ -1,0 +1,228 @@
+// `diagnose --fit motion` (diagnosis/motion_fit.h): the Jacobian against the closed form of a pendulum,
+// bad input, and closed-loop records of the shipped gait on a plant holding a hidden effect (the
+// shipped controller tracking the gait through the virtual bus, `exotwin run` with `plant: {effects}`):
+// the motion fit names the effect and nothing else; on the rigid plant nothing. Records of 15 s (ASan
+// runs them about 3x slower); the 60 s sweeps are `exotwin bench` rows.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/motion_fit.h"
+#include "formats/measured_data.h"
+#include "formats/model_file.h"
+#include "tests/app/cli_test_util.h"
+
+namespace exotwin {
+namespace {
+
+using testing::RunExotwin;
+using testing::WriteText;
+
+const std::string kSrc = EXOTWIN_SOURCE_DIR;
+
+// A one-joint pendulum without friction hanging at rest, I = 0.5 kg m^2, mgl = 5 N m, 4 s at 1 kHz,
+// no torque (commanded 0).
+struct Pendulum {
+  LegParams params;
+  MeasuredData data;
+};
+
+Pendulum RestingPendulum(const std::string& dir) {
+  WriteText(dir + "/pendulum.yaml", "joint: knee\ndevice: {I: 0.5, mgl: 5.0, R: 0, C: 0}\neffects: []\n");
+  std::string csv = "t,q_knee,tau_knee,cmd_knee\n";
+  for (int i = 0; i < 4000; ++i) csv += std::to_string(i * 1e-3) + ",0,0,0\n";
+  WriteText(dir + "/rest.csv", csv);
+  return {ReadModelFile(dir + "/pendulum.yaml"), ReadMeasuredCsv(dir + "/rest.csv")};
+}
+
+// The forward-difference Jacobian column of a constant torque (the offset parameter, a commanded
+// torque here) on a pendulum at rest: linearized, I x'' + mgl x = c from rest, so
+// dq/dc (tau) = (1 - cos(w tau)) / (I w^2), w^2 = mgl / I, tau the time since the window's restart.
+TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
+  const testing::ScopedTempDir tmp("motion_jac");
+  const Pendulum p = RestingPendulum(tmp.path());
+  DiagnoseOptions opt;
+  opt.threads = 2;
+  const MotionProblem P(p.params, {&p.data}, opt);
+  const int c = P.CandidateIndex("joint_stiffness", "knee");
+  ASSERT_GE(c, 0);
+  const int off = P.candidates()[static_cast<size_t>(c)].cols[1];  // k q0: the constant torque
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(P.parameters());
+  const MotionProblem::Rollout at = P.Simulate(zero, MotionProblem::Part::kBoth);
+  ASSERT_TRUE(at.ok);
+  const Eigen::MatrixXd J = P.Jacobian(zero, at, {off}, MotionProblem::Part::kBoth);
+  const std::vector<size_t>& rows = P.rows(0);
+  const size_t m = rows.size();
+  ASSERT_GT(m, 3000u);
+  const double w = std::sqrt(5.0 / 0.5);
+  double worst = 0, peak = 0;
+  const std::vector<double>& t = p.data.t();
+  // Windows of 0.5 s from each part's first sample (the fit part's at t = 0, the held-out part's at the
+  // sample before its first row); a window's last row is the next one's restart.
+  const double held_start = t[rows[P.fit_rows(0)] - 1];
+  for (size_t k = 0; k < m; ++k) {
+    const size_t i = rows[k];
+    double tau = std::fmod(t[i] - (k < P.fit_rows(0) ? 0.0 : held_start) + 1e-9, 0.5) - 1e-9;
+    if (tau < 1e-6) tau += 0.5;
+    const double truth = (1 - std::cos(w * tau)) / (0.5 * w * w);
+    worst = std::max(worst, std::abs(J(static_cast<Eigen::Index>(m + k), 0) - truth));
+    peak = std::max(peak, truth);
+  }
+  std::printf("constant-torque column: worst error %.3g of peak %.3g rad/(N m)\n", worst, peak);
+  EXPECT_GT(peak, 0.1);
+  EXPECT_LT(worst, 0.01 * peak);
+  // The hip of a one-joint device is no output (weight 0).
+  EXPECT_EQ(P.weight(0), 0.0);
+}
+
+// Bad input: --fit other than torque|motion; a record with neither a torque reading nor commands; a
+// record whose held-out part is shorter than a window. Exit 2, naming what and what was expected.
+TEST(MotionFit, BadInputIsExit2NamingTheFileAndWhatWasExpected) {
+  const testing::ScopedTempDir tmp("motion_bad");
+  const std::string d = tmp.path();
+  Pendulum p = RestingPendulum(d);
+  auto r = RunExotwin("diagnose --params " + d + "/pendulum.yaml --measured " + d + "/rest.csv --fit speed --out " + d + "/o");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--fit: 'speed', expected torque or motion"), std::string::npos) << r.output;
+  std::string csv = "t,q_knee,tau_knee\n";
+  for (int i = 0; i < 4000; ++i) csv += std::to_string(i * 1e-3) + "," + std::to_string(0.1 * std::sin(i * 1e-3)) + ",0\n";
+  WriteText(d + "/no_input.csv", csv);
+  r = RunExotwin("diagnose --params " + d + "/pendulum.yaml --measured " + d + "/no_input.csv --fit motion --out " + d + "/o");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("no_input.csv: the motion fit needs the actuator torque"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("expected either"), std::string::npos) << r.output;
+  csv = "t,q_knee,tau_knee,cmd_knee\n";
+  for (int i = 0; i < 1200; ++i) csv += std::to_string(i * 1e-3) + ",0,0,0\n";
+  WriteText(d + "/short.csv", csv);
+  r = RunExotwin("diagnose --params " + d + "/pendulum.yaml --measured " + d + "/short.csv --fit motion --out " + d + "/o");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("short.csv: the motion fit's windows of 0.5 s do not fit the record"), std::string::npos)
+      << r.output;
+  // The same through the API.
+  DiagnoseOptions opt;
+  opt.fit = DiagnoseFit::kMotion;
+  const MeasuredData shrt = ReadMeasuredCsv(d + "/short.csv");
+  EXPECT_THROW(Diagnose(p.params, shrt, opt), InputError);
+}
+
+// 15 s of the shipped gait (S1, closed loop) on a plant holding `effects`, into dir/measured.csv.
+MeasuredData GaitRecord(const std::string& effects, const std::string& dir, double duration = 15) {
+  std::ifstream in(kSrc + "/scenarios/gait_2kmh.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "duration: 60";
+  text.replace(text.find(key), key.size(), "duration: " + std::to_string(duration));
+  if (!effects.empty()) text += "plant: {effects: " + effects + "}\n";
+  WriteText(dir + "/s.yaml", text);
+  const auto r = RunExotwin("run " + dir + "/s.yaml --out " + dir + "/run");
+  EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 1) << r.output;
+  return ReadMeasuredCsv(dir + "/run/measured.csv");
+}
+
+Diagnosis MotionFit(const MeasuredData& data) {
+  DiagnoseOptions opt;
+  opt.fit = DiagnoseFit::kMotion;
+  opt.threads = 2;
+  return Diagnose(ReadModelFile(kSrc + "/examples/S1.yaml"), data, opt);
+}
+
+void Print(const std::string& what, const Diagnosis& d) {
+  std::printf("%s:", what.c_str());
+  for (const auto& e : d.effects)
+    std::printf(" %s(%s) = %.4g %s [%.4g, %.4g];", e.effect.name.c_str(), e.effect.joint.c_str(), e.effect.value,
+                e.effect.unit.c_str(), e.ci_lo, e.ci_hi);
+  std::printf(" | torque fit:");
+  for (const auto& e : d.torque_named)
+    std::printf(" %s(%s) = %.4g;", e.effect.name.c_str(), e.effect.joint.c_str(), e.effect.value);
+  std::printf(" | held-out sim knee %.4f -> %.4f deg\n", d.joints[1].rmse_before * 180 / M_PI,
+              d.joints[1].rmse_after * 180 / M_PI);
+}
+
+// Every effect of `truth` named within `tolerance` (relative) and nothing else.
+void ExpectNamed(const Diagnosis& d, const std::vector<Effect>& truth, double tolerance) {
+  EXPECT_EQ(d.effects.size(), truth.size());
+  for (const Effect& t : truth) {
+    const DiagnosedEffect* f = nullptr;
+    for (const auto& e : d.effects)
+      if (e.effect.name == t.name && e.effect.joint == t.joint) f = &e;
+    ASSERT_NE(f, nullptr) << t.name << " (" << t.joint << ") not named";
+    EXPECT_NEAR(f->effect.value, t.value, tolerance * t.value) << t.name;
+  }
+}
+
+Effect E(const std::string& name, const std::string& joint, double value) {
+  Effect e;
+  e.name = name, e.joint = joint, e.value = value;
+  return e;
+}
+
+// Every effect the torque fit names and the motion fit does not is listed as torque only.
+void ExpectTorqueOnlyListed(const Diagnosis& d) {
+  for (const auto& t : d.torque_named) {
+    bool named = false, listed = false;
+    for (const auto& e : d.effects) named = named || (e.effect.name == t.effect.name && e.effect.joint == t.effect.joint);
+    for (const auto& o : d.torque_only) listed = listed || (o.effect.name == t.effect.name && o.effect.joint == t.effect.joint);
+    EXPECT_NE(named, listed) << t.effect.name << " (" << t.effect.joint << ")";
+  }
+}
+
+TEST(MotionFit, HiddenKneeBacklashIsNamed) {
+  const testing::ScopedTempDir tmp("motion_backlash");
+  const Diagnosis d = MotionFit(GaitRecord("[{name: backlash, joint: knee, value: 0.02}]", tmp.path()));
+  Print("knee backlash 0.02 rad", d);
+  ExpectNamed(d, {E("backlash", "knee", 0.02)}, 0.2);
+  EXPECT_EQ(d.fit, DiagnoseFit::kMotion);
+  const std::string json = DiagnosisJson(d);
+  EXPECT_NE(json.find("\"fit\": \"motion\""), std::string::npos);
+  EXPECT_NE(json.find("\"torque_only\""), std::string::npos);
+  ExpectTorqueOnlyListed(d);
+  // The extended twin follows the held-out motion closer than the rigid one.
+  EXPECT_LT(d.simulation.split[1].rmse_after, 0.5 * d.simulation.split[1].rmse_before);
+}
+
+// A knee strap between the exoskeleton and the human's shank (Table 5's 1100 N m/rad is in the bench
+// script; 600 here).
+TEST(MotionFit, HiddenKneeStrapWithAHumanIsNamed) {
+  const testing::ScopedTempDir tmp("motion_strap");
+  const Diagnosis d = MotionFit(GaitRecord("[{name: series_compliance, joint: knee, value: 600}]", tmp.path()));
+  Print("knee strap 600 N m/rad", d);
+  // The strap first (it explains the most) and within 25 %. Not required: that nothing else is named
+  // (a small knee inertia_error comes along on this record: the strap restarts each window at its
+  // quasi-static deflection, Plant::Reset).
+  ASSERT_FALSE(d.effects.empty());
+  EXPECT_EQ(d.effects[0].effect.name, "series_compliance");
+  EXPECT_EQ(d.effects[0].effect.joint, "knee");
+  EXPECT_NEAR(d.effects[0].effect.value, 600, 0.25 * 600);
+  ExpectTorqueOnlyListed(d);
+}
+
+TEST(MotionFit, HiddenKneeSensorDelayIsNamed) {
+  const testing::ScopedTempDir tmp("motion_delay");
+  const Diagnosis d = MotionFit(GaitRecord("[{name: sensor_delay, joint: knee, value: 0.005}]", tmp.path()));
+  Print("knee sensor delay 5 ms", d);
+  ExpectNamed(d, {E("sensor_delay", "knee", 0.005)}, 0.2);
+}
+
+TEST(MotionFit, KneeBacklashAndCoulombFrictionAreBothNamed) {
+  const testing::ScopedTempDir tmp("motion_pair");
+  const Diagnosis d = MotionFit(GaitRecord(
+      "[{name: backlash, joint: knee, value: 0.02}, {name: coulomb_friction, joint: knee, value: 2.0}]", tmp.path()));
+  Print("knee backlash 0.02 rad + Coulomb 2 N m", d);
+  ExpectNamed(d, {E("backlash", "knee", 0.02), E("coulomb_friction", "knee", 2.0)}, 0.25);
+}
+
+TEST(MotionFit, NothingIsNamedOnTheRigidPlant) {
+  const testing::ScopedTempDir tmp("motion_clean");
+  const Diagnosis d = MotionFit(GaitRecord("", tmp.path()));
+  Print("rigid plant", d);
+  EXPECT_TRUE(d.effects.empty());
+}
+
+}  // namespace
+}  // namespace exotwin
