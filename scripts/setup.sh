@@ -38,4 +38,12 @@ fi
 if [ "${1:-}" != "--no-build" ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build build -j"$(nproc)"
+  # `import exotwin` for Debian's python3 without PYTHONPATH: a .pth in its site folder naming the build
+  # tree's module (cmake --install and the .deb install the module itself instead).
+  if [ -d build/lib/python3/dist-packages/exotwin ] && [ -x /usr/bin/python3 ]; then
+    site=$(/usr/bin/python3 -c 'import site; print(site.getsitepackages()[0])')
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO mkdir -p "$site"
+    echo "$PWD/build/lib/python3/dist-packages" | $SUDO tee "$site/exotwin-build-tree.pth" >/dev/null
+  fi
 fi
