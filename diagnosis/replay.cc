@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/error.h"
 #include "sim/plant_effects.h"
@@ -34,7 +35,9 @@ void RestartState(const std::string& source, double cutoff_hz, ReplaySeries* out
   const Sampling sampling = ExamineSampling(out->t, source);
   for (int j = 0; j < 2; ++j) {
     out->q0[j] = LowPassOnTimeBase(out->t, out->q[j], cutoff_hz, source);
-    out->qd0[j] = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, source).qd;
+    AngleRates rates = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, source);
+    out->qd0[j] = std::move(rates.qd);
+    out->qdd0[j] = std::move(rates.qdd);
   }
 }
 
@@ -129,7 +132,8 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
     const double t0 = t[start], t_end = t0 + horizon_s;
     const int w = static_cast<int>(out.score.windows);
     const Eigen::Vector2d tau0(s.tau_R[0][start], s.tau_R[1][start]);  // the dead band's flank at the restart
-    plant.Reset({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0, &tau0);
+    const Eigen::Vector2d qdd0(s.qdd0[0].empty() ? 0.0 : s.qdd0[0][start], s.qdd0[1].empty() ? 0.0 : s.qdd0[1][start]);
+    plant.Reset({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0, &tau0, &qdd0);
     in = start;
     Eigen::Vector2d q_prev = plant.q();
     double time_prev = t0;

@@ -12,7 +12,10 @@
 //    (formats/measured_data.h LowPassOnTimeBase) and its velocity (DeriveAngleRates at the same
 //    cutoff), at the window's first sample.
 //    A dead band (backlash) restarts against the flank of the input torque there (Plant::Reset's
-//    `transmitted`).
+//    `transmitted`); a strap (series compliance) at the deflection that carries the part behind it
+//    at the measured acceleration there (DeriveAngleRates' qdd; Plant::Reset's `qdd`): in gait the
+//    inertial torque of the limb is of the order of its gravity torque, and a strap restarted at its
+//    quasi-static deflection rings through every window.
 //  - windows: from the first sample, each window starts at the first sample at or after the previous
 //    window's start + horizon and is scored on its samples up to start + horizon (its first sample,
 //    the restart, excluded); a last part shorter than the horizon is not run.
@@ -34,7 +37,8 @@ struct ReplaySeries {
   std::string source;
   std::vector<double> t;
   std::vector<double> q[2];              // measured angle, rad (scored)
-  std::vector<double> q0[2], qd0[2];     // restart state: filtered angle (rad) and velocity (rad/s)
+  // restart state: filtered angle (rad), its velocity (rad/s) and acceleration (rad/s^2; empty: 0)
+  std::vector<double> q0[2], qd0[2], qdd0[2];
   std::vector<double> tau_R[2];          // actuator torque input, N m
   // The input between samples: false, linear interpolation (a rig's continuously sampled torque);
   // true, each sample held until the next (a zero-order hold: the twin's joint modules log the torque

@@ -445,7 +445,8 @@ void Plant::HoldHip() {
   mj_forward(m_, d_);
 }
 
-void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t, const Eigen::Vector2d* transmitted) {
+void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t, const Eigen::Vector2d* transmitted,
+                  const Eigen::Vector2d* qdd) {
   mj_resetData(m_, d_);
   for (int j = 0; j < 2; ++j) {
     d_->qpos[q_adr_[j]] = q[j];
@@ -460,7 +461,7 @@ void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t,
       d_->qpos[in_q_[j]] =
           structure_.backlash[j]
               ? -0.5 * fx_.backlash[j] * std::tanh(tau[j] / kBacklashTorqueWidth)
-              : CompliantAngle(rigid, j, fx_.compliance[j], q, qd, Eigen::Vector2d::Zero())[j] - q[j];
+              : CompliantAngle(rigid, j, fx_.compliance[j], q, qd, qdd ? *qdd : Eigen::Vector2d::Zero())[j] - q[j];
     }
   }
   if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;

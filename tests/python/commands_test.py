@@ -106,6 +106,26 @@ def test_bad_input_is_the_programs_text(tmp):
         exotwin.read_measured(tmp / "no_such.csv")
 
 
+def test_divergence_is_simulation_error_with_the_programs_text(tmp, record):
+    # A user's MJCF whose knee spring (1e9 N m/rad on ~0.1 kg m^2: a mode of ~1e5 rad/s against the
+    # 1 ms step) makes the explicit step blow up: the program exits 1 naming the time and MuJoCo's
+    # warning; the function raises SimulationError (a RuntimeError) with the same text.
+    params, path, _ = record
+    shipped = exotwin.data_path("mjcf/leg_exowheel.xml")
+    text = open(shipped).read()
+    stiff = text.replace('<joint name="knee" type="hinge"', '<joint name="knee" type="hinge" stiffness="1e9"')
+    assert stiff != text
+    mjcf = tmp / "stiff_knee.xml"
+    mjcf.write_text(stiff)
+    p = cli("replay", "--params", params, "--measured", path, "--mjcf", mjcf, "--out", tmp / "r", check=False)
+    assert p.returncode == 1
+    with pytest.raises(exotwin.SimulationError) as e:
+        exotwin.replay(params, [path], mjcf=mjcf)
+    assert isinstance(e.value, RuntimeError)
+    assert "diverged" in str(e.value) and "bad qacc" in str(e.value)
+    assert p.stderr.strip().endswith(str(e.value)), (p.stderr, str(e.value))
+
+
 def test_identify_is_the_programs(tmp):
     # the exoskeleton alone in the protocol's two configurations (scenarios/identification, cut to 10 s)
     records = []
