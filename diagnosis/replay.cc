@@ -119,6 +119,8 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
   for (auto& v : out.sim) v.assign(t.size(), std::nan(""));
   out.window.assign(t.size(), -1);
   const double dt = plant.timestep();
+  // A strap's run-in (replay.h): its settling time, at most one horizon.
+  const double run_in_s = std::min(horizon_s, plant.InternalSettlingTime());
   size_t start = begin;
   size_t in = begin;  // input interpolation: t[in] <= time < t[in + 1]
   auto Input = [&](double time) -> Eigen::Vector2d {
@@ -131,9 +133,29 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
   while (start < end && t[end - 1] - t[start] >= horizon_s) {
     const double t0 = t[start], t_end = t0 + horizon_s;
     const int w = static_cast<int>(out.score.windows);
-    const Eigen::Vector2d tau0(s.tau_R[0][start], s.tau_R[1][start]);  // the dead band's flank at the restart
-    const Eigen::Vector2d qdd0(s.qdd0[0].empty() ? 0.0 : s.qdd0[0][start], s.qdd0[1].empty() ? 0.0 : s.qdd0[1][start]);
-    plant.Reset({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0, &tau0, &qdd0);
+    // The run-in's first sample: run_in_s before t0, the series' first at the earliest.
+    const size_t r = run_in_s > 0 ? static_cast<size_t>(std::lower_bound(t.begin(), t.begin() + static_cast<long>(start),
+                                                                          t0 - run_in_s - 1e-12) - t.begin())
+                                  : start;
+    const Eigen::Vector2d tau0(s.tau_R[0][r], s.tau_R[1][r]);  // the dead band's flank at the (run-in's) start
+    const Eigen::Vector2d qdd0(s.qdd0[0].empty() ? 0.0 : s.qdd0[0][r], s.qdd0[1].empty() ? 0.0 : s.qdd0[1][r]);
+    plant.Reset({s.q0[0][r], s.q0[1][r]}, {s.qd0[0][r], s.qd0[1][r]}, t[r], &tau0, &qdd0);
+    if (r < start) {
+      // The measured joints follow the restart state's motion (linear between samples), each step
+      // driven by the input; the internal hinges move by their own dynamics.
+      in = r;
+      size_t k = r;
+      while (plant.time() < t0 - 0.5 * dt) {
+        const double time = plant.time();
+        while (k + 1 < start && t[k + 1] <= time) ++k;
+        const double a = std::clamp((time - t[k]) / (t[k + 1] - t[k]), 0.0, 1.0);
+        plant.Restate({s.q0[0][k] + a * (s.q0[0][k + 1] - s.q0[0][k]), s.q0[1][k] + a * (s.q0[1][k + 1] - s.q0[1][k])},
+                      {s.qd0[0][k] + a * (s.qd0[0][k + 1] - s.qd0[0][k]), s.qd0[1][k] + a * (s.qd0[1][k + 1] - s.qd0[1][k])},
+                      time);
+        plant.Step(Input(time + 0.5 * dt));
+      }
+      plant.Restate({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0);
+    }
     in = start;
     Eigen::Vector2d q_prev = plant.q();
     double time_prev = t0;

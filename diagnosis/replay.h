@@ -12,10 +12,14 @@
 //    (formats/measured_data.h LowPassOnTimeBase) and its velocity (DeriveAngleRates at the same
 //    cutoff), at the window's first sample.
 //    A dead band (backlash) restarts against the flank of the input torque there (Plant::Reset's
-//    `transmitted`); a strap (series compliance) at the deflection that carries the part behind it
-//    at the measured acceleration there (DeriveAngleRates' qdd; Plant::Reset's `qdd`): in gait the
-//    inertial torque of the limb is of the order of its gravity torque, and a strap restarted at its
-//    quasi-static deflection rings through every window.
+//    `transmitted`). A strap (series compliance) restarts by a run-in: from the restart state run_in
+//    before the window (the series' first sample at the earliest), the strap at the deflection that
+//    carries the part behind it at the restart state's acceleration there (Plant::Reset's `qdd`), the
+//    measured joints follow the restart state's motion step by step (Plant::Restate, linear between
+//    samples) under the input torque while the strap moves by its own dynamics; at the window's start
+//    the measured joints take the restart state and the window runs free. run_in =
+//    Plant::InternalSettlingTime() (a strap's start error decays below 1 %), at most one horizon.
+//    The run-in's samples are not scored (they may lie in an earlier window or part).
 //  - windows: from the first sample, each window starts at the first sample at or after the previous
 //    window's start + horizon and is scored on its samples up to start + horizon (its first sample,
 //    the restart, excluded); a last part shorter than the horizon is not run.

@@ -353,6 +353,7 @@ void Plant::CarryEffects(const PlantEffects& fx) {
     const bool rebuilt = !(structure == structure_);
     if (rebuilt) Rebuild(structure);
     if ((rebuilt || structure.any()) && has_params_) WriteRealization(params_);
+    strap_omega_[0] = strap_omega_[1] = 0;
     for (int j = 0; j < 2; ++j) {
       if (in_jnt_[j] < 0) continue;
       const int jnt = in_jnt_[j], dof = in_v_[j];
@@ -386,6 +387,7 @@ void Plant::CarryEffects(const PlantEffects& fx) {
            << m_->opt.timestep << " s step (expected at most " << 0.5 / m_->opt.timestep << " rad/s)";
         throw InputError(os.str());
       }
+      strap_omega_[j] = omega;
       m_->jnt_stiffness[jnt] = k;
       m_->qpos_spring[in_q_[j]] = 0.0;
       m_->dof_damping[dof] = 2 * kStrapDampingRatio * std::sqrt(k * J);
@@ -468,6 +470,41 @@ void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t,
   d_->time = t;
   mj_forward(m_, d_);
   CheckDivergence("reset");
+}
+
+double Plant::InternalSettlingTime() const {
+  // A strap's mode decays as exp(-zeta omega t), zeta = kStrapDampingRatio: 5 / (zeta omega) leaves
+  // e^-5 (< 1 %) of a start's error.
+  double t = 0;
+  for (int j = 0; j < 2; ++j)
+    if (in_q_[j] >= 0 && !structure_.backlash[j] && strap_omega_[j] > 0)
+      t = std::max(t, 5.0 / (kStrapDampingRatio * strap_omega_[j]));
+  return t;
+}
+
+void Plant::Restate(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t) {
+  for (int j = 0; j < 2; ++j) {
+    const int dof = j == 0 ? hip_dof_ : knee_dof_;
+    if (in_q_[j] >= 0 && structure_.backlash[j]) {
+      // A dead band's link keeps its own angle and rate (the hinge's coordinates are relative to the
+      // measured joint): moving the driven side does not carry the link along, except by the flank it
+      // would pass, which pushes the link with it. (Carried along, the rotor's own acceleration within
+      // each step, ~tau / J_r in the band, would be handed to the link as a velocity change.)
+      double& iq = d_->qpos[in_q_[j]];
+      double& iv = d_->qvel[in_v_[j]];
+      iq -= q[j] - d_->qpos[q_adr_[j]];
+      iv -= qd[j] - d_->qvel[dof];
+      const double half = 0.5 * fx_.backlash[j];
+      if (iq > half) iq = half, iv = std::min(iv, 0.0);
+      if (iq < -half) iq = -half, iv = std::max(iv, 0.0);
+    }  // a strap's follower keeps its deflection and deflection rate: it moves with the driven side
+    d_->qpos[q_adr_[j]] = q[j];
+    d_->qvel[dof] = qd[j];
+  }
+  if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;
+  d_->time = t;
+  mj_forward(m_, d_);
+  CheckDivergence("restate");
 }
 
 void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {

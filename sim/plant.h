@@ -98,6 +98,14 @@ class Plant {
   // motor presses the link with its own torque, not with the quasi-static one.
   void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0,
              const Eigen::Vector2d* transmitted = nullptr, const Eigen::Vector2d* qdd = nullptr);
+  // Time (s) in which a strap's mode (sim/plant.cc: damped at kStrapDampingRatio of critical) decays
+  // to 1 % of a start's error: 5 / (zeta omega), the slowest strap carried; 0 without a strap.
+  double InternalSettlingTime() const;
+  // Sets the measured (motor-side) joints' state (rad, rad/s) and the time (s); recomputes kinematics.
+  // A strap keeps its deflection and deflection rate (its follower moves with the driven side); a dead
+  // band's link keeps its angle and rate, pushed along by the flank it would pass. With Step, a motion of the measured joints prescribed step by step
+  // (replay's run-in, diagnosis/replay.h), along which the internal hinges move by their dynamics.
+  void Restate(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t);
   // Advances one physics step (model timestep) with actuator torque tau_R (N m) and an extra joint
   // torque tau_ext (N m, e.g. muscles or effects) acting on the link. Throws SimulationError on
   // divergence. P(q) is applied automatically when params.human is set, and the carried effects.
@@ -139,6 +147,7 @@ class Plant {
   int in_jnt_[2] = {-1, -1}, in_q_[2] = {-1, -1}, in_v_[2] = {-1, -1}, rotor_body_[2] = {-1, -1};
   InternalJoints structure_;
   double rotor_inertia_[2] = {0, 0};
+  double strap_omega_[2] = {0, 0};     // rad/s, a strap's undamped mode (0: none)
   bool has_params_ = false, free_ = false;
 };
 

@@ -192,13 +192,10 @@ TEST(MotionFit, HiddenKneeStrapWithAHumanIsNamed) {
   const testing::ScopedTempDir tmp("motion_strap");
   const Diagnosis d = MotionFit(GaitRecord("[{name: series_compliance, joint: knee, value: 600}]", tmp.path()));
   Print("knee strap 600 N m/rad", d);
-  // The strap first (it explains the most) and within 25 %. Not required: that nothing else is named
-  // (a small knee inertia_error comes along on this record: the strap restarts each window at its
-  // quasi-static deflection, Plant::Reset).
-  ASSERT_FALSE(d.effects.empty());
-  EXPECT_EQ(d.effects[0].effect.name, "series_compliance");
-  EXPECT_EQ(d.effects[0].effect.joint, "knee");
-  EXPECT_NEAR(d.effects[0].effect.value, 600, 0.25 * 600);
+  // The strap alone and within 25 % (issue 41's band): each window's strap starts with the deflection
+  // and rate of the measured motion (replay's run-in, diagnosis/replay.h); started at rest at its
+  // quasi-static deflection it rings, and a knee inertia_error (~0.005 kg m^2) stands in for that.
+  ExpectNamed(d, {E("series_compliance", "knee", 600)}, 0.25);
   ExpectTorqueOnlyListed(d);
 }
 

@@ -9,6 +9,8 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "core/error.h"
 #include "model/leg_dynamics.h"
@@ -119,6 +121,59 @@ TEST(InternalJoints, AtRestTheStrapDeflectsByTheStaticTorqueOverK) {
   // flank constraint's softness).
   EXPECT_NEAR(plant->internal_q()[1], -0.02 * side, 2e-4);
   EXPECT_LT((plant->q() - qb).norm(), 1e-3);  // the flank constraint is soft: its load moves the rest point a little
+}
+
+// A restart in motion by a run-in (Plant::Restate, as a replay window restarts, diagnosis/replay.h):
+// a reference plant with a strap at S1's knee (300 N m/rad against the human shank) is driven by a
+// smooth torque; at t = 1 s a second plant restarts from the reference's motor-side state and is driven
+// by the same torque for 0.3 s. Reference: the reference plant itself. Restarted with its strap at rest
+// at the quasi-static deflection, the strap rings and the motor angle departs; run in for
+// InternalSettlingTime() before (the measured joints prescribed to the reference's motion step by
+// step, the strap free), the motor angle follows the reference many times closer.
+TEST(InternalJoints, ARunInAlongTheMotionCarriesTheStrapsState) {
+  LegParams p = S1();
+  p.effects = {MakeEffect("series_compliance", "knee", 300)};
+  auto drive = [](double t) {
+    return Eigen::Vector2d(4.0 * std::sin(2 * M_PI * 0.8 * t), 6.0 * std::sin(2 * M_PI * 1.3 * t + 0.4));
+  };
+  auto ref = Carrying(p);
+  ref->FreeJointsAndTorque();
+  const Eigen::Vector2d q_start(0.4, -0.8), zero = Eigen::Vector2d::Zero();
+  ref->Reset(q_start, zero);
+  const Eigen::Vector2d hold = ActuatorTorque(p, q_start, zero, zero);  // + the drive: stays in range
+  const double dt = ref->timestep();
+  const int n0 = static_cast<int>(std::lround(1.0 / dt)), n1 = n0 + 300;
+  std::vector<Eigen::Vector2d> q(n1 + 1), qd(n1 + 1);
+  for (int i = 0; i <= n1; ++i) {
+    q[i] = ref->q(), qd[i] = ref->qd();
+    if (i < n1) ref->Step(hold + drive(i * dt));
+  }
+  const double settle = ref->InternalSettlingTime();
+  // 5 / (zeta omega), omega = sqrt(k / J), J the reduced inertia of S1's exoskeleton and human shanks.
+  const double J = p.exo.J2 * p.human->J2 / (p.exo.J2 + p.human->J2);
+  EXPECT_NEAR(settle, 5.0 / (0.5 * std::sqrt(300 / J)), 1e-12);
+  auto departure = [&](bool run_in) {
+    auto plant = Carrying(p);
+    plant->FreeJointsAndTorque();
+    const int r = run_in ? n0 - static_cast<int>(std::lround(settle / dt)) : n0;
+    plant->Reset(q[r], qd[r], r * dt);
+    for (int i = r; i < n0; ++i) {
+      plant->Restate(q[i], qd[i], i * dt);
+      plant->Step(hold + drive(i * dt));
+    }
+    plant->Restate(q[n0], qd[n0], n0 * dt);
+    double sse = 0;
+    for (int i = n0; i < n1; ++i) {
+      plant->Step(hold + drive(i * dt));
+      sse += (plant->q() - q[i + 1]).squaredNorm();
+    }
+    return std::sqrt(sse / (n1 - n0));
+  };
+  const double at_rest = departure(false), in_motion = departure(true);
+  std::printf("strap restart, motor angle RMS departure over 0.3 s: at rest %.3g rad, run in %.3g rad\n", at_rest,
+              in_motion);
+  EXPECT_GT(at_rest, 1e-4);  // the ringing is visible (rad RMS over 0.3 s)
+  EXPECT_LT(in_motion, 0.1 * at_rest) << "at rest " << at_rest << " rad, run in " << in_motion << " rad";
 }
 
 TEST(InternalJoints, WhatThePlantCannotCarryIsRefusedNamingTheEffect) {
