@@ -1004,7 +1004,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     os << "the model given and the motion fit's extended twin (their effects in the MuJoCo plant, joint limits off) "
           "driven by the measured torque, restarted every " << NumberText(opt.replay_horizon_s)
        << " s from the measured state (angle low-passed at " << NumberText(opt.replay_cutoff_hz)
-       << " Hz, zero-phase 2nd-order Butterworth, and its velocity), on the held-out parts"
+       << " Hz, zero-phase 2nd-order Butterworth, and its velocity; a strap run in over its settling time), on the held-out parts"
        << (loo ? " and on every whole record with the effects fitted on the others" : "");
     S.note = os.str();
   }
