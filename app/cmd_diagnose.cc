@@ -44,15 +44,14 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
   return [sub, o]() -> int {
     if (!*sub) return -1;
     KeepFreedMemoryForReuse();
-    if (o->fit != "torque" && o->fit != "motion")
-      throw InputError("diagnose --fit: '" + o->fit + "', expected torque or motion");
+    const DiagnoseFit fit = ParseDiagnoseFit(o->fit, "diagnose --fit");
     const LegParams params = ReadModelFile(o->params);
     DiagnoseOptions opt;
     opt.holdout_fraction = o->holdout;
     opt.mjcf = o->mjcf;
     opt.cutoff_hz = ParseCutoffOption(o->cutoff, "diagnose --cutoff");
     opt.max_effects = o->max_effects;
-    opt.fit = o->fit == "motion" ? DiagnoseFit::kMotion : DiagnoseFit::kTorque;
+    opt.fit = fit;
     std::vector<MeasuredData> data;
     std::string names;
     for (const std::string& m : o->measured) {

@@ -1,5 +1,5 @@
 // `exotwin table5 [--subjects S1,...] [--strides 10] [--out DIR] [--trials N] [--trial-duration S]
-//  [--plant FILE] [--plant-worn FILE | --realistic] [--seed N] [--diagnose]`:
+//  [--plant FILE] [--plant-worn FILE | --realistic] [--seed N] [--diagnose [--fit torque|motion]]`:
 // Hwang & Jeon 2015 Tables 3-5 reproduced by the twin, side by side with the paper (identification
 // steps 1-4 and relaxed gait through the closed loop, per subject; runner/table5_protocol.h), optionally
 // through a plant with effects (the realistic EXOwheel of data/plants/) and with diagnose on the
@@ -39,6 +39,7 @@ CommandRunner RegisterTable5(CLI::App& app) {
     uint64_t seed = 1;
     double trial_duration = 40.0;
     bool drop_logs = false, realistic = false, diagnose = false;
+    std::string fit = "torque";
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
@@ -61,6 +62,9 @@ CommandRunner RegisterTable5(CLI::App& app) {
                   "seed of the per-subject draws of a plant effect with a cv field (passive_moment; default 1)");
   sub->add_flag("--diagnose", o->diagnose,
                 "diagnose the gait and the steps 3-4 records with the identified rigid model (a section of the output)");
+  sub->add_option("--fit", o->fit,
+                  "with --diagnose, the gait records' fit: torque (default) or motion (the forward plant simulated on "
+                  "the gait, diagnosis/motion_fit.h); the steps 3-4 records keep the torque fit");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     Table5Options opt;
@@ -79,6 +83,9 @@ CommandRunner RegisterTable5(CLI::App& app) {
     opt.plant_worn_file = o->realistic ? DataPath("data/plants/relaxed_leg.yaml") : o->plant_worn;
     Table5PlantEffects(opt, true);  // reads both files up front: a bad file is exit 2 before any run
     opt.diagnose = o->diagnose;
+    opt.gait_fit = ParseDiagnoseFit(o->fit, "table5 --fit");
+    if (opt.gait_fit == DiagnoseFit::kMotion && !o->diagnose)
+      throw InputError("table5 --fit motion: expected --diagnose with it");
     opt.seed = o->seed;
     opt.log = [](const std::string& line) { std::fprintf(stderr, "table5: %s\n", line.c_str()); };
     const auto wall0 = std::chrono::steady_clock::now();

@@ -32,6 +32,14 @@
 #include "sim/plant.h"
 
 namespace exotwin {
+
+const char* DiagnoseFitName(DiagnoseFit fit) { return fit == DiagnoseFit::kMotion ? "motion" : "torque"; }
+
+DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where) {
+  if (text == "torque") return DiagnoseFit::kTorque;
+  if (text == "motion") return DiagnoseFit::kMotion;
+  throw InputError(where + ": '" + text + "', expected torque or motion");
+}
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};

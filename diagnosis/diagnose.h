@@ -120,6 +120,10 @@ struct SimulationScores {
 // Which fit sizes and chooses the effects: the torque residual (inverse dynamics, this header's method)
 // or the simulated motion (the forward plant on the records, diagnosis/motion_fit.h).
 enum class DiagnoseFit { kTorque, kMotion };
+// "torque" / "motion" (diagnosis.json's `fit`, the --fit option's words).
+const char* DiagnoseFitName(DiagnoseFit fit);
+// The fit a --fit option names; InputError "<where>: '<text>', expected torque or motion" otherwise.
+DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where);
 
 // The motion fit: an effect the torque fit names that the motion fit does not (it does not lower the
 // held-out simulated error enough, or is not carried by the plant).

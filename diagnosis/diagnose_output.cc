@@ -26,7 +26,7 @@ std::string AliasText(const EffectAlias& a) {
 std::string DiagnosisJson(const Diagnosis& d) {
   using nlohmann::json;
   json j;
-  j["fit"] = d.fit == DiagnoseFit::kMotion ? "motion" : "torque";
+  j["fit"] = DiagnoseFitName(d.fit);
   j["effects"] = json::array();
   for (const auto& e : d.effects) {
     json x = {{"name", e.effect.name}, {"joint", e.effect.joint}, {"value", e.effect.value},

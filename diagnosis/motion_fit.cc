@@ -299,9 +299,16 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   if (!given.ok) throw SimulationError(0, "the model given diverges in the forward simulation of the records");
   double sse[2];
   Sse(given, Part::kFit, sse);
-  double count = 0;
-  for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows);
+  double count = 0, all_rows = 0;
+  for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows), all_rows += static_cast<double>(rp->rows.size());
   for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse[j] / count), 1e-6);
+  fit_share_ = count / std::max(all_rows, 1.0);
+}
+
+double MotionProblem::ReplaysSimulated() const {
+  return static_cast<double>(rollouts_[static_cast<int>(Part::kFit)]) * fit_share_ +
+         static_cast<double>(rollouts_[static_cast<int>(Part::kHeldOut)]) * (1 - fit_share_) +
+         static_cast<double>(rollouts_[static_cast<int>(Part::kBoth)]);
 }
 
 int MotionProblem::CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis) const {
@@ -368,6 +375,7 @@ std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const
 }
 
 MotionProblem::Rollout MotionProblem::Simulate(const Eigen::VectorXd& theta, Part part) const {
+  ++rollouts_[static_cast<int>(part)];
   LegParams p = params_;
   const std::vector<Effect> extra = EffectsOf(theta);
   p.effects.insert(p.effects.end(), extra.begin(), extra.end());
@@ -566,8 +574,10 @@ struct Refined {
 };
 
 // Projected Levenberg-Marquardt on parameters `cols` (motion_fit.h step 4), from the best of `starts`.
+// With `jacobian` false, Refined::J and ::e are left empty where the last step moved theta (no rollouts
+// for a Jacobian nobody reads).
 Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::vector<Eigen::VectorXd>& starts,
-               int iterations = kMotionLmIterations) {
+               int iterations = kMotionLmIterations, bool jacobian = true) {
   const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
   const Eigen::VectorXd wv = RowWeights(P);
   auto Clamp = [&](Eigen::VectorXd x) {
@@ -610,6 +620,11 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
       for (size_t c = 0; c < cols.size(); ++c) x[cols[c]] += d[static_cast<Eigen::Index>(c)];
       x = Clamp(x);
       if ((x - R.theta).norm() == 0) break;
+      // The decrease the linear model predicts for the clamped step, |e|^2 - |e - J dx|^2: below the
+      // stopping rule's 1e-5 of the cost, no rollout can meet the rule (converged).
+      Eigen::VectorXd dx(static_cast<Eigen::Index>(cols.size()));
+      for (size_t c = 0; c < cols.size(); ++c) dx[static_cast<Eigen::Index>(c)] = x[cols[c]] - R.theta[cols[c]];
+      if (2 * dx.dot(g) - dx.dot(A * dx) < 1e-5 * R.cost) break;
       MotionProblem::Rollout rx = P.Simulate(x, Part::kFit);
       const double cx = Cost(P, rx, Part::kFit);
       if (cx < R.cost) {
@@ -622,11 +637,53 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
     }
     if (!improved || before - R.cost < 1e-5 * before) break;
   }
-  if (!fresh) {
+  if (!fresh && jacobian) {
     R.J = WeightedJ(at, R.theta);
     R.e = WeightedResidual(P, at, idx);
   }
   return R;
+}
+
+// One parameter k refined alone (motion_fit.h step 3's screening fit) by the secant method on the
+// fit part's weighted least squares: the derivative of the simulated angles is the secant through the
+// last two rollouts (the first: from `base`, theta's own rollout, to `start`), the step Gauss-Newton's
+// on it, clamped to the box; one rollout per iteration, at most `iterations`, fewer when the predicted
+// decrease falls below the refinement's stopping rule. Returns the best value seen (theta[k] itself
+// when nothing lowers the cost).
+double RefineOne(const MotionProblem& P, int k, const Eigen::VectorXd& theta, const MotionProblem::Rollout& base,
+                 double start, int iterations) {
+  const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
+  // e = w (q - qsim) on the fit rows, so the weighted derivative of qsim is -de/dx: the secant
+  // (e_prev - e_cur) / (x_cur - x_prev).
+  double x_prev = theta[k], x_cur = std::clamp(start, P.lower(k), P.upper(k));
+  if (!base.ok || x_cur == x_prev) return x_prev;
+  Eigen::VectorXd e_prev = WeightedResidual(P, base, idx);
+  double best_x = x_prev, best_cost = e_prev.squaredNorm();
+  Eigen::VectorXd x = theta;
+  x[k] = x_cur;
+  const MotionProblem::Rollout ro = P.Simulate(x, Part::kFit);
+  if (!ro.ok) return best_x;
+  Eigen::VectorXd e_cur = WeightedResidual(P, ro, idx);
+  double cost_cur = e_cur.squaredNorm();
+  if (cost_cur < best_cost) best_x = x_cur, best_cost = cost_cur;
+  for (int it = 1; it < iterations; ++it) {
+    const Eigen::VectorXd Jw = (e_prev - e_cur) / (x_cur - x_prev);
+    const double a = Jw.squaredNorm();
+    if (!(a > 0)) break;
+    // Gauss-Newton on the secant, e(x) ~ e_cur - Jw (x - x_cur), clamped to the box.
+    const double x_new = std::clamp(x_cur + Jw.dot(e_cur) / a, P.lower(k), P.upper(k));
+    const double dx = x_new - x_cur;
+    if (dx == 0 || 2 * dx * Jw.dot(e_cur) - a * dx * dx < 1e-5 * cost_cur) break;  // converged (the stopping rule)
+    x[k] = x_new;
+    const MotionProblem::Rollout rn = P.Simulate(x, Part::kFit);
+    if (!rn.ok) break;
+    Eigen::VectorXd e_new = WeightedResidual(P, rn, idx);
+    const double cost_new = e_new.squaredNorm();
+    if (cost_new < best_cost) best_x = x_new, best_cost = cost_new;
+    x_prev = x_cur, e_prev = std::move(e_cur);
+    x_cur = x_new, e_cur = std::move(e_new), cost_cur = cost_new;
+  }
+  return best_x;
 }
 
 std::string Labels(const MotionProblem& P, const std::vector<int>& set) {
@@ -682,8 +739,18 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   D.torque_named = T.effects;
   D.cutoff = T.cutoff;
 
+  // Where the simulation goes, in replays of the records (reported in the selection log).
+  enum Stage { kSetUp, kJacobians, kScreening, kRefinement, kGate, kScores, kStages };
+  double cost[kStages] = {0, 0, 0, 0, 0, 0}, mark = 0;
+  auto Charge = [&](Stage st) {
+    const double now = P.ReplaysSimulated();
+    cost[st] += now - mark;
+    mark = now;
+  };
+
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_par);
   const MotionProblem::Rollout given = P.Simulate(zero, Part::kBoth);
+  Charge(kSetUp);
   if (!given.ok) throw SimulationError(0, "the model given diverges in the forward simulation of the records");
   double window_rows = 0;
   {
@@ -760,6 +827,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     const std::vector<MotionProblem::Rollout> ro_without = P.SimulateAll(without, Part::kBoth);
     for (size_t k = 0; k < in_set.size(); ++k)
       if (ro_without[k].ok) Secant(&J, in_set[k], ro_without[k], -(theta[in_set[k]]));
+    Charge(kJacobians);
     std::vector<ColumnBank> banks;
     Grams g;
     Linearize(J, &banks, &g);
@@ -784,16 +852,20 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
         screen.push_back(k);
         start.push_back(x);
       }
-      std::vector<Refined> refined(screen.size());
+      std::vector<double> refined(screen.size());
       std::vector<MotionProblem::Rollout> at_refined(screen.size());
       ParallelFor(screen.size(), Threads(opt), [&](size_t i) {
-        refined[i] = Refine(P, {screen[i]}, {start[i]}, kMotionScreenIterations);
-        if (std::isfinite(refined[i].cost) && refined[i].theta[screen[i]] != theta[screen[i]])
-          at_refined[i] = P.Simulate(refined[i].theta, Part::kBoth);
+        const int k = screen[i];
+        refined[i] = RefineOne(P, k, theta, at, start[i][k], kMotionScreenIterations);
+        if (refined[i] == theta[k]) return;
+        Eigen::VectorXd x = theta;
+        x[k] = refined[i];
+        at_refined[i] = P.Simulate(x, Part::kBoth);
       });
       for (size_t i = 0; i < screen.size(); ++i)
-        if (at_refined[i].ok) Secant(&J, screen[i], at_refined[i], refined[i].theta[screen[i]] - theta[screen[i]]);
+        if (at_refined[i].ok) Secant(&J, screen[i], at_refined[i], refined[i] - theta[screen[i]]);
       if (!screen.empty()) Linearize(J, &banks, &g);
+      Charge(kScreening);
     }
     Fit lin;
     SelectionTrace trace;
@@ -819,7 +891,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       }
     std::vector<Eigen::VectorXd> starts = {start_lin};
     if (has_torque) starts.push_back(start_torque);
-    const Refined rf = Refine(P, cols, starts);
+    const Refined rf = Refine(P, cols, starts, kMotionLmIterations, false);
     if (!std::isfinite(rf.cost)) {
       D.selection.push_back("round " + std::to_string(round + 1) + ": " + Labels(P, chosen) +
                             " cannot be simulated at its fitted values; nothing named");
@@ -829,6 +901,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     }
     theta = rf.theta;
     at = P.Simulate(theta, Part::kBoth);
+    Charge(kRefinement);
     std::ostringstream os;
     os << "round " << round + 1 << ": refined on the plant:";
     for (int c : chosen) {
@@ -844,6 +917,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     previous = chosen;
   }
 
+  Charge(kRefinement);
   // 6. The exact held-out gate.
   std::vector<double> explained(chosen.size(), 0.0);
   double sse_given_te[2];
@@ -889,6 +963,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   }
   at = P.Simulate(theta, Part::kBoth);
   if (!at.ok) throw SimulationError(0, "the motion fit's extended twin diverges on the records");
+  Charge(kGate);
 
   // 7. Values and intervals from the final Jacobian.
   const std::vector<int> cols = ColumnsOf(cand_bank, chosen);
@@ -1043,6 +1118,16 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base_te[j] > 0 ? 100 * (s[j] / base_te[j] - 1) : 0.0;
   }
 
+  Charge(kScores);
+  {
+    std::ostringstream os;
+    os << "simulation, in replays of the records: set-up " << NumberText(cost[kSetUp], 3) << ", Jacobians "
+       << NumberText(cost[kJacobians], 3) << ", screening " << NumberText(cost[kScreening], 3) << ", refinement "
+       << NumberText(cost[kRefinement], 3) << ", held-out gate " << NumberText(cost[kGate], 3)
+       << ", intervals and scores " << NumberText(cost[kScores], 3) << " (" << NumberText(P.ReplaysSimulated(), 4)
+       << " in all)";
+    D.selection.push_back(os.str());
+  }
   D.kin = std::move(T.kin);
   D.split = T.split;
   std::ostringstream m;

@@ -38,8 +38,9 @@
 //     every scored sample; J's columns and the residual q - qsim(theta) + J theta form one ColumnBank
 //     per record (rows weighted by w_j), a linear model whose coefficients are the effects' values;
 //  3. screening: each one-parameter candidate whose linear fit on top of the current set is
-//     significant and lowers the BIC is refined alone on the exact plant (Levenberg-Marquardt, the set
-//     held; kMotionScreenIterations) and its column replaced by the secant to that value (the current
+//     significant and lowers the BIC is refined alone on the exact plant (the secant method from the
+//     current theta's rollout to the linear fit's value, one rollout per step, the set held;
+//     kMotionScreenIterations rollouts at most) and its column replaced by the secant to that value (the current
 //     set's own one-parameter effects: the secant from the set without them), so that the linear model
 //     holds every candidate's exact single fit (a dead band or a strap is far from linear in its value);
 //     then SelectEffects (diagnose_select.h: the torque fit's gates, shared) chooses the effects on that
@@ -48,7 +49,7 @@
 //     (kMinTorqueShare of the measured angle's RMS about its mean), |t| > kMinT from J's covariance,
 //     DESIGN.md's ranges, the simpler explanation preferred;
 //  4. the chosen effects' values are refined on the exact plant: projected Levenberg-Marquardt inside
-//     the box, forward-difference Jacobians, from the linear fit's values and from the torque fit's
+//     the box (stopped where the decrease it predicts is below 1e-5 of the cost), forward-difference Jacobians, from the linear fit's values and from the torque fit's
 //     where it named the effect (the lower error wins);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
 //  6. exact held-out gate: every chosen effect, taken out of the refined set, must raise the held-out
@@ -66,6 +67,7 @@
 // whole records left out), noise (1 / w_j, rad), tau_eff (rows), torque_named, torque_only; cutoff
 // and kin are the torque fit's (the report's header).
 #pragma once
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,7 +82,7 @@ namespace exotwin {
 
 constexpr int kMotionOuterSteps = 3;     // linearize-select-refine rounds at most
 constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per refinement at most
-constexpr int kMotionScreenIterations = 4;  // the same for a candidate's screening fit
+constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a
@@ -139,6 +141,9 @@ class MotionProblem {
   const Eigen::VectorXd& measured(size_t r) const;  // measured angle on the rows (rad), Simulate's layout
   // Weighted SSE of a rollout per joint, on the fit part or the held-out part.
   void Sse(const Rollout& ro, Part part, double sse[2]) const;
+  // The simulation done so far, in replays of the records: every Simulate call counts the share of the
+  // records' scored rows it simulates (a fit part alone: its share; both parts: 1).
+  double ReplaysSimulated() const;
 
  private:
   struct Record;
@@ -154,6 +159,8 @@ class MotionProblem {
   double w_[2] = {1, 1};
   bool reading_input_ = true;      // every record driven by its torque reading
   bool hold_ = false;              // ReplaySeries::hold of every record
+  double fit_share_ = 1;            // the fit parts' share of the scored rows
+  mutable std::atomic<long> rollouts_[3] = {{0}, {0}, {0}};  // Simulate calls per Part
 };
 
 }  // namespace exotwin

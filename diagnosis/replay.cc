@@ -137,9 +137,10 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
     const size_t r = run_in_s > 0 ? static_cast<size_t>(std::lower_bound(t.begin(), t.begin() + static_cast<long>(start),
                                                                           t0 - run_in_s - 1e-12) - t.begin())
                                   : start;
-    const Eigen::Vector2d tau0(s.tau_R[0][r], s.tau_R[1][r]);  // the dead band's flank at the (run-in's) start
+    // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
+    // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
     const Eigen::Vector2d qdd0(s.qdd0[0].empty() ? 0.0 : s.qdd0[0][r], s.qdd0[1].empty() ? 0.0 : s.qdd0[1][r]);
-    plant.Reset({s.q0[0][r], s.q0[1][r]}, {s.qd0[0][r], s.qd0[1][r]}, t[r], &tau0, &qdd0);
+    plant.Reset({s.q0[0][r], s.q0[1][r]}, {s.qd0[0][r], s.qd0[1][r]}, t[r], &qdd0);
     if (r < start) {
       // The measured joints follow the restart state's motion (linear between samples), each step
       // driven by the input; the internal hinges move by their own dynamics.

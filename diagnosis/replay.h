@@ -11,8 +11,9 @@
 //  - restart state: the angle low-passed by the zero-phase 2nd-order Butterworth at the cutoff
 //    (formats/measured_data.h LowPassOnTimeBase) and its velocity (DeriveAngleRates at the same
 //    cutoff), at the window's first sample.
-//    A dead band (backlash) restarts against the flank of the input torque there (Plant::Reset's
-//    `transmitted`). A strap (series compliance) restarts by a run-in: from the restart state run_in
+//    A dead band (backlash) restarts against the flank the rigid torque of the restart state's motion
+//    (angle, velocity, acceleration) presses, what the gear transmits in contact (Plant::Reset's
+//    `qdd`). A strap (series compliance) restarts by a run-in: from the restart state run_in
 //    before the window (the series' first sample at the earliest), the strap at the deflection that
 //    carries the part behind it at the restart state's acceleration there (Plant::Reset's `qdd`), the
 //    measured joints follow the restart state's motion step by step (Plant::Restate, linear between

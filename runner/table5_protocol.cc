@@ -85,11 +85,14 @@ void AddPlant(const std::vector<Effect>& fx, const Table5Options& opt, bool worn
 }
 
 Table5Diagnosis DiagnoseRecords(const std::string& what, const LegParams& model,
-                                const std::vector<const MeasuredData*>& records) {
+                                const std::vector<const MeasuredData*>& records, DiagnoseFit fit) {
   Table5Diagnosis out;
   out.records = what;
+  out.fit = fit;
   try {
-    const Diagnosis d = Diagnose(model, records);
+    DiagnoseOptions dopt;
+    dopt.fit = fit;
+    const Diagnosis d = Diagnose(model, records, dopt);
     out.done = true;
     for (const DiagnosedEffect& e : d.effects) {
       out.named.push_back(e.effect);
@@ -197,10 +200,10 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   ComputeTable5Rmse(g, t_from, t_to, preset.weight, preset.L2, &e);
   if (opt.diagnose) {
     const LegParams model = Table5ParameterSets(e.identified, preset.weight, preset.L2)[0];
-    run.diagnoses.push_back(DiagnoseRecords("gait", model, {&g}));
+    run.diagnoses.push_back(DiagnoseRecords("gait", model, {&g}, opt.gait_fit));
     std::vector<const MeasuredData*> steps34;
     for (const MeasuredData& f : human_files) steps34.push_back(&f);
-    run.diagnoses.push_back(DiagnoseRecords("steps 3-4", model, steps34));
+    run.diagnoses.push_back(DiagnoseRecords("steps 3-4", model, steps34, DiagnoseFit::kTorque));
   }
   if (!opt.keep_logs) fs::remove_all(gdir);
   run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -254,8 +257,9 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
   if (!any) return s;
   s += "\n## diagnose on the twin's own records, with the identified rigid model\n\n";
   s += "Per record set: the effects named (value [95 % interval], deviation from the plant's value of that "
-       "effect at that joint), and the held-out torque RMS error (N m, diagnose's filtered last 30 %) of the "
-       "identified twin -> the extended twin.\n\n";
+       "effect at that joint), and the held-out RMS error (diagnose's last 30 %) of the identified twin -> the "
+       "extended twin: of the filtered torque (N m) where the records are diagnosed by the torque fit, of the "
+       "simulated angle (rad) where by the motion fit (--fit motion: the gait).\n\n";
   s += "| subject | records | named | hip held-out | knee held-out | paper's identified hip / knee (Table 5) |\n"
        "| --- | --- | --- | --- | --- | --- |\n";
   struct Acc { double sum = 0, abs_dev = 0; int n = 0; };  // abs_dev: sum of |named - that subject's set value|
@@ -266,7 +270,7 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
       for (const Table5Row& p : PaperTable5())
         if (r.entry.subject == p.subject)
           paper = FormatNumber("%.2f", p.hip_identified) + " / " + FormatNumber("%.2f", p.knee_identified);
-      s += "| " + r.entry.subject + " | " + d.records + " | ";
+      s += "| " + r.entry.subject + " | " + d.records + (d.fit == DiagnoseFit::kMotion ? " (motion fit)" : "") + " | ";
       if (!d.done) {
         s += "not run: " + d.error + " | - | - | " + paper + " |\n";
         continue;
@@ -352,7 +356,9 @@ std::string Table5DiagnosisJson(const std::vector<Table5SubjectRun>& runs) {
       json held = json::object();
       for (int j = 0; j < 2; ++j)
         held[j ? "knee" : "hip"] = {{"rmse_before", d.rmse_before[j]}, {"rmse_after", d.rmse_after[j]}};
-      ds.push_back({{"records", d.records}, {"done", d.done}, {"error", d.error}, {"cutoff_hz", d.cutoff_hz},
+      ds.push_back({{"records", d.records}, {"fit", DiagnoseFitName(d.fit)},
+                    {"heldout_unit", d.fit == DiagnoseFit::kMotion ? "rad" : "N m"}, {"done", d.done}, {"error", d.error},
+                    {"cutoff_hz", d.cutoff_hz},
                     {"effects", fx}, {"not_identifiable", d.not_identifiable}, {"heldout", held}});
     }
     subjects.push_back({{"subject", r.entry.subject}, {"diagnoses", ds}});

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/diagnose.h"
 #include "identification/table5.h"
 #include "model/lumped_params.h"
 
@@ -28,6 +29,11 @@ struct Table5Options {
   std::string plant_file;       // the device's: every scenario (steps 1-4 and gait); "" = none
   std::string plant_worn_file;  // the worn leg's: where the subject wears the exoskeleton (steps 3-4, gait)
   bool diagnose = false;        // diagnose the gait and the steps 3-4 records with the identified model
+  // The gait records' fit (diagnosis/diagnose.h DiagnoseFit): kMotion sizes the effects by simulating the
+  // forward plant on the gait (diagnosis/motion_fit.h; a strap or a dead band shows in the motion). The
+  // steps 3-4 records (quasi-static identification trials, trials x trial_duration s each) keep the
+  // torque fit either way.
+  DiagnoseFit gait_fit = DiagnoseFit::kTorque;
   // Seed of the per-subject draws: an effect with a `cv` field (passive_moment) takes, for each subject,
   // a value drawn from (seed, subject name) (SubjectEffects).
   uint64_t seed = 1;
@@ -38,13 +44,16 @@ struct Table5Options {
 // identified rigid model (Table5Entry::identified, passive riener1999, no effects).
 struct Table5Diagnosis {
   std::string records;                  // "gait" or "steps 3-4"
+  DiagnoseFit fit = DiagnoseFit::kTorque;
   bool done = false;
   std::string error;                    // why not done (the InputError's message)
   std::vector<Effect> named;            // the effects named, with their 95 % intervals in `ci`
   std::vector<std::pair<double, double>> ci;
   std::vector<std::string> not_identifiable;  // candidates these records cannot identify
   double cutoff_hz = 0;
-  double rmse_before[2] = {0, 0}, rmse_after[2] = {0, 0};  // held-out, N m: identified vs extended twin
+  // Held-out, identified vs extended twin: the torque's RMS error (N m) for the torque fit, the simulated
+  // angle's (rad) for the motion fit.
+  double rmse_before[2] = {0, 0}, rmse_after[2] = {0, 0};
 };
 
 // Outcome of one subject: the entry of Table 5 and every scenario check that failed ("step: name").

@@ -4,6 +4,7 @@
 # with the rigid subject model (examples/S1.yaml); one line per case: what each fit names.
 #   scripts/motion_fit_table.sh [EXOTWIN] [DURATION] [SEEDS]   (defaults: build/app/exotwin, 60, 1)
 # SEEDS > 1 repeats every case with seeds 1..SEEDS (the scenario's noise and subject draws).
+# env CASES: an extended regex on the case labels (e.g. CASES=none for the clean sweep over seeds).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 exe="${1:-$root/build/app/exotwin}"
@@ -35,6 +36,7 @@ printf '| hidden in the plant | seed | --fit motion | --fit torque | motion fit 
 for c in "${cases[@]}"; do
   label="${c%%|*}"
   effects="${c#*|}"
+  [[ "$label" =~ ${CASES:-.} ]] || continue
   for seed in $(seq 1 "$seeds"); do
     dir="$work/case"
     rm -rf "$dir"

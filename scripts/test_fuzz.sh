@@ -4,7 +4,8 @@
 # report (ASan + UBSan), uncaught exception, hang (> 10 s on one input) or out-of-memory fails the
 # script, and the input that did it is kept in build-fuzz/findings/. New inputs the runs find go to a
 # scratch folder; the corpus in the source tree is not touched.
-# Usage: scripts/test_fuzz.sh [seconds per target (default 20)]   env: FUZZ_SEED (default 1), JOBS (2)
+# Usage: scripts/test_fuzz.sh [seconds per target (default 20)]   env: FUZZ_SEED (default 1), JOBS (2: targets
+# built and run two at a time)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,13 +28,30 @@ findings=build-fuzz/findings
 scratch=$(mktemp -d "${TMPDIR:-/tmp}/exotwin_fuzz_XXXXXX")
 trap 'rm -rf "$scratch"' EXIT
 mkdir -p "$findings"
-failed=""
-for t in $TARGETS; do
+# The targets run JOBS at a time (each libFuzzer run is one process on one core, for its own fixed
+# budget); their reports are printed in TARGETS' order.
+run_target() {
+  local t=$1
   mkdir -p "$scratch/$t"
   # -timeout: one input longer than 10 s is a hang; -rss_limit_mb: more than 2 GB an out-of-memory.
   if build-fuzz/fuzz/$t -seed="$SEED" -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=2048 \
        -print_final_stats=1 -artifact_prefix="$findings/$t-" "$scratch/$t" "fuzz/corpus/$t" \
        >"$scratch/$t.log" 2>&1; then
+    echo 0 > "$scratch/$t.rc"
+  else
+    echo 1 > "$scratch/$t.rc"
+  fi
+}
+running=0
+for t in $TARGETS; do
+  if [ "$running" -ge "$JOBS" ]; then wait -n; running=$((running - 1)); fi
+  run_target "$t" &
+  running=$((running + 1))
+done
+wait
+failed=""
+for t in $TARGETS; do
+  if [ "$(cat "$scratch/$t.rc")" = 0 ]; then
     echo "test_fuzz: $t: $(grep -o 'stat::number_of_executed_units: *[0-9]*' "$scratch/$t.log" | grep -o '[0-9]*$') inputs" \
          "in ${SECONDS_EACH} s, $(grep -o 'cov: [0-9]*' "$scratch/$t.log" | tail -1), no finding"
   else

@@ -447,8 +447,7 @@ void Plant::HoldHip() {
   mj_forward(m_, d_);
 }
 
-void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t, const Eigen::Vector2d* transmitted,
-                  const Eigen::Vector2d* qdd) {
+void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t, const Eigen::Vector2d* qdd) {
   mj_resetData(m_, d_);
   for (int j = 0; j < 2; ++j) {
     d_->qpos[q_adr_[j]] = q[j];
@@ -457,7 +456,7 @@ void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t,
   if (structure_.any()) {
     LegParams rigid = params_;
     rigid.effects.clear();
-    const Eigen::Vector2d tau = transmitted ? *transmitted : ActuatorTorque(rigid, q, qd, Eigen::Vector2d::Zero());
+    const Eigen::Vector2d tau = ActuatorTorque(rigid, q, qd, qdd ? *qdd : Eigen::Vector2d::Zero());
     for (int j = 0; j < 2; ++j) {
       if (in_q_[j] < 0) continue;
       d_->qpos[in_q_[j]] =

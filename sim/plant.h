@@ -90,14 +90,12 @@ class Plant {
 
   // Sets the state (rad, rad/s) and time (s) of the forward simulation; recomputes kinematics.
   // q, qd are the measured (motor-side) joints. Internal hinges start at rest relative to their
-  // joint: a dead band at the flank the rigid torque at qdd = 0 presses the link against (the inverse
+  // joint: a dead band at the flank the rigid torque at q, qd and the acceleration `qdd` presses the
+  // link against (the torque the link's motion needs, which the gear transmits in contact; the inverse
   // form's -value/2 tanh(tau / kBacklashTorqueWidth)), a strap at the deflection that carries the
-  // part's rigid torque at q, qd and the acceleration `qdd` (rad/s^2, when given, e.g. the measured
-  // one; else 0: quasi-static), CompliantAngle. `transmitted` (N m, when given, e.g. the measured
-  // actuator torque at t) chooses the dead band's flank instead of that rigid torque: in motion the
-  // motor presses the link with its own torque, not with the quasi-static one.
-  void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0,
-             const Eigen::Vector2d* transmitted = nullptr, const Eigen::Vector2d* qdd = nullptr);
+  // part's rigid torque at q, qd and `qdd` (rad/s^2, when given, e.g. the measured one; else 0:
+  // quasi-static), CompliantAngle.
+  void Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t = 0.0, const Eigen::Vector2d* qdd = nullptr);
   // Time (s) in which a strap's mode (sim/plant.cc: damped at kStrapDampingRatio of critical) decays
   // to 1 % of a start's error: 5 / (zeta omega), the slowest strap carried; 0 without a strap.
   double InternalSettlingTime() const;

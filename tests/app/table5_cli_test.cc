@@ -27,6 +27,8 @@ TEST(Table5Cli, BadPlantInputIsExit2BeforeAnyRun) {
       {"--realistic --plant " + plants + "exowheel_realistic.yaml", "--realistic: names its own plant files"},
       {"--plant " + tmp.path() + "/missing.yaml", "missing.yaml"},
       {"--plant-worn " + muscles, "effects[0]"},  // EMG is a record's input, not the plant's
+      {"--diagnose --fit inverse", "table5 --fit: 'inverse', expected torque or motion"},
+      {"--fit motion", "table5 --fit motion: expected --diagnose with it"},
   };
   for (const Case& c : cases) {
     const auto r = RunExotwin("table5 --subjects S1 --out " + out + " " + c.args);

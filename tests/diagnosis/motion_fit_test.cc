@@ -80,6 +80,11 @@ TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
   EXPECT_LT(worst, 0.01 * peak);
   // The hip of a one-joint device is no output (weight 0).
   EXPECT_EQ(P.weight(0), 0.0);
+  // The simulation counted in replays of the record: the constructor's five fit-part rollouts (the
+  // input's two holds, each for the model given and with the torque fit's effects, none here; then the
+  // model given for the weights), the rollout at zero and the one Jacobian column, both parts each.
+  const double fit_share = static_cast<double>(P.fit_rows(0)) / static_cast<double>(m);
+  EXPECT_NEAR(P.ReplaysSimulated(), 5 * fit_share + 2, 1e-12);
 }
 
 // Bad input: --fit other than torque|motion; a record with neither a torque reading nor commands; a
