@@ -699,8 +699,10 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
                             Num(gain) + " %, " + Num(100 * kMinHeldoutGain) + " % needed): " +
                             (d.calibration.msk_form[j] ? "musculoskeletal form" : "linear form"));
       d.notes.push_back(std::string(kJoint[j]) + ": the recorded muscles can reach " + Num(100 * m.reachable_share[j]) +
-                        " % of the calibration moment at full activation and their largest strength (the rest "
-                        "belongs to muscles nobody recorded)");
+                        " % of the calibration moment at full activation and their largest strength, " +
+                        Num(100 * m.reachable_share_recorded[j]) +
+                        " % at their recorded activation (the rest belongs to muscles nobody recorded, or to "
+                        "passive tissues)");
     }
   }
   // Channels whose fitted alpha contradicts their muscle's action (HJ15 eq. 23-24 signs): crosstalk,

@@ -214,7 +214,9 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
       << (d.calibration.msk_form[0] ? "chosen" : "linear form chosen") << "), knee " << NumberText(m.r2_cv[1], 3) << " ("
       << (d.calibration.msk_form[1] ? "chosen" : "linear form chosen") << "). The recorded muscles can reach "
       << NumberText(100 * m.reachable_share[0], 3) << " % of the hip's and " << NumberText(100 * m.reachable_share[1], 3)
-      << " % of the knee's calibration moment (full activation, 1.5 F_max). Delay " << NumberText(1e3 * m.delay, 3)
+      << " % of the knee's calibration moment at full activation and 1.5 F_max, "
+      << NumberText(100 * m.reachable_share_recorded[0], 3) << " % / " << NumberText(100 * m.reachable_share_recorded[1], 3)
+      << " % at their recorded activation. Tendon " << (m.elastic_tendon ? "elastic" : "rigid") << ". Delay " << NumberText(1e3 * m.delay, 3)
       << " ms, twitch " << NumberText(1e3 * m.twitch, 3) << " ms, A " << NumberText(m.a_shape, 3) << ".</p>";
     o << "<table><tr><th>channel</th><th>path</th><th>F_max (N)</th><th>strength (0.5-1.5)</th><th>l_ts (m) [bounds]</th>"
          "<th>l_opt (m) [bounds]</th><th>force over the trial (N) min / mean / max</th><th>fibre length (l_opt) min / max</th></tr>";

@@ -46,10 +46,12 @@ Geometry GeometryOf(const EmgRecording& rec, const std::vector<EmgMskMuscle>& mu
   const size_t n = rec.size();
   for (const EmgMskMuscle& m : mus) {
     std::vector<double> L(n), Ld(n), r0(n), r1(n);
+    const bool ankle = !rec.q_ankle.empty();
     for (size_t i = 0; i < n; ++i) {
-      const MtuKinematics k = MusculotendonKinematics(m.muscle, rec.q[0][i], rec.q[1][i]);
+      const MtuKinematics k = MusculotendonKinematics(m.muscle, rec.q[0][i], rec.q[1][i], ankle ? rec.q_ankle[i] : 0.0);
       L[i] = k.length, r0[i] = k.arm[0], r1[i] = k.arm[1];
-      Ld[i] = -(k.arm[0] * rec.qd[0][i] + k.arm[1] * rec.qd[1][i]);  // dL/dt = sum dL/dq qd = -sum r qd
+      // dL/dt = sum dL/dq qd = -sum r qd
+      Ld[i] = -(k.arm[0] * rec.qd[0][i] + k.arm[1] * rec.qd[1][i] + (ankle ? k.arm_ankle * rec.qd_ankle[i] : 0.0));
     }
     g.L.push_back(std::move(L)), g.Ld.push_back(std::move(Ld)), g.r[0].push_back(std::move(r0)),
         g.r[1].push_back(std::move(r1));
@@ -57,14 +59,33 @@ Geometry GeometryOf(const EmgRecording& rec, const std::vector<EmgMskMuscle>& mu
   return g;
 }
 
-// Unit-strength moment columns of channel c at both joints: F_max (a active + passive) r_j.
-void MuscleColumns(const EmgMskMuscle& m, const MusculotendonParams& p, const std::vector<double>& a, const Geometry& g,
-                   size_t c, std::vector<double> col[2]) {
+// The unit's states on a recording at activations a: force per F_max, normalized fibre length and
+// velocity per sample (the elastic tendon's series, or the rigid tendon's state sample by sample).
+TendonSeries UnitStates(const MusculotendonParams& p, bool elastic, const std::vector<double>& t, const Geometry& g,
+                        size_t c, const std::vector<double>& a) {
+  TendonSeries s;
+  if (elastic) {
+    ElasticTendonSeries(p, t, g.L[c], a, &s);
+    return s;
+  }
+  const size_t n = a.size();
+  s.fibre_length.resize(n), s.fibre_velocity.resize(n), s.force.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const HillState h = RigidTendonState(p, g.L[c][i], g.Ld[c][i]);
+    s.force[i] = a[i] * h.active + h.passive;
+    s.fibre_length[i] = h.fibre_length, s.fibre_velocity[i] = h.fibre_velocity;
+  }
+  return s;
+}
+
+// Unit-strength moment columns of channel c at both joints: F_max f r_j, f the force per F_max.
+void MuscleColumns(const EmgMskMuscle& m, const MusculotendonParams& p, bool elastic, const std::vector<double>& t,
+                   const std::vector<double>& a, const Geometry& g, size_t c, std::vector<double> col[2]) {
+  const TendonSeries s = UnitStates(p, elastic, t, g, c, a);
   const size_t n = a.size();
   col[0].resize(n), col[1].resize(n);
   for (size_t i = 0; i < n; ++i) {
-    const HillState s = RigidTendonState(p, g.L[c][i], g.Ld[c][i]);
-    const double F = m.nominal.f_max * (a[i] * s.active + s.passive);
+    const double F = m.nominal.f_max * s.force[i];
     col[0][i] = F * g.r[0][c][i], col[1][i] = F * g.r[1][c][i];
   }
 }
@@ -145,8 +166,8 @@ Solved SolveBounded(const Eigen::MatrixXd& G, const Eigen::VectorXd& b, double r
 
 class Calibration {
  public:
-  Calibration(std::vector<Rec>* recs, std::vector<EmgMskMuscle>* mus, const double w[2])
-      : recs_(*recs), mus_(*mus), w_{w[0], w[1]} {}
+  Calibration(std::vector<Rec>* recs, std::vector<EmgMskMuscle>* mus, const double w[2], bool elastic)
+      : recs_(*recs), mus_(*mus), w_{w[0], w[1]}, elastic_(elastic) {}
 
   // Fit rows: every row within the spike limit except those of the fold [a, b) of recording `rec`
   // (rec < 0: none left out).
@@ -163,7 +184,7 @@ class Calibration {
     for (Rec& r : recs_) {
       r.col.resize(mus_.size());
       std::vector<double> col[2];
-      MuscleColumns(mus_[c], p, r.act[c], r.geo, c, col);
+      MuscleColumns(mus_[c], p, elastic_, r.rec->t, r.act[c], r.geo, c, col);
       r.col[c][0] = std::move(col[0]), r.col[c][1] = std::move(col[1]);
     }
   }
@@ -286,24 +307,45 @@ class Calibration {
     double lambda = 1e-3;
     for (int it = 0; it < 15; ++it) {
       const Cols c0 = cols();
-      // d columns / d parameter k (central differences), for the searched parameters.
+      // d columns / d parameter k (central differences), for the searched parameters: delay and A move
+      // every channel's columns; a channel's lengths only its own (the others' derivatives left empty).
       std::vector<Cols> dcol(P);
       for (size_t k = 0; k < P; ++k) {
         const double h = k == 0 ? 1e-3 : k == 1 ? 1e-3 : 1e-4 * x[k];
         std::vector<double> v = x;
-        v[k] = x[k] + h;
-        set(v);
-        Cols up = cols();
-        v[k] = x[k] - h;
-        set(v);
-        const Cols dn = cols();
-        for (size_t r = 0; r < up.size(); ++r)
-          for (size_t c = 0; c < M; ++c)
-            for (int j = 0; j < 2; ++j)
-              for (size_t i = 0; i < up[r][c][j].size(); ++i) up[r][c][j][i] = (up[r][c][j][i] - dn[r][c][j][i]) / (2 * h);
-        dcol[k] = std::move(up);
+        if (k < 2) {
+          v[k] = x[k] + h;
+          set(v);
+          Cols up = cols();
+          v[k] = x[k] - h;
+          set(v);
+          const Cols dn = cols();
+          for (size_t r = 0; r < up.size(); ++r)
+            for (size_t c = 0; c < M; ++c)
+              for (int j = 0; j < 2; ++j)
+                for (size_t i = 0; i < up[r][c][j].size(); ++i) up[r][c][j][i] = (up[r][c][j][i] - dn[r][c][j][i]) / (2 * h);
+          dcol[k] = std::move(up);
+          set(x);
+          continue;
+        }
+        const size_t c = (k - 2) / 2;
+        auto own = [&](double value) {
+          (k % 2 == 0 ? mus_[c].l_ts : mus_[c].l_opt) = value;
+          SetColumns(c);
+          std::vector<std::array<std::vector<double>, 2>> out;
+          for (const Rec& r : recs_) out.push_back(r.col[c]);
+          return out;
+        };
+        auto up = own(x[k] + h);
+        const auto dn = own(x[k] - h);
+        own(x[k]);
+        dcol[k].assign(recs_.size(), std::vector<std::array<std::vector<double>, 2>>(M));
+        for (size_t r = 0; r < recs_.size(); ++r) {
+          for (int j = 0; j < 2; ++j)
+            for (size_t i = 0; i < up[r][j].size(); ++i) up[r][j][i] = (up[r][j][i] - dn[r][j][i]) / (2 * h);
+          dcol[k][r][c] = std::move(up[r]);
+        }
       }
-      set(x);
       // Normal equations of the residual w (tau - sum s_c col_c - extras) in all N parameters.
       Eigen::MatrixXd H = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(N), static_cast<Eigen::Index>(N));
       Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(N)), J(static_cast<Eigen::Index>(N));
@@ -326,7 +368,8 @@ class Calibration {
             J[static_cast<Eigen::Index>(P + M + kExtras * j + 2)] = 1;
             for (size_t p = 0; p < P; ++p) {
               double d = 0;
-              for (size_t c = 0; c < M; ++c) d += lin.x[static_cast<Eigen::Index>(c)] * dcol[p][k][c][j][i];
+              for (size_t c = 0; c < M; ++c)
+                if (!dcol[p][k][c][j].empty()) d += lin.x[static_cast<Eigen::Index>(c)] * dcol[p][k][c][j][i];
               J[static_cast<Eigen::Index>(p)] = d;
             }
             const double w = w_[j], res = e.tau[j][i] - pred;
@@ -381,6 +424,7 @@ class Calibration {
   std::vector<Rec>& recs_;
   std::vector<EmgMskMuscle>& mus_;
   double w_[2];
+  bool elastic_;
   int out_rec_ = -1;
   size_t out_a_ = 0, out_b_ = 0;
 };
@@ -400,11 +444,10 @@ EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec) {
     const EmgMskMuscle& mu = m.muscles[c];
     const MusculotendonParams p = mu.Params();
     const std::vector<double> a = Activation(rec, mu.channel, m.delay, m.twitch, m.a_shape);
-    std::vector<double> F(n), l(n), v(n);
+    TendonSeries st = UnitStates(p, m.elastic_tendon, rec.t, g, c, a);
+    std::vector<double> F(n), &l = st.fibre_length, &v = st.fibre_velocity;
     for (size_t i = 0; i < n; ++i) {
-      const HillState h = RigidTendonState(p, g.L[c][i], g.Ld[c][i]);
-      F[i] = mu.strength * p.f_max * (a[i] * h.active + h.passive);
-      l[i] = h.fibre_length, v[i] = h.fibre_velocity;
+      F[i] = mu.strength * p.f_max * st.force[i];
       const bool out = l[i] < mu.fibre_lo || l[i] > mu.fibre_hi || v[i] < mu.velocity_lo || v[i] > mu.velocity_hi;
       for (int j = 0; j < 2; ++j) {
         s.tau[j][i] += F[i] * g.r[j][c][i];
@@ -457,7 +500,8 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
   }
   const int M = static_cast<int>(model.muscles.size());
   // The calibration on every sample.
-  Calibration cal(&rs, &model.muscles, w);
+  model.elastic_tendon = opt.elastic_tendon;
+  Calibration cal(&rs, &model.muscles, w, model.elastic_tendon);
   cal.Calibrate(twitch, &model.delay, &model.a_shape);
   // Cross-validation: each fold predicted by the strengths and remainder fitted on the others, the
   // searched parameters (delay, A, lengths) kept (as the linear form's folds keep its delays).
@@ -497,10 +541,19 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     m.fibre_lo = m.velocity_lo = std::numeric_limits<double>::infinity(),
     m.fibre_hi = m.velocity_hi = -std::numeric_limits<double>::infinity();
   model.present = true;
-  double reach[2] = {0, 0}, total[2] = {0, 0};
+  double reach[2] = {0, 0}, reach_rec[2] = {0, 0}, total[2] = {0, 0};
   std::vector<double> meas[2], pred[2];
   for (size_t k = 0; k < recs.size(); ++k) {
     const EmgMskSeries ser = MskSeries(model, *recs[k]);
+    // Every unit at full activation, and at its recorded activation (the calibration's).
+    std::vector<TendonSeries> full, recorded;
+    const std::vector<double> ones(recs[k]->size(), 1.0);
+    for (size_t c = 0; c < model.muscles.size(); ++c) {
+      const EmgMskMuscle& m = model.muscles[c];
+      full.push_back(UnitStates(m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c, ones));
+      recorded.push_back(UnitStates(m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c,
+                                    Activation(*recs[k], m.channel, model.delay, model.twitch, model.a_shape)));
+    }
     for (size_t c = 0; c < model.muscles.size(); ++c) {
       EmgMskMuscle& m = model.muscles[c];
       const auto l = std::minmax_element(ser.fibre[c].begin(), ser.fibre[c].end());
@@ -513,19 +566,21 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
         if (!rs[k].spike_ok[j][i]) continue;
         const double tau = recs[k]->tau[j][i];
         meas[j].push_back(tau), pred[j].push_back(ser.tau[j][i]);
-        // Every muscle pulling along tau's direction at full activation and its largest strength.
-        double M_dir = 0;
+        // Every muscle pulling along tau's direction at its largest strength, at full activation and
+        // at its recorded one.
+        double M_dir = 0, M_rec = 0;
         for (size_t c = 0; c < model.muscles.size(); ++c) {
           const EmgMskMuscle& m = model.muscles[c];
-          const HillState h = RigidTendonState(m.Params(), rs[k].geo.L[c][i], rs[k].geo.Ld[c][i]);
-          const double mom = m.strength_hi * m.nominal.f_max * (h.active + h.passive) * rs[k].geo.r[j][c][i];
-          if (mom * tau > 0) M_dir += std::abs(mom);
+          const double arm = m.strength_hi * m.nominal.f_max * rs[k].geo.r[j][c][i];
+          if (arm * full[c].force[i] * tau > 0) M_dir += std::abs(arm * full[c].force[i]);
+          if (arm * recorded[c].force[i] * tau > 0) M_rec += std::abs(arm * recorded[c].force[i]);
         }
-        reach[j] += std::min(std::abs(tau), M_dir), total[j] += std::abs(tau);
+        reach[j] += std::min(std::abs(tau), M_dir), reach_rec[j] += std::min(std::abs(tau), M_rec), total[j] += std::abs(tau);
       }
   }
   for (int j = 0; j < 2; ++j) {
     model.reachable_share[j] = total[j] > 0 ? reach[j] / total[j] : 0;
+    model.reachable_share_recorded[j] = total[j] > 0 ? reach_rec[j] / total[j] : 0;
     std::vector<size_t> idx(meas[j].size());
     for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
     double rms;

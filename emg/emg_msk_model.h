@@ -8,8 +8,11 @@
 //              + beta_j q_j + gamma_j qd_j + offset_j
 //   a_c(t)   = the activation of emg_torque_model.h: A-shape (LB03 eq. 2) of the twitch-filtered
 //              envelope delayed by the electromechanical delay (one common A and delay here)
-//   l_c, v_c = fibre length and velocity of the rigid-tendon unit at the path length L_c(q) and its
-//              rate -sum_j r_c,j qd_j (sim/musculotendon.h RigidTendonState)
+//   l_c, v_c = fibre length and velocity of the unit along its path length L_c(q) (q: hip, knee and,
+//              for the gastrocnemius, the recording's ankle angle): with Thelen's elastic tendon in
+//              series (sim/musculotendon.h ElasticTendonSeries: the force above equals the tendon's,
+//              F_max f_T(strain), the fibre's dynamics by backward Euler on the samples); with a rigid
+//              tendon (models written before it) RigidTendonState at L_c and -sum_j r_c,j qd_j
 //
 // beta, gamma, offset carry what the recorded muscles do not (the muscles nobody recorded, passive
 // tissues): the terms of the linear form's remainder (HJ15 eq. 26).
@@ -50,6 +53,9 @@ struct EmgMskMuscle {
 
 struct EmgMskModel {
   bool present = false;
+  // Thelen's elastic tendon in series with the fibre (sim/musculotendon.h ElasticTendonSeries), or the
+  // rigid one (a file written before the elastic tendon: `tendon:` absent).
+  bool elastic_tendon = true;
   double delay = 0, twitch = 0, a_shape = 0;  // s, s, 1
   std::vector<EmgMskMuscle> muscles;
   double beta[2] = {0, 0}, gamma[2] = {0, 0}, offset[2] = {0, 0};
@@ -60,6 +66,9 @@ struct EmgMskModel {
   // scored samples of min(|tau|, M) / sum |tau|, M the moment of every muscle pulling in tau's
   // direction at full activation and kStrengthHi F_max (the others silent).
   double reachable_share[2] = {0, 0};
+  // The same at the recorded activations (the calibration's delay, twitch and shape): what the
+  // recorded muscles can reach as they were activated, every strength at its upper bound.
+  double reachable_share_recorded[2] = {0, 0};
   double seconds = 0;  // run time of the calibration (cross-validation included)
 };
 
@@ -77,6 +86,7 @@ EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec);
 struct EmgMskFitOptions {
   int blocks = 5;          // one recording: contiguous cross-validation blocks
   bool cross_validate = true;
+  bool elastic_tendon = true;  // EmgMskModel::elastic_tendon
   std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
 };
 

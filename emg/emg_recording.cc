@@ -107,10 +107,14 @@ MuscleMap ReadMuscleMap(const std::string& path) {
     }
   }
   if (const YAML::Node co = root["coordinates"]) {
-    YamlCheckKeys(c, co, "coordinates", {"hip", "knee"});
+    YamlCheckKeys(c, co, "coordinates", {"hip", "knee", "ankle"});
     for (const char* j : {"hip", "knee"}) {
       if (!co[j] || !co[j].IsScalar()) c.Fail(std::string("coordinates.") + j, "expected a coordinate name");
       (std::string(j) == "hip" ? m.hip_coordinate : m.knee_coordinate) = co[j].as<std::string>();
+    }
+    if (co["ankle"]) {
+      if (!co["ankle"].IsScalar()) c.Fail("coordinates.ankle", "expected a coordinate name" + YamlLine(co["ankle"]));
+      m.ankle_coordinate = co["ankle"].as<std::string>();
     }
   }
   return m;
@@ -163,8 +167,27 @@ EmgRecording ReadEmgRecording(const std::string& emg_path, const std::string& ki
   }
 
   // Kinematics on their own time base, derivatives there.
-  const MeasuredData md = KinematicsFromStorage(ReadStorage(kinematics_path), {hip_coord, knee_coord});
+  const StorageTable ik = ReadStorage(kinematics_path);
+  const MeasuredData md = KinematicsFromStorage(ik, {hip_coord, knee_coord});
   const Kinematics kin = DeriveKinematics(md);
+  // The ankle (the gastrocnemius' path): its rate derived as the hip's and the knee's.
+  const std::string ankle_coord = map.ankle_coordinate.empty() ? "ankle_angle" + side : map.ankle_coordinate;
+  std::vector<double> ankle, ankle_rate;
+  if (ik.Find(ankle_coord) >= 0) {
+    ankle = ik.AngleRad(ankle_coord);
+    for (size_t i = 0; i < ankle.size(); ++i)
+      if (!std::isfinite(ankle[i]) || std::abs(ankle[i]) > kMaxHumanJointAngle)
+        throw InputError(kinematics_path + ": line " + std::to_string(ik.line_of_row[i]) + ": angle " +
+                         NumberText(ankle[i]) + " rad in column '" + ankle_coord + "' (expected a finite human joint angle)");
+    const Sampling s = ExamineSampling(ik.Time(), kinematics_path);
+    constexpr double kCutoffHz = 20.0;  // DeriveKinematics' (HJ15 sec. 3.2)
+    ankle_rate = DeriveAngleRates(s, ik.Time(), ankle, kCutoffHz, kinematics_path).qd;
+  } else if (!map.ankle_coordinate.empty()) {
+    throw InputError(map.source + ": coordinates.ankle '" + ankle_coord + "' is not a column of " + kinematics_path);
+  } else {
+    r.notes.push_back("no " + ankle_coord + " in " + kinematics_path +
+                      ": the gastrocnemius path at ankle angle 0 (its length and fibre states approximate)");
+  }
 
   StorageTable id;
   if (!moments_path.empty()) id = ReadStorage(moments_path);
@@ -209,6 +232,7 @@ EmgRecording ReadEmgRecording(const std::string& emg_path, const std::string& ki
     r.q[j] = Interpolate(kin.t, kin.q[j], r.t);
     r.qd[j] = Interpolate(kin.t, kin.qd[j], r.t);
   }
+  if (!ankle.empty()) r.q_ankle = Interpolate(ik.Time(), ankle, r.t), r.qd_ankle = Interpolate(ik.Time(), ankle_rate, r.t);
   if (!moments_path.empty()) {
     const std::string name[2] = {hip_coord + "_moment", knee_coord + "_moment"};
     for (int j = 0; j < 2; ++j) {

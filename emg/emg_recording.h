@@ -23,6 +23,7 @@ struct MuscleMap {
   bool from_file = false;                         // every channel a file names must be recorded
   std::vector<std::pair<std::string, Muscle>> channels;  // channel name -> muscle, in map order
   std::string hip_coordinate, knee_coordinate;    // e.g. hip_flexion_r; empty: from the side
+  std::string ankle_coordinate;                   // e.g. ankle_angle_r; empty: ankle_angle_<side> if present
   // Strength bounds of the musculoskeletal form per channel (x F_max), narrowing the calibration's.
   std::map<std::string, std::array<double, 2>> strength_bounds;
 };
@@ -38,7 +39,7 @@ MuscleMap DefaultMuscleMap();
 //   muscles:                      # twin muscle -> EMG channel names (GMAX, VM, RF, ST, GAS)
 //     VM: [vas_med_r, vas_lat_r]
 //     RF: [rect_fem_r]
-//   coordinates: {hip: hip_flexion_r, knee: knee_angle_r}   # optional
+//   coordinates: {hip: hip_flexion_r, knee: knee_angle_r, ankle: ankle_angle_r}   # optional; ankle optional
 //   musculoskeletal:              # optional, per mapped channel (emg/emg_msk_model.h)
 //     rect_fem_r: {joints: [hip, knee], strength: [0.6, 1.4]}
 // `joints` must be the joints the channel's muscle path crosses (sim/muscles.h ActionSign: one force at
@@ -53,6 +54,9 @@ struct EmgRecording {
   std::vector<Muscle> muscle;               // the twin's muscle of each channel
   std::vector<std::vector<double>> e;       // envelope of each channel
   std::vector<double> q[2], qd[2];          // [0] hip, [1] knee: rad, rad/s
+  // Ankle angle (dorsiflexion positive, OpenSim's ankle_angle) and its rate, rad, rad/s: the
+  // gastrocnemius' path (sim/musculotendon.h); empty when the kinematics file has no ankle column.
+  std::vector<double> q_ankle, qd_ankle;
   std::vector<double> tau[2];               // N m; empty without a moments file
   std::vector<std::string> missing;         // twin muscles spanning hip or knee without a channel
   std::vector<std::string> notes;           // what was assumed (side, unused channels, trimmed ends)
@@ -62,7 +66,8 @@ struct EmgRecording {
 
 // Reads one recording. `moments_path` may be empty. The angles' velocities are derived as in Hwang &
 // Jeon sec. 3.2 (formats/measured_data.h DeriveKinematics: zero-phase 2nd-order Butterworth at
-// 20 Hz, central differences) on the kinematics file's own time base; angles, velocities and moments
+// 20 Hz, central differences) on the kinematics file's own time base (the ankle angle's, where the file
+// has it, alike); angles, velocities and moments
 // are interpolated linearly onto the EMG times inside the range every file covers.
 // Throws InputError (file, line or channel named) for: unreadable storage files, time bases that do
 // not overlap, a map naming a channel the EMG file lacks (map from a file), no mapped channel at

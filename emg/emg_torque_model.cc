@@ -557,12 +557,14 @@ std::string EmgMskYaml(const EmgTorqueModel& em) {
   std::ostringstream o;
   auto num = [](double v) { return NumberText(v, 17); };  // read back exactly (the state ranges' ends)
   auto form = [&](int j) { return em.msk_form[j] ? "musculoskeletal" : "linear"; };
-  o << "# The musculoskeletal form (emg/emg_msk_model.h): per channel one Hill unit (Thelen 2003 curves, rigid\n"
-       "# tendon) on a gait2392 path (Delp et al. 1990), force s F_max (a f_L f_V + f_PE) cos(phi) acting at every\n"
-       "# joint the path crosses with its moment arm -dL/dq; plus beta q + gamma qd + offset per joint. Bounds of\n"
-       "# CEINMS-RT's calibration (strength 0.5-1.5, l_ts +-5 %, l_opt +-2.5 % of the scaled gait2392 values).\n";
+  o << "# The musculoskeletal form (emg/emg_msk_model.h): per channel one Hill unit (Thelen 2003 curves, its\n"
+       "# tendon as `tendon` says) on a gait2392 path (Delp et al. 1990; hip, knee and the recording's ankle),\n"
+       "# force s F_max (a f_L f_V + f_PE) cos(phi) acting at every joint the path crosses with its moment arm\n"
+       "# -dL/dq; plus beta q + gamma qd + offset per joint. Bounds of CEINMS-RT's calibration (strength\n"
+       "# 0.5-1.5, l_ts +-5 %, l_opt +-2.5 % of the scaled gait2392 values).\n";
   o << "forms: {hip: " << form(0) << ", knee: " << form(1) << "}\n";
   o << "musculoskeletal:\n";
+  o << "  tendon: " << (m.elastic_tendon ? "elastic" : "rigid") << "   # elastic: Thelen 2003's f_T in series\n";
   o << "  activation: {delay: {value: " << num(m.delay) << ", bounds: [0.01, 0.1], unit: s, source: \"Cavanagh & Komi 1979\"}, "
     << "twitch: {value: " << num(m.twitch) << ", unit: s, source: \"the linear loop's twitch\"}, A_shape: {value: "
     << num(m.a_shape) << ", bounds: [-3, 0], unit: \"1\", source: \"LB03 eq. 2; CEINMS-RT bounds\"}}\n";
@@ -572,6 +574,8 @@ std::string EmgMskYaml(const EmgTorqueModel& em) {
       << num(m.offset[j]) << ", units: [\"N m/rad\", \"N m s/rad\", \"N m\"]}\n";
   o << "  reachable_share: {hip: " << NumberText(m.reachable_share[0], 4) << ", knee: " << NumberText(m.reachable_share[1], 4)
     << "}\n";
+  o << "  reachable_share_recorded: {hip: " << NumberText(m.reachable_share_recorded[0], 4)
+    << ", knee: " << NumberText(m.reachable_share_recorded[1], 4) << "}\n";
   o << "  fit: {hip: {r2_cv: " << NumberText(m.r2_cv[0], 4) << ", rms_cv: " << NumberText(m.rms_cv[0], 4) << ", r2_fit: "
     << NumberText(m.r2_fit[0], 4) << "}, knee: {r2_cv: " << NumberText(m.r2_cv[1], 4) << ", rms_cv: "
     << NumberText(m.rms_cv[1], 4) << ", r2_fit: " << NumberText(m.r2_fit[1], 4) << "}}\n";
@@ -610,6 +614,12 @@ void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em
     em->msk_form[j] = v.as<std::string>() == "musculoskeletal";
   }
   EmgMskModel& m = em->msk;
+  m.elastic_tendon = false;  // files written before the elastic tendon
+  if (const YAML::Node td = k["tendon"]) {
+    if (!td.IsScalar() || (td.as<std::string>() != "elastic" && td.as<std::string>() != "rigid"))
+      c.Fail("musculoskeletal.tendon", "expected elastic or rigid" + YamlLine(td));
+    m.elastic_tendon = td.as<std::string>() == "elastic";
+  }
   const YAML::Node a = k["activation"];
   m.delay = YamlNumber(c, a["delay"]["value"], "musculoskeletal.activation.delay.value", 0.01, 0.1, "s");
   m.twitch = YamlNumber(c, a["twitch"]["value"], "musculoskeletal.activation.twitch.value", 0, 1, "s");
@@ -621,6 +631,9 @@ void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em
     m.gamma[j] = YamlNumber(c, r["gamma"], key + ".gamma", -1e6, 1e6, "N m s/rad");
     m.offset[j] = YamlNumber(c, r["offset"], key + ".offset", -1e6, 1e6, "N m");
     if (k["reachable_share"]) m.reachable_share[j] = YamlNumber(c, k["reachable_share"][kJointName[j]], "musculoskeletal.reachable_share." + std::string(kJointName[j]), 0, 1, "");
+    if (k["reachable_share_recorded"])
+      m.reachable_share_recorded[j] = YamlNumber(c, k["reachable_share_recorded"][kJointName[j]],
+                                                 "musculoskeletal.reachable_share_recorded." + std::string(kJointName[j]), 0, 1, "");
   }
   const YAML::Node ms = k["muscles"];
   if (!ms || !ms.IsSequence() || ms.size() == 0) c.Fail("musculoskeletal.muscles", "expected a list of muscles" + YamlLine(ms));

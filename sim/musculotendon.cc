@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace exotwin {
 namespace {
@@ -80,6 +81,9 @@ const NaturalSpline& KneeTy() {
 // Calcaneus origin in the tibia frame (ankle and subtalar at 0): talus at (0, -0.483203, 0), calcn
 // at (-0.0620508, -0.0531864, 0.0101307) in the talus.
 const Vec3 kCalcnInTibia(-0.0620508, -0.483203 - 0.0531864, 0.0101307);
+// gait2392's ankle_r (talocrural) axis, in the tibia frame (its joint frame at orientation 0): the
+// talus turns about it by ankle_angle_r, dorsiflexion positive.
+const Vec3 kAnkleAxis(-0.10501355, -0.17402245, 0.97912632);
 
 const std::vector<double>& PatellaKnots() {
   static const std::vector<double> k = {-2.0944, -1.99997, -1.5708, -1.45752, -1.39626, -1.0472,
@@ -142,15 +146,16 @@ Eigen::Matrix3d Rz(double a) {
 // 0.43 m below the tibia, subtalar 0.04877 m): pelvis, femur, tibia, calcaneus.
 constexpr double kBodyScale[4] = {1.04599, 1.17378, 1.12373, 1.27231};
 
-// Path length at (qh, qk) with the conditional points chosen at qk_active; `generic`: every point
+// Path length at (qh, qk, qa) with the conditional points chosen at qk_active; `generic`: every point
 // and joint offset divided by its body's scale (the generic gait2392 leg).
-double PathLength(Muscle m, double qh, double qk, double qk_active, bool generic = false) {
+double PathLength(Muscle m, double qh, double qk, double qk_active, bool generic = false, double qa = 0) {
   const Eigen::Matrix3d Rh = Rz(qh), Rk = Rz(qk);
+  const Eigen::Matrix3d Ra = Eigen::AngleAxisd(qa, kAnkleAxis.normalized()).toRotationMatrix();
   auto sc = [generic](Body b) { return generic ? 1 / kBodyScale[static_cast<int>(b)] : 1.0; };
   const Vec3 knee = Vec3(KneeTx()(qk), KneeTy()(qk), 0) * sc(Body::kFemur);
   const Vec3 hip = kHip * sc(Body::kPelvis);
   const Vec3 talus(0, -0.483203 * sc(Body::kTibia), 0);
-  const Vec3 calcn = talus + (kCalcnInTibia - Vec3(0, -0.483203, 0)) * sc(Body::kCalcn);
+  const Vec3 calcn_in_talus = (kCalcnInTibia - Vec3(0, -0.483203, 0)) * sc(Body::kCalcn);
   auto in_pelvis = [&](const PathPoint& pp) -> Vec3 {
     Vec3 p = pp.p;
     if (pp.mx) p.x() = (*pp.mx)(qk), p.y() = (*pp.my)(qk);
@@ -159,7 +164,7 @@ double PathLength(Muscle m, double qh, double qk, double qk_active, bool generic
       case Body::kPelvis: return p;
       case Body::kFemur: return hip + Rh * p;
       case Body::kTibia: return hip + Rh * (knee + Rk * p);
-      case Body::kCalcn: return hip + Rh * (knee + Rk * (calcn + p));
+      case Body::kCalcn: return hip + Rh * (knee + Rk * (talus + Ra * (calcn_in_talus + p)));
     }
     return p;
   };
@@ -252,16 +257,24 @@ std::string MusculotendonPathSource(Muscle m) {
   return "";
 }
 
-MtuKinematics MusculotendonKinematics(Muscle m, double q_hip, double q_knee) {
+bool CrossesAnkle(Muscle m) { return m == Muscle::kGAS; }
+
+MtuKinematics MusculotendonKinematics(Muscle m, double q_hip, double q_knee, double q_ankle) {
   MtuKinematics k;
-  k.length = PathLength(m, q_hip, q_knee, q_knee);
+  const bool ankle = CrossesAnkle(m);
+  const double qa = ankle ? q_ankle : 0;
+  k.length = PathLength(m, q_hip, q_knee, q_knee, false, qa);
   constexpr double h = 1e-5;  // rad: central differences of a smooth path (via points fixed at q)
   for (int j = 0; j < 2; ++j) {
     if (ActionSign(m, j) == 0) continue;
     const double dh = j == 0 ? h : 0, dk = j == 1 ? h : 0;
-    k.arm[j] = -(PathLength(m, q_hip + dh, q_knee + dk, q_knee) - PathLength(m, q_hip - dh, q_knee - dk, q_knee)) /
+    k.arm[j] = -(PathLength(m, q_hip + dh, q_knee + dk, q_knee, false, qa) -
+                 PathLength(m, q_hip - dh, q_knee - dk, q_knee, false, qa)) /
                (2 * h);
   }
+  if (ankle)
+    k.arm_ankle = -(PathLength(m, q_hip, q_knee, q_knee, false, qa + h) - PathLength(m, q_hip, q_knee, q_knee, false, qa - h)) /
+                  (2 * h);
   return k;
 }
 
@@ -298,6 +311,83 @@ HillState RigidTendonState(const MusculotendonParams& p, double L, double Ldot) 
   s.active = ActiveForceLength(s.fibre_length) * ForceVelocity(s.fibre_velocity) * s.cos_pennation;
   s.passive = PassiveForceLength(s.fibre_length) * s.cos_pennation;
   return s;
+}
+
+namespace {
+
+// The elastic unit's balance at normalized fibre length l (ElasticTendonSeries): g(l) = fibre force -
+// tendon force (per F_max) and dg/dl, the fibre velocity (l - l_prev) rate (normalized: rate = 1 /
+// (v_max dt), 0 for the static equilibrium).
+struct Balance {
+  const MusculotendonParams& p;
+  double h, L, a, l_prev, rate;
+  double v(double l) const { return (l - l_prev) * rate; }
+  double Along(double l) const {
+    const double lm = l * p.l_opt;
+    return std::sqrt(std::max(lm * lm - h * h, 1e-30));
+  }
+  double Strain(double l) const { return (L - Along(l) - p.l_ts) / p.l_ts; }
+  // g and its derivative (Thelen 2003's curves and their closed-form slopes).
+  double operator()(double l, double* dg) const {
+    constexpr double kPE = 5.0, e0 = 0.6, Af = 0.25, Flen = 1.8, c = (2 + 2 / Af) / (Flen - 1);
+    constexpr double e0T = 0.04, k_toe = 3, F_toe = 0.33, e_toe = 0.609 * e0T, k_lin = 1.712 / e0T;
+    const double lm = l * p.l_opt, along = Along(l), cp = along / lm;
+    const double fL = ActiveForceLength(l), dfL = fL * (-2 * (l - 1) / 0.45);
+    const double fPE = PassiveForceLength(l), dfPE = l > 1 ? kPE / e0 * std::exp(kPE * (l - 1) / e0) / std::expm1(kPE) : 0;
+    const double vel = v(l), fV = ForceVelocity(vel);
+    const double dfV = vel <= -1 ? 0 : vel <= 0 ? (1 + 1 / Af) / ((1 - vel / Af) * (1 - vel / Af))
+                                                : c * (Flen - 1) / ((1 + c * vel) * (1 + c * vel));
+    const double e = (L - along - p.l_ts) / p.l_ts;
+    const double fT = TendonForceStrain(e);
+    const double dfT = e <= 0 ? 0 : e <= e_toe ? F_toe * k_toe / e_toe * std::exp(k_toe * e / e_toe) / std::expm1(k_toe) : k_lin;
+    const double dcp = h * h / (along * lm * lm) * p.l_opt;  // d cos(phi) / dl
+    const double de = -(lm / along) * p.l_opt / p.l_ts;      // d strain / dl
+    const double fm = a * fL * fV + fPE;
+    *dg = (a * (dfL * fV + fL * dfV * rate) + dfPE) * cp + fm * dcp - dfT * de;
+    return fm * cp - fT;
+  }
+};
+
+// The root of Balance b on [lo, hi] (g(lo) < 0 < g(hi) checked here), Newton from `start` kept inside
+// the bracket, bisection where Newton leaves it.
+double SolveBalance(const Balance& b, double start) {
+  const double h_norm = b.h / b.p.l_opt;
+  double lo = std::max(h_norm * (1 + 1e-9), 0.05);
+  double hi = std::sqrt(std::pow(std::max(b.L - b.p.l_ts, 1e-6), 2) + b.h * b.h) / b.p.l_opt;  // the tendon at slack
+  if (hi <= lo) return hi;
+  double d;
+  if (b(hi, &d) <= 0) return hi;  // no fibre force at the tendon's slack length: slack
+  if (b(lo, &d) >= 0) return lo;
+  double x = std::clamp(start, lo, hi);
+  for (int it = 0; it < 100; ++it) {
+    const double g = b(x, &d);
+    if (g == 0) return x;
+    (g < 0 ? lo : hi) = x;
+    double nx = d > 0 ? x - g / d : 0.5 * (lo + hi);
+    if (!(nx > lo && nx < hi)) nx = 0.5 * (lo + hi);
+    if (std::abs(nx - x) < 1e-12 || hi - lo < 1e-12) return nx;
+    x = nx;
+  }
+  return x;
+}
+
+}  // namespace
+
+void ElasticTendonSeries(const MusculotendonParams& p, const std::vector<double>& t, const std::vector<double>& L,
+                         const std::vector<double>& a, TendonSeries* out) {
+  const size_t n = t.size();
+  out->fibre_length.assign(n, 0.0), out->fibre_velocity.assign(n, 0.0), out->force.assign(n, 0.0);
+  const double h = p.l_opt * std::sin(p.pennation);
+  double l_prev = 1;
+  for (size_t i = 0; i < n; ++i) {
+    const double rate = i == 0 ? 0.0 : 1 / (kMaxShorteningVelocity * (t[i] - t[i - 1]));
+    const Balance b{p, h, L[i], a[i], l_prev, rate};
+    const double l = SolveBalance(b, i == 0 ? std::sqrt(std::pow(std::max(L[i] - p.l_ts, 1e-6), 2) + h * h) / p.l_opt : l_prev);
+    out->fibre_length[i] = l;
+    out->fibre_velocity[i] = b.v(l);
+    out->force[i] = TendonForceStrain(b.Strain(l));
+    l_prev = l;
+  }
 }
 
 double ElasticEquilibriumFibreLength(const MusculotendonParams& p, double L, double a) {

@@ -8,7 +8,9 @@
 // Path points, via points active only over a range of the knee angle (OpenSim ConditionalPathPoint)
 // and moving points (MovingPathPoint, natural cubic splines of the knee angle as OpenSim's
 // SimmSpline) are taken as published; the hip rotates about the pelvis z axis (hip_flexion), the
-// knee about the femur z axis with the translations (knee_angle), ankle and subtalar at 0. Each of
+// knee about the femur z axis with the translations (knee_angle), the talus about gait2392's oblique
+// ankle axis (-0.10501355, -0.17402245, 0.97912632) in the tibia (ankle_angle, dorsiflexion positive;
+// the gastrocnemius inserts on the calcaneus), subtalar at 0. Each of
 // the twin's muscles (sim/muscles.h) has the path of one gait2392 actuator:
 //   RF rect_fem; VM vas_int (Visser et al. 1990, Eur J Appl Physiol 61:453: the length changes of
 //   the vastus lateralis and medialis heads adjacent to the intermedius follow it); ST bifemlh (the
@@ -36,12 +38,14 @@
 //                        k_lin (e - e_toe) + F_toe above; e0_T = 0.04 (f_T(e0_T) ~ 1), k_toe = 3,
 //                        F_toe = 0.33, e_toe = 0.609 e0_T, k_lin = 1.712 / e0_T       (Thelen eq. 1)
 //   force along the tendon F = F_max (a f_L f_V + f_PE) cos(phi).
-// Tendon: rigid (l_m cos(phi) = L - l_ts). Against Thelen's elastic tendon in static equilibrium at
-// activation 0.2 over the angles of walking (tests/sim/musculotendon_test.cc TendonStretch...) the
-// force differs by up to 5 % for the vasti but 11-24 % for the long-tendon muscles (RF, hamstrings,
-// gastrocnemius) at the ends of the range: a limitation of this form, not a negligible choice.
+// Tendon: rigid (l_m cos(phi) = L - l_ts; RigidTendonState) or elastic (Thelen's f_T in series with
+// the fibre; ElasticTendonSeries). Against the elastic tendon in static equilibrium at activation 0.2
+// over the angles of walking (tests/sim/musculotendon_test.cc TendonStretch...) the rigid one's force
+// differs by up to 5 % for the vasti but 11-24 % for the long-tendon muscles (RF, hamstrings,
+// gastrocnemius) at the ends of the range: the EMG form takes the elastic tendon.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "sim/muscles.h"
 
@@ -71,12 +75,16 @@ MusculotendonParams GenericMusculotendon(Muscle m);
 // OpenSim's scale tool scales them (Delp et al. 2007).
 MusculotendonParams ScaledMusculotendon(Muscle m, const MusculotendonParams& generic);
 
-// Length and moment arms of twin muscle m's path at (q_hip, q_knee).
+// Length and moment arms of twin muscle m's path at (q_hip, q_knee, q_ankle) (rad; q_ankle
+// dorsiflexion positive, 0 where the recording has no ankle angle).
 struct MtuKinematics {
   double length = 0;         // m
   double arm[2] = {0, 0};    // -dL/dq at the hip and the knee, m (0 where the path spans neither)
+  double arm_ankle = 0;      // -dL/dq_ankle, m (the gastrocnemius: negative, a plantar flexor; else 0)
 };
-MtuKinematics MusculotendonKinematics(Muscle m, double q_hip, double q_knee);
+MtuKinematics MusculotendonKinematics(Muscle m, double q_hip, double q_knee, double q_ankle = 0);
+// True when m's path crosses the ankle (GAS).
+bool CrossesAnkle(Muscle m);
 // "gait2392 rect_fem (Delp et al. 1990)", ...
 std::string MusculotendonPathSource(Muscle m);
 
@@ -98,6 +106,23 @@ struct HillState {
 // The rigid-tendon state at muscle-tendon length L (m) and lengthening velocity Ldot (m/s); the force is
 // F_max (a active + passive).
 HillState RigidTendonState(const MusculotendonParams& p, double L, double Ldot);
+
+// States of an elastic-tendon Hill unit along a series (times t, s; path lengths L, m; activations a):
+// Thelen 2003's fibre dynamics dl_m/dt = v_max l_opt f_V^-1(...) solved by backward Euler, i.e. at
+// every sample the fibre length l_i at which the fibre's force at the velocity (l_i - l_{i-1}) / dt_i
+// balances the tendon's:
+//   (a f_L(l_i) f_V(v_i) + f_PE(l_i)) cos(phi_i) = f_T((L_i - l_m,i cos(phi_i) - l_ts) / l_ts)
+// (per F_max on both sides: the state does not depend on F_max or a strength scaling it, CEINMS's
+// convention). The first sample starts at the static equilibrium (ElasticEquilibriumFibreLength);
+// a slack tendon (its force 0) leaves the fibre at the path's rigid length. Safeguarded Newton on a
+// bracket, to 1e-12 l_opt.
+struct TendonSeries {
+  std::vector<double> fibre_length;    // normalized by l_opt
+  std::vector<double> fibre_velocity;  // normalized by v_max, lengthening positive
+  std::vector<double> force;           // tendon force per F_max (the unit's force is F_max force)
+};
+void ElasticTendonSeries(const MusculotendonParams& p, const std::vector<double>& t, const std::vector<double>& L,
+                         const std::vector<double>& a, TendonSeries* out);
 
 // The fibre length (normalized) of the elastic-tendon static equilibrium at activation a:
 // F_max (a f_L + f_PE) cos(phi) = F_max f_T((L - l_m cos(phi) - l_ts) / l_ts), solved by bisection

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -201,6 +202,8 @@ TEST(EmgMskModel, MapFileBoundsAndJointsAreChecked) {
       {"  rect_fem_r: {strength: [1.0, 4.0]}\n", "musculoskeletal.rect_fem_r.strength[1]"},
       {"  soleus_r: {joints: [knee]}\n", "musculoskeletal.soleus_r"},                     // not mapped
       {"  vas_lat_r: {joints: [ankle]}\n", "musculoskeletal.vas_lat_r.joints"},
+      {"  vas_lat_r: {joints: [knee]}\ncoordinates: {hip: hip_flexion_r, knee: knee_angle_r, ankle: [a]}\n",
+       "coordinates.ankle"},
   };
   for (const auto& b : bad) {
     WriteText(path, head + "musculoskeletal:\n" + b.first);
@@ -238,15 +241,22 @@ const std::string kDir = std::string(EXOTWIN_SOURCE_DIR) + "/../shared/data/real
 TEST(EmgMskModel, DevelopmentTrialStaysInsideTheBounds) {
   if (!std::ifstream(kDir + "/emgFilt.sto")) GTEST_SKIP() << "shared/data not beside the project";
   const EmgRecording r = ReadEmgRecording(kDir + "/emgFilt.sto", kDir + "/ik.sto", kDir + "/id.sto", DefaultMuscleMap());
+  // The ankle angle is read (ankle_angle_r: -15.0 .. 13.1 deg in the file).
+  ASSERT_EQ(r.q_ankle.size(), r.size());
+  const auto ar = std::minmax_element(r.q_ankle.begin(), r.q_ankle.end());
+  EXPECT_NEAR(*ar.first * 180 / M_PI, -15.02, 0.05);
+  EXPECT_NEAR(*ar.second * 180 / M_PI, 13.14, 0.05);
   const EmgMskModel m = FitEmgMsk({&r}, 0.065);  // the twitch emg-fit's loop names on this trial
+  EXPECT_TRUE(m.elastic_tendon);
   std::printf("delay %.3f A %.2f\n", m.delay, m.a_shape);
   for (const EmgMskMuscle& x : m.muscles)
     std::printf("%-10s strength %.3f l_ts %.4f (nom %.4f) l_opt %.4f (nom %.4f) fibre %.2f..%.2f v %.3f..%.3f\n",
                 x.channel.c_str(), x.strength, x.l_ts, x.nominal.l_ts, x.l_opt, x.nominal.l_opt, x.fibre_lo, x.fibre_hi,
                 x.velocity_lo, x.velocity_hi);
   for (int j = 0; j < 2; ++j)
-    std::printf("%s: r2_cv %.3f rms_cv %.2f r2_fit %.3f reachable %.3f beta %.2f gamma %.2f offset %.2f\n", j ? "knee" : "hip",
-                m.r2_cv[j], m.rms_cv[j], m.r2_fit[j], m.reachable_share[j], m.beta[j], m.gamma[j], m.offset[j]);
+    std::printf("%s: r2_cv %.3f rms_cv %.2f r2_fit %.3f reachable %.3f (recorded activation %.3f) beta %.2f gamma %.2f "
+                "offset %.2f\n", j ? "knee" : "hip", m.r2_cv[j], m.rms_cv[j], m.r2_fit[j], m.reachable_share[j],
+                m.reachable_share_recorded[j], m.beta[j], m.gamma[j], m.offset[j]);
   EXPECT_GE(m.delay, 0.01);
   EXPECT_LE(m.delay, 0.1);
   EXPECT_GT(m.a_shape, -3.0);
@@ -263,6 +273,9 @@ TEST(EmgMskModel, DevelopmentTrialStaysInsideTheBounds) {
     EXPECT_GT(m.r2_cv[j], 0.6);
     EXPECT_GT(m.reachable_share[j], 0.0);
     EXPECT_LE(m.reachable_share[j], 1.0);
+    // Activated as recorded the muscles reach less than fully activated (activation <= 1).
+    EXPECT_GT(m.reachable_share_recorded[j], 0.0);
+    EXPECT_LE(m.reachable_share_recorded[j], m.reachable_share[j] + 1e-12);
     for (char o : s.outside[j]) EXPECT_FALSE(o);  // the calibration's own samples are inside
   }
 }

@@ -60,6 +60,9 @@ inline EmgRecording GaitEnvelopesAndAngles(NormalRng<NormalPolar>& rng, const st
     r.qd[0].push_back(0.35 * qa[k] * w * std::cos(w * t));
     r.q[1].push_back(-0.65 - 0.45 * qa[k] * std::sin(w * t + 1.2));
     r.qd[1].push_back(-0.45 * qa[k] * w * std::cos(w * t + 1.2));
+    // The ankle (the gastrocnemius' path): -10..+16 deg, as in walking.
+    r.q_ankle.push_back(0.05 + 0.18 * qa[k] * std::sin(w * t - 0.6));
+    r.qd_ankle.push_back(0.18 * qa[k] * w * std::cos(w * t - 0.6));
   }
   return r;
 }

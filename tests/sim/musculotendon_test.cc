@@ -179,5 +179,95 @@ TEST(Musculotendon, TendonStretchAtWalkingActivations) {
   }
 }
 
+// The gastrocnemius' ankle moment arm from the virtual work (-dL/dq_ankle) equals the geometric lever
+// arm about gait2392's oblique ankle axis: axis . ((P - C) x u), P the calcaneal insertion, C the talus
+// origin (on the axis), u the unit vector from P toward the femoral point before it, all in the tibia
+// frame from the model's published points; and the arm lies in published ranges (Maganaris et al.
+// 1998, J Physiol 510:977: Achilles tendon moment arm ~ 4-6 cm in walking's range).
+TEST(Musculotendon, AnkleMomentArmIsTheGeometricLeverArm) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(-0.10501355, -0.17402245, 0.97912632).normalized();
+  const Eigen::Vector3d talus(0, -0.483203, 0), calcn_in_talus(-0.0620508, -0.0531864, 0.0101307),
+      insertion_in_calcn(0, 0.0318348, -0.00544272), femoral(-0.0352134, -0.472094, -0.0302835);
+  const double qk = -0.349066;  // a knot of both knee translation splines; the femoral via point active
+  const Eigen::Vector3d knee(-0.00117378, -0.466695, 0);
+  const double c = std::cos(qk), s = std::sin(qk);
+  Eigen::Matrix3d Rk;
+  Rk << c, -s, 0, s, c, 0, 0, 0, 1;
+  const Eigen::Vector3d femoral_in_tibia = Rk.transpose() * (femoral - knee);
+  for (double qa_deg : {-15.0, 0.0, 10.0, 20.0}) {
+    const double qa = qa_deg * kDeg;
+    const Eigen::Vector3d P = talus + Eigen::AngleAxisd(qa, axis) * (calcn_in_talus + insertion_in_calcn);
+    const Eigen::Vector3d u = (femoral_in_tibia - P).normalized();
+    const double lever = axis.dot((P - talus).cross(u));
+    const MtuKinematics k = MusculotendonKinematics(Muscle::kGAS, 0.1, qk, qa);
+    std::printf("ankle %5.1f deg: gastrocnemius arm %.2f mm (lever %.2f mm), length %.1f mm\n", qa_deg,
+                1e3 * k.arm_ankle, 1e3 * lever, 1e3 * k.length);
+    EXPECT_NEAR(k.arm_ankle, lever, 1e-6) << qa_deg;
+    EXPECT_LT(k.arm_ankle, -0.035) << "a plantar flexor";
+    EXPECT_GT(k.arm_ankle, -0.065);
+    // Dorsiflexion lengthens it; the hip does not move a path that starts on the femur.
+    EXPECT_GT(k.length, MusculotendonKinematics(Muscle::kGAS, 0.1, qk, qa - 0.05).length);
+    EXPECT_EQ(k.arm[0], 0.0);
+  }
+  // Paths that do not reach the foot ignore the ankle.
+  for (Muscle m : {Muscle::kRF, Muscle::kVM, Muscle::kST, Muscle::kGMAX}) {
+    EXPECT_FALSE(CrossesAnkle(m));
+    EXPECT_EQ(MusculotendonKinematics(m, 0.2, -0.5, 0.3).length, MusculotendonKinematics(m, 0.2, -0.5, 0).length);
+    EXPECT_EQ(MusculotendonKinematics(m, 0.2, -0.5, 0.3).arm_ankle, 0.0);
+  }
+}
+
+// The elastic unit's series against independent references: (1) driven slowly (a path stretched over
+// 20 s at a fixed activation) it stays in the static equilibrium that ElasticEquilibriumFibreLength
+// finds by bisection; (2) at every sample the fibre's force at the series' velocity balances the
+// tendon's (the backward-Euler step it solves); (3) at gait's speeds (a 1 Hz stretch with a varying
+// activation) its 100 Hz solution converges to the 10 kHz one: the force within 2 % of the peak.
+TEST(Musculotendon, ElasticTendonSeriesIsTheFibreDynamics) {
+  for (Muscle m : {Muscle::kVM, Muscle::kGAS}) {
+    const MusculotendonParams p = ScaledMusculotendon(m, GenericMusculotendon(m));
+    const double L0 = MusculotendonKinematics(m, 0.1, -0.3).length, dL = 0.25 * p.l_opt;
+    {
+      std::vector<double> t, L, a;
+      for (int i = 0; i <= 2000; ++i) t.push_back(0.01 * i), L.push_back(L0 - dL + 2 * dL * i / 2000.0), a.push_back(0.3);
+      TendonSeries s;
+      ElasticTendonSeries(p, t, L, a, &s);
+      double worst = 0, balance = 0;
+      const double h = p.l_opt * std::sin(p.pennation);
+      for (size_t i = 1; i < t.size(); i += 50) {
+        worst = std::max(worst, std::abs(s.fibre_length[i] - ElasticEquilibriumFibreLength(p, L[i], a[i])));
+        const double lm = s.fibre_length[i] * p.l_opt, cp = std::sqrt(lm * lm - h * h) / lm;
+        const double fm = (a[i] * ActiveForceLength(s.fibre_length[i]) * ForceVelocity(s.fibre_velocity[i]) +
+                           PassiveForceLength(s.fibre_length[i])) * cp;
+        balance = std::max(balance, std::abs(fm - s.force[i]));
+        EXPECT_NEAR(s.fibre_velocity[i], (s.fibre_length[i] - s.fibre_length[i - 1]) / (0.01 * kMaxShorteningVelocity), 1e-12);
+      }
+      std::printf("%s slow stretch: fibre off the static equilibrium by at most %.2e l_opt, balance %.1e\n",
+                  MuscleName(m), worst, balance);
+      EXPECT_LT(worst, 2e-3);
+      EXPECT_LT(balance, 1e-9);
+    }
+    auto drive = [&](double fs, TendonSeries* s, std::vector<double>* t) {
+      std::vector<double> L, a;
+      for (int i = 0; i <= static_cast<int>(2 * fs); ++i) {
+        const double x = i / fs;
+        t->push_back(x), L.push_back(L0 + dL * std::sin(2 * M_PI * x)), a.push_back(0.3 + 0.25 * std::sin(2 * M_PI * x + 1.0));
+      }
+      ElasticTendonSeries(p, *t, L, a, s);
+    };
+    TendonSeries coarse, fine;
+    std::vector<double> tc, tf;
+    drive(100, &coarse, &tc);
+    drive(10000, &fine, &tf);
+    double peak = 0, worst = 0;
+    for (size_t i = 100; i < tc.size(); ++i) {  // after the first second (the start's transient)
+      const double ref = fine.force[i * 100];
+      peak = std::max(peak, std::abs(ref)), worst = std::max(worst, std::abs(coarse.force[i] - ref));
+    }
+    std::printf("%s 1 Hz stretch: force at 100 Hz off the 10 kHz solution by %.2f %% of its peak %.3f F_max\n",
+                MuscleName(m), 100 * worst / peak, peak);
+    EXPECT_LT(worst, 0.02 * peak) << MuscleName(m);
+  }
+}
+
 }  // namespace
 }  // namespace exotwin
