@@ -96,9 +96,11 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
                   msk.r2_cv[1], "-", "-", msk.rms_cv[0], msk.rms_cv[1]);
       for (int j = 0; j < 2; ++j)
         std::printf("%s: %s form chosen (cross-validated R^2 linear %.3f, musculoskeletal %.3f); the recorded muscles can "
-                    "reach %.1f %% of the calibration moment (full activation, largest strength %.1f F_max)\n",
+                    "reach %.1f %% of the calibration moment at full activation, %.1f %% at their recorded activation "
+                    "(largest strength %.1f F_max)\n",
                     jn[j], d.calibration.msk_form[j] ? "musculoskeletal" : "linear", d.calibration.figures[j].r2_cv,
-                    msk.r2_cv[j], 100 * msk.reachable_share[j], kStrengthHi);  // the map may narrow it per channel
+                    msk.r2_cv[j], 100 * msk.reachable_share[j], 100 * msk.reachable_share_recorded[j],
+                    kStrengthHi);  // the map may narrow it per channel
     }
     for (int j = 0; j < 2; ++j)
       std::printf("%s: the estimate holds all but %g %% of its variance below %.1f Hz; the measured moment has %.1f %% of "

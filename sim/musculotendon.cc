@@ -327,19 +327,30 @@ struct Balance {
     return std::sqrt(std::max(lm * lm - h * h, 1e-30));
   }
   double Strain(double l) const { return (L - Along(l) - p.l_ts) / p.l_ts; }
-  // g and its derivative (Thelen 2003's curves and their closed-form slopes).
+  // g and its derivative (Thelen 2003's curves, as ActiveForceLength, PassiveForceLength,
+  // ForceVelocity and TendonForceStrain compute them, and their closed-form slopes).
   double operator()(double l, double* dg) const {
     constexpr double kPE = 5.0, e0 = 0.6, Af = 0.25, Flen = 1.8, c = (2 + 2 / Af) / (Flen - 1);
     constexpr double e0T = 0.04, k_toe = 3, F_toe = 0.33, e_toe = 0.609 * e0T, k_lin = 1.712 / e0T;
+    static const double kExpPE = std::expm1(kPE), kExpToe = std::expm1(k_toe);
     const double lm = l * p.l_opt, along = Along(l), cp = along / lm;
-    const double fL = ActiveForceLength(l), dfL = fL * (-2 * (l - 1) / 0.45);
-    const double fPE = PassiveForceLength(l), dfPE = l > 1 ? kPE / e0 * std::exp(kPE * (l - 1) / e0) / std::expm1(kPE) : 0;
+    const double fL = std::exp(-(l - 1) * (l - 1) / 0.45), dfL = fL * (-2 * (l - 1) / 0.45);
+    double fPE = 0, dfPE = 0;
+    if (l > 1) {
+      const double E = std::exp(kPE * (l - 1) / e0);
+      fPE = (E - 1) / kExpPE, dfPE = kPE / e0 * E / kExpPE;
+    }
     const double vel = v(l), fV = ForceVelocity(vel);
     const double dfV = vel <= -1 ? 0 : vel <= 0 ? (1 + 1 / Af) / ((1 - vel / Af) * (1 - vel / Af))
                                                 : c * (Flen - 1) / ((1 + c * vel) * (1 + c * vel));
     const double e = (L - along - p.l_ts) / p.l_ts;
-    const double fT = TendonForceStrain(e);
-    const double dfT = e <= 0 ? 0 : e <= e_toe ? F_toe * k_toe / e_toe * std::exp(k_toe * e / e_toe) / std::expm1(k_toe) : k_lin;
+    double fT = 0, dfT = 0;
+    if (e > e_toe) {
+      fT = k_lin * (e - e_toe) + F_toe, dfT = k_lin;
+    } else if (e > 0) {
+      const double E = std::exp(k_toe * e / e_toe);
+      fT = F_toe * (E - 1) / kExpToe, dfT = F_toe * k_toe / e_toe * E / kExpToe;
+    }
     const double dcp = h * h / (along * lm * lm) * p.l_opt;  // d cos(phi) / dl
     const double de = -(lm / along) * p.l_opt / p.l_ts;      // d strain / dl
     const double fm = a * fL * fV + fPE;
@@ -348,24 +359,36 @@ struct Balance {
   }
 };
 
-// The root of Balance b on [lo, hi] (g(lo) < 0 < g(hi) checked here), Newton from `start` kept inside
-// the bracket, bisection where Newton leaves it.
+// The root of Balance b on [lo, hi], lo the shortest fibre the pennation allows (or 0.05 l_opt), hi
+// the fibre at the tendon's slack length: Newton from `start`, kept inside the bracket its own
+// evaluations narrow, bisection where it would leave it; an end is evaluated only when a step would
+// pass it (hi with g <= 0: the tendon slack, the fibre there; lo with g >= 0: the fibre at lo).
 double SolveBalance(const Balance& b, double start) {
   const double h_norm = b.h / b.p.l_opt;
-  double lo = std::max(h_norm * (1 + 1e-9), 0.05);
-  double hi = std::sqrt(std::pow(std::max(b.L - b.p.l_ts, 1e-6), 2) + b.h * b.h) / b.p.l_opt;  // the tendon at slack
-  if (hi <= lo) return hi;
-  double d;
-  if (b(hi, &d) <= 0) return hi;  // no fibre force at the tendon's slack length: slack
-  if (b(lo, &d) >= 0) return lo;
+  const double lo_end = std::max(h_norm * (1 + 1e-9), 0.05);
+  const double hi_end = std::sqrt(std::pow(std::max(b.L - b.p.l_ts, 1e-6), 2) + b.h * b.h) / b.p.l_opt;
+  if (hi_end <= lo_end) return hi_end;
+  double lo = lo_end, hi = hi_end, d;
+  bool lo_known = false, hi_known = false;  // g(lo) < 0, g(hi) > 0 established
   double x = std::clamp(start, lo, hi);
   for (int it = 0; it < 100; ++it) {
     const double g = b(x, &d);
     if (g == 0) return x;
-    (g < 0 ? lo : hi) = x;
-    double nx = d > 0 ? x - g / d : 0.5 * (lo + hi);
-    if (!(nx > lo && nx < hi)) nx = 0.5 * (lo + hi);
-    if (std::abs(nx - x) < 1e-12 || hi - lo < 1e-12) return nx;
+    if (g < 0) lo = x, lo_known = true;
+    else hi = x, hi_known = true;
+    double nx = d > 0 ? x - g / d : (g < 0 ? hi : lo);
+    if (!(nx > lo && nx < hi)) {
+      if (!hi_known && nx >= hi) {
+        if (b(hi_end, &d) <= 0) return hi_end;  // no fibre force at the tendon's slack length: slack
+        hi_known = true;
+      }
+      if (!lo_known && nx <= lo) {
+        if (b(lo_end, &d) >= 0) return lo_end;
+        lo_known = true;
+      }
+      nx = 0.5 * (lo + hi);
+    }
+    if (std::abs(nx - x) < 1e-10 || hi - lo < 1e-10) return nx;
     x = nx;
   }
   return x;

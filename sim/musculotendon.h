@@ -115,7 +115,7 @@ HillState RigidTendonState(const MusculotendonParams& p, double L, double Ldot);
 // (per F_max on both sides: the state does not depend on F_max or a strength scaling it, CEINMS's
 // convention). The first sample starts at the static equilibrium (ElasticEquilibriumFibreLength);
 // a slack tendon (its force 0) leaves the fibre at the path's rigid length. Safeguarded Newton on a
-// bracket, to 1e-12 l_opt.
+// bracket, to 1e-10 l_opt.
 struct TendonSeries {
   std::vector<double> fibre_length;    // normalized by l_opt
   std::vector<double> fibre_velocity;  // normalized by v_max, lengthening positive

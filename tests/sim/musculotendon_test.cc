@@ -244,7 +244,7 @@ TEST(Musculotendon, ElasticTendonSeriesIsTheFibreDynamics) {
       std::printf("%s slow stretch: fibre off the static equilibrium by at most %.2e l_opt, balance %.1e\n",
                   MuscleName(m), worst, balance);
       EXPECT_LT(worst, 2e-3);
-      EXPECT_LT(balance, 1e-9);
+      EXPECT_LT(balance, 1e-7);  // the solver's 1e-10 l_opt times the balance's slope (< 1e3 F_max per l_opt)
     }
     auto drive = [&](double fs, TendonSeries* s, std::vector<double>* t) {
       std::vector<double> L, a;
