@@ -59,7 +59,8 @@ struct EmgMskModel {
   double delay = 0, twitch = 0, a_shape = 0;  // s, s, 1
   std::vector<EmgMskMuscle> muscles;
   double beta[2] = {0, 0}, gamma[2] = {0, 0}, offset[2] = {0, 0};
-  // Cross-validation (the folds of the linear form; lengths, A and delay searched again in every fold)
+  // Cross-validation (the folds of the linear form: strengths and remainder refitted per fold; lengths, A and
+  // delay kept from the whole calibration, as the linear form's folds keep its delays)
   // and fit figures per joint, within kSpikeMads of the median moment.
   double r2_cv[2] = {0, 0}, rms_cv[2] = {0, 0}, r2_fit[2] = {0, 0};
   // Share of the calibration moment the recorded muscles can reach at all (item 2): sum over the
