@@ -603,6 +603,7 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
   };
   double lambda = 1e-3;
   bool fresh = false;
+  auto Lm = [&]() {
   for (int it = 0; it < iterations; ++it) {
     R.J = WeightedJ(at, R.theta);
     R.e = WeightedResidual(P, at, idx);
@@ -636,6 +637,35 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
       }
     }
     if (!improved || before - R.cost < 1e-5 * before) break;
+  }
+  };
+  Lm();
+  // A dead band's cost is rough below the scale of its effect (a closure moves by a whole physics
+  // step as the band changes by a fraction of a step's travel: notches of a few % within 1e-4 rad),
+  // where the local step above sees a minimum that is none. Probes at a quarter and a half of the
+  // band's size (at least its secant step) on either side, the other values held; where one is
+  // lower the refinement restarts there (kMotionBandProbes rounds at most).
+  for (int round = 0; round < kMotionBandProbes; ++round) {
+    std::vector<Eigen::VectorXd> probes;
+    for (int k : cols) {
+      if (P.kind(k) != "backlash") continue;
+      const double size = std::max(R.theta[k], P.step(k));
+      for (double f : {-0.5, -0.25, 0.25, 0.5}) {
+        Eigen::VectorXd x = R.theta;
+        x[k] = std::clamp(x[k] + f * size, P.lower(k), P.upper(k));
+        if (x[k] != R.theta[k]) probes.push_back(x);
+      }
+    }
+    if (probes.empty()) break;
+    std::vector<MotionProblem::Rollout> pr = P.SimulateAll(probes, Part::kFit);
+    size_t b = 0;
+    for (size_t k = 1; k < probes.size(); ++k)
+      if (Cost(P, pr[k], Part::kFit) < Cost(P, pr[b], Part::kFit)) b = k;
+    const double cb = Cost(P, pr[b], Part::kFit);
+    if (!(cb < R.cost)) break;
+    R.theta = probes[b], R.cost = cb, at = std::move(pr[b]);
+    fresh = false, lambda = 1e-3;
+    Lm();
   }
   if (!fresh && jacobian) {
     R.J = WeightedJ(at, R.theta);

@@ -50,7 +50,9 @@
 //     DESIGN.md's ranges, the simpler explanation preferred;
 //  4. the chosen effects' values are refined on the exact plant: projected Levenberg-Marquardt inside
 //     the box (stopped where the decrease it predicts is below 1e-5 of the cost), forward-difference Jacobians, from the linear fit's values and from the torque fit's
-//     where it named the effect (the lower error wins);
+//     where it named the effect (the lower error wins); a dead band's value then probed at +-1/4 and
+//     +-1/2 of its size (its cost is rough below that scale: a closure moves by whole physics steps),
+//     the refinement restarted where a probe is lower (kMotionBandProbes rounds at most);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
 //  6. exact held-out gate: every chosen effect, taken out of the refined set, must raise the held-out
 //     simulated error at its joint by at least kMinHeldoutGain of the set's; one that does not is
@@ -83,6 +85,7 @@ namespace exotwin {
 constexpr int kMotionOuterSteps = 3;     // linearize-select-refine rounds at most
 constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per refinement at most
 constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
+constexpr int kMotionBandProbes = 3;  // rounds of a dead band's probes after a refinement at most (step 4)
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a
@@ -105,6 +108,7 @@ class MotionProblem {
   double lower(int k) const { return lo_[k]; }
   double upper(int k) const { return hi_[k]; }
   double step(int k) const { return step_[k]; }
+  const std::string& kind(int k) const { return kind_[static_cast<size_t>(k)]; }  // e.g. "backlash", "offset"
   // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
   int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
   const PhysicalScale& scale() const { return scale_; }
