@@ -52,13 +52,14 @@ void TrialLog::Row(const double* values, size_t n) {
 
 TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
                         const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
-                        std::vector<std::string>* files, LogCapture* capture) {
+                        std::vector<std::string>* files, LogCapture* capture, size_t rows) {
   const std::string suffix = trials > 1 ? "_trial" + std::to_string(trial + 1) : "";
   const std::string measured = "measured" + suffix + ".csv", truth = "truth" + suffix + ".csv";
   CapturedLog* captured[2] = {nullptr, nullptr};
   if (capture) {
     captured[0] = &capture->emplace_back(CapturedLog{measured, measured_columns, {}});
     captured[1] = &capture->emplace_back(CapturedLog{truth, truth_columns, {}});
+    for (CapturedLog* c : captured) c->values.reserve(rows * c->columns.size());
   }
   TrialLogs logs;
   logs.measured = std::make_unique<TrialLog>(dir + "/" + measured, measured_columns, comments, captured[0]);

@@ -69,6 +69,8 @@ struct CosimSchedule {
   long steps = 0;            // physics steps of the trial
   int steps_per_tick = 1;    // physics steps per controller tick
   long log_every = 1;        // LogSample on the steps k with k % log_every == 0
+  // The rows a trial's logs hold at most (LogSample's instants and the last step's end).
+  size_t LogRows() const { return static_cast<size_t>(steps / log_every + 2); }
   CosimClock clock = CosimClock::kGrid;
 };
 
@@ -95,14 +97,15 @@ class TrialLog {
 
 // The two logs of trial `trial` (0-based) of `trials`: DIR/measured[_trialN].csv (the rig's view) and
 // DIR/truth[_trialN].csv (the plant's), N = trial + 1 when trials > 1, each with `comments`; their
-// names are appended to *files, and with `capture` (may be null) their copies in memory to it. Throws
+// names are appended to *files, and with `capture` (may be null) their copies in memory to it, room
+// made for `rows` rows up front (CosimSchedule::LogRows: the copy then never moves as it grows). Throws
 // InputError if a file cannot be opened.
 struct TrialLogs {
   std::unique_ptr<TrialLog> measured, truth;
 };
 TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
                         const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
-                        std::vector<std::string>* files, LogCapture* capture = nullptr);
+                        std::vector<std::string>* files, LogCapture* capture = nullptr, size_t rows = 0);
 
 // Progress of a run over several trials: Run() reports done + k steps to `bar` (may be null).
 struct CosimProgress {

@@ -231,7 +231,7 @@ class ExowheelTrial : public CosimDevice {
         opt_.out_dir, trial, s_.protocol.trials, MeasuredColumns(), TruthColumns(),
         {"exotwin run " + s_.name + " trial " + std::to_string(trial + 1) + " seed " + std::to_string(result_->seed),
          "subject truth: L1 " + std::to_string(truth.L1) + (truth.human ? " with human" : " exo only")},
-        &result_->files, opt_.capture);
+        &result_->files, opt_.capture, schedule_.LogRows());
   }
 
   void AddVideoSample(double t) {

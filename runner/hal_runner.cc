@@ -118,7 +118,7 @@ class HalTrial : public CosimDevice {
                              "mu_contraction"},
                             {"exotwin run " + s.name + " (HAL-3) mode " + s.hal.mode + " B_v " +
                              std::to_string(B_v) + " seed " + std::to_string(result->seed)},
-                            &result->files, opt.capture);
+                            &result->files, opt.capture, schedule_.LogRows());
 
     const double w = 2 * kPi * s.hal.swing_freq;
     plant_.Reset(0.35, 0.65 * w, 0.0);
