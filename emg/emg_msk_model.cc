@@ -21,7 +21,7 @@ MusculotendonParams EmgMskMuscle::Params() const {
 
 namespace {
 
-constexpr int kExtras = 3;  // beta, gamma, offset per joint
+constexpr int kExtras = 4;  // beta, gamma, offset, passive_scale per joint
 
 // Activation of one channel (emg_torque_model.h: delay, twitch, A-shape).
 std::vector<double> Activation(const EmgRecording& rec, const std::string& channel, double delay, double twitch, double A) {
@@ -98,6 +98,7 @@ struct Rec {
   std::vector<std::vector<double>> act;            // per channel
   std::vector<std::array<std::vector<double>, 2>> col;  // per channel, per joint
   std::vector<char> spike_ok[2];                   // within kSpikeMads of the median (whole recording)
+  std::vector<double> passive[2];                  // M_P along each joint (PassiveMomentAlong, the model's range)
 };
 
 // Bounded least squares: min |W (X x - tau)|^2 over the fit rows, x = [strength per channel (in
@@ -208,6 +209,7 @@ class Calibration {
           x.setZero();
           for (int c = 0; c < M; ++c) x[c] = r.col[c][j][i];
           x[M + kExtras * j] = e.q[j][i], x[M + kExtras * j + 1] = e.qd[j][i], x[M + kExtras * j + 2] = 1;
+          x[M + kExtras * j + 3] = r.passive[j][i];
           G.selfadjointView<Eigen::Lower>().rankUpdate(x, w2);
           b += w2 * e.tau[j][i] * x;
           rr += w2 * e.tau[j][i] * e.tau[j][i];
@@ -357,7 +359,8 @@ class Calibration {
             if (!Fitted(k, j, i)) continue;
             double pred = lin.x[static_cast<Eigen::Index>(M + kExtras * j)] * e.q[j][i] +
                           lin.x[static_cast<Eigen::Index>(M + kExtras * j + 1)] * e.qd[j][i] +
-                          lin.x[static_cast<Eigen::Index>(M + kExtras * j + 2)];
+                          lin.x[static_cast<Eigen::Index>(M + kExtras * j + 2)] +
+                          lin.x[static_cast<Eigen::Index>(M + kExtras * j + 3)] * r.passive[j][i];
             J.setZero();
             for (size_t c = 0; c < M; ++c) {
               pred += lin.x[static_cast<Eigen::Index>(c)] * c0[k][c][j][i];
@@ -366,6 +369,7 @@ class Calibration {
             J[static_cast<Eigen::Index>(P + M + kExtras * j)] = e.q[j][i];
             J[static_cast<Eigen::Index>(P + M + kExtras * j + 1)] = e.qd[j][i];
             J[static_cast<Eigen::Index>(P + M + kExtras * j + 2)] = 1;
+            J[static_cast<Eigen::Index>(P + M + kExtras * j + 3)] = r.passive[j][i];
             for (size_t p = 0; p < P; ++p) {
               double d = 0;
               for (size_t c = 0; c < M; ++c)
@@ -413,7 +417,8 @@ class Calibration {
     const int M = static_cast<int>(mus_.size());
     std::vector<double> p(b - a);
     for (size_t i = a; i < b; ++i) {
-      double v = x[M + kExtras * j] * r.rec->q[j][i] + x[M + kExtras * j + 1] * r.rec->qd[j][i] + x[M + kExtras * j + 2];
+      double v = x[M + kExtras * j] * r.rec->q[j][i] + x[M + kExtras * j + 1] * r.rec->qd[j][i] + x[M + kExtras * j + 2] +
+                 x[M + kExtras * j + 3] * r.passive[j][i];
       for (int c = 0; c < M; ++c) v += x[c] * r.col[c][j][i];
       p[i - a] = v;
     }
@@ -437,7 +442,9 @@ EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec) {
   for (int j = 0; j < 2; ++j) {
     s.tau[j].assign(n, 0.0);
     s.outside[j].assign(n, 0);
-    for (size_t i = 0; i < n; ++i) s.tau[j][i] = m.beta[j] * rec.q[j][i] + m.gamma[j] * rec.qd[j][i] + m.offset[j];
+    for (size_t i = 0; i < n; ++i)
+      s.tau[j][i] = m.beta[j] * rec.q[j][i] + m.gamma[j] * rec.qd[j][i] + m.offset[j] +
+                    (m.passive_scale[j] != 0 ? m.passive_scale[j] * PassiveMomentAlong(j, rec.q[0][i], rec.q[1][i], m.q_lo, m.q_hi) : 0.0);
   }
   const Geometry g = GeometryOf(rec, m.muscles);
   for (size_t c = 0; c < m.muscles.size(); ++c) {
@@ -487,9 +494,19 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     if (!(var > 0)) throw InputError(r0.source + ": a joint moment is constant");
     w[j] = 1 / std::sqrt(var);
   }
+  // The calibration's angle range (the passive moment is continued along its tangent outside it).
+  for (int j = 0; j < 2; ++j) {
+    model.q_lo[j] = std::numeric_limits<double>::infinity(), model.q_hi[j] = -std::numeric_limits<double>::infinity();
+    for (const EmgRecording* r : recs)
+      for (double q : r->q[j]) model.q_lo[j] = std::min(model.q_lo[j], q), model.q_hi[j] = std::max(model.q_hi[j], q);
+  }
   for (const EmgRecording* r : recs) {
     if (!r->has_moments()) throw InputError(r->source + ": no joint moments to fit (--moments)");
     Rec x;
+    for (int j = 0; j < 2; ++j) {
+      x.passive[j].resize(r->size());
+      for (size_t i = 0; i < r->size(); ++i) x.passive[j][i] = PassiveMomentAlong(j, r->q[0][i], r->q[1][i], model.q_lo, model.q_hi);
+    }
     x.rec = r;
     x.geo = GeometryOf(*r, model.muscles);
     for (int j = 0; j < 2; ++j) {
@@ -536,7 +553,8 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
   const Solved s = cal.Solve();
   for (int c = 0; c < M; ++c) model.muscles[static_cast<size_t>(c)].strength = s.x[c];
   for (int j = 0; j < 2; ++j)
-    model.beta[j] = s.x[M + kExtras * j], model.gamma[j] = s.x[M + kExtras * j + 1], model.offset[j] = s.x[M + kExtras * j + 2];
+    model.beta[j] = s.x[M + kExtras * j], model.gamma[j] = s.x[M + kExtras * j + 1], model.offset[j] = s.x[M + kExtras * j + 2],
+    model.passive_scale[j] = s.x[M + kExtras * j + 3];
   for (EmgMskMuscle& m : model.muscles)
     m.fibre_lo = m.velocity_lo = std::numeric_limits<double>::infinity(),
     m.fibre_hi = m.velocity_hi = -std::numeric_limits<double>::infinity();

@@ -5,7 +5,7 @@
 // two moments). Per joint j:
 //
 //   tau_j(t) = sum_c s_c F_max,c (a_c(t) f_L(l_c) f_V(v_c) + f_PE(l_c)) cos(phi_c) r_c,j(q)
-//              + beta_j q_j + gamma_j qd_j + offset_j
+//              + beta_j q_j + gamma_j qd_j + offset_j + passive_scale_j M_P,j(q)
 //   a_c(t)   = the activation of emg_torque_model.h: A-shape (LB03 eq. 2) of the twitch-filtered
 //              envelope delayed by the electromechanical delay (one common A and delay here)
 //   l_c, v_c = fibre length and velocity of the unit along its path length L_c(q) (q: hip, knee and,
@@ -15,7 +15,9 @@
 //              tendon (models written before it) RigidTendonState at L_c and -sum_j r_c,j qd_j
 //
 // beta, gamma, offset carry what the recorded muscles do not (the muscles nobody recorded, passive
-// tissues): the terms of the linear form's remainder (HJ15 eq. 26).
+// tissues): the terms of the linear form's remainder (HJ15 eq. 26); passive_scale the passive tissues'
+// moment in Riener & Edrich 1999's form, as the linear form's passive term (M_P along coordinate j,
+// continued along its tangent outside the calibration's angles), free of sign like beta.
 // Calibrated parameters and their bounds (CEINMS-RT's calibration,
 // StrengthCoefficients_ShapeFactor_TendonSlackLength_single: strength 0.5-1.5 x F_max, A in (-3, 0),
 // tendon slack length +-5 % and optimal fibre length +-2.5 % of the subject-scaled model):
@@ -59,6 +61,11 @@ struct EmgMskModel {
   double delay = 0, twitch = 0, a_shape = 0;  // s, s, 1
   std::vector<EmgMskMuscle> muscles;
   double beta[2] = {0, 0}, gamma[2] = {0, 0}, offset[2] = {0, 0};
+  // The passive tissues' moment: passive_scale M_P(q), M_P Riener & Edrich 1999 (the linear form's
+  // passive term, emg_torque_model.h PassiveMomentAlong), continued along its tangent outside the
+  // calibration's angle range q_lo .. q_hi (rad, hip and knee).
+  double passive_scale[2] = {0, 0};
+  double q_lo[2] = {-10, -10}, q_hi[2] = {10, 10};
   // Cross-validation (the folds of the linear form: strengths and remainder refitted per fold; lengths, A and
   // delay kept from the whole calibration, as the linear form's folds keep its delays)
   // and fit figures per joint, within kSpikeMads of the median moment.

@@ -161,21 +161,24 @@ std::vector<double> ChannelEnvelope(const EmgRecording& rec, const std::string& 
 
 namespace {
 
-// Riener & Edrich's passive moment along coordinate j (minus P of HJ15 eq. 1) at (q0, q1); with a
-// calibration range, continued along its tangent outside it (header).
+// Riener & Edrich's passive moment along coordinate j, with the calibration's range of the spec.
 double PassiveAlong(const EmgModelSpec& spec, int j, double q0, double q1) {
+  return spec.bounded ? PassiveMomentAlong(j, q0, q1, spec.q_lo, spec.q_hi) : PassiveMomentAlong(j, q0, q1);
+}
+
+}  // namespace
+
+double PassiveMomentAlong(int j, double q0, double q1, const double* q_lo, const double* q_hi) {
   auto P = [j](double a, double b) {
     return -PassiveElasticTorque(PassiveModel::kRiener1999, Eigen::Vector2d(a, b))[j];
   };
-  if (!spec.bounded) return P(q0, q1);
-  const double c0 = std::clamp(q0, spec.q_lo[0], spec.q_hi[0]), c1 = std::clamp(q1, spec.q_lo[1], spec.q_hi[1]);
+  if (!q_lo || !q_hi) return P(q0, q1);
+  const double c0 = std::clamp(q0, q_lo[0], q_hi[0]), c1 = std::clamp(q1, q_lo[1], q_hi[1]);
   if (c0 == q0 && c1 == q1) return P(q0, q1);
   constexpr double h = 1e-4;  // rad: central differences of a smooth sum of exponentials
   return P(c0, c1) + (P(c0 + h, c1) - P(c0 - h, c1)) / (2 * h) * (q0 - c0) +
          (P(c0, c1 + h) - P(c0, c1 - h)) / (2 * h) * (q1 - c1);
 }
-
-}  // namespace
 
 std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, const EmgRecording& rec) {
   const size_t n = rec.size();
@@ -571,7 +574,8 @@ std::string EmgMskYaml(const EmgTorqueModel& em) {
   o << "  remainder:\n";
   for (int j = 0; j < 2; ++j)
     o << "    " << kJointName[j] << ": {beta: " << num(m.beta[j]) << ", gamma: " << num(m.gamma[j]) << ", offset: "
-      << num(m.offset[j]) << ", units: [\"N m/rad\", \"N m s/rad\", \"N m\"]}\n";
+      << num(m.offset[j]) << ", passive_scale: " << num(m.passive_scale[j]) << ", angle_range: [" << num(m.q_lo[j]) << ", "
+      << num(m.q_hi[j]) << "], units: [\"N m/rad\", \"N m s/rad\", \"N m\", \"1 (x Riener & Edrich 1999)\", rad]}\n";
   o << "  reachable_share: {hip: " << NumberText(m.reachable_share[0], 4) << ", knee: " << NumberText(m.reachable_share[1], 4)
     << "}\n";
   o << "  reachable_share_recorded: {hip: " << NumberText(m.reachable_share_recorded[0], 4)
@@ -630,6 +634,13 @@ void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em
     m.beta[j] = YamlNumber(c, r["beta"], key + ".beta", -1e6, 1e6, "N m/rad");
     m.gamma[j] = YamlNumber(c, r["gamma"], key + ".gamma", -1e6, 1e6, "N m s/rad");
     m.offset[j] = YamlNumber(c, r["offset"], key + ".offset", -1e6, 1e6, "N m");
+    // Files written before the passive term: none (and no angle range).
+    if (r["passive_scale"]) m.passive_scale[j] = YamlNumber(c, r["passive_scale"], key + ".passive_scale", -100, 100, "");
+    if (const YAML::Node ar = r["angle_range"]) {
+      if (!ar.IsSequence() || ar.size() != 2) c.Fail(key + ".angle_range", "expected [low, high] (rad)" + YamlLine(ar));
+      m.q_lo[j] = YamlNumber(c, ar[0], key + ".angle_range[0]", -kMaxHumanJointAngle, kMaxHumanJointAngle, "rad");
+      m.q_hi[j] = YamlNumber(c, ar[1], key + ".angle_range[1]", m.q_lo[j], kMaxHumanJointAngle, "rad");
+    }
     if (k["reachable_share"]) m.reachable_share[j] = YamlNumber(c, k["reachable_share"][kJointName[j]], "musculoskeletal.reachable_share." + std::string(kJointName[j]), 0, 1, "");
     if (k["reachable_share_recorded"])
       m.reachable_share_recorded[j] = YamlNumber(c, k["reachable_share_recorded"][kJointName[j]],

@@ -157,6 +157,11 @@ std::vector<EmgTerm> TermsOf(const EmgModelSpec& spec, const EmgRecording& rec);
 // continued along its tangent outside (header).
 double ActivationShape(double u, double A);
 
+// Riener & Edrich 1999's passive moment along coordinate j (N m; minus P of HJ15 eq. 1) at the angles
+// (q0, q1) (rad, hip and knee); with a calibrated range (q_lo, q_hi: two angles each) continued along
+// its tangent outside it, so that its exponentials do not explode beyond the angles it was fitted on.
+double PassiveMomentAlong(int j, double q0, double q1, const double* q_lo = nullptr, const double* q_hi = nullptr);
+
 // The twitch filter T_tau (header) of u sampled at times t (causal, starts at rest at u[0]).
 std::vector<double> TwitchFilter(const std::vector<double>& t, const std::vector<double>& u, double tau);
 

@@ -28,6 +28,7 @@ struct Law {
   double lo_change[5] = {-0.02, 0.01, 0.02, -0.015, 0.0};   // fraction of the nominal l_opt
   double A = -1.6, delay = 0.045, twitch = 0.0;
   double beta[2] = {-15, 8}, gamma[2] = {-1.5, 1.0}, offset[2] = {4, -3};
+  double passive_scale[2] = {0.6, 1.4};  // x Riener & Edrich 1999
   double noise = 1.0;  // N m
 };
 
@@ -49,7 +50,8 @@ EmgMskModel ApplyLaw(const Law& law, EmgRecording* r, uint64_t seed) {
     x.fibre_lo = x.velocity_lo = -1e9, x.fibre_hi = x.velocity_hi = 1e9;
     m.muscles.push_back(x);
   }
-  for (int j = 0; j < 2; ++j) m.beta[j] = law.beta[j], m.gamma[j] = law.gamma[j], m.offset[j] = law.offset[j];
+  for (int j = 0; j < 2; ++j)
+    m.beta[j] = law.beta[j], m.gamma[j] = law.gamma[j], m.offset[j] = law.offset[j], m.passive_scale[j] = law.passive_scale[j];
   const EmgMskSeries s = MskSeries(m, *r);
   NormalRng<NormalPolar> rng(seed * 7919);
   for (int j = 0; j < 2; ++j) {
@@ -95,6 +97,8 @@ TEST(EmgMskModel, SyntheticHillLawIsRecoveredWithin10Percent) {
   }
   for (int j = 0; j < 2; ++j) {
     EXPECT_NEAR(fit.beta[j], law.beta[j], 0.1 * std::abs(law.beta[j]));
+    std::printf("%s: passive_scale %.3f (truth %.3f)\n", j ? "knee" : "hip", fit.passive_scale[j], law.passive_scale[j]);
+    EXPECT_NEAR(fit.passive_scale[j], law.passive_scale[j], 0.1 * law.passive_scale[j]);
     const double r2 = R2(b.tau[j], MskSeries(fit, b).tau[j]);
     std::printf("%s: R^2 on another trial of the law %.4f\n", j ? "knee" : "hip", r2);
     EXPECT_GE(r2, 0.97);
