@@ -603,41 +603,42 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
   };
   double lambda = 1e-3;
   bool fresh = false;
+  // The Levenberg-Marquardt iterations from R.theta (its rollout `at`).
   auto Lm = [&]() {
-  for (int it = 0; it < iterations; ++it) {
-    R.J = WeightedJ(at, R.theta);
-    R.e = WeightedResidual(P, at, idx);
-    fresh = true;
-    const Eigen::MatrixXd A = R.J.transpose() * R.J;
-    const Eigen::VectorXd g = R.J.transpose() * R.e;
-    const Eigen::VectorXd D = A.diagonal().cwiseMax(1e-12 * std::max(A.diagonal().maxCoeff(), 1e-300));
-    bool improved = false;
-    const double before = R.cost;
-    for (int trial = 0; trial < 6 && !improved; ++trial) {
-      Eigen::MatrixXd Al = A;
-      Al.diagonal() += lambda * D;
-      const Eigen::VectorXd d = Al.ldlt().solve(g);
-      Eigen::VectorXd x = R.theta;
-      for (size_t c = 0; c < cols.size(); ++c) x[cols[c]] += d[static_cast<Eigen::Index>(c)];
-      x = Clamp(x);
-      if ((x - R.theta).norm() == 0) break;
-      // The decrease the linear model predicts for the clamped step, |e|^2 - |e - J dx|^2: below the
-      // stopping rule's 1e-5 of the cost, no rollout can meet the rule (converged).
-      Eigen::VectorXd dx(static_cast<Eigen::Index>(cols.size()));
-      for (size_t c = 0; c < cols.size(); ++c) dx[static_cast<Eigen::Index>(c)] = x[cols[c]] - R.theta[cols[c]];
-      if (2 * dx.dot(g) - dx.dot(A * dx) < 1e-5 * R.cost) break;
-      MotionProblem::Rollout rx = P.Simulate(x, Part::kFit);
-      const double cx = Cost(P, rx, Part::kFit);
-      if (cx < R.cost) {
-        R.theta = x, R.cost = cx, at = std::move(rx);
-        lambda = std::max(lambda / 3, 1e-9);
-        improved = true, fresh = false;
-      } else {
-        lambda *= 5;
+    for (int it = 0; it < iterations; ++it) {
+      R.J = WeightedJ(at, R.theta);
+      R.e = WeightedResidual(P, at, idx);
+      fresh = true;
+      const Eigen::MatrixXd A = R.J.transpose() * R.J;
+      const Eigen::VectorXd g = R.J.transpose() * R.e;
+      const Eigen::VectorXd D = A.diagonal().cwiseMax(1e-12 * std::max(A.diagonal().maxCoeff(), 1e-300));
+      bool improved = false;
+      const double before = R.cost;
+      for (int trial = 0; trial < 6 && !improved; ++trial) {
+        Eigen::MatrixXd Al = A;
+        Al.diagonal() += lambda * D;
+        const Eigen::VectorXd d = Al.ldlt().solve(g);
+        Eigen::VectorXd x = R.theta;
+        for (size_t c = 0; c < cols.size(); ++c) x[cols[c]] += d[static_cast<Eigen::Index>(c)];
+        x = Clamp(x);
+        if ((x - R.theta).norm() == 0) break;
+        // The decrease the linear model predicts for the clamped step, |e|^2 - |e - J dx|^2: below the
+        // stopping rule's 1e-5 of the cost, no rollout can meet the rule (converged).
+        Eigen::VectorXd dx(static_cast<Eigen::Index>(cols.size()));
+        for (size_t c = 0; c < cols.size(); ++c) dx[static_cast<Eigen::Index>(c)] = x[cols[c]] - R.theta[cols[c]];
+        if (2 * dx.dot(g) - dx.dot(A * dx) < 1e-5 * R.cost) break;
+        MotionProblem::Rollout rx = P.Simulate(x, Part::kFit);
+        const double cx = Cost(P, rx, Part::kFit);
+        if (cx < R.cost) {
+          R.theta = x, R.cost = cx, at = std::move(rx);
+          lambda = std::max(lambda / 3, 1e-9);
+          improved = true, fresh = false;
+        } else {
+          lambda *= 5;
+        }
       }
+      if (!improved || before - R.cost < 1e-5 * before) break;
     }
-    if (!improved || before - R.cost < 1e-5 * before) break;
-  }
   };
   Lm();
   // A dead band's cost is rough below the scale of its effect (a closure moves by a whole physics
