@@ -563,8 +563,9 @@ std::string EmgMskYaml(const EmgTorqueModel& em) {
   o << "# The musculoskeletal form (emg/emg_msk_model.h): per channel one Hill unit (Thelen 2003 curves, its\n"
        "# tendon as `tendon` says) on a gait2392 path (Delp et al. 1990; hip, knee and the recording's ankle),\n"
        "# force s F_max (a f_L f_V + f_PE) cos(phi) acting at every joint the path crosses with its moment arm\n"
-       "# -dL/dq; plus beta q + gamma qd + offset per joint. Bounds of CEINMS-RT's calibration (strength\n"
-       "# 0.5-1.5, l_ts +-5 %, l_opt +-2.5 % of the scaled gait2392 values).\n";
+       "# -dL/dq; plus beta q + gamma qd + offset + passive_scale M_P(q) per joint (M_P Riener & Edrich 1999,\n"
+       "# along its tangent outside angle_range). Bounds of CEINMS-RT's calibration (strength 0.5-1.5, l_ts\n"
+       "# +-5 %, l_opt +-2.5 % of the scaled gait2392 values).\n";
   o << "forms: {hip: " << form(0) << ", knee: " << form(1) << "}\n";
   o << "musculoskeletal:\n";
   o << "  tendon: " << (m.elastic_tendon ? "elastic" : "rigid") << "   # elastic: Thelen 2003's f_T in series\n";
