@@ -660,9 +660,11 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
     if (probes.empty()) break;
     std::vector<MotionProblem::Rollout> pr = P.SimulateAll(probes, Part::kFit);
     size_t b = 0;
-    for (size_t k = 1; k < probes.size(); ++k)
-      if (Cost(P, pr[k], Part::kFit) < Cost(P, pr[b], Part::kFit)) b = k;
-    const double cb = Cost(P, pr[b], Part::kFit);
+    double cb = Cost(P, pr[0], Part::kFit);
+    for (size_t k = 1; k < probes.size(); ++k) {
+      const double ck = Cost(P, pr[k], Part::kFit);
+      if (ck < cb) cb = ck, b = k;
+    }
     if (!(cb < R.cost)) break;
     R.theta = probes[b], R.cost = cb, at = std::move(pr[b]);
     fresh = false, lambda = 1e-3;
