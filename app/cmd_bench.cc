@@ -73,9 +73,10 @@ CommandRunner RegisterBench(CLI::App& app) {
     for (const std::string& name : selected) {
       std::fprintf(stderr, "bench: %s...\n", name.c_str());
       // Single-threaded work runs on the fastest CPU, its baseline too (bench_probes.h BenchCpu); the
-      // render (llvmpipe and encoder threads), `run` (its log writer thread) and the sweep use them all.
+      // render (llvmpipe and encoder threads), `run` (its log writer thread), the sweep and `diagnose`
+      // (its cutoff choice, columns and replays on every core; the row says how many) use them all.
       const bool threaded = name == "render" || name == "run" || name == "sweep" || name == "link" || name == "python" ||
-                            name == "motion_fit";
+                            name == "motion_fit" || name == "diagnose_long";
       const ScopedCpuPin pin(threaded ? -1 : FastestCpu(c.cpus));
       if (name == "startup") j[name] = BenchStartup(c);
       if (name == "run") j[name] = BenchRunCommand(c);

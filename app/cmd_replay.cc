@@ -94,13 +94,13 @@ CommandRunner RegisterReplay(CLI::App& app) {
       for (int j = j0; j < 2; ++j) x["joints"][names[j]] = {{"rmse_rad", rec.score.Rmse(j)}};
       records.push_back(x);
       for (size_t i = 0; i < s.t.size(); ++i) {
-        if (rec.window[i] < 0) continue;
+        if (rec.Window(i) < 0) continue;
         col_t.push_back(s.t[i]);
         for (int j = 0; j < 2; ++j) {
           col_q[j].push_back(s.q[j][i]);
-          col_sim[j].push_back(rec.sim[j][i]);
+          col_sim[j].push_back(rec.Sim(j, i));
         }
-        col_w.push_back(rec.window[i]);
+        col_w.push_back(rec.Window(i));
         col_r.push_back(static_cast<double>(r));
       }
       std::printf("replay: %s: %zu windows of %g s, RMS angle error%s\n", s.source.c_str(), rec.score.windows,

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <thread>
 
 #include <Eigen/Eigenvalues>
 
 #include "formats/number_text.h"
 #include "dsp/statistics.h"
 #include "core/error.h"
+#include "core/parallel_for.h"
 #include "model/regressors.h"
 
 namespace exotwin {
@@ -72,7 +74,7 @@ double ResolveCutoffOption(const std::string& value, const std::string& what,
 }
 
 CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g,
-                          CutoffUse use) {
+                          CutoffUse use, int threads_asked) {
   const bool parallel = use == CutoffUse::kParallel;
   CutoffChoice c;
   if (records.empty()) throw InputError("cutoff choice: no record");
@@ -137,6 +139,12 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
   constexpr size_t kBatch = 6;                  // columns low-passed together (memory: kBatch records)
   std::vector<double> batch[kBatch];
+  // The work of a candidate on two threads where it splits without more memory: the two angles'
+  // rates (each into its own reused vectors), the regressor's samples by halves, a batch's low-pass by
+  // halves (each signal filtered as alone). The same bits on any thread count.
+  const int threads =
+      std::min(2, threads_asked > 0 ? threads_asked : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  AngleRates derived_buffer[2];  // the rates of the record at hand, its vectors reused
   for (double fc : c.candidates_hz) {
     // Per record, on the rows: the regressor (parallel: from the angles differentiated at
     // DerivativeCutoffHz(fc), each column and the torque low-passed at fc; else differentiated at
@@ -156,13 +164,17 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       const std::vector<size_t>& at = B.at;
       // The rates DeriveKinematics(d, cutoff) gives: a recorded column as recorded.
       const double cutoff = parallel ? DerivativeCutoffHz(fc, 1.0 / B.sampling.dt) : fc;
-      AngleRates derived[2];
+      AngleRates* derived = derived_buffer;
       const std::vector<double>* q[2] = {&d.q_hip(), &d.q_knee()};
       const std::vector<double>* qd[2];
       const std::vector<double>* qdd[2];
-      for (int j = 0; j < 2; ++j) {
+      for (int j = 0; j < 2; ++j)  // sized here: the threads write into them, allocating nothing (a
+        derived[j].qd.reserve(n), derived[j].qdd.reserve(n);  // block freed in a thread's arena stays there)
+      ParallelFor(2, threads, [&](size_t j) {
         if (!B.recorded[j][0] || !B.recorded[j][1])
-          derived[j] = DeriveAngleRates(B.sampling, d.t(), *q[j], cutoff, d.source);
+          DeriveAngleRatesInto(B.sampling, d.t(), *q[j], cutoff, d.source, &derived[j]);
+      });
+      for (int j = 0; j < 2; ++j) {
         qd[j] = B.recorded[j][0] ? B.recorded[j][0] : &derived[j].qd;
         qdd[j] = B.recorded[j][1] ? B.recorded[j][1] : &derived[j].qdd;
       }
@@ -207,15 +219,20 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
               }
           }
           if (regressor)
-            for (size_t i = 0; i < n; ++i) {
-              const Matrix26 Y =
-                  FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
-              for (size_t e = 0; e < K; ++e)
-                if (kFiltered[c0 + e].kind == kRegressor) batch[e][i] = Y(kFiltered[c0 + e].j, kFiltered[c0 + e].col);
-            }
+            ParallelFor(2, threads, [&](size_t half) {
+              for (size_t i = half * n / 2; i < (half + 1) * n / 2; ++i) {
+                const Matrix26 Y =
+                    FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
+                for (size_t e = 0; e < K; ++e)
+                  if (kFiltered[c0 + e].kind == kRegressor) batch[e][i] = Y(kFiltered[c0 + e].j, kFiltered[c0 + e].col);
+              }
+            });
           std::vector<double>* ptr[kBatch];
           for (size_t e = 0; e < K; ++e) ptr[e] = &batch[e];
-          low.Apply(ptr, K);
+          ParallelFor(2, threads, [&](size_t half) {
+            const size_t e0 = half * K / 2, e1 = (half + 1) * K / 2;
+            if (e1 > e0) low.Apply(ptr + e0, e1 - e0);
+          });
           for (size_t e = 0; e < K; ++e) {
             const Col& c = kFiltered[c0 + e];
             const std::vector<double>& v = batch[e];

@@ -42,10 +42,11 @@ struct CutoffChoice {
 
 // Chooses the cutoff for records of one device (each at least 200 samples). L1 (m) and g (m/s^2)
 // enter the regressor's coupling and gravity columns. Throws InputError when no candidate fits the
-// records' sample rate (fs / 4 <= 1.5 Hz).
+// records' sample rate (fs / 4 <= 1.5 Hz). threads: the candidates' rates, regressor and low-passes on
+// up to that many threads (0: every core, at most 2 used); the same choice, bit for bit, on any count.
 enum class CutoffUse { kDerivatives, kParallel };
 CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, double L1, double g,
-                          CutoffUse use);
+                          CutoffUse use, int threads = 0);
 
 // The angles' derivative cutoff under a residual low-pass at fc: 4 fc (the zero-phase 2nd-order
 // Butterworth then passes 99 % at fc, so measured and predicted torque see one filter), at most

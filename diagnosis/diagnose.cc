@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <Eigen/Cholesky>
 
@@ -27,11 +28,17 @@
 #include "dsp/statistics.h"
 #include "core/error.h"
 #include "core/heap_policy.h"
+#include "core/parallel_for.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
 #include "sim/plant.h"
 
 namespace exotwin {
+
+int DiagnoseThreads(const DiagnoseOptions& opt) {
+  if (opt.threads > 0) return opt.threads;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 const char* DiagnoseFitName(DiagnoseFit fit) { return fit == DiagnoseFit::kMotion ? "motion" : "torque"; }
 
@@ -233,7 +240,7 @@ CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const Meas
     c.why = "given (--cutoff " + NumberText(opt.cutoff_hz) + ")";
     return c;
   }
-  return ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel);
+  return ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel, DiagnoseThreads(opt));
 }
 
 // Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
@@ -413,7 +420,7 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Re
   std::vector<const Kinematics*> kins;
   for (Rec& rc : recs) {  // BuildColumns releases rc.resid (a long record's memory)
     banks.push_back(BuildColumns(params, rc.kin, rc.tau_S, rc.resid, w, rc.split,
-                                 std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn()));
+                                 std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn(), DiagnoseThreads(opt)));
     kins.push_back(&rc.kin);
   }
   std::vector<Eigen::VectorXd> raw;
@@ -804,25 +811,26 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
     const bool split_long = t.back() - t[rc.split] >= opt.replay_horizon_s;
     const bool whole_long = D.leave_one_out && t.back() - t.front() >= opt.replay_horizon_s;
     const long from = static_cast<long>(rc.split);
-    ReplayScore b_split, b_whole;
+    // The rigid twin and the other (extended, or the left-out fit's) replayed side by side on
+    // DiagnoseThreads threads, the other's input re-formed for its sensor effects into its own vectors.
+    const int threads = DiagnoseThreads(opt);
+    std::vector<double> tau_other[2];
     if (split_long) {
-      const ReplayRecord b = Replay(*rigid, series, opt.replay_horizon_s, rc.split, n);
-      b_split = b.score;
-      if (r == 0)
-        for (int j = 0; j < 2; ++j) S.rigid[j].assign(b.sim[j].begin() + from, b.sim[j].end());
-    }
-    if (whole_long) b_whole = Replay(*rigid, series, opt.replay_horizon_s).score;
-    if (split_long) {
-      ActuatorTorqueFromReading(ext_fx, t, tau_S, series.tau_R);
-      const ReplayRecord a = Replay(*ext, series, opt.replay_horizon_s, rc.split, n);
-      Score(b_split, a.score, rs.sim_split);
-      rs.sim_split_windows = b_split.windows;
-      sb.Add(b_split), sa.Add(a.score);
+      ActuatorTorqueFromReading(ext_fx, t, tau_S, tau_other);
+      ReplayRecord b, a;
+      ParallelFor(2, threads, [&](size_t k) {
+        if (k == 0) b = Replay(*rigid, series, opt.replay_horizon_s, rc.split, n);
+        else a = Replay(*ext, series, opt.replay_horizon_s, rc.split, n, tau_other);
+      });
+      Score(b.score, a.score, rs.sim_split);
+      rs.sim_split_windows = b.score.windows;
+      sb.Add(b.score), sa.Add(a.score);
       if (r == 0) {
         S.t.assign(t.begin() + from, t.end());
         for (int j = 0; j < 2; ++j) {
+          S.rigid[j] = std::move(b.sim[j]);  // samples rc.split .. n, as S.t
           S.measured[j].assign(series.q[j].begin() + from, series.q[j].end());
-          S.extended[j].assign(a.sim[j].begin() + from, a.sim[j].end());
+          S.extended[j] = std::move(a.sim[j]);
         }
       }
     }
@@ -832,11 +840,15 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
       std::unique_ptr<Plant> loo_plant;
       PlantEffects loo_fx;
       if (!Make(loo, rc.source + " left out", &loo_plant, &loo_fx)) return;
-      ActuatorTorqueFromReading(loo_fx, t, tau_S, series.tau_R);
-      const ReplayScore a = Replay(*loo_plant, series, opt.replay_horizon_s).score;
-      Score(b_whole, a, rs.sim_left_out);
-      rs.sim_left_out_windows = b_whole.windows;
-      lb.Add(b_whole), la.Add(a);
+      ActuatorTorqueFromReading(loo_fx, t, tau_S, tau_other);
+      ReplayScore b, a;
+      ParallelFor(2, threads, [&](size_t k) {
+        if (k == 0) b = Replay(*rigid, series, opt.replay_horizon_s).score;
+        else a = Replay(*loo_plant, series, opt.replay_horizon_s, 0, static_cast<size_t>(-1), tau_other).score;
+      });
+      Score(b, a, rs.sim_left_out);
+      rs.sim_left_out_windows = b.windows;
+      lb.Add(b), la.Add(a);
     }
   }
   for (int j = 0; j < 2; ++j) {

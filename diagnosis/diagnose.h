@@ -177,8 +177,12 @@ struct DiagnoseOptions {
   double replay_cutoff_hz = kReplayCutoffHz;  // step 6b: filter of the restart state
   DiagnoseFit fit = DiagnoseFit::kTorque;     // kMotion: diagnosis/motion_fit.h (windows of replay_horizon_s,
                                               // restart state at replay_cutoff_hz)
-  int threads = 0;                            // the motion fit's rollouts in parallel (0: every core)
+  int threads = 0;  // threads for the replays (the motion fit's rollouts; the torque fit's rigid and
+                    // extended twins side by side, step 6b); 0: every core. The result does not depend on it.
 };
+
+// The threads DiagnoseOptions::threads asks for: itself when > 0, else the machine's cores (at least 1).
+int DiagnoseThreads(const DiagnoseOptions& opt);
 
 // Runs the discrepancy analysis. `params` is the twin to confront, `records` the measured records of
 // one device (each >= 200 samples, the same columns, comparable sample rates). Throws InputError on

@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include <Eigen/Cholesky>
 
+#include "core/parallel_for.h"
 #include "diagnosis/effects.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
+#include "model/regressors.h"
 
 namespace exotwin {
 
@@ -21,6 +24,17 @@ namespace {
 double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
 // The index of a new column of the bank (X grown when full).
+// f(i) for i = 0 .. n - 1 on the machine's cores, each thread a contiguous range: for the loops that
+// evaluate a column on every sample of a record (f writes only sample i's values, into vectors sized
+// beforehand: a worker allocates nothing record-long). The same bits on any thread count.
+template <class F>
+void ForEachSample(const ColumnBank& b, size_t n, F f) {
+  const size_t T = n < 20000 ? 1 : static_cast<size_t>(std::max(1, b.threads));
+  ParallelFor(T, static_cast<int>(T), [&](size_t k) {
+    for (size_t i = k * n / T; i < (k + 1) * n / T; ++i) f(i);
+  });
+}
+
 int NewColumn(ColumnBank& b) {
   const int c = b.used++;
   if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);
@@ -34,10 +48,10 @@ int AddColumn(ColumnBank& b, const double w[2], F f) {
   const int c = NewColumn(b);
   if (b.filter) {
     std::vector<double> v[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
-    for (size_t i = 0; i < b.n; ++i) {
+    ForEachSample(b, b.n, [&](size_t i) {
       const Eigen::Vector2d x = f(i);
       v[0][i] = x[0], v[1][i] = x[1];
-    }
+    });
     SetColumn(b, c, w, v);
     return c;
   }
@@ -68,10 +82,11 @@ void AddColumnPair(ColumnBank& b, const double w[2], int c1, int c2, F f) {
   if (b.filter) {
     std::vector<double> v1[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
     std::vector<double> v2[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
-    for (size_t i = 0; i < b.n; ++i) {
-      f(i, &x1, &x2);
-      v1[0][i] = x1[0], v1[1][i] = x1[1], v2[0][i] = x2[0], v2[1][i] = x2[1];
-    }
+    ForEachSample(b, b.n, [&](size_t i) {
+      Eigen::Vector2d y1, y2;
+      f(i, &y1, &y2);
+      v1[0][i] = y1[0], v1[1][i] = y1[1], v2[0][i] = y2[0], v2[1][i] = y2[1];
+    });
     SetColumn(b, c1, w, v1);
     for (auto& v : v1) std::vector<double>().swap(v);
     SetColumn(b, c2, w, v2);
@@ -86,35 +101,49 @@ void AddColumnPair(ColumnBank& b, const double w[2], int c1, int c2, F f) {
 
 // The actuator torque R[k] = ActuatorTorque(rigid, x_k, qd, qdd) and the compliant part's torque
 // C[k] = CompliantPartTorque(rigid, x_k, qd, qdd) at x_0 = q, x_1 = q + 1e-5 e_j, x_2 = q - 1e-5 e_j,
-// bit for bit, with what they share computed once: each point's passive moment (in both) and, for
-// the hip (j = 0: M and V depend on the knee angle alone), M qdd + V of q. `total`: rigid.Total().
+// equal to them up to rounding: each point's rigid torque in the regressor form Y(x_k, qd, qdd) theta
+// (HJ15 eq. 18-21, model/regressors.h), one Y for both parameter sets, the sines and cosines of the
+// shifted angles from those of q by the angle-addition formulas (3 sincos per sample instead of 24),
+// and each point's passive moment computed once (in both). `total`: rigid.Total().
 struct NearTorques {
   Eigen::Vector2d R[3], C[3];
 };
 NearTorques TorquesNear(const LegParams& rigid, const LumpedParams& total, int j, const Eigen::Vector2d& q,
                         const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
-  Eigen::Vector2d x[3] = {q, q, q};
-  x[1][j] += 1e-5, x[2][j] -= 1e-5;
-  // RigidInverseDynamics at the three points: (M qdd + V) + G, in its order.
-  auto rigid_id = [&](const LumpedParams& p, Eigen::Vector2d out[3]) {
-    if (j == 0) {
-      const Eigen::Vector2d mv = MassMatrix(p, rigid.L1, q[1]) * qdd + CoriolisCentrifugal(p, rigid.L1, q, qd);
-      for (int k = 0; k < 3; ++k) out[k] = mv + GravityTorque(p, rigid.g, x[k]);
-    } else {
-      for (int k = 0; k < 3; ++k) out[k] = RigidInverseDynamics(p, rigid.L1, rigid.g, x[k], qd, qdd);
-    }
+  constexpr double kH = 1e-5;
+  static const double ch = std::cos(kH), sh = std::sin(kH);
+  RegressorTrig trig[3];
+  trig[0] = TrigOf(q);
+  trig[1] = trig[2] = trig[0];
+  // sin(a +- h) = s ch +- c sh, cos(a +- h) = c ch -+ s sh, for the angles that move with q_j: th1 and
+  // th1 + th2 (j = 0) or th2 and th1 + th2 (j = 1).
+  auto shift = [](double* s_out, double* c_out, double s, double c, double sign) {
+    *s_out = s * ch + sign * c * sh;
+    *c_out = c * ch - sign * s * sh;
   };
-  NearTorques t;
-  rigid_id(total, t.R);
-  if (!rigid.human) {  // no human: the compliant part is the whole chain
-    for (int k = 0; k < 3; ++k) t.C[k] = t.R[k];
-    return t;
+  for (int k = 1; k < 3; ++k) {
+    const double sign = k == 1 ? 1.0 : -1.0;
+    RegressorTrig& t = trig[k];
+    if (j == 0) shift(&t.s1, &t.c1, trig[0].s1, trig[0].c1, sign);
+    else shift(&t.s2, &t.c2, trig[0].s2, trig[0].c2, sign);
+    shift(&t.s12, &t.c12, trig[0].s12, trig[0].c12, sign);
   }
+  const Vector6 theta_R = ToVector(total);
+  NearTorques t;
   Eigen::Vector2d passive[3];
-  for (int k = 0; k < 3; ++k) passive[k] = PassiveElasticTorque(rigid.passive, x[k]);
-  for (int k = 0; k < 3; ++k) t.R[k] += passive[k];
-  rigid_id(*rigid.human, t.C);
-  for (int k = 0; k < 3; ++k) t.C[k] = t.C[k] + passive[k];
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector2d x = q;
+    x[j] += k == 0 ? 0.0 : (k == 1 ? kH : -kH);
+    const Matrix26 Y = FullRegressorOfTrig(rigid.L1, rigid.g, trig[k], qd, qdd);
+    t.R[k] = Y * theta_R;
+    if (!rigid.human) {  // no human: the compliant part is the whole chain
+      t.C[k] = t.R[k];
+      continue;
+    }
+    passive[k] = PassiveElasticTorque(rigid.passive, x);
+    t.C[k] = Y * ToVector(*rigid.human) + passive[k];
+    t.R[k] += passive[k];
+  }
   return t;
 }
 
@@ -145,7 +174,7 @@ int AddJointColumn(ColumnBank& b, const double w[2], int j, G g) {
   const int c = NewColumn(b);
   if (b.filter) {
     std::vector<double> x(b.n);
-    for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
+    ForEachSample(b, b.n, [&](size_t i) { x[i] = g(i); });
     SetJointColumn(b, c, w, j, std::move(x));
     return c;
   }
@@ -165,7 +194,7 @@ int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
   const size_t m = b.sample.size();
   if (b.filter) {
     std::vector<double> x(b.n);
-    for (size_t i = 0; i < b.n; ++i) x[i] = g(i);
+    ForEachSample(b, b.n, [&](size_t i) { x[i] = g(i); });
     FilterColumn(b, x);
     for (int j = 0; j < 2; ++j)
       for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * x[b.sample[k]];
@@ -192,8 +221,9 @@ void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         const std::vector<double> tau_S[2],
                         std::vector<double> resid[2], const double w[2], size_t split,
-                        size_t max_rows, std::function<void(std::vector<double>&)> filter) {
+                        size_t max_rows, std::function<void(std::vector<double>&)> filter, int threads) {
   ColumnBank b;
+  b.threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const size_t n = kin.t.size();
   b.filter = std::move(filter);
   b.n = n;
@@ -348,10 +378,10 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       const double ww[2] = {j == 0 ? w : 0.0, j == 1 ? w : 0.0};
       for (int k = 0; k < 2; ++k) {  // -sin, then -cos: joint j's rows (the other joint's are zero)
         std::vector<double> v(n);
-        for (size_t i = 0; i < n; ++i) {
+        ForEachSample(b, n, [&](size_t i) {
           const double x = 2 * M_PI * f * kins[r]->q[j][i];
           v[i] = k == 0 ? -std::sin(x) : -std::cos(x);
-        }
+        });
         SetJointColumn(b, c0 + k, ww, j, std::move(v));
       }
       Candidate c;

@@ -35,16 +35,17 @@ struct ColumnBank {
   // filtered by it before its fit rows are taken. Empty: no filter.
   std::function<void(std::vector<double>&)> filter;  // in place
   size_t n = 0;                // samples of the record
+  int threads = 1;             // threads evaluating a column on the n samples (the same bits on any count)
 };
 
 // Builds every candidate for both joints. tau_S: the twin's prediction (N m) on all samples (its rigid
 // tau_R, ActuatorTorque, is evaluated where a column needs it); resid[j]: measured - predicted
 // tau_S, released (left empty) once the fit rows' values are taken; w[j]: row weights (1/N m);
-// split: first held-out sample.
+// split: first held-out sample; threads: ColumnBank::threads (0: every core).
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin, const std::vector<double> tau_S[2],
                         std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows,
-                        std::function<void(std::vector<double>&)> filter = {});
+                        std::function<void(std::vector<double>&)> filter = {}, int threads = 0);
 
 // Stores column c of the bank from per-sample values v[0] (hip rows), v[1] (knee rows), n each,
 // filtered by bank.filter when set and weighted by w.

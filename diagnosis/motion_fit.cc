@@ -11,6 +11,7 @@
 #include <Eigen/Cholesky>
 
 #include "core/error.h"
+#include "core/parallel_for.h"
 #include "diagnosis/replay.h"
 #include "dsp/statistics.h"
 #include "formats/number_text.h"
@@ -33,43 +34,6 @@ std::mutex& BuildMutex() {
   return m;
 }
 
-// Runs f(0) .. f(n - 1) on up to `threads` std::threads (the calling thread among them); the first
-// exception is rethrown after all have finished.
-thread_local bool tl_in_worker = false;  // inside ParallelFor's work: nested calls run serially
-
-template <class F>
-void ParallelFor(size_t n, int threads, F f) {
-  if (tl_in_worker) {
-    for (size_t i = 0; i < n; ++i) f(i);
-    return;
-  }
-  std::atomic<size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    tl_in_worker = true;
-    for (size_t i; (i = next.fetch_add(1)) < n;) {
-      try {
-        f(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-    tl_in_worker = false;
-  };
-  const size_t T = std::min(n, static_cast<size_t>(std::max(1, threads)));
-  std::vector<std::thread> pool;
-  for (size_t k = 1; k < T; ++k) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
-}
-
-int Threads(const DiagnoseOptions& opt) {
-  if (opt.threads > 0) return opt.threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
 
 bool AllZero(const std::vector<double>& v) {
   return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0; });
@@ -267,7 +231,7 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
     const ReplayRecord a = Replay(*plant, s, H, 0, R.split);
     const ReplayRecord b = Replay(*plant, s, H, R.split, R.n);
     for (size_t i = 0; i < R.n; ++i)
-      if (a.window[i] >= 0 || b.window[i] >= 0) R.rows.push_back(i);
+      if (a.Window(i) >= 0 || b.Window(i) >= 0) R.rows.push_back(i);
     R.fit_rows = static_cast<size_t>(std::lower_bound(R.rows.begin(), R.rows.end(), R.split) - R.rows.begin());
     const size_t m = R.rows.size();
     R.q.resize(static_cast<Eigen::Index>(2 * m));
@@ -408,7 +372,7 @@ MotionProblem::Rollout MotionProblem::Simulate(const Eigen::VectorXd& theta, Par
     try {
       auto Take = [&](const ReplayRecord& rr, size_t k0, size_t k1) {
         for (size_t k = k0; k < k1; ++k)
-          for (int j = 0; j < 2; ++j) q[static_cast<Eigen::Index>(j * m + k)] = rr.sim[j][R.rows[k]];
+          for (int j = 0; j < 2; ++j) q[static_cast<Eigen::Index>(j * m + k)] = rr.Sim(j, R.rows[k]);
       };
       if (part != Part::kHeldOut) Take(Replay(*plant, s, H, 0, R.split), 0, R.fit_rows);
       if (part != Part::kFit) Take(Replay(*plant, s, H, R.split, R.n), R.fit_rows, m);
@@ -428,7 +392,7 @@ MotionProblem::Rollout MotionProblem::Simulate(const Eigen::VectorXd& theta, Par
 std::vector<MotionProblem::Rollout> MotionProblem::SimulateAll(const std::vector<Eigen::VectorXd>& thetas,
                                                                Part part) const {
   std::vector<Rollout> out(thetas.size());
-  ParallelFor(thetas.size(), Threads(opt_), [&](size_t k) { out[k] = Simulate(thetas[k], part); });
+  ParallelFor(thetas.size(), DiagnoseThreads(opt_), [&](size_t k) { out[k] = Simulate(thetas[k], part); });
   return out;
 }
 
@@ -887,7 +851,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       }
       std::vector<double> refined(screen.size());
       std::vector<MotionProblem::Rollout> at_refined(screen.size());
-      ParallelFor(screen.size(), Threads(opt), [&](size_t i) {
+      ParallelFor(screen.size(), DiagnoseThreads(opt), [&](size_t i) {
         const int k = screen[i];
         refined[i] = RefineOne(P, k, theta, at, start[i][k], kMotionScreenIterations);
         if (refined[i] == theta[k]) return;

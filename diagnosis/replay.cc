@@ -107,8 +107,16 @@ std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::strin
   return plant;
 }
 
-ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin, size_t end) {
+double ReplayRecord::Sim(int j, size_t i) const {
+  return i >= first && i - first < sim[j].size() ? sim[j][i - first] : std::nan("");
+}
+
+int ReplayRecord::Window(size_t i) const { return i >= first && i - first < window.size() ? window[i - first] : -1; }
+
+ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin, size_t end,
+                    const std::vector<double>* tau_R) {
   const std::vector<double>& t = s.t;
+  const std::vector<double>* u = tau_R ? tau_R : s.tau_R;
   end = std::min(end, t.size());
   if (!(horizon_s > 0)) throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s, expected > 0");
   if (begin >= end || t[end - 1] - t[begin] < horizon_s)
@@ -116,8 +124,9 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
                      std::to_string(begin < end ? t[end - 1] - t[begin] : 0.0) + " s)");
   ReplayRecord out;
   out.source = s.source;
-  for (auto& v : out.sim) v.assign(t.size(), std::nan(""));
-  out.window.assign(t.size(), -1);
+  out.first = begin;
+  for (auto& v : out.sim) v.assign(end - begin, std::nan(""));
+  out.window.assign(end - begin, -1);
   const double dt = plant.timestep();
   // A strap's run-in (replay.h): its settling time, at most one horizon.
   const double run_in_s = std::min(horizon_s, plant.InternalSettlingTime());
@@ -125,10 +134,9 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
   size_t in = begin;  // input interpolation: t[in] <= time < t[in + 1]
   auto Input = [&](double time) -> Eigen::Vector2d {
     while (in + 1 < t.size() && t[in + 1] <= time) ++in;
-    if (s.hold || in + 1 >= t.size() || time <= t[in]) return {s.tau_R[0][in], s.tau_R[1][in]};
+    if (s.hold || in + 1 >= t.size() || time <= t[in]) return {u[0][in], u[1][in]};
     const double a = (time - t[in]) / (t[in + 1] - t[in]);
-    return {s.tau_R[0][in] + a * (s.tau_R[0][in + 1] - s.tau_R[0][in]),
-            s.tau_R[1][in] + a * (s.tau_R[1][in + 1] - s.tau_R[1][in])};
+    return {u[0][in] + a * (u[0][in + 1] - u[0][in]), u[1][in] + a * (u[1][in + 1] - u[1][in])};
   };
   while (start < end && t[end - 1] - t[start] >= horizon_s) {
     const double t0 = t[start], t_end = t0 + horizon_s;
@@ -171,10 +179,10 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
       const double a = span > 0 ? (t[i] - time_prev) / span : 1.0;
       const Eigen::Vector2d qs = q_prev + a * (plant.q() - q_prev);
       for (int j = 0; j < 2; ++j) {
-        out.sim[j][i] = qs[j];
+        out.sim[j][i - begin] = qs[j];
         out.score.sse[j] += (qs[j] - s.q[j][i]) * (qs[j] - s.q[j][i]);
       }
-      out.window[i] = w;
+      out.window[i - begin] = w;
       ++out.score.count;
     }
     ++out.score.windows;

@@ -83,13 +83,21 @@ struct ReplayScore {
 struct ReplayRecord {
   std::string source;
   ReplayScore score;
-  std::vector<double> sim[2];  // simulated angle per sample of s.t (NaN where not scored)
-  std::vector<int> window;     // window index per sample (-1 where not scored)
+  // Samples [first, first + window.size()) of s.t, the part replayed: the simulated angle (NaN where not
+  // scored) and the window index (-1 where not scored) of sample first + k at k.
+  size_t first = 0;
+  std::vector<double> sim[2];
+  std::vector<int> window;
+  // The same by the sample's index in s.t: NaN / -1 outside the part replayed too.
+  double Sim(int j, size_t i) const;
+  int Window(size_t i) const;
 };
 
 // Replays samples [begin, end) of `s` with `plant` (parameters set and effects carried) in windows
-// of horizon_s. Throws InputError when [begin, end) is shorter than one horizon, SimulationError on
-// divergence.
+// of horizon_s, driven by s.tau_R or, given, by `tau_R` (the same record's input for another twin's
+// sensor effects; each the length of s.t). Throws InputError when [begin, end) is shorter than one
+// horizon, SimulationError on divergence. Replays of one series with different plants may run on
+// different threads.
 // The plant a replay drives: the MJCF `mjcf` (empty: the shipped EXOwheel model, with or without the
 // human by params) realizing params, carrying its effects (ToPlantEffects: InputError naming `source`
 // for an effect the plant cannot carry; *fx receives them when given) with joint limits and torque
@@ -99,6 +107,6 @@ std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::strin
                                        PlantEffects* fx = nullptr);
 
 ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin = 0,
-                    size_t end = static_cast<size_t>(-1));
+                    size_t end = static_cast<size_t>(-1), const std::vector<double>* tau_R = nullptr);
 
 }  // namespace exotwin

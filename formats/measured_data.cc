@@ -235,16 +235,22 @@ std::vector<double> LowPassOnTimeBase(const std::vector<double>& t, const std::v
 
 AngleRates DeriveAngleRates(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
                             double cutoff_hz, const std::string& source) {
-  CheckCutoff(s, cutoff_hz, source);
   AngleRates r;
-  dsp::Derivatives der = dsp::ZeroPhaseDerivatives(s.uniform ? q : Interpolate(t, q, s.grid), s.dt, cutoff_hz);
-  r.qd = std::move(der.first);
-  r.qdd = std::move(der.second);
-  if (!s.uniform) {
-    r.qd = Interpolate(s.grid, r.qd, t);
-    r.qdd = Interpolate(s.grid, r.qdd, t);
-  }
+  DeriveAngleRatesInto(s, t, q, cutoff_hz, source, &r);
   return r;
+}
+
+void DeriveAngleRatesInto(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
+                          double cutoff_hz, const std::string& source, AngleRates* out) {
+  CheckCutoff(s, cutoff_hz, source);
+  AngleRates& r = *out;
+  if (s.uniform) {
+    dsp::ZeroPhaseRates(q, s.dt, cutoff_hz, &r.qd, &r.qdd);
+    return;
+  }
+  dsp::ZeroPhaseRates(Interpolate(t, q, s.grid), s.dt, cutoff_hz, &r.qd, &r.qdd);
+  r.qd = Interpolate(s.grid, r.qd, t);
+  r.qdd = Interpolate(s.grid, r.qdd, t);
 }
 
 namespace {

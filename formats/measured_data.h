@@ -160,6 +160,9 @@ struct AngleRates {
 };
 AngleRates DeriveAngleRates(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
                             double cutoff_hz, const std::string& source);
+// The same into *out, its vectors' storage reused (a caller deriving at several cutoffs), bit for bit.
+void DeriveAngleRatesInto(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
+                          double cutoff_hz, const std::string& source, AngleRates* out);
 
 // Median sample period (s) of strictly increasing times (>= 2 samples).
 double MedianStep(const std::vector<double>& t);

@@ -226,6 +226,30 @@ TEST(Replay, TheTwinThatMadeARecordReplaysIt) {
   rigid.FreeJointsAndTorque();
   const ReplayRecord other = Replay(rigid, s, 0.5);
   EXPECT_GT(other.score.Rmse(1), 20 * same.score.Rmse(1));
+  // A part [begin, end) keeps its own samples only (first = begin); by index outside it: NaN, -1.
+  const size_t begin = s.t.size() / 3;
+  const ReplayRecord part = Replay(twin, s, 0.5, begin, s.t.size());
+  EXPECT_EQ(part.first, begin);
+  ASSERT_EQ(part.window.size(), s.t.size() - begin);
+  EXPECT_TRUE(std::isnan(part.Sim(0, begin - 1)));
+  EXPECT_EQ(part.Window(begin - 1), -1);
+  EXPECT_EQ(part.Window(begin), -1);  // a window's restart sample is not scored
+  EXPECT_EQ(part.Window(begin + 1), 0);
+  EXPECT_EQ(part.Sim(1, begin + 1), part.sim[1][1]);
+  EXPECT_TRUE(std::isnan(part.Sim(1, s.t.size())));
+  // Another input given beside the series: the replay of a series holding that input, bit for bit.
+  std::vector<double> other_input[2];
+  ReplaySeries s2 = s;
+  for (int j = 0; j < 2; ++j) {
+    other_input[j] = s.tau_R[j];
+    for (double& v : other_input[j]) v = 0.9 * v + 0.05;
+    s2.tau_R[j] = other_input[j];
+  }
+  const ReplayRecord given = Replay(twin, s, 0.5, 0, s.t.size(), other_input);
+  const ReplayRecord held = Replay(twin, s2, 0.5);
+  EXPECT_EQ(given.score.sse[0], held.score.sse[0]);
+  EXPECT_EQ(given.score.sse[1], held.score.sse[1]);
+  EXPECT_NE(given.score.sse[1], same.score.sse[1]);
   // A horizon longer than the part replayed is an input error.
   EXPECT_THROW(Replay(twin, s, 5.0), InputError);
   EXPECT_THROW(Replay(twin, s, 0.0), InputError);

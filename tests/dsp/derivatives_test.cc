@@ -55,6 +55,22 @@ TEST(Derivatives, ZeroPhaseDerivativesRejectRippleAboveTheCutoff) {
   for (size_t i = 500; i + 500 < x.size(); ++i) EXPECT_LT(std::abs(d.second[i]), 1.0);
 }
 
+// ZeroPhaseRates writes ZeroPhaseDerivatives' first and second derivatives, bit for bit, into vectors
+// whatever they held (longer, shorter); GradientInto gives Gradient.
+TEST(Derivatives, ZeroPhaseRatesAreZeroPhaseDerivativesBitForBit) {
+  std::vector<double> x(3001);
+  for (size_t i = 0; i < x.size(); ++i) x[i] = std::sin(0.013 * i) + 0.3 * std::cos(0.11 * i) + 1e-3 * ((i * 7919) % 13);
+  const double dt = 1e-3, fc = 12.0;
+  const Derivatives d = ZeroPhaseDerivatives(x, dt, fc);
+  std::vector<double> first(5000, 7.0), second(10, -1.0);
+  ZeroPhaseRates(x, dt, fc, &first, &second);
+  EXPECT_EQ(first, d.first);
+  EXPECT_EQ(second, d.second);
+  std::vector<double> g(3, 1.0);
+  GradientInto(x, dt, &g);
+  EXPECT_EQ(g, Gradient(x, dt));
+}
+
 TEST(Derivatives, RejectsACutoffAboveNyquist) {
   EXPECT_THROW(ZeroPhaseDerivatives(std::vector<double>(100, 0.0), 1e-3, 600.0), std::invalid_argument);
 }

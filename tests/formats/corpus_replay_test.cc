@@ -70,8 +70,12 @@ void ReplayTextCorpus(const std::string& target, Harness harness) {
     const std::string name = std::filesystem::path(f).filename().string();
     try {
       const bool parsed = harness(fuzz::FileBytes(f), tmp.path());
-      if (name.rfind("valid_", 0) == 0) EXPECT_TRUE(parsed) << name;
-      if (name.rfind("invalid_", 0) == 0 || name.rfind("crash_", 0) == 0) EXPECT_FALSE(parsed) << name;
+      if (name.rfind("valid_", 0) == 0) {
+        EXPECT_TRUE(parsed) << name;
+      }
+      if (name.rfind("invalid_", 0) == 0 || name.rfind("crash_", 0) == 0) {
+        EXPECT_FALSE(parsed) << name;
+      }
     } catch (const std::exception& e) {
       ADD_FAILURE() << f << ": " << e.what();
     }

@@ -157,6 +157,11 @@ TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
       const AngleRates r = DeriveAngleRates(s, d.t(), j == 0 ? d.q_hip() : d.q_knee(), 15.0, d.source);
       EXPECT_EQ(r.qd, k.qd[j]);
       EXPECT_EQ(r.qdd, k.qdd[j]);
+      // Into vectors that held another cutoff's rates (their storage reused): the same bits.
+      AngleRates into = DeriveAngleRates(s, d.t(), j == 0 ? d.q_hip() : d.q_knee(), 4.0, d.source);
+      DeriveAngleRatesInto(s, d.t(), j == 0 ? d.q_hip() : d.q_knee(), 15.0, d.source, &into);
+      EXPECT_EQ(into.qd, k.qd[j]);
+      EXPECT_EQ(into.qdd, k.qdd[j]);
     }
     EXPECT_THROW(TimeBaseLowPass(s, d.t(), 600.0, d.source), InputError);  // above half the sample rate
   }
