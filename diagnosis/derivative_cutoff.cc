@@ -205,28 +205,32 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
           const size_t K = std::min(kBatch, std::size(kFiltered) - c0);
           bool regressor = false;
           for (size_t e = 0; e < K; ++e) {
-            const Col& c = kFiltered[c0 + e];
-            std::vector<double>& v = batch[e];
-            v.resize(n);
-            if (c.kind == kRegressor) regressor = true;
-            if (c.kind == kOnes) std::fill(v.begin(), v.end(), 1.0);
-            if (c.kind == kRate) std::copy(qd[c.j]->begin(), qd[c.j]->end(), v.begin());
-            if (c.kind == kTorque) std::copy(tau[c.j]->begin(), tau[c.j]->end(), v.begin());
-            if (c.kind == kSign)
-              for (size_t i = 0; i < n; ++i) {
-                const double w = (*qd[c.j])[i];
-                v[i] = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
-              }
+            batch[e].resize(n);  // here: the threads below allocate nothing
+            regressor = regressor || kFiltered[c0 + e].kind == kRegressor;
           }
-          if (regressor)
-            ParallelFor(2, threads, [&](size_t half) {
-              for (size_t i = half * n / 2; i < (half + 1) * n / 2; ++i) {
-                const Matrix26 Y =
-                    FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
-                for (size_t e = 0; e < K; ++e)
-                  if (kFiltered[c0 + e].kind == kRegressor) batch[e][i] = Y(kFiltered[c0 + e].j, kFiltered[c0 + e].col);
+          // Every column of the batch on every sample, the samples by halves.
+          ParallelFor(2, threads, [&](size_t half) {
+            for (size_t i = half * n / 2; i < (half + 1) * n / 2; ++i) {
+              Matrix26 Y = Matrix26::Zero();
+              if (regressor)
+                Y = FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
+              for (size_t e = 0; e < K; ++e) {
+                const Col& c = kFiltered[c0 + e];
+                double& v = batch[e][i];
+                switch (c.kind) {
+                  case kRegressor: v = Y(c.j, c.col); break;
+                  case kOnes: v = 1.0; break;
+                  case kRate: v = (*qd[c.j])[i]; break;
+                  case kTorque: v = (*tau[c.j])[i]; break;
+                  case kSign: {
+                    const double w = (*qd[c.j])[i];
+                    v = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
+                    break;
+                  }
+                }
               }
-            });
+            }
+          });
           std::vector<double>* ptr[kBatch];
           for (size_t e = 0; e < K; ++e) ptr[e] = &batch[e];
           ParallelFor(2, threads, [&](size_t half) {

@@ -249,7 +249,7 @@ CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const Meas
 // (the record itself, which Diagnose may consume) its columns are moved, not copied: the record is
 // left empty.
 void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
-                   const CutoffChoice& cutoff, double holdout_fraction, Rec* out) {
+                   const CutoffChoice& cutoff, double holdout_fraction, int threads, Rec* out) {
   Rec& rc = *out;
   rc.source = data.source;
   rc.samples = data.size();
@@ -286,11 +286,14 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
   // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
   // run (ScoreExtendedTwin) is predict itself.
   for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
-                                               {kin.qdd[0][i], kin.qdd[1][i]});
-    rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
-  }
+  const size_t parts = n < 20000 ? 1 : static_cast<size_t>(threads);  // contiguous ranges, the same bits
+  ParallelFor(parts, static_cast<int>(parts), [&](size_t k) {
+    for (size_t i = k * n / parts; i < (k + 1) * n / parts; ++i) {
+      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
+                                                 {kin.qdd[0][i], kin.qdd[1][i]});
+      rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
+    }
+  });
   if (params.effects.empty()) {
     ApplyEffects(params, kin, rc.tau_R, rc.tau_S);  // leaves rc.tau_R as it is
   } else {
@@ -682,8 +685,18 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
                        const DiagnoseOptions& opt, Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   const size_t R = recs.size();
-  Plant ext_plant(opt.mjcf.empty() ? ExowheelMjcfPath(D.extended.human.has_value()) : opt.mjcf);
-  ext_plant.SetParams(D.extended);
+  // The extended twin's inverse dynamics on DiagnoseThreads plants (PredictTorque's ranges), one for a
+  // short record.
+  size_t longest = 0;
+  for (const Rec& rc : recs) longest = std::max(longest, rc.n());
+  const size_t T = longest < 20000 ? 1 : static_cast<size_t>(DiagnoseThreads(opt));
+  std::vector<std::unique_ptr<Plant>> ext_plants;
+  std::vector<Plant*> ext;
+  for (size_t k = 0; k < T; ++k) {
+    ext_plants.push_back(std::make_unique<Plant>(opt.mjcf.empty() ? ExowheelMjcfPath(D.extended.human.has_value()) : opt.mjcf));
+    ext_plants.back()->SetParams(D.extended);
+    ext.push_back(ext_plants.back().get());
+  }
   double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
   const std::vector<int> cols = ColumnsOf(bank, chosen);
   for (size_t r = 0; r < R; ++r) {
@@ -699,7 +712,7 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
     // only the held-out samples are scored.
     const size_t warm = static_cast<size_t>(
         std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
-    const Prediction held = PredictTorque(ext_plant, Slice(rc.kin, warm, n));
+    const Prediction held = PredictTorque(ext, Slice(rc.kin, warm, n));
     for (int j = 0; j < 2; ++j) {
       std::vector<double> ea(n - warm);
       for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
@@ -963,7 +976,8 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   plant.SetParams(params);  // validates the realization
   std::vector<Rec> recs(R);  // in place: Rec::FilterFn captures its record
   for (size_t r = 0; r < R; ++r)
-    PrepareRecord(params, *records[r], owned ? &(*owned)[r] : nullptr, D.cutoff, opt.holdout_fraction, &recs[r]);
+    PrepareRecord(params, *records[r], owned ? &(*owned)[r] : nullptr, D.cutoff, opt.holdout_fraction,
+                  DiagnoseThreads(opt), &recs[r]);
   double w[2];
   NoiseAndWeights(recs, D.noise, w);
   if (params.one_joint) w[0] = 0, D.noise[0] = 0;  // one joint: the embedding's held hip is no data
