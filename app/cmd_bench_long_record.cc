@@ -176,8 +176,11 @@ json LongRecordRow(const BenchConfig& c, const std::string& command, int pairs) 
 
 }  // namespace
 
-json BenchPredictLong(const BenchConfig& c) { return LongRecordRow(c, "predict", std::max(3, c.repeat)); }
+// Pairs: at least 3 (their median), --quick as --repeat says (a check that the rows work, no figure).
+int LongRecordPairs(const BenchConfig& c) { return c.quick ? std::max(1, c.repeat) : std::max(3, c.repeat); }
 
-json BenchDiagnoseLong(const BenchConfig& c) { return LongRecordRow(c, "diagnose", std::max(3, c.repeat)); }
+json BenchPredictLong(const BenchConfig& c) { return LongRecordRow(c, "predict", LongRecordPairs(c)); }
+
+json BenchDiagnoseLong(const BenchConfig& c) { return LongRecordRow(c, "diagnose", LongRecordPairs(c)); }
 
 }  // namespace exotwin

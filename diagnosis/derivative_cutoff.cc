@@ -142,7 +142,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   // The work of a candidate on two threads where it splits without more memory: the two angles'
   // rates (each into its own reused vectors), the regressor's samples by halves, a batch's low-pass by
   // halves (each signal filtered as alone). The same bits on any thread count.
-  const int threads =
+  const int threads_of_records =
       std::min(2, threads_asked > 0 ? threads_asked : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
   AngleRates derived_buffer[2];  // the rates of the record at hand, its vectors reused
   for (double fc : c.candidates_hz) {
@@ -165,6 +165,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       // The rates DeriveKinematics(d, cutoff) gives: a recorded column as recorded.
       const double cutoff = parallel ? DerivativeCutoffHz(fc, 1.0 / B.sampling.dt) : fc;
       AngleRates* derived = derived_buffer;
+      const int threads = n < 20000 ? 1 : threads_of_records;  // a short record: not worth a thread
       const std::vector<double>* q[2] = {&d.q_hip(), &d.q_knee()};
       const std::vector<double>* qd[2];
       const std::vector<double>* qdd[2];
