@@ -23,7 +23,6 @@ namespace {
 
 double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
-// The index of a new column of the bank (X grown when full).
 // f(i) for i = 0 .. n - 1 on the machine's cores, each thread a contiguous range: for the loops that
 // evaluate a column on every sample of a record (f writes only sample i's values, into vectors sized
 // beforehand: a worker allocates nothing record-long). The same bits on any thread count.
@@ -35,6 +34,7 @@ void ForEachSample(const ColumnBank& b, size_t n, F f) {
   });
 }
 
+// The index of a new column of the bank (X grown when full).
 int NewColumn(ColumnBank& b) {
   const int c = b.used++;
   if (c >= b.X.cols()) b.X.conservativeResize(Eigen::NoChange, 2 * c + 8);

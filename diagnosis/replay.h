@@ -93,11 +93,6 @@ struct ReplayRecord {
   int Window(size_t i) const;
 };
 
-// Replays samples [begin, end) of `s` with `plant` (parameters set and effects carried) in windows
-// of horizon_s, driven by s.tau_R or, given, by `tau_R` (the same record's input for another twin's
-// sensor effects; each the length of s.t). Throws InputError when [begin, end) is shorter than one
-// horizon, SimulationError on divergence. Replays of one series with different plants may run on
-// different threads.
 // The plant a replay drives: the MJCF `mjcf` (empty: the shipped EXOwheel model, with or without the
 // human by params) realizing params, carrying its effects (ToPlantEffects: InputError naming `source`
 // for an effect the plant cannot carry; *fx receives them when given) with joint limits and torque
@@ -106,6 +101,11 @@ struct ReplayRecord {
 std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::string& source, const std::string& mjcf = "",
                                        PlantEffects* fx = nullptr);
 
+// Replays samples [begin, end) of `s` with `plant` (parameters set and effects carried) in windows
+// of horizon_s, driven by s.tau_R or, given, by `tau_R` (the same record's input for another twin's
+// sensor effects; each the length of s.t). Throws InputError when [begin, end) is shorter than one
+// horizon, SimulationError on divergence. Replays of one series with different plants may run on
+// different threads.
 ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin = 0,
                     size_t end = static_cast<size_t>(-1), const std::vector<double>* tau_R = nullptr);
 
