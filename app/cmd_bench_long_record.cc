@@ -174,10 +174,10 @@ json LongRecordRow(const BenchConfig& c, const std::string& command, int pairs) 
                                        command == "predict" ? "<= 2.5x, <= 150 MB" : "<= 3x, <= 150 MB", detail}})}};
 }
 
-}  // namespace
-
 // Pairs: at least 3 (their median), --quick as --repeat says (a check that the rows work, no figure).
 int LongRecordPairs(const BenchConfig& c) { return c.quick ? std::max(1, c.repeat) : std::max(3, c.repeat); }
+
+}  // namespace
 
 json BenchPredictLong(const BenchConfig& c) { return LongRecordRow(c, "predict", LongRecordPairs(c)); }
 
