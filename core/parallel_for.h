@@ -49,4 +49,17 @@ void ParallelFor(size_t n, int threads, F f) {
   if (error) std::rethrow_exception(error);
 }
 
+// A loop over a record's samples shorter than this runs on the calling thread: a thread costs more
+// than it saves there.
+constexpr size_t kMinSamplesToSplit = 20000;
+
+// f(begin, end) over [0, n) cut into contiguous ranges, one per thread: `threads` of them, one when
+// n < kMinSamplesToSplit. For per-sample loops whose item i writes only its own values (the same bits on
+// any thread count).
+template <class F>
+void ParallelForRanges(size_t n, int threads, F f) {
+  const size_t T = n < kMinSamplesToSplit ? 1 : static_cast<size_t>(std::max(1, threads));
+  ParallelFor(T, static_cast<int>(T), [&](size_t k) { f(k * n / T, (k + 1) * n / T); });
+}
+
 }  // namespace exotwin

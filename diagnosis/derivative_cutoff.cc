@@ -165,7 +165,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
       // The rates DeriveKinematics(d, cutoff) gives: a recorded column as recorded.
       const double cutoff = parallel ? DerivativeCutoffHz(fc, 1.0 / B.sampling.dt) : fc;
       AngleRates* derived = derived_buffer;
-      const int threads = n < 20000 ? 1 : threads_of_records;  // a short record: not worth a thread
+      const int threads = n < kMinSamplesToSplit ? 1 : threads_of_records;
       const std::vector<double>* q[2] = {&d.q_hip(), &d.q_knee()};
       const std::vector<double>* qd[2];
       const std::vector<double>* qdd[2];
@@ -209,9 +209,9 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
             batch[e].resize(n);  // here: the threads below allocate nothing
             regressor = regressor || kFiltered[c0 + e].kind == kRegressor;
           }
-          // Every column of the batch on every sample, the samples by halves.
-          ParallelFor(2, threads, [&](size_t half) {
-            for (size_t i = half * n / 2; i < (half + 1) * n / 2; ++i) {
+          // Every column of the batch on every sample, the samples in ranges.
+          ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
+            for (size_t i = begin; i < end; ++i) {
               Matrix26 Y = Matrix26::Zero();
               if (regressor)
                 Y = FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});

@@ -286,9 +286,8 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
   // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
   // run (ScoreExtendedTwin) is predict itself.
   for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
-  const size_t parts = n < 20000 ? 1 : static_cast<size_t>(threads);  // contiguous ranges, the same bits
-  ParallelFor(parts, static_cast<int>(parts), [&](size_t k) {
-    for (size_t i = k * n / parts; i < (k + 1) * n / parts; ++i) {
+  ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
       const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
                                                  {kin.qdd[0][i], kin.qdd[1][i]});
       rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
@@ -689,7 +688,7 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
   // short record.
   size_t longest = 0;
   for (const Rec& rc : recs) longest = std::max(longest, rc.n());
-  const size_t T = longest < 20000 ? 1 : static_cast<size_t>(DiagnoseThreads(opt));
+  const size_t T = longest < kMinSamplesToSplit ? 1 : static_cast<size_t>(DiagnoseThreads(opt));
   std::vector<std::unique_ptr<Plant>> ext_plants;
   std::vector<Plant*> ext;
   for (size_t k = 0; k < T; ++k) {

@@ -28,9 +28,8 @@ double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 // beforehand: a worker allocates nothing record-long). The same bits on any thread count.
 template <class F>
 void ForEachSample(const ColumnBank& b, size_t n, F f) {
-  const size_t T = n < 20000 ? 1 : static_cast<size_t>(std::max(1, b.threads));
-  ParallelFor(T, static_cast<int>(T), [&](size_t k) {
-    for (size_t i = k * n / T; i < (k + 1) * n / T; ++i) f(i);
+  ParallelForRanges(n, b.threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) f(i);
   });
 }
 

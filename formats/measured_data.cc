@@ -281,7 +281,7 @@ void Derive(const std::vector<double>* measured[2][2], const std::string& source
   // record-long on a uniform record), the same bits as one after the other.
   AngleRates r[2];
   for (int j = 0; j < 2; ++j) r[j].qd.reserve(k.t.size()), r[j].qdd.reserve(k.t.size());
-  const int threads = k.t.size() < 20000 ? 1 : 2;
+  const int threads = k.t.size() < kMinSamplesToSplit ? 1 : 2;
   ParallelFor(2, threads, [&](size_t j) { DeriveAngleRatesInto(s, k.t, k.q[j], cutoff_hz, source, &r[j]); });
   for (int j = 0; j < 2; ++j) {
     const auto* qd = measured[j][0];

@@ -51,5 +51,22 @@ TEST(ParallelFor, ANestedCallRunsOnTheWorkersThread) {
     for (size_t k = 0; k < 3; ++k) EXPECT_EQ(inner[3 * i + k], outer[i]);
 }
 
+// ParallelForRanges: contiguous ranges covering [0, n) once, as many as the threads asked for, one
+// for a loop shorter than kMinSamplesToSplit.
+TEST(ParallelFor, RangesCoverTheSamplesOnceInContiguousPieces) {
+  for (size_t n : {size_t{0}, size_t{7}, kMinSamplesToSplit - 1, kMinSamplesToSplit, size_t{100003}}) {
+    for (int threads : {1, 2, 3}) {
+      std::vector<int> hits(n, 0);
+      std::atomic<int> ranges{0};
+      ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
+        ranges.fetch_add(1);
+        for (size_t i = begin; i < end; ++i) ++hits[i];
+      });
+      for (size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i], 1) << "n " << n << " threads " << threads << " i " << i;
+      EXPECT_EQ(ranges.load(), n < kMinSamplesToSplit ? 1 : threads) << "n " << n;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace exotwin
