@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "sim/mjcf_cache.h"
+#include "sim/mujoco_messages.h"
 #include "sim/subjects.h"
 
 namespace exotwin {
@@ -85,6 +86,7 @@ void Hal3Plant::SetParams(const Hal3PlantParams& p) {
 }
 
 void Hal3Plant::Reset(double th, double thd, double t) {
+  ClearMujocoWarning();
   mj_resetData(m_, d_);
   d_->qpos[0] = th;
   d_->qvel[0] = thd;
@@ -101,6 +103,7 @@ void Hal3Plant::Step(double tau_motor, double tau_muscle) {
   const double friction = p_.R * thd0 + p_.C * std::tanh(thd0 / p_.coulomb_eps);
   d_->qfrc_applied[dof_] = tau_muscle - friction;
   d_->ctrl[0] = tau_motor;
+  ClearMujocoWarning();
   mj_step(m_, d_);
   CheckDivergence("step");
   thdd_ = d_->qacc[dof_];
@@ -111,9 +114,11 @@ void Hal3Plant::Step(double tau_motor, double tau_muscle) {
 }
 
 void Hal3Plant::CheckDivergence(const char* where) {
+  const std::string text = TakeMujocoWarning();  // as Plant::CheckDivergence
   for (int i = 0; i < mjNWARNING; ++i)
     if (d_->warning[i].number > 0)
       throw SimulationError(d_->time, std::string("MuJoCo warning ") + std::to_string(i) + " in " + where);
+  if (!text.empty()) throw SimulationError(d_->time, "MuJoCo warning '" + text + "' in " + where);
   if (!std::isfinite(d_->qpos[0]) || !std::isfinite(d_->qvel[0]) || std::abs(d_->qvel[0]) > 100.0)
     throw SimulationError(d_->time, std::string("knee state diverged (|thd| > 100 rad/s or non-finite) in ") + where);
 }

@@ -4,6 +4,8 @@
 #include <map>
 #include <memory>
 
+#include "sim/mujoco_messages.h"
+
 namespace exotwin {
 namespace {
 
@@ -20,18 +22,23 @@ std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>>& Kept() {
 }  // namespace
 
 mjModel* LoadMjcfModel(const std::string& path, char* err, int err_size) {
+  KeepMujocoWarnings();
   const auto it = Kept().find(path);
   if (it != Kept().end()) {
     if (err_size > 0) err[0] = '\0';
     return mj_copyModel(nullptr, it->second.get());
   }
-  return mj_loadXML(path.c_str(), nullptr, err, err_size);
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, err, err_size);
+  TakeMujocoWarning();  // the loader's warnings are in err
+  return m;
 }
 
 bool KeepMjcfModel(const std::string& path) {
   if (Kept().count(path)) return true;
+  KeepMujocoWarnings();
   char err[1000] = "";
   mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof(err));
+  TakeMujocoWarning();  // in err
   if (!m || err[0]) {
     if (m) mj_deleteModel(m);
     return false;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "sim/mujoco_messages.h"
 
 namespace exotwin {
 namespace {
@@ -74,8 +75,10 @@ mjModel* LoadMjcfText(const std::string& mjcf_path, const std::string& xml, cons
   if (mj_makeEmptyFileVFS(vfs.get(), base.c_str(), static_cast<int>(xml.size())) != 0)
     throw InputError(mjcf_path + ": cannot stage " + what + " in MuJoCo's virtual file system");
   std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), base.c_str())], xml.data(), xml.size());
+  KeepMujocoWarnings();
   char err[1000] = "";
   mjModel* m = mj_loadXML(mjcf_path.c_str(), vfs.get(), err, sizeof err);
+  TakeMujocoWarning();  // the loader's warnings are in err
   mj_deleteVFS(vfs.get());
   if (!m) throw InputError(mjcf_path + ": " + what + " does not load: " + err);
   if (err[0]) {

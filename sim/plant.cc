@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "sim/mjcf_cache.h"
 #include "sim/mjcf_text.h"
+#include "sim/mujoco_messages.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 #include "sim/realizability.h"
@@ -448,6 +449,7 @@ void Plant::HoldHip() {
 }
 
 void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t, const Eigen::Vector2d* qdd) {
+  ClearMujocoWarning();
   mj_resetData(m_, d_);
   for (int j = 0; j < 2; ++j) {
     d_->qpos[q_adr_[j]] = q[j];
@@ -482,6 +484,7 @@ double Plant::InternalSettlingTime() const {
 }
 
 void Plant::Restate(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t) {
+  ClearMujocoWarning();
   for (int j = 0; j < 2; ++j) {
     const int dof = j == 0 ? hip_dof_ : knee_dof_;
     if (in_q_[j] >= 0 && structure_.backlash[j]) {
@@ -521,12 +524,16 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   // Actuators are plain motors with gear 1: ctrl is the joint torque (clamped by ctrlrange).
   d_->ctrl[0] = tau_R[0];
   d_->ctrl[1] = tau_R[1];
+  ClearMujocoWarning();
   mj_step(m_, d_);
   if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;
   CheckDivergence("step");
 }
 
 void Plant::CheckDivergence(const char* where) {
+  // A warning MuJoCo counts (d_->warning) also raises its text; the text alone: a warning MuJoCo does
+  // not count (the solver's "Linesearch objective is not convex").
+  const std::string text = TakeMujocoWarning();
   for (int i = 0; i < mjNWARNING; ++i) {
     if (d_->warning[i].number > 0) {
       static const char* kNames[mjNWARNING] = {"inertia",  "contact full", "constraint full",
@@ -535,6 +542,7 @@ void Plant::CheckDivergence(const char* where) {
       throw SimulationError(d_->time, std::string("MuJoCo warning '") + kNames[i] + "' in " + where);
     }
   }
+  if (!text.empty()) throw SimulationError(d_->time, "MuJoCo warning '" + text + "' in " + where);
   for (int i = 0; i < m_->nq; ++i)
     if (!std::isfinite(d_->qpos[i]) || !std::isfinite(d_->qvel[i]))
       throw SimulationError(d_->time, std::string("non-finite state in ") + where);
