@@ -809,6 +809,59 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       off += rx.q[r].size();
     }
   };
+  // Exact BIC of the fit part at a rollout with k parameters (the selection's effective sample size).
+  auto ExactBic = [&](const MotionProblem::Rollout& ro, size_t k) {
+    const double n_eff = g_last.n_eff > 0 ? g_last.n_eff : 1.0, n_tr = std::max(g_last.n_tr, 1.0);
+    return n_eff * std::log(Cost(P, ro, Part::kFit) / n_tr) + static_cast<double>(k) * std::log(n_eff);
+  };
+  auto ParameterCount = [&](const std::vector<int>& set) {
+    size_t k = 0;
+    for (int c : set) k += cands[static_cast<size_t>(c)].cols.size();
+    return k;
+  };
+  // Step 5b, exchange: a chosen effect replaced by a candidate where the linear model of this round
+  // (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the swapped set refined
+  // from the set's values, the effect taken out, and from the linear fit's: its fit-part BIC lower).
+  // Forward selection with backward elimination misses a swap when an effect entered early stands in
+  // for one that only pays once others are in (a knee joint_stiffness for a strap, issue 41).
+  auto Exchange = [&](const ColumnBank& bank, const Grams& g, int round) {
+    bool any = false;
+    for (int ex = 0; ex < kMotionExchanges; ++ex) {
+      const Fit cur = FitCols(g, ColumnsOf(bank, chosen), false);
+      if (!cur.ok) break;
+      double best_bic = cur.bic;
+      std::vector<int> best_set;
+      Fit best_fit;
+      for (size_t i = 0; i < chosen.size(); ++i)
+        for (size_t c = 0; c < cands.size(); ++c) {
+          if (std::find(chosen.begin(), chosen.end(), static_cast<int>(c)) != chosen.end()) continue;
+          std::vector<int> set = chosen;
+          set[i] = static_cast<int>(c);
+          const Fit f = FitCols(g, ColumnsOf(bank, set), false);
+          if (f.ok && f.bic < best_bic) best_bic = f.bic, best_set = set, best_fit = f;
+        }
+      if (best_set.empty()) break;
+      Eigen::VectorXd kept = theta, lin = theta;
+      for (int c : chosen)
+        if (std::find(best_set.begin(), best_set.end(), c) == best_set.end())
+          for (int k : cands[static_cast<size_t>(c)].cols) kept[k] = lin[k] = 0;
+      for (size_t k = 0; k < best_fit.cols.size(); ++k)
+        lin[best_fit.cols[k]] =
+            std::clamp(best_fit.coef[static_cast<Eigen::Index>(k)], P.lower(best_fit.cols[k]), P.upper(best_fit.cols[k]));
+      const Refined rf = Refine(P, ColumnsOf(cand_bank, best_set), {lin, kept}, kMotionLmIterations, false);
+      if (!std::isfinite(rf.cost)) break;
+      const MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);
+      const double bic_now = ExactBic(at, ParameterCount(chosen)), bic_x = ExactBic(rx, ParameterCount(best_set));
+      const bool better = rx.ok && bic_x < bic_now;
+      D.selection.push_back("round " + std::to_string(round + 1) + ": exchange " + Labels(P, chosen) + " -> " +
+                            Labels(P, best_set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " +
+                            NumberText(bic_x, 4) + (better ? ", taken" : ", not taken"));
+      if (!better) break;
+      chosen = best_set, theta = rf.theta, at = rx;
+      any = true;
+    }
+    return any;
+  };
   for (int round = 0; round < kMotionOuterSteps; ++round) {
     Eigen::MatrixXd J = P.Jacobian(theta, at, all, Part::kBoth);
     tau_eff = ResidualAutocorrelation(P, at, window_rows);
@@ -909,9 +962,13 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     D.selection.push_back(os.str());
     std::vector<int> key = chosen;
     std::sort(key.begin(), key.end());
-    if (std::find(seen.begin(), seen.end(), key) != seen.end()) break;
-    seen.push_back(key);
+    const bool repeated = std::find(seen.begin(), seen.end(), key) != seen.end();
+    if (!repeated) seen.push_back(key);
     previous = chosen;
+    if (!repeated && round + 1 < kMotionOuterSteps) continue;
+    // Converged (the set repeats) or out of rounds: the exchanges on this round's linear model.
+    Exchange(banks[0], g_last, round);
+    break;
   }
 
   Charge(kRefinement);

@@ -54,6 +54,11 @@
 //     +-1/2 of its size (its cost is rough below that scale: a closure moves by whole physics steps),
 //     the refinement restarted where a probe is lower (kMotionBandProbes rounds at most);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
+//     then exchanges (at most kMotionExchanges): the swap of one chosen effect for one candidate that
+//     the last round's linear model ranks lowest in BIC, refined on the exact plant (step 4's
+//     refinement from the set's values with the effect taken out and from the linear fit's), taken
+//     where the exact fit-part BIC is lower (stepwise selection keeps an effect that entered early and
+//     stands in for one that only pays once the others are in);
 //  6. exact held-out gate: every chosen effect, taken out of the refined set, must raise the held-out
 //     simulated error at its joint by at least kMinHeldoutGain of the set's; one that does not is
 //     dropped (the weakest first) and the rest refined again;
@@ -86,6 +91,7 @@ constexpr int kMotionOuterSteps = 3;     // linearize-select-refine rounds at mo
 constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per refinement at most
 constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
 constexpr int kMotionBandProbes = 3;  // rounds of a dead band's probes after a refinement at most (step 4)
+constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5b)
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a

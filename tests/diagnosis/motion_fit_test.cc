@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "diagnosis/motion_fit.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
+#include "sim/subjects.h"
 #include "tests/app/cli_test_util.h"
 
 namespace exotwin {
@@ -236,6 +238,49 @@ TEST(MotionFit, KneeBacklashAndCoulombFrictionAreBothNamed) {
       "[{name: backlash, joint: knee, value: 0.02}, {name: coulomb_friction, joint: knee, value: 2.0}]", tmp.path()));
   Print("knee backlash 0.02 rad + Coulomb 2 N m", d);
   ExpectNamed(d, {E("backlash", "knee", 0.02), E("coulomb_friction", "knee", 2.0)}, 0.25);
+}
+
+// Table 5's human side (data/plants/human_side.yaml, subject S2 with its passive-moment draw of seed 1)
+// on the relaxed gait, the rigid parameters and the device's sensor calibration given: the strap, the
+// leg's damping and the subject's passive moment are to be found. Forward selection stops at a set
+// with a knee gravity_error and a hip gravity_error in the strap's and the hip damping's place; the
+// exchanges (motion_fit.h step 5) swap them on the exact plant.
+TEST(MotionFit, ExchangesReplaceEffectsThatStoodInForAStrap) {
+  const testing::ScopedTempDir tmp("motion_exchange");
+  std::ifstream in(kSrc + "/scenarios/gait_2kmh.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("duration: 60"), 12, "duration: 22.2");
+  text.replace(text.find("preset: S1"), 10, "preset: S2");
+  const std::string sensor =
+      "{name: sensor_offset, joint: hip, value: 0.12}, {name: sensor_gain, joint: hip, value: 0.005}, "
+      "{name: sensor_offset, joint: knee, value: -0.12}, {name: sensor_gain, joint: knee, value: -0.005}";
+  text += "human: {behaviour: relaxed}\nplant: {effects: [{name: viscous_friction, joint: hip, value: 0.2}, "
+          "{name: viscous_friction, joint: knee, value: 0.1}, {name: series_compliance, joint: knee, value: 1100}, "
+          "{name: passive_moment, joint: hip, value: -0.288}, {name: passive_moment, joint: knee, value: 0.104}, " +
+          sensor + "]}\n";
+  WriteText(tmp.path() + "/s.yaml", text);
+  const auto r = RunExotwin("run " + tmp.path() + "/s.yaml --out " + tmp.path() + "/run");
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 1) << r.output;
+  LegParams given = SubjectLegParams(PresetSubject("S2"));  // the scenario's subject
+  given.passive = PassiveModel::kRiener1999;
+  given.effects = {E("sensor_offset", "hip", 0.12), E("sensor_gain", "hip", 0.005), E("sensor_offset", "knee", -0.12),
+                   E("sensor_gain", "knee", -0.005)};
+  DiagnoseOptions opt;
+  opt.fit = DiagnoseFit::kMotion;
+  opt.threads = 2;
+  const Diagnosis d = Diagnose(given, ReadMeasuredCsv(tmp.path() + "/run/measured.csv"), opt);
+  Print("S2's human side", d);
+  bool exchanged = false;
+  for (const auto& s : d.selection) exchanged = exchanged || (s.find("exchange") != std::string::npos && s.find(", taken") != std::string::npos);
+  EXPECT_TRUE(exchanged);
+  std::map<std::string, double> named;
+  for (const auto& e : d.effects) named[e.effect.name + "(" + e.effect.joint + ")"] = e.effect.value;
+  ASSERT_TRUE(named.count("series_compliance(knee)")) << "the strap is not named";
+  EXPECT_NEAR(named["series_compliance(knee)"], 1100, 0.25 * 1100);
+  EXPECT_NEAR(named["passive_moment(hip)"], -0.288, 0.25 * 0.288);
+  EXPECT_NEAR(named["passive_moment(knee)"], 0.104, 0.25 * 0.104);
+  EXPECT_NEAR(named["viscous_friction(knee)"], 0.1, 0.25 * 0.1);
+  EXPECT_FALSE(named.count("gravity_error(knee)") || named.count("gravity_error(hip)"));
 }
 
 TEST(MotionFit, NothingIsNamedOnTheRigidPlant) {
