@@ -941,12 +941,20 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       }
     std::vector<Eigen::VectorXd> starts = {start_lin};
     if (has_torque) starts.push_back(start_torque);
-    const Refined rf = Refine(P, cols, starts, kMotionLmIterations, false);
+    Refined rf = Refine(P, cols, starts, kMotionLmIterations, false);
+    if (!std::isfinite(rf.cost)) {
+      // Neither start simulates (e.g. a strap's linear value too stiff for the step): from the current
+      // values (the set's new effects at 0), which do.
+      Eigen::VectorXd from_theta = zero;
+      for (int k : cols) from_theta[k] = theta[k];
+      rf = Refine(P, cols, {from_theta}, kMotionLmIterations, false);
+    }
     if (!std::isfinite(rf.cost)) {
       D.selection.push_back("round " + std::to_string(round + 1) + ": " + Labels(P, chosen) +
-                            " cannot be simulated at its fitted values; nothing named");
-      chosen.clear();
-      theta = zero, at = given;
+                            " cannot be simulated at its fitted values; " +
+                            (previous.empty() ? "nothing named" : "the last round's set kept"));
+      chosen = previous;
+      if (chosen.empty()) theta = zero, at = given;
       break;
     }
     theta = rf.theta;

@@ -50,7 +50,8 @@
 //     DESIGN.md's ranges, the simpler explanation preferred;
 //  4. the chosen effects' values are refined on the exact plant: projected Levenberg-Marquardt inside
 //     the box (stopped where the decrease it predicts is below 1e-5 of the cost), forward-difference Jacobians, from the linear fit's values and from the torque fit's
-//     where it named the effect (the lower error wins); a dead band's value then probed at +-1/4 and
+//     where it named the effect (the lower error wins; where neither simulates, from the current
+//     values with the set's new effects at 0; where that fails too, the last round's set stays); a dead band's value then probed at +-1/4 and
 //     +-1/2 of its size (its cost is rough below that scale: a closure moves by whole physics steps),
 //     the refinement restarted where a probe is lower (kMotionBandProbes rounds at most);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);

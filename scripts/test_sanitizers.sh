@@ -39,12 +39,13 @@ export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/build-asan/lsan.supp:prin
 SWEEPS="IdentificationRecovery\.FiftyRandomSubjects|IdentificationRecovery\.PaperSubjects"
 SWEEPS="$SWEEPS|IdentificationSensitivity\.TableOfErrorGrowth|Excitation\.GainInRecoveryError"
 SWEEPS="$SWEEPS|DiagnoseHiddenEffect\.EverySingleEffectIsNamedMeasuredAndRemoved|DiagnoseHiddenEffect\.NoEffectNamedOnCleanData"
-#   The motion fit's hidden-effect cases beyond one: the strap, the delay, the pair and the hip dead band
-#   (a 60 s record) drive the same rollouts, Jacobian threads, selection and dead-band probes as
+#   The motion fit's hidden-effect cases beyond one: the strap, the delay, the pair and the hip dead bands
+#   (60 s records) drive the same rollouts, Jacobian threads, selection and dead-band probes as
 #   HiddenKneeBacklashIsNamed and NothingIsNamedOnTheRigidPlant, which stay (each case ~25 s in Release
 #   at load 10).
 SWEEPS="$SWEEPS|MotionFit\.HiddenKneeStrapWithAHumanIsNamed|MotionFit\.HiddenKneeSensorDelayIsNamed"
 SWEEPS="$SWEEPS|MotionFit\.KneeBacklashAndCoulombFrictionAreBothNamed|MotionFit\.HiddenHipBacklashIsSizedWithin20Percent"
+SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone"
 #   Further sweeps and repeats, each over 8 s in the Release suite (30-90 s here): cli.regress_suite_test
 #   (the 20 shipped scenarios through `regress`; each scenario's runner runs in the runner, app and cli
 #   tests), DiagnoseHiddenEffect.PairsAreFound and .OffsetAndFrictionTogetherAreBothNamed (pairs of the
