@@ -819,13 +819,13 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     for (int c : set) k += cands[static_cast<size_t>(c)].cols.size();
     return k;
   };
-  // Step 5b, exchange: a chosen effect replaced by a candidate where the linear model of this round
-  // (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the swapped set refined
-  // from the set's values, the effect taken out, and from the linear fit's: its fit-part BIC lower).
+  // The exchanges of motion_fit.h step 5: a chosen effect replaced by a candidate where the linear
+  // model of this round (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the
+  // swapped set refined from the set's values, the effect taken out, and from the linear fit's: its
+  // fit-part BIC lower); kMotionExchanges at most.
   // Forward selection with backward elimination misses a swap when an effect entered early stands in
   // for one that only pays once others are in (a knee joint_stiffness for a strap, issue 41).
   auto Exchange = [&](const ColumnBank& bank, const Grams& g, int round) {
-    bool any = false;
     for (int ex = 0; ex < kMotionExchanges; ++ex) {
       const Fit cur = FitCols(g, ColumnsOf(bank, chosen), false);
       if (!cur.ok) break;
@@ -858,9 +858,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
                             NumberText(bic_x, 4) + (better ? ", taken" : ", not taken"));
       if (!better) break;
       chosen = best_set, theta = rf.theta, at = rx;
-      any = true;
     }
-    return any;
   };
   for (int round = 0; round < kMotionOuterSteps; ++round) {
     Eigen::MatrixXd J = P.Jacobian(theta, at, all, Part::kBoth);
