@@ -809,10 +809,11 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       off += rx.q[r].size();
     }
   };
-  // Exact BIC of the fit part at a rollout with k parameters (the selection's effective sample size).
-  auto ExactBic = [&](const MotionProblem::Rollout& ro, size_t k) {
+  // Exact BIC of a fit-part cost (Cost, Part::kFit) with k parameters (the selection's effective
+  // sample size).
+  auto ExactBic = [&](double cost, size_t k) {
     const double n_eff = g_last.n_eff > 0 ? g_last.n_eff : 1.0, n_tr = std::max(g_last.n_tr, 1.0);
-    return n_eff * std::log(Cost(P, ro, Part::kFit) / n_tr) + static_cast<double>(k) * std::log(n_eff);
+    return n_eff * std::log(cost / n_tr) + static_cast<double>(k) * std::log(n_eff);
   };
   auto ParameterCount = [&](const std::vector<int>& set) {
     size_t k = 0;
@@ -850,14 +851,16 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
             std::clamp(best_fit.coef[static_cast<Eigen::Index>(k)], P.lower(best_fit.cols[k]), P.upper(best_fit.cols[k]));
       const Refined rf = Refine(P, ColumnsOf(cand_bank, best_set), {lin, kept}, kMotionLmIterations, false);
       if (!std::isfinite(rf.cost)) break;
-      const MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);
-      const double bic_now = ExactBic(at, ParameterCount(chosen)), bic_x = ExactBic(rx, ParameterCount(best_set));
-      const bool better = rx.ok && bic_x < bic_now;
+      const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+      const double bic_x = ExactBic(rf.cost, ParameterCount(best_set));
+      const bool better = bic_x < bic_now;
       D.selection.push_back("round " + std::to_string(round + 1) + ": exchange " + Labels(P, chosen) + " -> " +
                             Labels(P, best_set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " +
                             NumberText(bic_x, 4) + (better ? ", taken" : ", not taken"));
       if (!better) break;
-      chosen = best_set, theta = rf.theta, at = rx;
+      MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);  // both parts, for what follows
+      if (!rx.ok) break;
+      chosen = best_set, theta = rf.theta, at = std::move(rx);
     }
   };
   for (int round = 0; round < kMotionOuterSteps; ++round) {

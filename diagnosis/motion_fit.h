@@ -49,11 +49,13 @@
 //     (kMinTorqueShare of the measured angle's RMS about its mean), |t| > kMinT from J's covariance,
 //     DESIGN.md's ranges, the simpler explanation preferred;
 //  4. the chosen effects' values are refined on the exact plant: projected Levenberg-Marquardt inside
-//     the box (stopped where the decrease it predicts is below 1e-5 of the cost), forward-difference Jacobians, from the linear fit's values and from the torque fit's
-//     where it named the effect (the lower error wins; where neither simulates, from the current
-//     values with the set's new effects at 0; where that fails too, the last round's set stays); a dead band's value then probed at +-1/4 and
-//     +-1/2 of its size (its cost is rough below that scale: a closure moves by whole physics steps),
-//     the refinement restarted where a probe is lower (kMotionBandProbes rounds at most);
+//     the box (stopped where the decrease it predicts is below 1e-5 of the cost), forward-difference
+//     Jacobians, from the linear fit's values and from the torque fit's where it named the effect
+//     (the lower error wins; where neither simulates, from the current values with the set's new
+//     effects at 0; where that fails too, the last round's set stays); a dead band's value then
+//     probed at +-1/4 and +-1/2 of its size (its cost is rough below that scale: a closure moves by
+//     whole physics steps), the refinement restarted where a probe is lower (kMotionBandProbes rounds
+//     at most);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
 //     then exchanges (at most kMotionExchanges): the swap of one chosen effect for one candidate that
 //     the last round's linear model ranks lowest in BIC, refined on the exact plant (step 4's
@@ -92,7 +94,7 @@ constexpr int kMotionOuterSteps = 3;     // linearize-select-refine rounds at mo
 constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per refinement at most
 constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
 constexpr int kMotionBandProbes = 3;  // rounds of a dead band's probes after a refinement at most (step 4)
-constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5b)
+constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5)
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a
