@@ -1,7 +1,8 @@
 // exotwin emg-predict (DESIGN.md): the joint moments an EMG model (emg-fit) estimates for a
 // recording, t,tau_hip,tau_knee on the EMG file's time base; with --moments, R^2 per joint; the
 // extrapolation report: per channel and joint, the share of samples outside the calibration's range
-// (a warning above kExtrapolationWarn).
+// (a warning above kExtrapolationWarn); per joint whether the recording is another gait than the
+// calibrated one (the papers' form predicts it, emg_torque_model.h kOtherGaitShare).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -73,12 +74,35 @@ void ReportMuscleStates(const EmgTorqueModel& model, const EmgRecording& rec, co
                 ("muscle " + m.channel).c_str(), 100 * out / n, m.fibre_lo, m.fibre_hi, m.velocity_lo, m.velocity_hi);
   }
   for (int j = 0; j < 2; ++j) {
-    if (!model.msk_form[j]) continue;
+    if (!model.msk_form[j] || pr.papers[j]) continue;  // another gait: ReportOtherGait
     std::printf("%s: the linear form stands in on %.1f %% of the samples (a muscle spanning the joint outside its "
                 "calibrated state)\n", jn[j], 100 * pr.fallback_share[j]);
     if (pr.fallback_share[j] > kExtrapolationWarn)
       std::fprintf(stderr, "emg-predict: warning: at the %s, %.1f %% of the samples leave the muscles' calibrated states: "
                    "predicted by the linear form there\n", jn[j], 100 * pr.fallback_share[j]);
+  }
+}
+
+// Per joint: the share of samples outside the calibration's range, and whether the papers' form
+// predicts the joint as another gait's (emg_torque_model.h kOtherGaitShare).
+void ReportOtherGait(const EmgTorqueModel& model, const EmgPrediction& pr) {
+  if (model.range.empty()) return;
+  const char* jn[2] = {"hip", "knee"};
+  for (int j = 0; j < 2; ++j) {
+    std::printf("%s: %.1f %% of the samples outside the calibration's range (either joint's angle or velocity, or a "
+                "muscle spanning the %s)", jn[j], 100 * pr.outside_share[j], jn[j]);
+    if (pr.papers[j]) {
+      std::printf(": another gait than the calibrated one (above %.0f %%): predicted by the papers' form (HJ15 eq. 26) "
+                  "on the whole recording\n", 100 * kOtherGaitShare);
+      std::fprintf(stderr, "emg-predict: warning: at the %s, %.1f %% of the samples lie outside the calibration's range: "
+                   "another gait; the papers' form (HJ15 eq. 26) predicts it, not the calibrated %s form\n", jn[j],
+                   100 * pr.outside_share[j], model.msk.present && model.msk_form[j] ? "musculoskeletal" : "linear");
+    } else if (pr.outside_share[j] > kOtherGaitShare) {
+      std::printf(": another gait, but the model file has no papers_form (written before it): the calibrated form "
+                  "predicts\n");
+    } else {
+      std::printf(": the calibrated form predicts\n");
+    }
   }
 }
 
@@ -104,6 +128,7 @@ CommandRunner RegisterEmgPredict(CLI::App& app) {
     const EmgPrediction pr = PredictMoments(model, rec);
     const std::vector<double>* tau = pr.tau;
     ReportMuscleStates(model, rec, pr);
+    ReportOtherGait(model, pr);
     WriteCsv(o->out, {"t", "tau_hip", "tau_knee"}, {&rec.t, &pr.tau[0], &pr.tau[1]},
              {"exotwin emg-predict: estimated muscular joint moment (N m, hip flexion +, knee extension +)",
               "model: " + o->model + ", emg: " + o->emg + ", kinematics: " + o->kin});

@@ -676,6 +676,8 @@ EmgDiagnosis DiagnoseEmg(const std::vector<const EmgRecording*>& recs, const Emg
     o.autocorr_rows = 0;
     ProfileAll(all, &spec);
     d.calibration = all.Fit(spec);
+    // The papers' form on the same samples: what predicts a joint of another gait (kOtherGaitShare).
+    d.calibration.papers_terms = all.Fit(EmgModelSpec{}).terms;
     // Outside the calibrated angles the angle-dependent terms continue as emg_torque_model.h says.
     d.calibration.spec.bounded = true;
     for (int j = 0; j < 2; ++j)

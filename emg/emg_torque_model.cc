@@ -214,7 +214,25 @@ std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, co
   return v;
 }
 
+namespace {
+
+// Another gait at joint j (kOtherGaitShare), and the share behind the answer.
+bool OtherGait(const EmgTorqueModel& model, const EmgRecording& rec, int joint, double* share) {
+  *share = model.range.empty() ? 0.0 : JointOutsideShare(model.range, rec, joint, model.spec.gmax_proxy);
+  return !model.papers_terms.empty() && !model.range.empty() && *share > kOtherGaitShare;
+}
+
+std::vector<double> PapersMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint) {
+  EmgTorqueModel papers;  // the papers' form: the default structure
+  papers.terms = model.papers_terms;
+  return PredictLinearMoment(papers, rec, joint);
+}
+
+}  // namespace
+
 std::vector<double> PredictMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint) {
+  double share;
+  if (OtherGait(model, rec, joint, &share)) return PapersMoment(model, rec, joint);
   if (!(model.msk.present && model.msk_form[joint])) return PredictLinearMoment(model, rec, joint);
   return PredictMoments(model, rec).tau[joint];
 }
@@ -226,6 +244,11 @@ EmgPrediction PredictMoments(const EmgTorqueModel& model, const EmgRecording& re
   for (int j = 0; j < 2; ++j) {
     p.tau[j] = PredictLinearMoment(model, rec, j);
     p.fallback[j].assign(rec.size(), 0);
+    p.papers[j] = OtherGait(model, rec, j, &p.outside_share[j]);
+    if (p.papers[j]) {
+      p.tau[j] = PapersMoment(model, rec, j);
+      continue;
+    }
     if (!(any && model.msk_form[j])) continue;
     double n = 0;
     for (size_t i = 0; i < rec.size(); ++i) {
@@ -550,6 +573,26 @@ EmgExtrapolation ExtrapolationOf(const EmgCalibrationRange& g, const EmgRecordin
   return x;
 }
 
+double JointOutsideShare(const EmgCalibrationRange& g, const EmgRecording& rec, int joint, bool gmax_proxy) {
+  if (rec.size() == 0) return 0.0;
+  std::vector<char> out(rec.size(), 0);
+  auto mark = [&](const std::vector<double>& v, double lo, double hi) {
+    for (size_t i = 0; i < v.size() && i < out.size(); ++i) out[i] |= (v[i] < lo || v[i] > hi) ? 1 : 0;
+  };
+  for (int k = 0; k < 2; ++k) mark(rec.q[k], g.q_lo[k], g.q_hi[k]), mark(rec.qd[k], g.qd_lo[k], g.qd_hi[k]);
+  for (size_t c = 0; c < rec.channels.size(); ++c) {
+    const Muscle m = rec.muscle[c];
+    if (ActionSign(m, joint) == 0 && !(gmax_proxy && joint == 0 && m == Muscle::kVM)) continue;
+    const auto it = std::find(g.channels.begin(), g.channels.end(), rec.channels[c]);
+    if (it == g.channels.end()) return 1.0;
+    const size_t k = static_cast<size_t>(it - g.channels.begin());
+    mark(rec.e[c], g.e_lo[k], g.e_hi[k]);
+  }
+  double n = 0;
+  for (char o : out) n += o;
+  return n / static_cast<double>(rec.size());
+}
+
 // ---- EMGMODEL.yaml ----
 
 namespace {
@@ -719,19 +762,27 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
   o << "missing_channels: [";
   for (size_t i = 0; i < m.missing.size(); ++i) o << (i ? ", " : "") << m.missing[i];
   o << "]\nautocorrelation_rows: " << NumberText(m.autocorr_rows, 6) << "\n";
-  o << "parameters:\n";
-  for (int j = 0; j < 2; ++j) {
-    o << "  " << kJointName[j] << ":\n";
-    for (const EmgTerm& t : m.terms) {
-      if (t.joint != j) continue;
-      o << "    - {term: " << t.Kind();
-      if (!t.channel.empty())
-        o << ", channel: " << t.channel << ", muscle: " << MuscleName(t.muscle)
-          << (t.proxy ? ", proxy_for: GMAX" : "")
-          << ", expected_sign: " << t.ExpectedSign() << (t.held ? ", held_at_zero: true" : "");
-      o << ", value: " << NumberText(t.value, 10) << ", se: " << NumberText(t.se, 4) << ", unit: \"" << t.Unit()
-        << "\"}\n";
+  auto terms = [&](const char* key, const std::vector<EmgTerm>& list) {
+    o << key << ":\n";
+    for (int j = 0; j < 2; ++j) {
+      o << "  " << kJointName[j] << ":\n";
+      for (const EmgTerm& t : list) {
+        if (t.joint != j) continue;
+        o << "    - {term: " << t.Kind();
+        if (!t.channel.empty())
+          o << ", channel: " << t.channel << ", muscle: " << MuscleName(t.muscle)
+            << (t.proxy ? ", proxy_for: GMAX" : "")
+            << ", expected_sign: " << t.ExpectedSign() << (t.held ? ", held_at_zero: true" : "");
+        o << ", value: " << NumberText(t.value, 10) << ", se: " << NumberText(t.se, 4) << ", unit: \"" << t.Unit()
+          << "\"}\n";
+      }
     }
+  };
+  terms("parameters", m.terms);
+  if (!m.papers_terms.empty()) {
+    o << "# The papers' form (HJ15 eq. 26, alphas free of sign, every sample): it predicts a joint of another\n"
+         "# gait (more than half the samples outside calibration_range there).\n";
+    terms("papers_form", m.papers_terms);
   }
   if (!m.range.empty()) {
     // 17 significant digits: the ends read back exactly (a sample at the end is inside).
@@ -757,12 +808,17 @@ std::string EmgModelYaml(const EmgTorqueModel& m, const std::vector<std::string>
   return o.str();
 }
 
+namespace {
+// The term lists of `block` (parameters, papers_form): hip: [...] and knee: [...].
+std::vector<EmgTerm> ReadEmgTerms(const YamlContext& c, const YAML::Node& p, const std::string& block);
+}  // namespace
+
 EmgTorqueModel ReadEmgModel(const std::string& path) {
   const YamlContext c{path};
   const YAML::Node root = ParseYaml(ReadYamlText(path, "EMG model"), path);
   YamlCheckKeys(c, root, "",
                 {"model", "activation", "twitch", "delays", "structure", "missing_channels", "autocorrelation_rows",
-                 "parameters", "calibration_range", "fit", "forms", "musculoskeletal"});
+                 "parameters", "calibration_range", "fit", "forms", "musculoskeletal", "papers_form"});
   if (!root["model"] || !root["model"].IsScalar() || root["model"].as<std::string>() != "emg_torque_hj15")
     c.Fail("model", "expected 'emg_torque_hj15' (a file written by exotwin emg-fit)" + YamlLine(root["model"]));
   EmgTorqueModel m;
@@ -826,12 +882,28 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
   ReadEmgMsk(c, root, &m);
   const YAML::Node p = root["parameters"];
   if (!p || !p.IsMap()) c.Fail("parameters", "expected hip: and knee: lists of parameters");
+  m.terms = ReadEmgTerms(c, p, "parameters");
+  if (const YAML::Node pf = root["papers_form"]) {
+    if (!pf.IsMap()) c.Fail("papers_form", "expected hip: and knee: lists of parameters" + YamlLine(pf));
+    m.papers_terms = ReadEmgTerms(c, pf, "papers_form");
+    for (const EmgTerm& t : m.papers_terms)
+      if (t.kind == TermKind::kAlphaQ || t.kind == TermKind::kPassive || t.channel.find('+') != std::string::npos)
+        c.Fail("papers_form." + std::string(kJointName[t.joint]), "expected the papers' terms only (alpha of one channel, "
+               "beta, gamma, offset), found " + t.Name());
+  }
+  return m;
+}
+
+namespace {
+
+std::vector<EmgTerm> ReadEmgTerms(const YamlContext& c, const YAML::Node& p, const std::string& block) {
+  std::vector<EmgTerm> terms;
   const std::map<std::string, TermKind> kinds = {{"alpha", TermKind::kAlpha},   {"alpha_q", TermKind::kAlphaQ},
                                                  {"beta", TermKind::kBeta},     {"gamma", TermKind::kGamma},
                                                  {"offset", TermKind::kOffset}, {"passive_scale", TermKind::kPassive}};
   for (int j = 0; j < 2; ++j) {
     const YAML::Node list = p[kJointName[j]];
-    const std::string key = std::string("parameters.") + kJointName[j];
+    const std::string key = block + "." + kJointName[j];
     if (!list || !list.IsSequence()) c.Fail(key, "expected a list of parameters" + YamlLine(list));
     for (size_t i = 0; i < list.size(); ++i) {
       const YAML::Node e = list[i];
@@ -854,10 +926,12 @@ EmgTorqueModel ReadEmgModel(const std::string& path) {
       }
       t.value = YamlNumber(c, e["value"], ek + ".value", -1e6, 1e6, t.Unit());
       if (e["se"]) t.se = YamlNumber(c, e["se"], ek + ".se", 0, 1e12, t.Unit());
-      m.terms.push_back(t);
+      terms.push_back(t);
     }
   }
-  return m;
+  return terms;
 }
+
+}  // namespace
 
 }  // namespace exotwin

@@ -98,6 +98,18 @@ struct EmgExtrapolation {
 };
 EmgExtrapolation ExtrapolationOf(const EmgCalibrationRange& range, const EmgRecording& rec);
 
+// Most of a recording's samples outside the calibration's range at a joint: another gait than the one
+// calibrated (issue 42: a model calibrated on walking, applied to running). There every cause the
+// calibration added to the papers' form was validated on none of the samples, and its structure is
+// not what carries: emg-predict predicts the joint by the papers' form (EmgTorqueModel::papers_terms).
+constexpr double kOtherGaitShare = 0.5;
+
+// Share of the samples of `rec` where an input of joint j leaves `range`: either joint's angle or
+// velocity (the forms read both: passive moments and biarticular paths), or the envelope of a channel
+// whose muscle spans j (the vasti at the hip too where `gmax_proxy`); a channel the range lacks is
+// outside throughout.
+double JointOutsideShare(const EmgCalibrationRange& range, const EmgRecording& rec, int joint, bool gmax_proxy);
+
 enum class TermKind { kAlpha, kAlphaQ, kBeta, kGamma, kOffset, kPassive };
 
 // One fitted parameter.
@@ -148,6 +160,10 @@ struct EmgTorqueModel {
   // predicts (issue 42: chosen by the same blocked cross-validation; the linear form otherwise).
   EmgMskModel msk;
   bool msk_form[2] = {false, false};
+  // The papers' form (HJ15 eq. 26: alphas free of sign, beta, gamma, offset; no delay, twitch or other
+  // cause) fitted on every sample of the calibration: what predicts a joint on another gait
+  // (kOtherGaitShare). Empty in files written before it: no such fallback.
+  std::vector<EmgTerm> papers_terms;
 };
 
 // The terms of `spec` for the channels of `rec` (coefficients zero).
@@ -175,13 +191,17 @@ std::vector<double> TermColumn(const EmgTerm& term, const EmgModelSpec& spec, co
 // Estimated joint moment (N m) at joint j on every sample of `rec`: the linear form's, or at a joint in
 // the musculoskeletal form its moment, except on the samples where a muscle spanning the joint leaves
 // its calibrated fibre length or velocity: there the linear form, validated on the same calibration,
-// stands in (PredictMoments says where).
+// stands in (PredictMoments says where). On another gait (more than kOtherGaitShare of the samples
+// outside the calibration's range at the joint, JointOutsideShare) the papers' form predicts the whole
+// recording at that joint, whatever its form (when the model has papers_terms).
 std::vector<double> PredictMoment(const EmgTorqueModel& model, const EmgRecording& rec, int joint);
 
 struct EmgPrediction {
   std::vector<double> tau[2];       // N m
   std::vector<char> fallback[2];    // samples predicted by the linear form in place of the musculoskeletal one
   double fallback_share[2] = {0, 0};
+  double outside_share[2] = {0, 0};  // JointOutsideShare (0 without a calibration range)
+  bool papers[2] = {false, false};   // another gait: the papers' form predicts the joint
   EmgMskSeries msk;                 // the musculoskeletal series (empty without msk.present)
 };
 EmgPrediction PredictMoments(const EmgTorqueModel& model, const EmgRecording& rec);

@@ -176,6 +176,75 @@ TEST_F(EmgCli, PredictReportsExtrapolationPerChannelAndJoint) {
   EXPECT_EQ(r.output.find("of the samples of envelope vas_lat_r"), std::string::npos) << r.output;
 }
 
+// Another gait (issue 42): emg-fit keeps the papers' form (HJ15 eq. 26) beside the calibrated one, the
+// very fit `--linear` writes; on a recording most of whose samples leave the calibration's range at a
+// joint, emg-predict predicts that joint by it and says so; on the calibration's own recording the
+// calibrated form predicts.
+TEST_F(EmgCli, AnotherGaitIsPredictedByThePapersFormAndSaysSo) {
+  ASSERT_EQ(Fit().exit_code, 0);
+  ASSERT_EQ(RunExotwin("emg-fit" + Files() + " --linear --out " + dir_ + "/linear.yaml").exit_code, 0);
+  // The papers_form block of the full model is the --linear model's parameters block, line for line.
+  auto block = [](const std::string& text, const std::string& key) {
+    const size_t a = text.find("\n" + key + ":\n");
+    if (a == std::string::npos) return std::string();
+    size_t b = a + key.size() + 3;
+    while (b < text.size() && text[b] == ' ') b = text.find('\n', b) + 1;
+    return text.substr(a + key.size() + 3, b - (a + key.size() + 3));
+  };
+  const std::string papers = block(ReadText(dir_ + "/model.yaml"), "papers_form");
+  ASSERT_FALSE(papers.empty());
+  EXPECT_EQ(papers, block(ReadText(dir_ + "/linear.yaml"), "parameters"));
+  // The trial twice as fast with every envelope doubled: most samples outside at both joints.
+  auto faster = [](const std::string& text, bool envelopes) {
+    std::istringstream in(text);
+    std::ostringstream out;
+    std::string line;
+    bool body = false;
+    while (std::getline(in, line)) {
+      if (body && !line.empty()) {
+        std::istringstream f(line);
+        std::vector<double> v;
+        for (double x; f >> x;) v.push_back(x);
+        v[0] /= 2;
+        for (size_t i = 1; envelopes && i < v.size(); ++i) v[i] *= 2;
+        for (size_t i = 0; i < v.size(); ++i) out << (i ? "\t" : "") << v[i];
+        out << "\n";
+        continue;
+      }
+      body |= line.rfind("time", 0) == 0;
+      out << line << "\n";
+    }
+    return out.str();
+  };
+  WriteText(dir_ + "/fast_emg.sto", faster(EmgSto(), true));
+  WriteText(dir_ + "/fast_ik.sto", faster(IkSto(), false));
+  auto predict = [&](const std::string& model, const std::string& emg, const std::string& ik, const std::string& out) {
+    return RunExotwin("emg-predict --model " + dir_ + "/" + model + " --emg " + dir_ + "/" + emg + " --kinematics " +
+                      dir_ + "/" + ik + " --out " + dir_ + "/" + out);
+  };
+  const auto r = predict("model.yaml", "fast_emg.sto", "fast_ik.sto", "fast.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* j : {"hip", "knee"}) {
+    const std::string said = std::string(j) + ": ";
+    const size_t at = r.output.find(said, r.output.find("forms:"));
+    ASSERT_NE(at, std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("another gait than the calibrated one (above 50 %): predicted by the papers' form", at),
+              std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("warning: at the " + std::string(j)), std::string::npos) << r.output;
+  }
+  ASSERT_EQ(predict("linear.yaml", "fast_emg.sto", "fast_ik.sto", "fast_linear.csv").exit_code, 0);
+  const CsvTable a = ReadCsv(dir_ + "/fast.csv"), b = ReadCsv(dir_ + "/fast_linear.csv");
+  ASSERT_EQ(a.rows(), b.rows());
+  for (size_t c = 1; c < 3; ++c)
+    for (size_t i = 0; i < a.rows(); ++i) ASSERT_EQ(a.columns[c][i], b.columns[c][i]) << c << " " << i;
+  // The calibration's own trial: the calibrated form.
+  const auto own = predict("model.yaml", "emg.sto", "ik.sto", "own.csv");
+  ASSERT_EQ(own.exit_code, 0) << own.output;
+  EXPECT_NE(own.output.find("hip: 0.0 % of the samples outside the calibration's range"), std::string::npos) << own.output;
+  EXPECT_NE(own.output.find("the calibrated form predicts"), std::string::npos) << own.output;
+  EXPECT_EQ(own.output.find("another gait"), std::string::npos) << own.output;
+}
+
 TEST_F(EmgCli, SeveralRecordingsAreFoldsAndBlocksNeedTwo) {
   WriteText(dir_ + "/emg2.sto", EmgSto());
   const auto r = RunExotwin("emg-fit" + Files() + Files("emg2.sto") + " --out " + dir_ + "/m2.yaml");
@@ -226,6 +295,19 @@ TEST_F(EmgCli, AngleUnitNotStated) {
 TEST_F(EmgCli, RecordingsNotInStep) {
   ExpectBadInput(RunExotwin("emg-fit" + Files() + " --emg " + dir_ + "/emg.sto --out " + dir_ + "/m.yaml"),
                  {"--emg", "--kinematics"});
+}
+
+TEST_F(EmgCli, PapersFormWithAnotherTerm) {
+  ASSERT_EQ(Fit().exit_code, 0);
+  std::string y = ReadText(dir_ + "/model.yaml");
+  const std::string key = "papers_form:\n  hip:\n";
+  const size_t at = y.find(key);
+  ASSERT_NE(at, std::string::npos) << y;
+  y.insert(at + key.size(), "    - {term: passive_scale, value: 1, se: 0, unit: \"1\"}\n");
+  WriteText(dir_ + "/bad.yaml", y);
+  ExpectBadInput(RunExotwin("emg-predict --model " + dir_ + "/bad.yaml --emg " + dir_ + "/emg.sto --kinematics " +
+                            dir_ + "/ik.sto --out " + dir_ + "/p.csv"),
+                 {"bad.yaml", "papers_form.hip", "passive_scale"});
 }
 
 TEST_F(EmgCli, BadModelFile) {

@@ -211,7 +211,8 @@ TEST(EmgTorqueModel, ModelFileRoundTrips) {
   s.delay_se[Muscle::kVM] = 0.002;
   s.passive[0] = true;
   s.moment_arm[1] = true;
-  const EmgTorqueModel m = FitEmgModel(s, {&r});
+  EmgTorqueModel m = FitEmgModel(s, {&r});
+  m.papers_terms = FitEmgModel(EmgModelSpec{}, {&r}).terms;
   const testing::ScopedTempDir dir_tmp("emgmodel");
   const std::string dir = dir_tmp.path();
   const std::string path = dir + "/m.yaml";
@@ -234,6 +235,11 @@ TEST(EmgTorqueModel, ModelFileRoundTrips) {
   EXPECT_TRUE(back.spec.signed_alphas);
   EXPECT_TRUE(Term(m, 0, TermKind::kAlpha, "rect_fem_r").held);
   for (size_t k = 0; k < m.terms.size(); ++k) EXPECT_EQ(back.terms[k].held, m.terms[k].held) << m.terms[k].Name();
+  ASSERT_EQ(back.papers_terms.size(), m.papers_terms.size());
+  for (size_t k = 0; k < m.papers_terms.size(); ++k) {
+    EXPECT_EQ(back.papers_terms[k].Name(), m.papers_terms[k].Name());
+    EXPECT_NEAR(back.papers_terms[k].value, m.papers_terms[k].value, 1e-8 * (1 + std::abs(m.papers_terms[k].value)));
+  }
   for (int j = 0; j < 2; ++j) {
     const std::vector<double> a = PredictMoment(m, r, j), b = PredictMoment(back, r, j);
     for (size_t i = 0; i < a.size(); i += 97) EXPECT_NEAR(a[i], b[i], 1e-6 * (1 + std::abs(a[i])));
@@ -334,6 +340,62 @@ TEST(EmgTorqueModel, ExtrapolationSharesCountTheSamplesOutside) {
   EXPECT_DOUBLE_EQ(x.angle_share[0], count(r.q[0], [](double v) { return v > 0.3; }));
   EXPECT_DOUBLE_EQ(x.velocity_share[1], count(r.qd[1], [](double v) { return v < 0.0; }));
   EXPECT_GT(x.velocity_share[1], 0.3);
+}
+
+// A joint's share of samples outside the calibration (JointOutsideShare) against a count written
+// here: a sample is outside when either joint's angle or velocity, or the envelope of a channel whose
+// muscle spans the joint, leaves its range. More than kOtherGaitShare outside: the papers' form
+// predicts the joint, bit for bit; at or below it the calibrated form does.
+TEST(EmgTorqueModel, AnotherGaitIsPredictedByThePapersForm) {
+  Truth tr;
+  tr.delay = 0.04;
+  const EmgRecording r = Synthetic(tr);
+  EmgModelSpec s;
+  s.common_delay = 0.04;
+  EmgTorqueModel m = FitEmgModel(s, {&r});
+  m.papers_terms = FitEmgModel(EmgModelSpec{}, {&r}).terms;
+  EmgTorqueModel papers;
+  papers.terms = m.papers_terms;
+  // The calibration's own recording: nothing outside; the calibrated form predicts.
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_EQ(JointOutsideShare(m.range, r, j, false), 0.0);
+    EXPECT_EQ(PredictMoment(m, r, j), PredictLinearMoment(m, r, j));
+  }
+  // The ranges shrunk: the med_gas_r envelope (spans the knee, not the hip) and the hip angle.
+  EmgCalibrationRange g = m.range;
+  g.e_hi[4] = 0.1, g.q_hi[0] = 0.25;
+  for (int j = 0; j < 2; ++j) {
+    double n = 0;
+    for (size_t i = 0; i < r.size(); ++i) n += r.q[0][i] > 0.25 || (j == 1 && r.e[4][i] > 0.1);
+    EXPECT_DOUBLE_EQ(JointOutsideShare(g, r, j, false), n / static_cast<double>(r.size())) << j;
+  }
+  EXPECT_GT(JointOutsideShare(g, r, 1, false), JointOutsideShare(g, r, 0, false));
+  // Another gait: the angles widened by half about their means and every envelope doubled.
+  EmgRecording other = r;
+  for (int j = 0; j < 2; ++j) {
+    double mean = 0;
+    for (double q : r.q[j]) mean += q / static_cast<double>(r.size());
+    for (size_t i = 0; i < r.size(); ++i)
+      other.q[j][i] = mean + 1.5 * (r.q[j][i] - mean), other.qd[j][i] = 1.5 * r.qd[j][i];
+  }
+  for (auto& e : other.e)
+    for (double& v : e) v *= 2;
+  const EmgPrediction p = PredictMoments(m, other);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_GT(p.outside_share[j], kOtherGaitShare) << j;
+    EXPECT_TRUE(p.papers[j]) << j;
+    EXPECT_EQ(p.tau[j], PredictLinearMoment(papers, other, j)) << j;
+    EXPECT_EQ(PredictMoment(m, other, j), p.tau[j]) << j;
+    EXPECT_NE(p.tau[j], PredictLinearMoment(m, other, j)) << j;
+  }
+  // Without the papers' form (a file written before it): the calibrated form, whatever the share.
+  EmgTorqueModel old = m;
+  old.papers_terms.clear();
+  const EmgPrediction q = PredictMoments(old, other);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_FALSE(q.papers[j]);
+    EXPECT_EQ(q.tau[j], PredictLinearMoment(m, other, j));
+  }
 }
 
 // ---- Collinear channels of one muscle ----
