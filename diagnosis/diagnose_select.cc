@@ -314,9 +314,19 @@ bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* wh
     else if (!(q0 >= s.q_min[j] - 0.5 && q0 <= s.q_max[j] + 0.5))
       no = "rest angle q0 " + Num(q0) + " rad outside the recorded range widened by 0.5 rad";
   }
+  // A dead band, or a strap's RMS static deflection under the torque it carries, below the
+  // materiality scale of the angle (kMinTorqueShare of its RMS about the mean, as the selection's)
+  // cannot move the quasi-static motion by a material amount: what it changes in a simulation is not
+  // a band's or a strap's geometry.
+  const double angle_floor = kMinTorqueShare * s.q_rms[j];
   if (e.name == "backlash" && !(v > 0 && v <= 0.1)) no = "dead band outside (0, 0.1] rad";
+  else if (e.name == "backlash" && !(v >= angle_floor))
+    no = "dead band " + Num(v) + " rad below the angle's materiality " + Num(angle_floor) + " rad";
   if (e.name == "series_compliance" && !(v > 0 && s.tau_C_max[j] / v <= 0.5 * range))
     no = "strap deflection " + Num(v > 0 ? s.tau_C_max[j] / v : 0) + " rad beyond half the motion range";
+  else if (e.name == "series_compliance" && !(s.tau_C_rms[j] / v >= angle_floor))
+    no = "strap deflection " + Num(s.tau_C_rms[j] / v) + " rad RMS, below the angle's materiality " +
+         Num(angle_floor) + " rad";
   else if (e.name == "series_compliance" && !(s.strap_dynamics[j] / v <= kStrapDynamics))
     no = "strap resonance sqrt(k / J) at " + Num(std::sqrt(v / s.strap_dynamics[j])) +
          " times the motion's frequency, expected above " + Num(1 / std::sqrt(kStrapDynamics)) +
@@ -345,11 +355,12 @@ PhysicalScale ScaleOf(const LegParams& params, const std::vector<ScaleRecord>& r
     // w = RMS(qdd) / RMS(qd) (of the velocity: a link that spins through many turns has a slow
     // angle but a fast velocity). The strap's neglected dynamics are J_c w^2.
     const LumpedParams& compliant = params.human ? *params.human : tot;
-    double msum = 0, jc = 0, v2 = 0, a2 = 0, cnt = 0;
+    double msum = 0, jc = 0, v2 = 0, a2 = 0, tc2 = 0, cnt = 0, qsum = 0, qsq = 0, qn = 0;
     for (const ScaleRecord& rc : recs) {
       const Kinematics& kin = *rc.kin;
       const size_t n = kin.t.size();
       for (size_t i = 0; i < n; ++i) {
+        qsum += kin.q[j][i], qsq += kin.q[j][i] * kin.q[j][i], qn += 1;
         scale.q_min[j] = std::min(scale.q_min[j], kin.q[j][i]);
         scale.q_max[j] = std::max(scale.q_max[j], kin.q[j][i]);
         scale.tau_max[j] = std::max(scale.tau_max[j], std::abs((*rc.tau[j])[i]));
@@ -361,10 +372,14 @@ PhysicalScale ScaleOf(const LegParams& params, const std::vector<ScaleRecord>& r
         msum += MassMatrix(tot, params.L1, q[1])(j, j);
         jc += MassMatrix(compliant, params.L1, q[1])(j, j);
         v2 += qd[j] * qd[j], a2 += qdd[j] * qdd[j], cnt += 1;
-        scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(CompliantPartTorque(rigid, q, qd, qdd)[j]));
+        const double tc = CompliantPartTorque(rigid, q, qd, qdd)[j];
+        scale.tau_C_max[j] = std::max(scale.tau_C_max[j], std::abs(tc));
+        tc2 += tc * tc;
       }
     }
+    if (qn > 0) scale.q_rms[j] = std::sqrt(std::max(0.0, qsq / qn - (qsum / qn) * (qsum / qn)));
     scale.M_jj[j] = msum / cnt;
+    scale.tau_C_rms[j] = std::sqrt(tc2 / cnt);
     scale.strap_dynamics[j] = v2 > 0 ? jc / cnt * a2 / v2 : 0.0;
   }
   return scale;

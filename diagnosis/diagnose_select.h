@@ -95,8 +95,10 @@ double SeOf(const Fit& f, int col);
 // range and torque per joint, and the twin's own inertia and distal gravity terms.
 struct PhysicalScale {
   double q_min[2] = {0, 0}, q_max[2] = {0, 0};  // rad, over every record
+  double q_rms[2] = {0, 0};                     // rad, RMS of the angle about its mean, every record
   double tau_max[2] = {0, 0};                   // N m, max |measured torque|
   double tau_C_max[2] = {0, 0};                 // N m, max |torque of the series-compliant part|
+  double tau_C_rms[2] = {0, 0};                 // N m, its RMS (strided over every record)
   // N m/rad: J_c w^2, with J_c the compliant part's mean diagonal inertia and w = RMS(qdd) /
   // RMS(qd) the motion's effective angular frequency. The quasi-static strap model holds below the
   // strap's resonance sqrt(k / J_c): strap_dynamics / k = (w / resonance)^2.

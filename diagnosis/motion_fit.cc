@@ -767,6 +767,12 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   Grams g_last;
   double tau_eff = 1;
   std::vector<std::vector<int>> seen;
+  struct Round {
+    std::vector<int> set;
+    Eigen::VectorXd theta;
+    double cost;  // fit-part cost of the refined set
+  };
+  std::vector<Round> rounds;
   const Eigen::VectorXd wv = RowWeights(P);
   // The linear model at theta of Jacobian J (motion_fit.h step 2): one bank per record, their Grams.
   auto Linearize = [&](const Eigen::MatrixXd& J, std::vector<ColumnBank>* banks_out, Grams* g_out) {
@@ -961,6 +967,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     theta = rf.theta;
     at = P.Simulate(theta, Part::kBoth);
     Charge(kRefinement);
+    rounds.push_back({chosen, theta, rf.cost});
     std::ostringstream os;
     os << "round " << round + 1 << ": refined on the plant:";
     for (int c : chosen) {
@@ -975,7 +982,25 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     if (!repeated) seen.push_back(key);
     previous = chosen;
     if (!repeated && round + 1 < kMotionOuterSteps) continue;
-    // Converged (the set repeats) or out of rounds: the exchanges on this round's linear model.
+    // Converged (the set repeats): this set. Out of rounds without a repeat: the rounds' set of the
+    // lowest exact fit-part BIC (a round linearized elsewhere may end on a worse set than an earlier
+    // one). Then the exchanges on this round's linear model.
+    size_t best = rounds.size() - 1;
+    for (size_t k = 0; !repeated && k < rounds.size(); ++k)
+      if (ExactBic(rounds[k].cost, ParameterCount(rounds[k].set)) <
+          ExactBic(rounds[best].cost, ParameterCount(rounds[best].set)))
+        best = k;
+    if (best + 1 != rounds.size()) {
+      MotionProblem::Rollout rb = P.Simulate(rounds[best].theta, Part::kBoth);
+      if (rb.ok) {
+        D.selection.push_back("round " + std::to_string(best + 1) + "'s set " + Labels(P, rounds[best].set) +
+                              " kept: exact BIC " +
+                              NumberText(ExactBic(rounds[best].cost, ParameterCount(rounds[best].set)), 4) +
+                              ", the last round's " + Labels(P, chosen) + " " +
+                              NumberText(ExactBic(rounds.back().cost, ParameterCount(chosen)), 4));
+        chosen = rounds[best].set, theta = rounds[best].theta, at = std::move(rb);
+      }
+    }
     Exchange(banks[0], g_last, round);
     break;
   }
@@ -988,6 +1013,30 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   Refined last;
   bool have_last = false;
   while (!chosen.empty()) {
+    // A refined value outside its range (DESIGN.md's table: the selection checked the linear fit's)
+    // goes first.
+    int implausible = -1;
+    std::string why;
+    for (size_t k = 0; k < chosen.size() && implausible < 0; ++k) {
+      const Candidate& c = cands[static_cast<size_t>(chosen[k])];
+      Eigen::VectorXd coef(static_cast<Eigen::Index>(c.cols.size()));
+      for (size_t i = 0; i < c.cols.size(); ++i) coef[static_cast<Eigen::Index>(i)] = theta[c.cols[i]];
+      if (!Plausible(ToEffect(c, coef, c.cols), P.scale(), &why)) implausible = static_cast<int>(k);
+    }
+    if (implausible >= 0) {
+      const Candidate& ic = cands[static_cast<size_t>(chosen[static_cast<size_t>(implausible)])];
+      D.selection.push_back("range: " + ic.Label() + " removed at its refined value: " + why);
+      chosen.erase(chosen.begin() + implausible);
+      for (int k : ic.cols) theta[k] = 0;
+      have_last = false;
+      if (chosen.empty()) {
+        theta = zero;
+        break;
+      }
+      const Refined rf = Refine(P, ColumnsOf(cand_bank, chosen), {theta});
+      if (std::isfinite(rf.cost)) theta = rf.theta, last = rf, have_last = true;
+      continue;
+    }
     std::vector<Eigen::VectorXd> thetas = {theta};
     for (int c : chosen) {
       Eigen::VectorXd x = theta;

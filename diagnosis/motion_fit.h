@@ -57,12 +57,16 @@
 //     whole physics steps), the refinement restarted where a probe is lower (kMotionBandProbes rounds
 //     at most);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
-//     then exchanges (at most kMotionExchanges): the swap of one chosen effect for one candidate that
+//     where no set repeated, the rounds' refined set of the lowest exact fit-part BIC stays (a round
+//     linearized elsewhere may end on a worse set than an earlier one); then exchanges (at most
+//     kMotionExchanges): the swap of one chosen effect for one candidate that
 //     the last round's linear model ranks lowest in BIC, refined on the exact plant (step 4's
 //     refinement from the set's values with the effect taken out and from the linear fit's), taken
 //     where the exact fit-part BIC is lower (stepwise selection keeps an effect that entered early and
 //     stands in for one that only pays once the others are in);
-//  6. exact held-out gate: every chosen effect, taken out of the refined set, must raise the held-out
+//  6. ranges and the exact held-out gate: a chosen effect whose refined value leaves its range
+//     (Plausible; the selection checked the linear fit's value) is dropped and the rest refined again;
+//     every chosen effect, taken out of the refined set, must raise the held-out
 //     simulated error at its joint by at least kMinHeldoutGain of the set's; one that does not is
 //     dropped (the weakest first) and the rest refined again;
 //  7. 95 % intervals from the final Jacobian: cov = s^2 (J'J)^-1, s^2 the fit part's residual variance
@@ -90,7 +94,7 @@
 
 namespace exotwin {
 
-constexpr int kMotionOuterSteps = 3;     // linearize-select-refine rounds at most
+constexpr int kMotionOuterSteps = 4;     // linearize-select-refine rounds at most
 constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per refinement at most
 constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
 constexpr int kMotionBandProbes = 3;  // rounds of a dead band's probes after a refinement at most (step 4)

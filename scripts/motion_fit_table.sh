@@ -19,13 +19,17 @@ cases=(
   "knee backlash 0.01|{name: backlash, joint: knee, value: 0.01}"
   "knee backlash 0.02|{name: backlash, joint: knee, value: 0.02}"
   "knee backlash 0.03|{name: backlash, joint: knee, value: 0.03}"
+  "hip backlash 0.005|{name: backlash, joint: hip, value: 0.005}"
   "hip backlash 0.01|{name: backlash, joint: hip, value: 0.01}"
+  "hip backlash 0.02|{name: backlash, joint: hip, value: 0.02}"
   "hip backlash 0.03|{name: backlash, joint: hip, value: 0.03}"
   "knee strap 300|{name: series_compliance, joint: knee, value: 300}"
+  "knee strap 600|{name: series_compliance, joint: knee, value: 600}"
   "knee strap 1100|{name: series_compliance, joint: knee, value: 1100}"
   "knee strap 1500|{name: series_compliance, joint: knee, value: 1500}"
   "knee sensor_delay 0.003|{name: sensor_delay, joint: knee, value: 0.003}"
   "knee backlash 0.02 + knee coulomb 2|{name: backlash, joint: knee, value: 0.02}, {name: coulomb_friction, joint: knee, value: 2.0}"
+  "hip backlash 0.02 + knee coulomb 2|{name: backlash, joint: hip, value: 0.02}, {name: coulomb_friction, joint: knee, value: 2.0}"
 )
 named() {  # the effects of a diagnosis.json, one line
   python3 -c 'import json,sys

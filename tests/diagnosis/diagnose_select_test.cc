@@ -10,6 +10,8 @@
 #include <Eigen/Dense>
 
 #include "core/rng.h"
+#include "diagnosis/effects.h"
+#include "formats/model_file.h"
 
 namespace exotwin {
 namespace {
@@ -88,6 +90,57 @@ TEST(SolveSigned, UnconstrainedSolutionWhenItKeepsTheSigns) {
   ASSERT_TRUE(SolveSigned(A, b, {1, 1}, &x));  // x1 >= 0: held at zero, x0 = b0 / A00
   EXPECT_EQ(x[1], 0.0);
   EXPECT_NEAR(x[0], b[0] / A(0, 0), 1e-12);
+}
+
+// The physical scale's angle RMS and strap torque RMS (ScaleOf) on a gait-like sinusoid of whole
+// periods, against closed forms and a direct sum; the ranges (Plausible) of a dead band and a strap at
+// the angle's materiality, kMinTorqueShare of its RMS about the mean (DESIGN.md's table).
+TEST(PhysicalScale, DeadBandsAndStrapsBelowTheAnglesMaterialityAreOutsideTheirRange) {
+  const LegParams params = ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml");
+  ASSERT_TRUE(params.human);
+  Kinematics kin;
+  const double A[2] = {0.35, 0.5}, w = 2 * M_PI;  // 1 Hz, 4 whole periods at 1 kHz
+  std::vector<double> tau[2];
+  for (int i = 0; i < 4000; ++i) {
+    const double t = 0.001 * i;
+    kin.t.push_back(t);
+    for (int j = 0; j < 2; ++j) {
+      const double ph = j == 0 ? 0.0 : 1.0, mean = j == 0 ? 0.1 : -0.6;
+      kin.q[j].push_back(mean + A[j] * std::sin(w * t + ph));
+      kin.qd[j].push_back(A[j] * w * std::cos(w * t + ph));
+      kin.qdd[j].push_back(-A[j] * w * w * std::sin(w * t + ph));
+      tau[j].push_back(1.0);
+    }
+  }
+  const PhysicalScale s = ScaleOf(params, {{&kin, {&tau[0], &tau[1]}}});
+  LegParams rigid = params;
+  rigid.effects.clear();
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_NEAR(s.q_rms[j], A[j] / std::sqrt(2.0), 1e-9) << j;
+    double sum = 0, n = 0;  // ScaleOf's stride: every sample below 4000 per record
+    for (size_t i = 0; i < kin.t.size(); ++i) {
+      const Eigen::Vector2d q(kin.q[0][i], kin.q[1][i]), qd(kin.qd[0][i], kin.qd[1][i]), qdd(kin.qdd[0][i], kin.qdd[1][i]);
+      sum += std::pow(CompliantPartTorque(rigid, q, qd, qdd)[j], 2), n += 1;
+    }
+    EXPECT_NEAR(s.tau_C_rms[j], std::sqrt(sum / n), 1e-9 * (1 + s.tau_C_rms[j])) << j;
+  }
+  // At the knee: the floor kMinTorqueShare q_rms, a dead band and a strap 10 % either side of it.
+  const double floor = kMinTorqueShare * s.q_rms[1], k_floor = s.tau_C_rms[1] / floor;
+  auto effect = [](const std::string& name, double v) {
+    DiagnosedEffect d;
+    d.effect.name = name, d.effect.joint = "knee", d.effect.value = v;
+    return d;
+  };
+  std::string why;
+  EXPECT_TRUE(Plausible(effect("backlash", 1.1 * floor), s, &why)) << why;
+  EXPECT_FALSE(Plausible(effect("backlash", 0.9 * floor), s, &why));
+  EXPECT_NE(why.find("materiality"), std::string::npos) << why;
+  EXPECT_FALSE(Plausible(effect("series_compliance", 1.1 * k_floor), s, &why));
+  EXPECT_NE(why.find("materiality"), std::string::npos) << why;
+  // Just inside the floor (a strap that stiff resonates far above this 1 Hz motion).
+  EXPECT_TRUE(Plausible(effect("series_compliance", 0.9 * k_floor), s, &why)) << why;
+  // The straps (300-1500 N m/rad) on this motion: far above the floor.
+  EXPECT_GT(k_floor, 3 * 1500.0);
 }
 
 }  // namespace

@@ -256,10 +256,12 @@ TEST(MotionFit, KneeBacklashAndCoulombFrictionAreBothNamed) {
 
 // Table 5's human side (data/plants/human_side.yaml, subject S2 with its passive-moment draw of seed 1)
 // on the relaxed gait, the rigid parameters and the device's sensor calibration given: the strap, the
-// leg's damping and the subject's passive moment are to be found. Forward selection stops at a set
-// with a knee gravity_error and a hip gravity_error in the strap's and the hip damping's place; the
-// exchanges (motion_fit.h step 5) swap them on the exact plant.
-TEST(MotionFit, ExchangesReplaceEffectsThatStoodInForAStrap) {
+// leg's damping at both joints and the subject's passive moments are to be found, and nothing else.
+// Forward selection linearized at the model given stops at a knee joint_stiffness in the strap's place
+// and a hip Coulomb friction in the hip damping's; the later rounds (linearized at their refined
+// values), the choice among the rounds' sets and the exchanges (motion_fit.h step 5) reach the
+// plant's five.
+TEST(MotionFit, HumanSideStrapDampingAndPassiveMomentsAreNamed) {
   const testing::ScopedTempDir tmp("motion_exchange");
   const std::string sensor =
       "{name: sensor_offset, joint: hip, value: 0.12}, {name: sensor_gain, joint: hip, value: 0.005}, "
@@ -278,17 +280,20 @@ TEST(MotionFit, ExchangesReplaceEffectsThatStoodInForAStrap) {
   opt.threads = 2;
   const Diagnosis d = Diagnose(given, record, opt);
   Print("S2's human side", d);
-  bool exchanged = false;
-  for (const auto& s : d.selection) exchanged = exchanged || (s.find("exchange") != std::string::npos && s.find(", taken") != std::string::npos);
-  EXPECT_TRUE(exchanged);
+  for (const auto& s : d.selection)
+    if (s.find("chosen") != std::string::npos || s.find("exchange") != std::string::npos ||
+        s.find("kept") != std::string::npos)
+      std::printf("  %s\n", s.c_str());
   std::map<std::string, double> named;
   for (const auto& e : d.effects) named[e.effect.name + "(" + e.effect.joint + ")"] = e.effect.value;
-  ASSERT_TRUE(named.count("series_compliance(knee)")) << "the strap is not named";
-  EXPECT_NEAR(named["series_compliance(knee)"], 1100, 0.25 * 1100);
-  EXPECT_NEAR(named["passive_moment(hip)"], -0.288, 0.25 * 0.288);
-  EXPECT_NEAR(named["passive_moment(knee)"], 0.104, 0.25 * 0.104);
-  EXPECT_NEAR(named["viscous_friction(knee)"], 0.1, 0.25 * 0.1);
-  EXPECT_FALSE(named.count("gravity_error(knee)") || named.count("gravity_error(hip)"));
+  const std::map<std::string, double> truth = {{"series_compliance(knee)", 1100}, {"passive_moment(hip)", -0.288},
+                                               {"passive_moment(knee)", 0.104},   {"viscous_friction(knee)", 0.1},
+                                               {"viscous_friction(hip)", 0.2}};
+  EXPECT_EQ(named.size(), truth.size());
+  for (const auto& t : truth) {
+    ASSERT_TRUE(named.count(t.first)) << t.first << " not named";
+    EXPECT_NEAR(named[t.first], t.second, 0.25 * std::abs(t.second)) << t.first;
+  }
 }
 
 TEST(MotionFit, NothingIsNamedOnTheRigidPlant) {
