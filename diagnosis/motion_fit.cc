@@ -1014,57 +1014,49 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   bool have_last = false;
   while (!chosen.empty()) {
     // A refined value outside its range (DESIGN.md's table: the selection checked the linear fit's)
-    // goes first.
-    int implausible = -1;
+    // goes first; else the effect whose removal raises the held-out error at its joint least, if below
+    // kMinHeldoutGain.
+    int drop = -1;
     std::string why;
-    for (size_t k = 0; k < chosen.size() && implausible < 0; ++k) {
+    for (size_t k = 0; k < chosen.size() && drop < 0; ++k) {
       const Candidate& c = cands[static_cast<size_t>(chosen[k])];
       Eigen::VectorXd coef(static_cast<Eigen::Index>(c.cols.size()));
       for (size_t i = 0; i < c.cols.size(); ++i) coef[static_cast<Eigen::Index>(i)] = theta[c.cols[i]];
-      if (!Plausible(ToEffect(c, coef, c.cols), P.scale(), &why)) implausible = static_cast<int>(k);
-    }
-    if (implausible >= 0) {
-      const Candidate& ic = cands[static_cast<size_t>(chosen[static_cast<size_t>(implausible)])];
-      D.selection.push_back("range: " + ic.Label() + " removed at its refined value: " + why);
-      chosen.erase(chosen.begin() + implausible);
-      for (int k : ic.cols) theta[k] = 0;
-      have_last = false;
-      if (chosen.empty()) {
-        theta = zero;
-        break;
+      if (!Plausible(ToEffect(c, coef, c.cols), P.scale(), &why)) {
+        drop = static_cast<int>(k);
+        why = "range: " + c.Label() + " removed at its refined value: " + why;
       }
-      const Refined rf = Refine(P, ColumnsOf(cand_bank, chosen), {theta});
-      if (std::isfinite(rf.cost)) theta = rf.theta, last = rf, have_last = true;
-      continue;
     }
-    std::vector<Eigen::VectorXd> thetas = {theta};
-    for (int c : chosen) {
-      Eigen::VectorXd x = theta;
-      for (int k : cands[static_cast<size_t>(c)].cols) x[k] = 0;
-      thetas.push_back(x);
+    if (drop < 0) {
+      std::vector<Eigen::VectorXd> thetas = {theta};
+      for (int c : chosen) {
+        Eigen::VectorXd x = theta;
+        for (int k : cands[static_cast<size_t>(c)].cols) x[k] = 0;
+        thetas.push_back(x);
+      }
+      const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(thetas, Part::kHeldOut);
+      double full[2];
+      P.Sse(ro[0], Part::kHeldOut, full);
+      double worst_gain = INFINITY;
+      explained.assign(chosen.size(), 0.0);
+      for (size_t k = 0; k < chosen.size(); ++k) {
+        const int j = cands[static_cast<size_t>(chosen[k])].joint;
+        double without[2] = {INFINITY, INFINITY};
+        if (ro[k + 1].ok) P.Sse(ro[k + 1], Part::kHeldOut, without);
+        const double gain = without[j] > 0 ? 1 - full[j] / without[j] : 0.0;
+        explained[k] = 100 * ((without[0] + without[1]) - (full[0] + full[1])) /
+                       std::max(sse_given_te[0] + sse_given_te[1], 1e-300);
+        if (gain < worst_gain) worst_gain = gain, drop = static_cast<int>(k);
+      }
+      if (worst_gain >= kMinHeldoutGain) break;
+      const Candidate& wc = cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])];
+      why = "exact held-out gate: " + wc.Label() + " removed: without it the held-out simulated error at the " +
+            kJoint[wc.joint] + " is only " + NumberText(100 * worst_gain, 3) + " % higher (needed " +
+            NumberText(100 * kMinHeldoutGain) + " %)";
     }
-    const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(thetas, Part::kHeldOut);
-    double full[2];
-    P.Sse(ro[0], Part::kHeldOut, full);
-    int worst = -1;
-    double worst_gain = INFINITY;
-    explained.assign(chosen.size(), 0.0);
-    for (size_t k = 0; k < chosen.size(); ++k) {
-      const int j = cands[static_cast<size_t>(chosen[k])].joint;
-      double without[2] = {INFINITY, INFINITY};
-      if (ro[k + 1].ok) P.Sse(ro[k + 1], Part::kHeldOut, without);
-      const double gain = without[j] > 0 ? 1 - full[j] / without[j] : 0.0;
-      explained[k] = 100 * ((without[0] + without[1]) - (full[0] + full[1])) /
-                     std::max(sse_given_te[0] + sse_given_te[1], 1e-300);
-      if (gain < worst_gain) worst_gain = gain, worst = static_cast<int>(k);
-    }
-    if (worst_gain >= kMinHeldoutGain) break;
-    const Candidate& wc = cands[static_cast<size_t>(chosen[static_cast<size_t>(worst)])];
-    D.selection.push_back("exact held-out gate: " + wc.Label() + " removed: without it the held-out simulated error at the " +
-                          kJoint[wc.joint] + " is only " + NumberText(100 * worst_gain, 3) + " % higher (needed " +
-                          NumberText(100 * kMinHeldoutGain) + " %)");
-    chosen.erase(chosen.begin() + worst);
-    for (int k : wc.cols) theta[k] = 0;
+    D.selection.push_back(why);
+    for (int k : cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])].cols) theta[k] = 0;
+    chosen.erase(chosen.begin() + drop);
     have_last = false;
     if (chosen.empty()) {
       theta = zero;

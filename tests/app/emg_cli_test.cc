@@ -65,6 +65,30 @@ std::string IdSto(int drop_value_row = -1) {
   return o.str();
 }
 
+// A storage file's trial played twice as fast (time halved), the value columns `doubled` (1-based
+// after time) doubled.
+std::string PlayedFaster(const std::string& text, const std::vector<int>& doubled) {
+  std::istringstream in(text);
+  std::ostringstream out;
+  std::string line;
+  bool body = false;
+  while (std::getline(in, line)) {
+    if (body && !line.empty()) {
+      std::istringstream f(line);
+      std::vector<double> v;
+      for (double x; f >> x;) v.push_back(x);
+      v[0] /= 2;
+      for (int c : doubled) v[static_cast<size_t>(c)] *= 2;
+      for (size_t i = 0; i < v.size(); ++i) out << (i ? "\t" : "") << v[i];
+      out << "\n";
+      continue;
+    }
+    body |= line.rfind("time", 0) == 0;
+    out << line << "\n";
+  }
+  return out.str();
+}
+
 class EmgCli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -135,29 +159,8 @@ TEST_F(EmgCli, PredictReportsExtrapolationPerChannelAndJoint) {
   // The same trial played twice as fast (velocities doubled) with the rectus femoris' envelope
   // doubled: its samples above the calibrated peak, and the velocities beyond theirs, are counted.
   std::string emg = EmgSto(), ik = IkSto();
-  auto faster = [](const std::string& text, int value_column_to_double) {
-    std::istringstream in(text);
-    std::ostringstream out;
-    std::string line;
-    bool body = false;
-    while (std::getline(in, line)) {
-      if (body && !line.empty()) {
-        std::istringstream f(line);
-        std::vector<double> v;
-        for (double x; f >> x;) v.push_back(x);
-        v[0] /= 2;
-        if (value_column_to_double > 0) v[value_column_to_double] *= 2;
-        for (size_t i = 0; i < v.size(); ++i) out << (i ? "\t" : "") << v[i];
-        out << "\n";
-        continue;
-      }
-      body |= line.rfind("time", 0) == 0;
-      out << line << "\n";
-    }
-    return out.str();
-  };
-  WriteText(dir_ + "/fast_emg.sto", faster(emg, 1));
-  WriteText(dir_ + "/fast_ik.sto", faster(ik, 0));
+  WriteText(dir_ + "/fast_emg.sto", PlayedFaster(emg, {1}));
+  WriteText(dir_ + "/fast_ik.sto", PlayedFaster(ik, {}));
   const auto r = RunExotwin("emg-predict --model " + dir_ + "/model.yaml --emg " + dir_ + "/fast_emg.sto --kinematics " +
                             dir_ + "/fast_ik.sto --out " + dir_ + "/pred.csv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -195,29 +198,8 @@ TEST_F(EmgCli, AnotherGaitIsPredictedByThePapersFormAndSaysSo) {
   ASSERT_FALSE(papers.empty());
   EXPECT_EQ(papers, block(ReadText(dir_ + "/linear.yaml"), "parameters"));
   // The trial twice as fast with every envelope doubled: most samples outside at both joints.
-  auto faster = [](const std::string& text, bool envelopes) {
-    std::istringstream in(text);
-    std::ostringstream out;
-    std::string line;
-    bool body = false;
-    while (std::getline(in, line)) {
-      if (body && !line.empty()) {
-        std::istringstream f(line);
-        std::vector<double> v;
-        for (double x; f >> x;) v.push_back(x);
-        v[0] /= 2;
-        for (size_t i = 1; envelopes && i < v.size(); ++i) v[i] *= 2;
-        for (size_t i = 0; i < v.size(); ++i) out << (i ? "\t" : "") << v[i];
-        out << "\n";
-        continue;
-      }
-      body |= line.rfind("time", 0) == 0;
-      out << line << "\n";
-    }
-    return out.str();
-  };
-  WriteText(dir_ + "/fast_emg.sto", faster(EmgSto(), true));
-  WriteText(dir_ + "/fast_ik.sto", faster(IkSto(), false));
+  WriteText(dir_ + "/fast_emg.sto", PlayedFaster(EmgSto(), {1, 2, 3, 4, 5}));
+  WriteText(dir_ + "/fast_ik.sto", PlayedFaster(IkSto(), {}));
   auto predict = [&](const std::string& model, const std::string& emg, const std::string& ik, const std::string& out) {
     return RunExotwin("emg-predict --model " + dir_ + "/" + model + " --emg " + dir_ + "/" + emg + " --kinematics " +
                       dir_ + "/" + ik + " --out " + dir_ + "/" + out);
