@@ -1,6 +1,7 @@
 #include "diagnosis/motion_fit.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -267,12 +268,14 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows), all_rows += static_cast<double>(rp->rows.size());
   for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse[j] / count), 1e-6);
   fit_share_ = count / std::max(all_rows, 1.0);
+  all_rows_ = std::max(all_rows, 1.0);
 }
 
 double MotionProblem::ReplaysSimulated() const {
   return static_cast<double>(rollouts_[static_cast<int>(Part::kFit)]) * fit_share_ +
          static_cast<double>(rollouts_[static_cast<int>(Part::kHeldOut)]) * (1 - fit_share_) +
-         static_cast<double>(rollouts_[static_cast<int>(Part::kBoth)]);
+         static_cast<double>(rollouts_[static_cast<int>(Part::kBoth)]) +
+         static_cast<double>(record_rows_) / all_rows_;
 }
 
 int MotionProblem::CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis) const {
@@ -340,6 +343,21 @@ std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const
 
 MotionProblem::Rollout MotionProblem::Simulate(const Eigen::VectorXd& theta, Part part) const {
   ++rollouts_[static_cast<int>(part)];
+  return Run(theta, part, -1);
+}
+
+MotionProblem::Rollout MotionProblem::SimulateRecord(const Eigen::VectorXd& theta, size_t record) const {
+  record_rows_ += static_cast<long>(rec_[record]->rows.size());
+  return Run(theta, Part::kBoth, static_cast<int>(record));
+}
+
+std::vector<MotionProblem::Rollout> MotionProblem::SimulateEachRecord(const std::vector<Eigen::VectorXd>& thetas) const {
+  std::vector<Rollout> out(thetas.size());
+  ParallelFor(thetas.size(), DiagnoseThreads(opt_), [&](size_t r) { out[r] = SimulateRecord(thetas[r], r); });
+  return out;
+}
+
+MotionProblem::Rollout MotionProblem::Run(const Eigen::VectorXd& theta, Part part, int only) const {
   LegParams p = params_;
   const std::vector<Effect> extra = EffectsOf(theta);
   p.effects.insert(p.effects.end(), extra.begin(), extra.end());
@@ -356,8 +374,12 @@ MotionProblem::Rollout MotionProblem::Simulate(const Eigen::VectorXd& theta, Par
   Rollout out;
   out.ok = true;
   const double H = opt_.replay_horizon_s;
-  for (const auto& rp : rec_) {
-    const Record& R = *rp;
+  for (size_t r = 0; r < rec_.size(); ++r) {
+    const Record& R = *rec_[r];
+    if (only >= 0 && static_cast<size_t>(only) != r) {
+      out.q.push_back(Eigen::VectorXd::Constant(static_cast<Eigen::Index>(2 * R.rows.size()), std::nan("")));
+      continue;
+    }
     ReplaySeries s = R.series;
     if (R.by_reading) {
       ActuatorTorqueFromReading(fx, s.t, R.reading, s.tau_R);
@@ -530,6 +552,63 @@ double ResidualAutocorrelation(const MotionProblem& P, const MotionProblem::Roll
   return std::min(tau, std::max(1.0, window_rows));
 }
 
+// The weighted Jacobian of the fit rows (PartRows(P, kFit), rows weighted as RowWeights) of
+// parameters `cols` at theta, whose rollout (fit part at least) is `at`.
+Eigen::MatrixXd WeightedFitJacobian(const MotionProblem& P, const Eigen::VectorXd& theta, const MotionProblem::Rollout& at,
+                                    const std::vector<int>& cols) {
+  const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
+  const Eigen::VectorXd wv = RowWeights(P);
+  const Eigen::MatrixXd Jall = P.Jacobian(theta, at, cols, Part::kFit);
+  Eigen::MatrixXd J(static_cast<Eigen::Index>(idx.size()), Jall.cols());
+  for (size_t k = 0; k < idx.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = wv[idx[k]] * Jall.row(idx[k]);
+  return J;
+}
+
+// Each record left out in turn: the values of `cols` one Gauss-Newton step from theta on the other
+// records' fit parts (J, e: the weighted Jacobian and residual of the fit rows at theta), inside the
+// box; the rest of theta as it is. Where without a record the values are not identifiable, that
+// record's index in *unidentifiable (else -1) and an empty result.
+std::vector<Eigen::VectorXd> LeftOutThetas(const MotionProblem& P, const Eigen::VectorXd& theta,
+                                           const std::vector<int>& cols, const Eigen::MatrixXd& J,
+                                           const Eigen::VectorXd& e, int* unidentifiable) {
+  *unidentifiable = -1;
+  const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
+  std::vector<size_t> owner(idx.size());
+  Eigen::Index off = 0;
+  size_t rec = 0;
+  for (size_t k = 0; k < idx.size(); ++k) {
+    while (idx[k] >= off + P.measured(rec).size()) off += P.measured(rec).size(), ++rec;
+    owner[k] = rec;
+  }
+  std::vector<Eigen::VectorXd> out;
+  const Eigen::Index p = static_cast<Eigen::Index>(cols.size());
+  for (size_t r = 0; r < P.records(); ++r) {
+    Eigen::VectorXd x = theta;
+    if (p > 0) {
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(p, p);
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(p);
+      for (size_t k = 0; k < owner.size(); ++k) {
+        if (owner[k] == r) continue;
+        const Eigen::Index i = static_cast<Eigen::Index>(k);
+        A.noalias() += J.row(i).transpose() * J.row(i);
+        g.noalias() += J.row(i).transpose() * e[i];
+      }
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+      const Eigen::VectorXd d = ldlt.solve(g);
+      if (ldlt.info() != Eigen::Success || !d.allFinite() || !(A.diagonal().minCoeff() > 0)) {
+        *unidentifiable = static_cast<int>(r);
+        return {};
+      }
+      for (Eigen::Index c = 0; c < p; ++c) {
+        const int k = cols[static_cast<size_t>(c)];
+        x[k] = std::clamp(theta[k] + d[c], P.lower(k), P.upper(k));
+      }
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
 struct Refined {
   Eigen::VectorXd theta;
   double cost = INFINITY;
@@ -560,10 +639,7 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
   R.cost = Cost(P, at, Part::kFit);
   if (!std::isfinite(R.cost)) return R;
   auto WeightedJ = [&](const MotionProblem::Rollout& a, const Eigen::VectorXd& theta) {
-    const Eigen::MatrixXd Jall = P.Jacobian(theta, a, cols, Part::kFit);
-    Eigen::MatrixXd J(static_cast<Eigen::Index>(idx.size()), Jall.cols());
-    for (size_t k = 0; k < idx.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = wv[idx[k]] * Jall.row(idx[k]);
-    return J;
+    return WeightedFitJacobian(P, theta, a, cols);
   };
   double lambda = 1e-3;
   bool fresh = false;
@@ -1034,25 +1110,65 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
         for (int k : cands[static_cast<size_t>(c)].cols) x[k] = 0;
         thetas.push_back(x);
       }
-      const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(thetas, Part::kHeldOut);
+      // With several records, both parts: the fit part's residual gives the values each record left
+      // out takes (LeftOutThetas), whose whole-record error is the second test.
+      const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(thetas, loo ? Part::kBoth : Part::kHeldOut);
       double full[2];
       P.Sse(ro[0], Part::kHeldOut, full);
-      double worst_gain = INFINITY;
+      std::vector<std::array<double, 2>> left_out(thetas.size(), {NAN, NAN});
+      if (loo && ro[0].ok) {
+        const std::vector<int> cols = ColumnsOf(cand_bank, chosen);
+        const Eigen::MatrixXd J = WeightedFitJacobian(P, theta, ro[0], cols);
+        const std::vector<Eigen::Index> fit_rows = PartRows(P, Part::kFit);
+        for (size_t set = 0; set < thetas.size(); ++set) {
+          if (!ro[set].ok) continue;
+          std::vector<int> cs;
+          std::vector<Eigen::Index> keep;
+          for (size_t c = 0; c < cols.size(); ++c) {
+            const auto& out = set == 0 ? std::vector<int>{} : cands[static_cast<size_t>(chosen[set - 1])].cols;
+            if (std::find(out.begin(), out.end(), cols[c]) != out.end()) continue;
+            cs.push_back(cols[c]);
+            keep.push_back(static_cast<Eigen::Index>(c));
+          }
+          Eigen::MatrixXd Js(J.rows(), static_cast<Eigen::Index>(keep.size()));
+          for (size_t c = 0; c < keep.size(); ++c) Js.col(static_cast<Eigen::Index>(c)) = J.col(keep[c]);
+          int bad = -1;
+          const std::vector<Eigen::VectorXd> lt =
+              cs.empty() ? std::vector<Eigen::VectorXd>(P.records(), thetas[set])
+                         : LeftOutThetas(P, thetas[set], cs, Js, WeightedResidual(P, ro[set], fit_rows), &bad);
+          if (bad >= 0) continue;
+          const std::vector<MotionProblem::Rollout> lro = P.SimulateEachRecord(lt);
+          std::array<double, 2> sum = {0, 0};
+          for (size_t r = 0; r < lro.size() && std::isfinite(sum[0]); ++r) {
+            double a[2] = {NAN, NAN}, n;
+            if (lro[r].ok) RecordSse(P, lro[r], r, Part::kBoth, a, &n);
+            sum[0] += a[0], sum[1] += a[1];
+          }
+          left_out[set] = sum;
+        }
+      }
+      double worst_gain = INFINITY, worst_held = 0, worst_left = NAN;
       explained.assign(chosen.size(), 0.0);
       for (size_t k = 0; k < chosen.size(); ++k) {
         const int j = cands[static_cast<size_t>(chosen[k])].joint;
         double without[2] = {INFINITY, INFINITY};
         if (ro[k + 1].ok) P.Sse(ro[k + 1], Part::kHeldOut, without);
-        const double gain = without[j] > 0 ? 1 - full[j] / without[j] : 0.0;
+        const double held = without[j] > 0 ? 1 - full[j] / without[j] : 0.0;
+        // Records left out (several records): kept where either test gains kMinHeldoutGain (a record's
+        // held-out end may lack the motion an effect shows in, which the other records carry).
+        const double left = left_out[0][j] / left_out[k + 1][j];
+        const double gain = std::isfinite(left) && left_out[k + 1][j] > 0 ? std::max(held, 1 - left) : held;
         explained[k] = 100 * ((without[0] + without[1]) - (full[0] + full[1])) /
                        std::max(sse_given_te[0] + sse_given_te[1], 1e-300);
-        if (gain < worst_gain) worst_gain = gain, drop = static_cast<int>(k);
+        if (gain < worst_gain)
+          worst_gain = gain, worst_held = held, worst_left = std::isfinite(left) ? 1 - left : NAN, drop = static_cast<int>(k);
       }
       if (worst_gain >= kMinHeldoutGain) break;
       const Candidate& wc = cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])];
       why = "exact held-out gate: " + wc.Label() + " removed: without it the held-out simulated error at the " +
-            kJoint[wc.joint] + " is only " + NumberText(100 * worst_gain, 3) + " % higher (needed " +
-            NumberText(100 * kMinHeldoutGain) + " %)";
+            kJoint[wc.joint] + " is only " + NumberText(100 * worst_held, 3) + " % higher" +
+            (std::isfinite(worst_left) ? ", the records' left out " + NumberText(100 * worst_left, 3) + " %" : "") +
+            " (needed " + NumberText(100 * kMinHeldoutGain) + " %)";
     }
     D.selection.push_back(why);
     for (int k : cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])].cols) theta[k] = 0;
@@ -1112,19 +1228,20 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   S.horizon_s = opt.replay_horizon_s;
   S.cutoff_hz = opt.replay_cutoff_hz;
   double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
+  // Each record left out in turn: the values one Gauss-Newton step from the final ones on the other
+  // records' fit parts (the final refinement's Jacobian and residual; the round's linear model g_last
+  // is linearized where that round started, which the rounds' choice and the exchanges may have left
+  // far behind), each simulated on its record.
   std::vector<Eigen::VectorXd> loo_thetas;
-  if (loo)
-    for (size_t r = 0; r < P.records(); ++r) {
-      Eigen::VectorXd x = zero;
-      if (!cols.empty()) {
-        const Eigen::VectorXd v = FitLeavingOut(g_last, cols, r);
-        if (v.size() == 0) throw InputError(records[r]->source + ": without this record the chosen effects are not identifiable");
-        for (size_t k = 0; k < cols.size(); ++k)
-          x[cols[k]] = std::clamp(v[static_cast<Eigen::Index>(k)], P.lower(cols[k]), P.upper(cols[k]));
-      }
-      loo_thetas.push_back(x);
-    }
-  const std::vector<MotionProblem::Rollout> loo_ro = P.SimulateAll(loo_thetas, Part::kBoth);
+  if (loo) {
+    int bad = -1;
+    if (cols.empty()) loo_thetas.assign(P.records(), theta);
+    else loo_thetas = LeftOutThetas(P, theta, cols, last.J, last.e, &bad);
+    if (bad >= 0)
+      throw InputError(records[static_cast<size_t>(bad)]->source +
+                       ": without this record the chosen effects are not identifiable");
+  }
+  const std::vector<MotionProblem::Rollout> loo_ro = P.SimulateEachRecord(loo_thetas);
   for (size_t r = 0; r < P.records(); ++r) {
     RecordScore rs;
     rs.source = records[r]->source;

@@ -67,11 +67,16 @@
 //  6. ranges and the exact held-out gate: a chosen effect whose refined value leaves its range
 //     (Plausible; the selection checked the linear fit's value) is dropped and the rest refined again;
 //     every chosen effect, taken out of the refined set, must raise the held-out
-//     simulated error at its joint by at least kMinHeldoutGain of the set's; one that does not is
-//     dropped (the weakest first) and the rest refined again;
+//     simulated error at its joint by at least kMinHeldoutGain of the set's, or (several records) the
+//     error of the whole records left out, each simulated with the values of the set (with or without
+//     the effect) one Gauss-Newton step from its refined ones on the other records' fit parts
+//     (LeftOutThetas: a record's held-out end may lack the motion an effect shows in); one that passes
+//     neither is dropped (the weakest first) and the rest refined again;
 //  7. 95 % intervals from the final Jacobian: cov = s^2 (J'J)^-1, s^2 the fit part's residual variance
 //     inflated by its autocorrelation length; every effect the torque fit names and the motion fit
-//     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings.
+//     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings;
+//     the records left out (simulation.left_out) with the values LeftOutThetas gives at the final
+//     Jacobian.
 // Rollouts run in parallel on DiagnoseOptions::threads std::threads (one plant per rollout, built under
 // a lock: MuJoCo's compiler is not reentrant), each stored by its index: the result does not depend on
 // the thread count (the same bits).
@@ -143,8 +148,12 @@ class MotionProblem {
     std::vector<Eigen::VectorXd> q;
   };
   Rollout Simulate(const Eigen::VectorXd& theta, Part part) const;
+  // Record `record` alone, both parts (the other records' rows NaN).
+  Rollout SimulateRecord(const Eigen::VectorXd& theta, size_t record) const;
   // Many rollouts in parallel (the result of k at [k]).
   std::vector<Rollout> SimulateAll(const std::vector<Eigen::VectorXd>& thetas, Part part) const;
+  // thetas[r] on record r alone, in parallel (SimulateRecord).
+  std::vector<Rollout> SimulateEachRecord(const std::vector<Eigen::VectorXd>& thetas) const;
 
   // Forward-difference Jacobian of the simulated angles (rad per unit of parameter; rows as Simulate's,
   // records stacked) with respect to parameters `cols` at theta, whose rollout is `at`; a column is
@@ -164,6 +173,7 @@ class MotionProblem {
 
  private:
   struct Record;
+  Rollout Run(const Eigen::VectorXd& theta, Part part, int only) const;  // only >= 0: that record alone
   LegParams params_;
   DiagnoseOptions opt_;
   std::vector<std::unique_ptr<Record>> rec_;
@@ -178,6 +188,8 @@ class MotionProblem {
   bool hold_ = false;              // ReplaySeries::hold of every record
   double fit_share_ = 1;            // the fit parts' share of the scored rows
   mutable std::atomic<long> rollouts_[3] = {{0}, {0}, {0}};  // Simulate calls per Part
+  mutable std::atomic<long> record_rows_{0};  // scored rows simulated by SimulateRecord
+  double all_rows_ = 1;                       // scored rows of every record
 };
 
 }  // namespace exotwin

@@ -196,5 +196,36 @@ TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfS
   EXPECT_GE(both, 6);
 }
 
+// The motion fit of several records keeps an effect that moves the records left out, not only the
+// held-out ends (motion_fit.h step 6): fitted on six records, record 00 (the fastest) left out, the
+// knee's rotor inertia gains 3.5 % on the six held-out ends (below the 5 % gate) but the whole records
+// each predicted by the values fitted on the others move far better with it; dropped, record 00
+// replays with 15.9 deg knee error, kept 2.2 deg (rigid 24.5).
+TEST(DiagnoseRealRig, MotionFitOfSixRecordsKeepsTheRotorInertiaTheSeventhNeeds) {
+  if (!HaveData()) GTEST_SKIP() << kDir << " not found (shared/data beside the project)";
+  const std::vector<MeasuredData> rig = ReadRig();
+  std::vector<const MeasuredData*> six;
+  for (size_t r = 1; r < rig.size(); ++r) six.push_back(&rig[r]);
+  DiagnoseOptions opt;
+  opt.fit = DiagnoseFit::kMotion;
+  const Diagnosis d = Diagnose(RigModel(), six, opt);
+  Print(d);
+  const Effect* ie = Named(d, "inertia_error", "knee");
+  ASSERT_NE(ie, nullptr) << "the knee's rotor inertia is not named";
+  EXPECT_NEAR(ie->value, 0.00276, 0.4 * 0.00276);  // the makers' gr^2 Ir
+  for (const char* j : {"hip", "knee"}) EXPECT_NE(Named(d, "coulomb_friction", j), nullptr) << j;
+  ReplayScore s[2];
+  for (int k = 0; k < 2; ++k) {
+    const LegParams p = k == 0 ? RigModel() : d.extended;
+    PlantEffects fx;
+    const std::unique_ptr<Plant> plant = MakeReplayPlant(p, "test", "", &fx);
+    s[k] = Replay(*plant, ReplaySeriesOf(rig[0], fx, ReplayInput::kTorque, kReplayCutoffHz), 0.5).score;
+  }
+  std::printf("record 00 left out: hip %.2f -> %.2f deg, knee %.2f -> %.2f deg\n", s[0].Rmse(0) * 180 / M_PI,
+              s[1].Rmse(0) * 180 / M_PI, s[0].Rmse(1) * 180 / M_PI, s[1].Rmse(1) * 180 / M_PI);
+  EXPECT_LT(s[1].Rmse(1), 0.2 * s[0].Rmse(1));
+  EXPECT_LT(s[1].Rmse(0), 0.3 * s[0].Rmse(0));
+}
+
 }  // namespace
 }  // namespace exotwin
