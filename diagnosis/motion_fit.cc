@@ -1090,7 +1090,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   bool have_last = false;
   while (!chosen.empty()) {
     // A refined value outside its range (DESIGN.md's table: the selection checked the linear fit's)
-    // goes first; else the effect whose removal raises the held-out error at its joint least, if below
+    // goes first; else the effect whose removal raises the error at its joint least (of the held-out
+    // ends, or with several records the better of that and the whole records left out), if below
     // kMinHeldoutGain.
     int drop = -1;
     std::string why;

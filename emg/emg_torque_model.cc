@@ -584,7 +584,7 @@ double JointOutsideShare(const EmgCalibrationRange& g, const EmgRecording& rec, 
     const Muscle m = rec.muscle[c];
     if (ActionSign(m, joint) == 0 && !(gmax_proxy && joint == 0 && m == Muscle::kVM)) continue;
     const auto it = std::find(g.channels.begin(), g.channels.end(), rec.channels[c]);
-    if (it == g.channels.end()) return 1.0;
+    if (it == g.channels.end()) continue;  // not an input of the calibrated model
     const size_t k = static_cast<size_t>(it - g.channels.begin());
     mark(rec.e[c], g.e_lo[k], g.e_hi[k]);
   }

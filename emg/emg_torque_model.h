@@ -106,8 +106,8 @@ constexpr double kOtherGaitShare = 0.5;
 
 // Share of the samples of `rec` where an input of joint j leaves `range`: either joint's angle or
 // velocity (the forms read both: passive moments and biarticular paths), or the envelope of a channel
-// whose muscle spans j (the vasti at the hip too where `gmax_proxy`); a channel the range lacks is
-// outside throughout.
+// whose muscle spans j (the vasti at the hip too where `gmax_proxy`); a channel the range lacks is no
+// input of the calibrated model and is not counted (ExtrapolationOf reports it).
 double JointOutsideShare(const EmgCalibrationRange& range, const EmgRecording& rec, int joint, bool gmax_proxy);
 
 enum class TermKind { kAlpha, kAlphaQ, kBeta, kGamma, kOffset, kPassive };

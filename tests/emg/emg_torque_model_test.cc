@@ -361,6 +361,12 @@ TEST(EmgTorqueModel, AnotherGaitIsPredictedByThePapersForm) {
     EXPECT_EQ(JointOutsideShare(m.range, r, j, false), 0.0);
     EXPECT_EQ(PredictMoment(m, r, j), PredictLinearMoment(m, r, j));
   }
+  // A channel the calibration lacks is no input of its model: not counted.
+  EmgRecording extra = r;
+  extra.channels.push_back("glut_max1_r");
+  extra.muscle.push_back(Muscle::kGMAX);
+  extra.e.push_back(std::vector<double>(r.size(), 5.0));
+  EXPECT_EQ(JointOutsideShare(m.range, extra, 0, false), 0.0);
   // The ranges shrunk: the med_gas_r envelope (spans the knee, not the hip) and the hip angle.
   EmgCalibrationRange g = m.range;
   g.e_hi[4] = 0.1, g.q_hi[0] = 0.25;
