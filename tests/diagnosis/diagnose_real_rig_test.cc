@@ -197,7 +197,7 @@ TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfS
 }
 
 // The motion fit of several records keeps an effect that moves the records left out, not only the
-// held-out ends (motion_fit.h step 6): fitted on six records, record 00 (the fastest) left out, the
+// held-out ends (motion_fit.h step 6): fitted on six records, record 00 left out, the
 // knee's rotor inertia gains 3.5 % on the six held-out ends (below the 5 % gate) but the whole records
 // each predicted by the values fitted on the others move far better with it; dropped, record 00
 // replays with 15.9 deg knee error, kept 2.2 deg (rigid 24.5).
