@@ -243,6 +243,7 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   // the given twin follows the fit parts closer.
   Eigen::VectorXd zero = Eigen::VectorXd::Zero(parameters());
   w_[0] = w_[1] = 1;
+  rw_.assign(rec_.size(), {1.0, 1.0});
   // The model given and, where the torque fit names effects the plant carries, with those too (a
   // delayed reading, say, would otherwise hide which hold fits).
   Eigen::VectorXd with_torque = zero;
@@ -267,6 +268,15 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   double count = 0, all_rows = 0;
   for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows), all_rows += static_cast<double>(rp->rows.size());
   for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse[j] / count), 1e-6);
+  rw_.assign(rec_.size(), {w_[0], w_[1]});
+  for (size_t r = 0; r < rec_.size(); ++r) {
+    double e[2] = {0, 0};
+    const size_t m = rec_[r]->rows.size(), mf = rec_[r]->fit_rows;
+    for (int j = j0; j < 2 && mf > 0; ++j) {
+      for (size_t k = 0; k < mf; ++k) e[j] += std::pow(rec_[r]->q[static_cast<Eigen::Index>(j * m + k)] - given.q[r][static_cast<Eigen::Index>(j * m + k)], 2);
+      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(e[j] / static_cast<double>(mf)), 1e-6);
+    }
+  }
   fit_share_ = count / std::max(all_rows, 1.0);
   all_rows_ = std::max(all_rows, 1.0);
 }
@@ -462,7 +472,7 @@ void MotionProblem::Sse(const Rollout& ro, Part part, double sse[2]) const {
     for (int j = 0; j < 2; ++j)
       for (size_t k = k0; k < k1; ++k) {
         const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
-        sse[j] += std::pow(w_[j] * (R.q[i] - ro.q[r][i]), 2);
+        sse[j] += std::pow(rw_[r][static_cast<size_t>(j)] * (R.q[i] - ro.q[r][i]), 2);
       }
   }
 }
@@ -510,8 +520,8 @@ Eigen::VectorXd WeightedResidual(const MotionProblem& P, const MotionProblem::Ro
   for (size_t r = 0; r < P.records(); ++r) {
     const Eigen::Index m2 = P.measured(r).size();
     all.segment(off, m2) = P.measured(r) - ro.q[r];
-    wv.segment(off, m2 / 2).setConstant(P.weight(0));
-    wv.segment(off + m2 / 2, m2 / 2).setConstant(P.weight(1));
+    wv.segment(off, m2 / 2).setConstant(P.weight(r, 0));
+    wv.segment(off + m2 / 2, m2 / 2).setConstant(P.weight(r, 1));
     off += m2;
   }
   Eigen::VectorXd e(static_cast<Eigen::Index>(idx.size()));
@@ -526,8 +536,8 @@ Eigen::VectorXd RowWeights(const MotionProblem& P) {
   Eigen::Index off = 0;
   for (size_t r = 0; r < P.records(); ++r) {
     const Eigen::Index m2 = P.measured(r).size();
-    wv.segment(off, m2 / 2).setConstant(P.weight(0));
-    wv.segment(off + m2 / 2, m2 / 2).setConstant(P.weight(1));
+    wv.segment(off, m2 / 2).setConstant(P.weight(r, 0));
+    wv.segment(off + m2 / 2, m2 / 2).setConstant(P.weight(r, 1));
     off += m2;
   }
   return wv;
@@ -876,7 +886,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       for (int j = 0; j < 2; ++j) {
         std::vector<double> q;
         for (size_t k = mf; k < m; ++k) q.push_back(P.measured(r)[static_cast<Eigen::Index>(j * m + k)]);
-        const double s = RmsAboutMean(q) * P.weight(j);
+        const double s = RmsAboutMean(q) * P.weight(r, j);
         g.tt_te[j] += s * s * static_cast<double>(q.size());
       }
     }

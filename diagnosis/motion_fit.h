@@ -5,7 +5,7 @@
 //
 // What is fitted: theta, the values of the candidate effects, minimizing over the fit part of every
 // record
-//     S(theta) = sum_records sum_joints j sum_scored samples i  w_j^2 (q_j(t_i) - qsim_j(t_i; theta))^2
+//     S(theta) = sum_records r sum_joints j sum_scored samples i  w_rj^2 (q_j(t_i) - qsim_j(t_i; theta))^2
 // where qsim is the angle of the forward plant replay uses (diagnosis/replay.h MakeReplayPlant / Replay:
 // the model given + the candidates' effects, carried as sim/plant_effects.h says), driven by the
 // record's actuator torque (the torque reading with the model's and the candidates' sensor effects
@@ -19,8 +19,10 @@
 // every record's time, the held-out part the rest; no window straddles the split.
 // The torque reading is the input, so it is no output here (the twin's sensor reads the motor
 // torque, HJ15 eq. 8: the simulated reading would be the input itself); the outputs are the angles.
-// Output weights: w_j = 1 / (the model given's RMS simulated-angle error at joint j on the fit parts,
-// pooled): each joint counts by what the given twin leaves there (a one-joint device's held hip: 0).
+// Output weights: w_rj = 1 / (the model given's RMS simulated-angle error at joint j on record r's fit
+// part): each joint and record counts by what the given twin leaves there (weighted least squares,
+// each record its own misfit level: a chaotic record the twin cannot follow does not size the values
+// alone; a one-joint device's held hip: 0).
 //
 // Candidates (MotionCandidates): every effect the plant carries, at every joint of the device:
 // coulomb_friction, viscous_friction, inertia_error, gravity_error (X, Y), joint_stiffness (two
@@ -36,7 +38,7 @@
 //  2. at the current theta (first: the model given, theta = 0) one rollout per parameter (forward
 //     differences, each parameter's secant step MotionCandidateStep) gives the Jacobian J of qsim on
 //     every scored sample; J's columns and the residual q - qsim(theta) + J theta form one ColumnBank
-//     per record (rows weighted by w_j), a linear model whose coefficients are the effects' values;
+//     per record (rows weighted by w_rj), a linear model whose coefficients are the effects' values;
 //  3. screening: each one-parameter candidate whose linear fit on top of the current set is
 //     significant and lowers the BIC is refined alone on the exact plant (the secant method from the
 //     current theta's rollout to the linear fit's value, one rollout per step, the set held;
@@ -83,9 +85,10 @@
 //
 // Diagnosis fields of a motion fit: effects (value, ci95), extended, selection, records (split: the
 // simulated angle, rad), joints (the same pooled, rad), simulation (rigid vs extended, held-out and
-// whole records left out), noise (1 / w_j, rad), tau_eff (rows), torque_named, torque_only; cutoff
+// whole records left out), noise (the records pooled: 1 / w_j, rad), tau_eff (rows), torque_named, torque_only; cutoff
 // and kin are the torque fit's (the report's header).
 #pragma once
+#include <array>
 #include <atomic>
 #include <memory>
 #include <string>
@@ -130,7 +133,9 @@ class MotionProblem {
   // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
   int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
   const PhysicalScale& scale() const { return scale_; }
-  double weight(int j) const { return w_[j]; }
+  double weight(int j) const { return w_[j]; }  // pooled over the records (the noise reported)
+  // The weight of record r's rows at joint j: 1 / the given twin's RMS simulated-angle error there.
+  double weight(size_t r, int j) const { return rw_[r][static_cast<size_t>(j)]; }
   size_t records() const { return rec_.size(); }
   // The input between samples (ReplaySeries::hold): the one under which the model given follows the
   // records' fit parts closer.
@@ -184,6 +189,7 @@ class MotionProblem {
   std::vector<double> ripple_f_;   // per parameter (torque_ripple)
   PhysicalScale scale_;
   double w_[2] = {1, 1};
+  std::vector<std::array<double, 2>> rw_;  // per record
   bool reading_input_ = true;      // every record driven by its torque reading
   bool hold_ = false;              // ReplaySeries::hold of every record
   double fit_share_ = 1;            // the fit parts' share of the scored rows

@@ -89,6 +89,45 @@ TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
   EXPECT_NEAR(P.ReplaysSimulated(), 5 * fit_share + 2, 1e-12);
 }
 
+// Output weights per record (motion_fit.h): two records of the unpowered pendulum whose measured angle
+// swings 0.01 and 0.05 rad at 0.7 Hz (not its own motion: the twin at rest cannot follow it). Each
+// record's weight is 1 / its own RMS simulated-angle error on the fit part (recomputed here from the
+// rollout), the pooled weight 1 / the pooled RMS, and Sse the sum of the records' weighted squares.
+TEST(MotionFit, EachRecordIsWeightedByItsOwnMisfit) {
+  const testing::ScopedTempDir tmp("motion_weights");
+  const Pendulum p = RestingPendulum(tmp.path());
+  std::vector<MeasuredData> data;
+  for (const double a : {0.01, 0.05}) {
+    std::string csv = "t,q_knee,tau_knee,cmd_knee\n";
+    for (int i = 0; i < 4000; ++i)
+      csv += std::to_string(i * 1e-3) + "," + std::to_string(a * std::sin(2 * M_PI * 0.7 * i * 1e-3)) + ",0,0\n";
+    const std::string path = tmp.path() + "/swing" + std::to_string(data.size()) + ".csv";
+    WriteText(path, csv);
+    data.push_back(ReadMeasuredCsv(path));
+  }
+  DiagnoseOptions opt;
+  opt.threads = 2;
+  const MotionProblem P(p.params, {&data[0], &data[1]}, opt);
+  const MotionProblem::Rollout given = P.Simulate(Eigen::VectorXd::Zero(P.parameters()), MotionProblem::Part::kFit);
+  ASSERT_TRUE(given.ok);
+  double pooled = 0, rows = 0, sse = 0, rms[2];
+  for (size_t r = 0; r < 2; ++r) {
+    const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
+    double e = 0;
+    for (size_t k = 0; k < mf; ++k) e += std::pow(P.measured(r)[static_cast<Eigen::Index>(m + k)] - given.q[r][static_cast<Eigen::Index>(m + k)], 2);
+    rms[r] = std::sqrt(e / static_cast<double>(mf));
+    EXPECT_NEAR(P.weight(r, 1), 1 / rms[r], 1e-9 / rms[r]);
+    EXPECT_EQ(P.weight(r, 0), 0.0);  // the held hip of a one-joint device
+    pooled += e, rows += static_cast<double>(mf), sse += e / (rms[r] * rms[r]);
+  }
+  EXPECT_GT(rms[1], 3 * rms[0]);  // the records' misfits differ, so the weights do
+  EXPECT_NEAR(P.weight(1), 1 / std::sqrt(pooled / rows), 1e-9 * P.weight(1));
+  double s[2];
+  P.Sse(given, MotionProblem::Part::kFit, s);
+  EXPECT_EQ(s[0], 0.0);
+  EXPECT_NEAR(s[1], sse, 1e-9 * sse);
+}
+
 // Bad input: --fit other than torque|motion; a record with neither a torque reading nor commands; a
 // record whose held-out part is shorter than a window. Exit 2, naming what and what was expected.
 TEST(MotionFit, BadInputIsExit2NamingTheFileAndWhatWasExpected) {
