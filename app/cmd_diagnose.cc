@@ -85,6 +85,22 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
                     d.leave_one_out ? (", whole records left out " + NumberText(d.left_out[j].rmse_before * 180 / M_PI, 4) +
                                        " -> " + NumberText(d.left_out[j].rmse_after * 180 / M_PI, 4) + " deg").c_str()
                                     : "");
+      const SimulationScores& S = d.simulation;
+      if (S.torque_fit_done) {
+        std::string line = "diagnose: the torque fit's twin on the same rows: held-out";
+        for (int j = j0; j < 2; ++j)
+          line += std::string(j == j0 ? " " : ", ") + (j == 0 ? "hip " : "knee ") + NumberText(S.torque_fit_split[j].rmse_after * 180 / M_PI, 4);
+        line += " deg";
+        if (d.leave_one_out) {
+          line += ", whole records left out";
+          for (int j = j0; j < 2; ++j)
+            line += std::string(j == j0 ? " " : ", ") + (j == 0 ? "hip " : "knee ") + NumberText(S.torque_fit_left_out[j].rmse_after * 180 / M_PI, 4);
+          line += " deg";
+        }
+        for (size_t k = 0; k < S.torque_fit_not_carried.size(); ++k)
+          line += (k == 0 ? " (not carried: " : ", ") + S.torque_fit_not_carried[k] + (k + 1 == S.torque_fit_not_carried.size() ? ")" : "");
+        std::printf("%s\n", line.c_str());
+      }
       std::printf("diagnose: report %s/report.html\n", o->out.c_str());
       return 0;
     }

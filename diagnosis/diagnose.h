@@ -112,6 +112,13 @@ struct SimulationScores {
   double cutoff_hz = 10;     // the restart state's filter
   JointScore split[2];       // pooled over the held-out parts, rad
   JointScore left_out[2];    // pooled over the whole records left out, rad
+  // A motion fit: the torque fit's extended twin (its effects, and per record left out the torque
+  // fit's values without that record) simulated on the same rows as split and left_out (rmse_before
+  // the model given, rmse_after the torque fit's twin); effects the plant cannot carry are left out
+  // of it and listed in torque_fit_not_carried.
+  bool torque_fit_done = false;
+  JointScore torque_fit_split[2], torque_fit_left_out[2];
+  std::vector<std::string> torque_fit_not_carried;
   // First record's held-out part: time, measured angle, rigid and extended twin's simulated angle
   // (NaN between windows).
   std::vector<double> t, measured[2], rigid[2], extended[2];

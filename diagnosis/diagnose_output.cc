@@ -109,6 +109,13 @@ std::string DiagnosisJson(const Diagnosis& d) {
       }
       js["records"].push_back(x);
     }
+    if (S.torque_fit_done) {
+      json t = {{"not_carried", S.torque_fit_not_carried}};
+      for (int k = k0; k < 2; ++k) t["joints"][names[k]] = sim(S.torque_fit_split[k]);
+      if (d.leave_one_out)
+        for (int k = k0; k < 2; ++k) t["left_out"][names[k]] = sim(S.torque_fit_left_out[k]);
+      js["torque_fit"] = t;
+    }
   }
   j["simulation"] = js;
   if (d.fit == DiagnoseFit::kMotion) {  // what the torque fit would have named, and what it alone names

@@ -1,3 +1,4 @@
+#include <cstdlib>
 #include "diagnosis/motion_fit.h"
 
 #include <algorithm>
@@ -176,6 +177,7 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
     }
     qdev = std::max(RmsAboutMean(all_q), 1e-3);
     const double qd_rms = std::max(std::sqrt(qd2 / std::max(cnt, 1.0)), 1e-3);
+    qd_rms_[j] = qd_rms;
     const double tau = std::max(scale_.tau_max[j], 1e-3);
     const double M = std::max(scale_.M_jj[j], 1e-6);
     const double grav = 0.5 * scale_.distal_moment[j] + 0.05;
@@ -260,21 +262,34 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   }
   hold_ = by_hold[1] < by_hold[0];
   for (auto& rp : rec_) rp->series.hold = hold_;
-  // Output weights: 1 / the given twin's RMS simulated-angle error per joint on the fit parts.
+  // Output weights: 1 / the misfit level per record and joint on the fit parts, the lower RMS
+  // simulated-angle error of the model given and of the model with the torque fit's effects.
   const Rollout given = Simulate(zero, Part::kFit);
   if (!given.ok) throw SimulationError(0, "the model given diverges in the forward simulation of the records");
-  double sse[2];
-  Sse(given, Part::kFit, sse);
+  const bool torque_twin = !torque_named.empty();
+  const Rollout by_torque = torque_twin ? Simulate(with_torque, Part::kFit) : Rollout{};
   double count = 0, all_rows = 0;
   for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows), all_rows += static_cast<double>(rp->rows.size());
-  for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse[j] / count), 1e-6);
-  rw_.assign(rec_.size(), {w_[0], w_[1]});
+  rw_.assign(rec_.size(), {0.0, 0.0});
+  double pooled[2][2] = {{0, 0}, {0, 0}};  // [twin][joint]
+  std::vector<std::array<double, 4>> e(rec_.size(), {0, 0, 0, 0});  // [twin * 2 + joint]
   for (size_t r = 0; r < rec_.size(); ++r) {
-    double e[2] = {0, 0};
     const size_t m = rec_[r]->rows.size(), mf = rec_[r]->fit_rows;
-    for (int j = j0; j < 2 && mf > 0; ++j) {
-      for (size_t k = 0; k < mf; ++k) e[j] += std::pow(rec_[r]->q[static_cast<Eigen::Index>(j * m + k)] - given.q[r][static_cast<Eigen::Index>(j * m + k)], 2);
-      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(e[j] / static_cast<double>(mf)), 1e-6);
+    for (int j = j0; j < 2; ++j)
+      for (size_t k = 0; k < mf; ++k) {
+        const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
+        e[r][static_cast<size_t>(j)] += std::pow(rec_[r]->q[i] - given.q[r][i], 2);
+        if (by_torque.ok) e[r][static_cast<size_t>(2 + j)] += std::pow(rec_[r]->q[i] - by_torque.q[r][i], 2);
+      }
+    for (int j = j0; j < 2; ++j) pooled[0][j] += e[r][static_cast<size_t>(j)], pooled[1][j] += e[r][static_cast<size_t>(2 + j)];
+  }
+  for (int j = 0; j < 2; ++j) {
+    const double sse = by_torque.ok ? std::min(pooled[0][j], pooled[1][j]) : pooled[0][j];
+    w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse / count), 1e-6);
+    for (size_t r = 0; r < rec_.size() && j >= j0; ++r) {
+      const double mf = std::max<double>(1, static_cast<double>(rec_[r]->fit_rows));
+      const double er = by_torque.ok ? std::min(e[r][static_cast<size_t>(j)], e[r][static_cast<size_t>(2 + j)]) : e[r][static_cast<size_t>(j)];
+      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(er / mf), 1e-6);
     }
   }
   fit_share_ = count / std::max(all_rows, 1.0);
@@ -954,6 +969,42 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       if (!rx.ok) break;
       chosen = best_set, theta = rf.theta, at = std::move(rx);
     }
+    // The friction's form on the exact plant: each named viscous friction exchanged for a Coulomb
+    // friction at its joint and the other way round (the linear model's ranking cannot tell the two
+    // apart where the joint's speed is nearly constant in magnitude; the torque fit's confusion),
+    // from the value dissipating the same power at the joint's RMS speed (c = b qd_rms) and from the
+    // torque fit's, taken where the exact fit-part BIC is lower.
+    for (size_t i = 0; i < chosen.size(); ++i) {
+      const Candidate& from = cands[static_cast<size_t>(chosen[i])];
+      if (from.name != "viscous_friction" && from.name != "coulomb_friction") continue;
+      const bool to_coulomb = from.name == "viscous_friction";
+      const int to = P.CandidateIndex(to_coulomb ? "coulomb_friction" : "viscous_friction", kJoint[from.joint]);
+      if (to < 0 || std::find(chosen.begin(), chosen.end(), to) != chosen.end()) continue;
+      std::vector<int> set = chosen;
+      set[i] = to;
+      const int kf = from.cols[0], kt = cands[static_cast<size_t>(to)].cols[0];
+      const double v = theta[kf], speed = P.qd_rms(from.joint);
+      std::vector<Eigen::VectorXd> starts(1, theta);
+      starts[0][kf] = 0;
+      starts[0][kt] = std::clamp(to_coulomb ? v * speed : v / speed, P.lower(kt), P.upper(kt));
+      for (const DiagnosedEffect& d : T.effects)
+        if (d.effect.name == cands[static_cast<size_t>(to)].name && d.effect.joint == kJoint[from.joint]) {
+          starts.push_back(starts[0]);
+          starts.back()[kt] = std::clamp(d.effect.value, P.lower(kt), P.upper(kt));
+        }
+      const Refined rf = Refine(P, ColumnsOf(cand_bank, set), starts, kMotionLmIterations, false);
+      if (!std::isfinite(rf.cost)) continue;
+      const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+      const double bic_x = ExactBic(rf.cost, ParameterCount(set));
+      const bool better = bic_x < bic_now;
+      D.selection.push_back("round " + std::to_string(round + 1) + ": friction form " + Labels(P, chosen) + " -> " +
+                            Labels(P, set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " + NumberText(bic_x, 4) +
+                            (better ? ", taken" : ", not taken"));
+      if (!better) continue;
+      MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);
+      if (!rx.ok) continue;
+      chosen = set, theta = rf.theta, at = std::move(rx);
+    }
   };
   for (int round = 0; round < kMotionOuterSteps; ++round) {
     Eigen::MatrixXd J = P.Jacobian(theta, at, all, Part::kBoth);
@@ -1065,14 +1116,18 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     std::vector<int> key = chosen;
     std::sort(key.begin(), key.end());
     const bool repeated = std::find(seen.begin(), seen.end(), key) != seen.end();
+    std::vector<int> last_key = previous;
+    std::sort(last_key.begin(), last_key.end());
+    const bool converged = repeated && rounds.size() >= 2 && last_key == key;
     if (!repeated) seen.push_back(key);
     previous = chosen;
     if (!repeated && round + 1 < kMotionOuterSteps) continue;
-    // Converged (the set repeats): this set. Out of rounds without a repeat: the rounds' set of the
-    // lowest exact fit-part BIC (a round linearized elsewhere may end on a worse set than an earlier
-    // one). Then the exchanges on this round's linear model.
+    // Converged (the round chose the last round's set again): this set. A cycle (a set of an earlier
+    // round, not the last's) or out of rounds: the rounds' set of the lowest exact fit-part BIC (a
+    // round linearized elsewhere may end on a worse set than an earlier one). Then the exchanges on
+    // this round's linear model.
     size_t best = rounds.size() - 1;
-    for (size_t k = 0; !repeated && k < rounds.size(); ++k)
+    for (size_t k = 0; !converged && k < rounds.size(); ++k)
       if (ExactBic(rounds[k].cost, ParameterCount(rounds[k].set)) <
           ExactBic(rounds[best].cost, ParameterCount(rounds[best].set)))
         best = k;
@@ -1348,6 +1403,56 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     double s[2];
     P.Sse(tro[k], Part::kHeldOut, s);
     for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base_te[j] > 0 ? 100 * (s[j] / base_te[j] - 1) : 0.0;
+  }
+
+  // The torque fit's twin on the same rows (SimulationScores::torque_fit_*): its effects, and per
+  // record left out its values fitted without that record, as the plant carries them.
+  if (S.done) {
+    auto ThetaOf = [&](const std::vector<Effect>& fx, std::vector<std::string>* not_carried) {
+      Eigen::VectorXd x = zero;
+      for (const Effect& e : fx) {
+        if (TorqueValues(P, e, &x)) continue;
+        const std::string label = e.name + " (" + e.joint + ")";
+        if (not_carried && std::find(not_carried->begin(), not_carried->end(), label) == not_carried->end())
+          not_carried->push_back(label);
+      }
+      for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
+      return x;
+    };
+    std::vector<Effect> named;
+    for (const DiagnosedEffect& d : T.effects) named.push_back(d.effect);
+    const Eigen::VectorXd t_theta = ThetaOf(named, &S.torque_fit_not_carried);
+    const MotionProblem::Rollout t_ro = P.Simulate(t_theta, Part::kHeldOut);
+    std::vector<Eigen::VectorXd> t_loo;
+    if (loo)
+      for (size_t r = 0; r < P.records(); ++r) {
+        const std::vector<Effect>& fx = T.records[r].left_out_effects;
+        t_loo.push_back(ThetaOf(std::vector<Effect>(fx.begin() + static_cast<long>(std::min(params.effects.size(), fx.size())), fx.end()),
+                                &S.torque_fit_not_carried));
+      }
+    const std::vector<MotionProblem::Rollout> t_loo_ro = P.SimulateEachRecord(t_loo);
+    bool ok = t_ro.ok;
+    for (const auto& ro : t_loo_ro) ok = ok && ro.ok;
+    if (ok) {
+      double tb[2] = {0, 0}, ta[2] = {0, 0}, tc = 0, ltb[2] = {0, 0}, lta[2] = {0, 0}, ltc = 0;
+      for (size_t r = 0; r < P.records(); ++r) {
+        double b[2], a[2], c;
+        RecordSse(P, given, r, Part::kHeldOut, b, &c);
+        RecordSse(P, t_ro, r, Part::kHeldOut, a, &c);
+        for (int j = 0; j < 2; ++j) tb[j] += b[j], ta[j] += a[j];
+        tc += c;
+        if (!loo) continue;
+        RecordSse(P, given, r, Part::kBoth, b, &c);
+        RecordSse(P, t_loo_ro[r], r, Part::kBoth, a, &c);
+        for (int j = 0; j < 2; ++j) ltb[j] += b[j], lta[j] += a[j];
+        ltc += c;
+      }
+      for (int j = 0; j < 2; ++j) {
+        S.torque_fit_split[j] = Score(tb[j], ta[j], tc);
+        if (loo) S.torque_fit_left_out[j] = Score(ltb[j], lta[j], ltc);
+      }
+      S.torque_fit_done = true;
+    }
   }
 
   Charge(kScores);

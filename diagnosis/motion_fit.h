@@ -19,10 +19,13 @@
 // every record's time, the held-out part the rest; no window straddles the split.
 // The torque reading is the input, so it is no output here (the twin's sensor reads the motor
 // torque, HJ15 eq. 8: the simulated reading would be the input itself); the outputs are the angles.
-// Output weights: w_rj = 1 / (the model given's RMS simulated-angle error at joint j on record r's fit
-// part): each joint and record counts by what the given twin leaves there (weighted least squares,
-// each record its own misfit level: a chaotic record the twin cannot follow does not size the values
-// alone; a one-joint device's held hip: 0).
+// Output weights: w_rj = 1 / (the misfit level at joint j on record r's fit part: the lower RMS
+// simulated-angle error of the model given and of the model with the torque fit's effects): weighted
+// least squares, each output its own misfit level, estimated by the better twin at hand before the fit
+// (the given twin's error at a joint it misses by a lacking friction, 28 deg at the real rig's knee
+// against 8 at its hip, overstates the level the fit ends at and tips the balance to the other joint);
+// per record, so that a chaotic record the twin cannot follow does not size the values alone; a
+// one-joint device's held hip: 0.
 //
 // Candidates (MotionCandidates): every effect the plant carries, at every joint of the device:
 // coulomb_friction, viscous_friction, inertia_error, gravity_error (X, Y), joint_stiffness (two
@@ -59,13 +62,18 @@
 //     whole physics steps), the refinement restarted where a probe is lower (kMotionBandProbes rounds
 //     at most);
 //  5. steps 2-4 repeat at the refined theta until the chosen set repeats (at most kMotionOuterSteps);
-//     where no set repeated, the rounds' refined set of the lowest exact fit-part BIC stays (a round
-//     linearized elsewhere may end on a worse set than an earlier one); then exchanges (at most
+//     a round that chose the last round's set again converged, and that set stays; where an earlier
+//     round's set came back (a cycle) or no set repeated, the rounds' refined set of the lowest exact
+//     fit-part BIC stays (a round linearized elsewhere may end on a worse set than an earlier one);
+//     then exchanges (at most
 //     kMotionExchanges): the swap of one chosen effect for one candidate that
 //     the last round's linear model ranks lowest in BIC, refined on the exact plant (step 4's
 //     refinement from the set's values with the effect taken out and from the linear fit's), taken
 //     where the exact fit-part BIC is lower (stepwise selection keeps an effect that entered early and
-//     stands in for one that only pays once the others are in);
+//     stands in for one that only pays once the others are in); then the friction's form: each named
+//     viscous friction exchanged for a Coulomb one at its joint and the other way round, refined
+//     from the value of the same power at the joint's RMS speed (c = b qd_rms) and the torque fit's,
+//     taken where the exact fit-part BIC is lower;
 //  6. ranges and the exact held-out gate: a chosen effect whose refined value leaves its range
 //     (Plausible; the selection checked the linear fit's value) is dropped and the rest refined again;
 //     every chosen effect, taken out of the refined set, must raise the held-out
@@ -78,7 +86,8 @@
 //     inflated by its autocorrelation length; every effect the torque fit names and the motion fit
 //     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings;
 //     the records left out (simulation.left_out) with the values LeftOutThetas gives at the final
-//     Jacobian.
+//     Jacobian; beside them the torque fit's twin on the same rows (SimulationScores::torque_fit_*:
+//     its effects on the held-out parts, its values fitted without each record on that record).
 // Rollouts run in parallel on DiagnoseOptions::threads std::threads (one plant per rollout, built under
 // a lock: MuJoCo's compiler is not reentrant), each stored by its index: the result does not depend on
 // the thread count (the same bits).
@@ -133,6 +142,7 @@ class MotionProblem {
   // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
   int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
   const PhysicalScale& scale() const { return scale_; }
+  double qd_rms(int j) const { return qd_rms_[j]; }  // rad/s, RMS of the measured joint speed, every record
   double weight(int j) const { return w_[j]; }  // pooled over the records (the noise reported)
   // The weight of record r's rows at joint j: 1 / the given twin's RMS simulated-angle error there.
   double weight(size_t r, int j) const { return rw_[r][static_cast<size_t>(j)]; }
@@ -189,6 +199,7 @@ class MotionProblem {
   std::vector<double> ripple_f_;   // per parameter (torque_ripple)
   PhysicalScale scale_;
   double w_[2] = {1, 1};
+  double qd_rms_[2] = {1, 1};
   std::vector<std::array<double, 2>> rw_;  // per record
   bool reading_input_ = true;      // every record driven by its torque reading
   bool hold_ = false;              // ReplaySeries::hold of every record

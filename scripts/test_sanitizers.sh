@@ -49,6 +49,7 @@ SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone"
 #   The motion fits of real-rig records (each alone, and six together; the same paths on real data).
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfSeven"
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfSixRecordsKeepsTheRotorInertiaTheSeventhNeeds"
+SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitReplaysTheRecordsLeftOutAtLeastAsWellAsTheTorqueFit"
 #   Further sweeps and repeats, each over 8 s in the Release suite (30-90 s here): cli.regress_suite_test
 #   (the 20 shipped scenarios through `regress`; each scenario's runner runs in the runner, app and cli
 #   tests), DiagnoseHiddenEffect.PairsAreFound and .OffsetAndFrictionTogetherAreBothNamed (pairs of the

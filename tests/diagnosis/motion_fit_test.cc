@@ -89,43 +89,70 @@ TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
   EXPECT_NEAR(P.ReplaysSimulated(), 5 * fit_share + 2, 1e-12);
 }
 
-// Output weights per record (motion_fit.h): two records of the unpowered pendulum whose measured angle
-// swings 0.01 and 0.05 rad at 0.7 Hz (not its own motion: the twin at rest cannot follow it). Each
-// record's weight is 1 / its own RMS simulated-angle error on the fit part (recomputed here from the
-// rollout), the pooled weight 1 / the pooled RMS, and Sse the sum of the records' weighted squares.
+// Output weights per record (motion_fit.h): two records of the pendulum swinging freely from 0.01 and
+// 0.05 rad with a viscous damping b = 0.5 N m s/rad the model given lacks (the small-angle closed form
+// q = A exp(-b t / 2I) cos(w_d t), w_d^2 = mgl / I - (b / 2I)^2). Each record's weight is 1 / its own
+// misfit level on the fit part, the lower RMS simulated-angle error of the model given and of the model
+// with the torque fit's effects (here the damping: the lower one), recomputed from the two rollouts;
+// without a torque fit, the model given's. The pooled weight the same over both records, and Sse the
+// sum of the records' weighted squares.
 TEST(MotionFit, EachRecordIsWeightedByItsOwnMisfit) {
   const testing::ScopedTempDir tmp("motion_weights");
   const Pendulum p = RestingPendulum(tmp.path());
+  const double I = 0.5, mgl = 5.0, b = 0.5, decay = b / (2 * I), wd = std::sqrt(mgl / I - decay * decay);
   std::vector<MeasuredData> data;
   for (const double a : {0.01, 0.05}) {
     std::string csv = "t,q_knee,tau_knee,cmd_knee\n";
-    for (int i = 0; i < 4000; ++i)
-      csv += std::to_string(i * 1e-3) + "," + std::to_string(a * std::sin(2 * M_PI * 0.7 * i * 1e-3)) + ",0,0\n";
+    for (int i = 0; i < 4000; ++i) {
+      const double t = i * 1e-3;
+      csv += std::to_string(t) + "," + std::to_string(a * std::exp(-decay * t) * std::cos(wd * t)) + ",0,0\n";
+    }
     const std::string path = tmp.path() + "/swing" + std::to_string(data.size()) + ".csv";
     WriteText(path, csv);
     data.push_back(ReadMeasuredCsv(path));
   }
   DiagnoseOptions opt;
   opt.threads = 2;
-  const MotionProblem P(p.params, {&data[0], &data[1]}, opt);
-  const MotionProblem::Rollout given = P.Simulate(Eigen::VectorXd::Zero(P.parameters()), MotionProblem::Part::kFit);
-  ASSERT_TRUE(given.ok);
-  double pooled = 0, rows = 0, sse = 0, rms[2];
-  for (size_t r = 0; r < 2; ++r) {
-    const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
-    double e = 0;
-    for (size_t k = 0; k < mf; ++k) e += std::pow(P.measured(r)[static_cast<Eigen::Index>(m + k)] - given.q[r][static_cast<Eigen::Index>(m + k)], 2);
-    rms[r] = std::sqrt(e / static_cast<double>(mf));
-    EXPECT_NEAR(P.weight(r, 1), 1 / rms[r], 1e-9 / rms[r]);
-    EXPECT_EQ(P.weight(r, 0), 0.0);  // the held hip of a one-joint device
-    pooled += e, rows += static_cast<double>(mf), sse += e / (rms[r] * rms[r]);
+  DiagnosedEffect damping;
+  damping.effect.name = "viscous_friction", damping.effect.joint = "knee", damping.effect.value = b;
+  damping.effect.unit = "N m s/rad";
+  for (const bool with_torque_fit : {false, true}) {
+    SCOPED_TRACE(with_torque_fit ? "with the torque fit's damping" : "the model given alone");
+    const MotionProblem P(p.params, {&data[0], &data[1]}, opt,
+                          with_torque_fit ? std::vector<DiagnosedEffect>{damping} : std::vector<DiagnosedEffect>{});
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(P.parameters());
+    const MotionProblem::Rollout given = P.Simulate(x, MotionProblem::Part::kFit);
+    const int c = P.CandidateIndex("viscous_friction", "knee");
+    ASSERT_GE(c, 0);
+    const int kc = P.candidates()[static_cast<size_t>(c)].cols[0];
+    ASSERT_LT(b, P.upper(kc));  // inside its range (DESIGN.md), as the torque fit's values are taken
+    x[kc] = b;
+    const MotionProblem::Rollout damped = P.Simulate(x, MotionProblem::Part::kFit);
+    ASSERT_TRUE(given.ok && damped.ok);
+    double pooled[2] = {0, 0}, rows = 0, sse = 0, rms[2];
+    for (size_t r = 0; r < 2; ++r) {
+      const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
+      double e[2] = {0, 0};
+      for (size_t k = 0; k < mf; ++k) {
+        const Eigen::Index i = static_cast<Eigen::Index>(m + k);
+        e[0] += std::pow(P.measured(r)[i] - given.q[r][i], 2);
+        e[1] += std::pow(P.measured(r)[i] - damped.q[r][i], 2);
+      }
+      EXPECT_LT(e[1], 0.1 * e[0]);  // the damped twin follows the swing
+      const double level = with_torque_fit ? std::min(e[0], e[1]) : e[0];
+      rms[r] = std::sqrt(level / static_cast<double>(mf));
+      EXPECT_NEAR(P.weight(r, 1), 1 / rms[r], 1e-9 / rms[r]);
+      EXPECT_EQ(P.weight(r, 0), 0.0);  // the held hip of a one-joint device
+      pooled[0] += e[0], pooled[1] += e[1], rows += static_cast<double>(mf), sse += e[0] / (rms[r] * rms[r]);
+    }
+    EXPECT_GT(rms[1], 3 * rms[0]);  // the records' misfits differ, so the weights do
+    const double level = with_torque_fit ? std::min(pooled[0], pooled[1]) : pooled[0];
+    EXPECT_NEAR(P.weight(1), 1 / std::sqrt(level / rows), 1e-9 * P.weight(1));
+    double s[2];
+    P.Sse(given, MotionProblem::Part::kFit, s);
+    EXPECT_EQ(s[0], 0.0);
+    EXPECT_NEAR(s[1], sse, 1e-9 * sse);
   }
-  EXPECT_GT(rms[1], 3 * rms[0]);  // the records' misfits differ, so the weights do
-  EXPECT_NEAR(P.weight(1), 1 / std::sqrt(pooled / rows), 1e-9 * P.weight(1));
-  double s[2];
-  P.Sse(given, MotionProblem::Part::kFit, s);
-  EXPECT_EQ(s[0], 0.0);
-  EXPECT_NEAR(s[1], sse, 1e-9 * sse);
 }
 
 // Bad input: --fit other than torque|motion; a record with neither a torque reading nor commands; a
