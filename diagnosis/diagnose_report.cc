@@ -74,7 +74,26 @@ std::string SimulationTable(const Diagnosis& d) {
   }
   o << "<tr><th>all</th><td>" << deg(S.split[0]) << "</td><td>" << deg(S.split[1]) << "</td>";
   if (d.leave_one_out) o << "<td>" << deg(S.left_out[0]) << "</td><td>" << deg(S.left_out[1]) << "</td>";
-  o << "</tr></table><p>RMS error of the simulated angle against the measured one.</p>";
+  o << "</tr>";
+  if (S.torque_fit_done) {  // a motion fit: the torque fit's twin on the same rows
+    o << "<tr><th>all, the torque fit's twin</th><td>" << deg(S.torque_fit_split[0]) << "</td><td>"
+      << deg(S.torque_fit_split[1]) << "</td>";
+    if (d.leave_one_out)
+      o << "<td>" << deg(S.torque_fit_left_out[0]) << "</td><td>" << deg(S.torque_fit_left_out[1]) << "</td>";
+    o << "</tr>";
+  }
+  o << "</table><p>RMS error of the simulated angle against the measured one"
+    << (S.torque_fit_done ? "; the last row: the torque fit's extended twin on the same rows (each record left out with the "
+                            "torque fit's values without it" +
+                                (S.torque_fit_not_carried.empty()
+                                     ? std::string(")")
+                                     : "; not carried by the plant, left out: " + HtmlEscape([&] {
+                                         std::string t;
+                                         for (const auto& x : S.torque_fit_not_carried) t += (t.empty() ? "" : ", ") + x;
+                                         return t;
+                                       }()) + ")")
+                          : std::string())
+    << ".</p>";
   return o.str();
 }
 
