@@ -189,10 +189,11 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
       candidates_.push_back(c);
     };
     const int off = Add("offset", j, -0.5 * tau, 0.5 * tau, 0.02 * tau);
-    if (!Has("coulomb_friction", j)) Cand("coulomb_friction", {Add("coulomb_friction", j, 0, 0.5 * tau, 0.02 * tau)});
-    if (!Has("viscous_friction", j))
-      Cand("viscous_friction", {Add("viscous_friction", j, 0, 100 * tau / qd_rms, 0.02 * tau / qd_rms)});
-    if (!Has("inertia_error", j)) Cand("inertia_error", {Add("inertia_error", j, -0.45 * M, M, 0.02 * M)});
+    // Friction and inertia are summed by the plant (sim/plant_effects.h): candidates on top of the
+    // model's own (a one-joint device's R and C are its knee's frictions, model/one_joint.h).
+    Cand("coulomb_friction", {Add("coulomb_friction", j, 0, 0.5 * tau, 0.02 * tau)});
+    Cand("viscous_friction", {Add("viscous_friction", j, 0, 100 * tau / qd_rms, 0.02 * tau / qd_rms)});
+    Cand("inertia_error", {Add("inertia_error", j, -0.45 * M, M, 0.02 * M)});
     if (!Has("gravity_error", j)) {
       Cand("gravity_error", {Add("gravity_error.X", j, -grav, grav, 0.02 * grav)}, "X");
       Cand("gravity_error", {Add("gravity_error.Y", j, -grav, grav, 0.02 * grav)}, "Y");

@@ -32,7 +32,9 @@
 // parameters, k and k q0), passive_moment (a two-joint model with a human), backlash,
 // series_compliance (as the compliance 1/k; at the knee with a human, at either joint without),
 // sensor_offset, sensor_gain, sensor_delay (a reading as input), torque_ripple at the frequency the
-// torque fit found (when it names one); not an effect the model given already carries at that joint.
+// torque fit found (when it names one); not an effect the model given already carries at that joint,
+// except the frictions and the inertia error, which the plant sums (a change on top of the model's
+// own: a one-joint device's R and C are its knee's frictions).
 // Box bounds: DESIGN.md's ranges (PhysicalScale of the records, diagnose_select.h).
 //
 // Method (Gauss-Newton with selection):
