@@ -1,4 +1,3 @@
-#include <cstdlib>
 #include "diagnosis/motion_fit.h"
 
 #include <algorithm>
