@@ -161,7 +161,6 @@ TEST(OneJointHiddenEffect, MotionFitNamesAFrictionOnTopOfTheDevicesOwn) {
   }
 }
 
-
 // Every effect of DESIGN.md's table hidden alone in a HAL-3 twin record: named, at its value within
 // 15 %, the only one named.
 TEST(OneJointHiddenEffect, EverySingleEffectIsNamedAtItsValue) {

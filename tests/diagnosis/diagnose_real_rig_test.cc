@@ -229,8 +229,9 @@ TEST(DiagnoseRealRig, MotionFitOfSixRecordsKeepsTheRotorInertiaTheSeventhNeeds) 
 
 // The target for the records left out: all seven records, the motion fit's extended twin (each
 // record with the values fitted on the others) replays the records left out at least as well as the
-// torque fit's twin (each record with the torque fit's values without it), at both joints, on the same
-// rows (the model given's scores of both blocks are the same numbers). Measured: hip 2.02 / 2.71 deg,
+// torque fit's twin (each record with the torque fit's values without it), at both joints. The two
+// blocks' rmse_before are the model given's on the rows each block scored: equal while both score the
+// same rows (a guard on the block's layout, not a check of its numbers). Measured: hip 2.02 / 2.71 deg,
 // knee 6.16 / 6.61 deg (motion / torque). Release suite only (a minute under the sanitizers' 3x).
 TEST(DiagnoseRealRig, MotionFitReplaysTheRecordsLeftOutAtLeastAsWellAsTheTorqueFit) {
   if (!HaveData()) GTEST_SKIP() << kDir << " not found (shared/data beside the project)";
