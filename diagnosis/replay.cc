@@ -29,19 +29,15 @@ void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>
   }
 }
 
-namespace {
-
-void RestartState(const std::string& source, double cutoff_hz, ReplaySeries* out) {
-  const Sampling sampling = ExamineSampling(out->t, source);
+void SetRestartState(double cutoff_hz, ReplaySeries* out) {
+  const Sampling sampling = ExamineSampling(out->t, out->source);
   for (int j = 0; j < 2; ++j) {
-    out->q0[j] = LowPassOnTimeBase(out->t, out->q[j], cutoff_hz, source);
-    AngleRates rates = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, source);
+    out->q0[j] = LowPassOnTimeBase(out->t, out->q[j], cutoff_hz, out->source);
+    AngleRates rates = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, out->source);
     out->qd0[j] = std::move(rates.qd);
     out->qdd0[j] = std::move(rates.qdd);
   }
 }
-
-}  // namespace
 
 ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
                             const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz) {
@@ -55,7 +51,7 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
 }
 
 void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s) {
-  RestartState(s->source, cutoff_hz, s);
+  SetRestartState(cutoff_hz, s);
   ActuatorTorqueFromReading(fx, s->t, tau_S, s->tau_R);
 }
 
@@ -82,7 +78,7 @@ ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, Re
                        "' (the commanded actuator torque, N m); the record has none");
     s.tau_R[j] = *c;
   }
-  RestartState(data.source, cutoff_hz, &s);
+  SetRestartState(cutoff_hz, &s);
   return s;
 }
 
@@ -138,6 +134,14 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
     const double a = (time - t[in]) / (t[in + 1] - t[in]);
     return {u[0][in] + a * (u[0][in + 1] - u[0][in]), u[1][in] + a * (u[1][in + 1] - u[1][in])};
   };
+  // The restart state's acceleration at sample i (0 where the series has none) and the velocity the
+  // integrator holds with the angle there: half a step earlier (replay.h).
+  auto Acceleration = [&](size_t i) -> Eigen::Vector2d {
+    return {s.qdd0[0].empty() ? 0.0 : s.qdd0[0][i], s.qdd0[1].empty() ? 0.0 : s.qdd0[1][i]};
+  };
+  auto StepVelocity = [&](size_t i) -> Eigen::Vector2d {
+    return Eigen::Vector2d(s.qd0[0][i], s.qd0[1][i]) - 0.5 * dt * Acceleration(i);
+  };
   while (start < end && t[end - 1] - t[start] >= horizon_s) {
     const double t0 = t[start], t_end = t0 + horizon_s;
     const int w = static_cast<int>(out.score.windows);
@@ -147,8 +151,8 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
                                   : start;
     // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
     // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
-    const Eigen::Vector2d qdd0(s.qdd0[0].empty() ? 0.0 : s.qdd0[0][r], s.qdd0[1].empty() ? 0.0 : s.qdd0[1][r]);
-    plant.Reset({s.q0[0][r], s.q0[1][r]}, {s.qd0[0][r], s.qd0[1][r]}, t[r], &qdd0);
+    const Eigen::Vector2d qdd0 = Acceleration(r);
+    plant.Reset({s.q0[0][r], s.q0[1][r]}, StepVelocity(r), t[r], &qdd0);
     if (r < start) {
       // The measured joints follow the restart state's motion (linear between samples), each step
       // driven by the input; the internal hinges move by their own dynamics.
@@ -159,11 +163,10 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
         while (k + 1 < start && t[k + 1] <= time) ++k;
         const double a = std::clamp((time - t[k]) / (t[k + 1] - t[k]), 0.0, 1.0);
         plant.Restate({s.q0[0][k] + a * (s.q0[0][k + 1] - s.q0[0][k]), s.q0[1][k] + a * (s.q0[1][k + 1] - s.q0[1][k])},
-                      {s.qd0[0][k] + a * (s.qd0[0][k + 1] - s.qd0[0][k]), s.qd0[1][k] + a * (s.qd0[1][k + 1] - s.qd0[1][k])},
-                      time);
+                      StepVelocity(k) + a * (StepVelocity(k + 1) - StepVelocity(k)), time);
         plant.Step(Input(time + 0.5 * dt));
       }
-      plant.Restate({s.q0[0][start], s.q0[1][start]}, {s.qd0[0][start], s.qd0[1][start]}, t0);
+      plant.Restate({s.q0[0][start], s.q0[1][start]}, StepVelocity(start), t0);
     }
     in = start;
     Eigen::Vector2d q_prev = plant.q();

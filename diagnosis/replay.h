@@ -10,7 +10,14 @@
 //    sample at or before that middle).
 //  - restart state: the angle low-passed by the zero-phase 2nd-order Butterworth at the cutoff
 //    (formats/measured_data.h LowPassOnTimeBase) and its velocity (DeriveAngleRates at the same
-//    cutoff), at the window's first sample.
+//    cutoff), at the window's first sample. The integrator is handed the velocity half a step earlier,
+//    qd - dt/2 qdd (qdd the derived acceleration, 0 where the series has none): MuJoCo's semi-implicit
+//    Euler steps q(t + dt) = q(t) + dt qd(t + dt), so the velocity it holds with q(t) is the mean over
+//    the step before, (q(t) - q(t - dt)) / dt = qd(t) - dt/2 qdd(t) + O(dt^2) (DESIGN.md "Sampling
+//    instant of a joint node"); the derived qd(t), a central difference, runs dt/2 qdd ahead of it, and
+//    that offset grows over the window (the real rig's twin swung by sums of sines, restarted from
+//    its exact angles: 0.33 / 1.06 mrad RMS hip / knee half a step behind, 1.75 / 7.68 mrad at the
+//    derived velocity; tests/diagnosis/replay_test.cc).
 //    A dead band (backlash) restarts against the flank the rigid torque of the restart state's motion
 //    (angle, velocity, acceleration) presses, what the gear transmits in contact (Plant::Reset's
 //    `qdd`). A strap (series compliance) restarts by a run-in: from the restart state run_in
@@ -71,6 +78,9 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
 // The same on a series whose source, t and q the caller filled (e.g. moved in, not copied): the restart
 // state and the input.
 void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s);
+// The restart state of a series whose source, t and q are filled (q0, qd0, qdd0 at cutoff_hz), the
+// rest kept. Throws InputError naming the source for a cutoff not below half the sample rate.
+void SetRestartState(double cutoff_hz, ReplaySeries* s);
 
 struct ReplayScore {
   double sse[2] = {0, 0};  // sum of squared angle errors, rad^2
