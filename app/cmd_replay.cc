@@ -110,7 +110,8 @@ CommandRunner RegisterReplay(CLI::App& app) {
                         {"windows", total.windows},
                         {"input", o->input},
                         {"restart_state", "angle low-passed by a zero-phase 2nd-order Butterworth at " +
-                                              std::to_string(o->cutoff) + " Hz and its velocity (central differences); a dead band on the flank "
+                                              std::to_string(o->cutoff) + " Hz and its velocity (central differences, handed to the "
+                                              "integrator half a step behind); a dead band on the flank "
                                               "the rigid torque of that motion presses, a strap run in over its settling time (DESIGN.md)"},
                         {"joint_limits", "disabled (and the actuators' ctrlrange)"},
                         {"records", records}};
