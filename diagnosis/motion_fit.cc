@@ -251,23 +251,26 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   Eigen::VectorXd with_torque = zero;
   for (const DiagnosedEffect& d : torque_named) TorqueValues(*this, d.effect, &with_torque);
   for (int k = 0; k < parameters(); ++k) with_torque[k] = std::clamp(with_torque[k], lo_[k], hi_[k]);
+  // (The torque fit's twin is simulated where its effects are candidates: else it is the model given.)
+  const bool torque_twin = with_torque != zero;
   double by_hold[2] = {INFINITY, INFINITY};
+  Rollout rollouts[2][2];  // [hold][the model given, the torque fit's twin]
   for (int h = 0; h < 2; ++h) {
     for (auto& rp : rec_) rp->series.hold = h == 1;
-    for (const Eigen::VectorXd* x : {&zero, &with_torque}) {
-      const Rollout ro = Simulate(*x, Part::kFit);
+    for (int k = 0; k < (torque_twin ? 2 : 1); ++k) {
+      rollouts[h][k] = Simulate(k == 0 ? zero : with_torque, Part::kFit);
       double s2[2];
-      if (ro.ok) Sse(ro, Part::kFit, s2), by_hold[h] = std::min(by_hold[h], s2[0] + s2[1]);
+      if (rollouts[h][k].ok) Sse(rollouts[h][k], Part::kFit, s2), by_hold[h] = std::min(by_hold[h], s2[0] + s2[1]);
     }
   }
   hold_ = by_hold[1] < by_hold[0];
   for (auto& rp : rec_) rp->series.hold = hold_;
   // Output weights: 1 / the misfit level per record and joint on the fit parts, the lower RMS
-  // simulated-angle error of the model given and of the model with the torque fit's effects.
-  const Rollout given = Simulate(zero, Part::kFit);
+  // simulated-angle error of the model given and of the model with the torque fit's effects (the
+  // rollouts of the hold chosen).
+  const Rollout& given = rollouts[hold_][0];
   if (!given.ok) throw SimulationError(0, "the model given diverges in the forward simulation of the records");
-  const bool torque_twin = !torque_named.empty();
-  const Rollout by_torque = torque_twin ? Simulate(with_torque, Part::kFit) : Rollout{};
+  const Rollout& by_torque = rollouts[hold_][1];
   double count = 0, all_rows = 0;
   for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows), all_rows += static_cast<double>(rp->rows.size());
   rw_.assign(rec_.size(), {0.0, 0.0});

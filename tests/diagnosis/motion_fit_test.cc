@@ -82,11 +82,12 @@ TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
   EXPECT_LT(worst, 0.01 * peak);
   // The hip of a one-joint device is no output (weight 0).
   EXPECT_EQ(P.weight(0), 0.0);
-  // The simulation counted in replays of the record: the constructor's five fit-part rollouts (the
-  // input's two holds, each for the model given and with the torque fit's effects, none here; then the
-  // model given for the weights), the rollout at zero and the one Jacobian column, both parts each.
+  // The simulation counted in replays of the record: the constructor's two fit-part rollouts (the
+  // model given under each of the input's two holds, its chosen one's kept for the weights; no torque
+  // fit's twin: no effects of a torque fit here), the rollout at zero and the one Jacobian column,
+  // both parts each.
   const double fit_share = static_cast<double>(P.fit_rows(0)) / static_cast<double>(m);
-  EXPECT_NEAR(P.ReplaysSimulated(), 5 * fit_share + 2, 1e-12);
+  EXPECT_NEAR(P.ReplaysSimulated(), 2 * fit_share + 2, 1e-12);
 }
 
 // Output weights per record (motion_fit.h): two records of the pendulum swinging freely from 0.01 and
