@@ -275,7 +275,10 @@ TEST(Replay, TheRestartVelocityIsTheIntegratorsHalfStepBehind) {
   }
   s.hold = true;
   SetRestartState(200, &s);
-  const double dt = 1e-3;
+  Plant twin(ExowheelMjcfPath(false));
+  twin.SetParams(p);
+  twin.FreeJointsAndTorque();
+  const double dt = twin.timestep();
   for (int j = 0; j < 2; ++j) {
     double ahead = 0, behind = 0;
     for (size_t i = 10; i + 10 < s.t.size(); ++i) {  // away from the filter's edges
@@ -286,9 +289,6 @@ TEST(Replay, TheRestartVelocityIsTheIntegratorsHalfStepBehind) {
                 std::sqrt(ahead / s.t.size()), std::sqrt(behind / s.t.size()));
     EXPECT_LT(behind, 1e-3 * ahead);
   }
-  Plant twin(ExowheelMjcfPath(false));
-  twin.SetParams(p);
-  twin.FreeJointsAndTorque();
   const ReplayRecord half_step = Replay(twin, s, 0.5);
   ReplaySeries derived_series = s;
   for (auto& a : derived_series.qdd0) a.clear();  // no acceleration: the derived velocity itself
