@@ -50,8 +50,8 @@ CommandRunner RegisterReplay(CLI::App& app) {
                   "torque (tau_R = -tau_S of the record, sensor effects inverted; default) or command (cmd_* columns)");
   sub->add_option("--horizon", o->horizon, "seconds between restarts from the measured state (default 0.5)");
   sub->add_option("--cutoff", o->cutoff,
-                  "Hz, the zero-phase 2nd-order Butterworth giving the restart state (filtered angle and its "
-                  "velocity); default 10");
+                  "Hz, the zero-phase 2nd-order Butterworth of the angle whose central differences give the restart "
+                  "velocity (the restart angle is the measured one); default 10");
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
   return [sub, o]() -> int {
     if (!*sub) return -1;
@@ -109,8 +109,8 @@ CommandRunner RegisterReplay(CLI::App& app) {
     nlohmann::json j = {{"horizon_s", o->horizon},
                         {"windows", total.windows},
                         {"input", o->input},
-                        {"restart_state", "angle low-passed by a zero-phase 2nd-order Butterworth at " +
-                                              std::to_string(o->cutoff) + " Hz and its velocity (central differences, handed to the "
+                        {"restart_state", "the measured angle and its velocity (central differences of the angle low-passed by a "
+                                              "zero-phase 2nd-order Butterworth at " + std::to_string(o->cutoff) + " Hz, handed to the "
                                               "integrator half a step behind); a dead band on the flank "
                                               "the rigid torque of that motion presses, a strap run in over its settling time (DESIGN.md)"},
                         {"joint_limits", "disabled (and the actuators' ctrlrange)"},

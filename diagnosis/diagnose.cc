@@ -871,8 +871,8 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
   std::ostringstream os;
   os << "the rigid and the extended twin (their effects in the MuJoCo plant, joint limits off) driven by the "
         "measured torque, restarted every " << NumberText(opt.replay_horizon_s)
-     << " s from the measured state (angle low-passed at " << NumberText(opt.replay_cutoff_hz)
-     << " Hz, zero-phase 2nd-order Butterworth, and its velocity; a strap run in over its settling time): " << sb.windows << " windows on the held-out parts"
+     << " s from the measured state (the measured angle and its velocity, derived at " << NumberText(opt.replay_cutoff_hz)
+     << " Hz, zero-phase 2nd-order Butterworth; a strap run in over its settling time): " << sb.windows << " windows on the held-out parts"
      << (D.leave_one_out ? ", " + std::to_string(lb.windows) + " on the whole records left out" : std::string());
   S.note = S.done ? os.str() : "not simulated: every part is shorter than the horizon of " + NumberText(opt.replay_horizon_s) + " s";
 }

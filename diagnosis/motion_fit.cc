@@ -1368,8 +1368,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     std::ostringstream os;
     os << "the model given and the motion fit's extended twin (their effects in the MuJoCo plant, joint limits off) "
           "driven by the measured torque, restarted every " << NumberText(opt.replay_horizon_s)
-       << " s from the measured state (angle low-passed at " << NumberText(opt.replay_cutoff_hz)
-       << " Hz, zero-phase 2nd-order Butterworth, and its velocity; a strap run in over its settling time), on the held-out parts"
+       << " s from the measured state (the measured angle and its velocity, derived at " << NumberText(opt.replay_cutoff_hz)
+       << " Hz, zero-phase 2nd-order Butterworth; a strap run in over its settling time), on the held-out parts"
        << (loo ? " and on every whole record with the effects fitted on the others" : "");
     S.note = os.str();
   }
@@ -1472,8 +1472,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   D.split = T.split;
   std::ostringstream m;
   m << "motion fit: the candidate effects' values fitted by simulating the forward plant on the records (multiple "
-       "shooting: windows of " << NumberText(opt.replay_horizon_s) << " s restarted from the measured state, the angle "
-       "low-passed at " << NumberText(opt.replay_cutoff_hz) << " Hz), driven by the recorded actuator torque ("
+       "shooting: windows of " << NumberText(opt.replay_horizon_s) << " s restarted from the measured state, the measured angle and "
+       "its velocity derived at " << NumberText(opt.replay_cutoff_hz) << " Hz), driven by the recorded actuator torque ("
     << (P.hold() ? "each sample held over the step" : "interpolated linearly between samples")
     << ", the closer of the two for the model given); outputs the "
        "angles weighted by 1 / the given twin's RMS simulated error per joint (" << NumberText(D.noise[0], 3) << " / "

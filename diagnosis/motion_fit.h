@@ -13,8 +13,8 @@
 // held between samples or interpolated (ReplaySeries::hold: whichever the model given, alone or with
 // the torque fit's effects, follows closer on the fit parts: a record of the twin's own joint modules
 // is held, MotionProblem::hold),
-// restarted from the measured state (the angle low-passed at DiagnoseOptions::replay_cutoff_hz,
-// zero-phase, and its velocity) every DiagnoseOptions::replay_horizon_s: multiple shooting, each
+// restarted from the measured state (the measured angle and its velocity derived at
+// DiagnoseOptions::replay_cutoff_hz, zero-phase; replay.h) every DiagnoseOptions::replay_horizon_s: multiple shooting, each
 // window scored on its samples after the restart. The fit part is the first 1 - holdout_fraction of
 // every record's time, the held-out part the rest; no window straddles the split.
 // The torque reading is the input, so it is no output here (the twin's sensor reads the motor

@@ -32,7 +32,7 @@ void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>
 void SetRestartState(double cutoff_hz, ReplaySeries* out) {
   const Sampling sampling = ExamineSampling(out->t, out->source);
   for (int j = 0; j < 2; ++j) {
-    out->q0[j] = LowPassOnTimeBase(out->t, out->q[j], cutoff_hz, out->source);
+    out->q0[j] = out->q[j];  // the measured angle itself (replay.h)
     AngleRates rates = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, out->source);
     out->qd0[j] = std::move(rates.qd);
     out->qdd0[j] = std::move(rates.qdd);
