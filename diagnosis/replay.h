@@ -12,7 +12,7 @@
 //    the angle low-passed by the zero-phase 2nd-order Butterworth at the cutoff), at the window's first
 //    sample. The angle is not low-passed: the filter's bias where the motion has content near the
 //    cutoff (a dead band's knocks, a strap's mode, the gait's harmonics) is held over the whole window,
-//    while an encoder's noise is one count (the clean closed-loop gait of S1 replayed by its own model:
+//    while the measured angle's own error is the encoder's noise (the clean closed-loop gait of S1 replayed by its own model:
 //    0.607 / 1.089 mrad RMS hip / knee restarted from the angle low-passed at 10 Hz, 0.570 / 0.972 from
 //    the measured one). The integrator is handed the velocity half a step earlier,
 //    qd - dt/2 qdd (qdd the derived acceleration, 0 where the series has none): MuJoCo's semi-implicit
