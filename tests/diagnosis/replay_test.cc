@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "core/error.h"
 #include "tests/real_rig_model.h"
@@ -255,6 +256,28 @@ TEST(Replay, TheTwinThatMadeARecordReplaysIt) {
   EXPECT_THROW(Replay(twin, s, 0.0), InputError);
 }
 
+// The series of the twin's own record r: its exact angles, each torque held over its step as the
+// twin's joint modules log it (the restart state is the caller's).
+ReplaySeries ExactRecord(const ForwardRun& r) {
+  ReplaySeries s;
+  s.source = "sim";
+  s.t = r.kin.t;
+  for (int j = 0; j < 2; ++j) {
+    s.q[j] = r.kin.q[j];
+    s.tau_R[j] = r.tau_R[j];
+  }
+  s.hold = true;
+  return s;
+}
+
+// The shipped two-link plant with p, its joints and torque free (as replay's).
+std::unique_ptr<Plant> FreeTwin(const LegParams& p) {
+  auto twin = std::make_unique<Plant>(ExowheelMjcfPath(false));
+  twin->SetParams(p);
+  twin->FreeJointsAndTorque();
+  return twin;
+}
+
 // The restart velocity handed to the integrator is half a step behind the derived one (replay.h):
 // semi-implicit Euler's velocity state is the mean over the step before. The twin's own record (the
 // real rig's double pendulum swung by sums of sines, each torque held over its step as the twin's
@@ -266,18 +289,10 @@ TEST(Replay, TheTwinThatMadeARecordReplaysIt) {
 TEST(Replay, TheRestartVelocityIsTheIntegratorsHalfStepBehind) {
   const LegParams p = RealRigModel();
   const ForwardRun r = Simulate(p, 3.0);
-  ReplaySeries s;
-  s.source = "sim";
-  s.t = r.kin.t;
-  for (int j = 0; j < 2; ++j) {
-    s.q[j] = r.kin.q[j];
-    s.tau_R[j] = r.tau_R[j];
-  }
-  s.hold = true;
+  ReplaySeries s = ExactRecord(r);
   SetRestartState(200, &s);
-  Plant twin(ExowheelMjcfPath(false));
-  twin.SetParams(p);
-  twin.FreeJointsAndTorque();
+  const std::unique_ptr<Plant> free_twin = FreeTwin(p);
+  Plant& twin = *free_twin;
   const double dt = twin.timestep();
   for (int j = 0; j < 2; ++j) {
     double ahead = 0, behind = 0;
@@ -308,20 +323,11 @@ TEST(Replay, TheRestartVelocityIsTheIntegratorsHalfStepBehind) {
 // low-passed at 10 Hz (zero-phase, as the velocity's filter).
 TEST(Replay, TheRestartAngleIsTheMeasuredOne) {
   const LegParams p = RealRigModel();
-  const ForwardRun r = Simulate(p, 3.0);
-  ReplaySeries s;
-  s.source = "sim";
-  s.t = r.kin.t;
-  for (int j = 0; j < 2; ++j) {
-    s.q[j] = r.kin.q[j];
-    s.tau_R[j] = r.tau_R[j];
-  }
-  s.hold = true;
+  ReplaySeries s = ExactRecord(Simulate(p, 3.0));
   SetRestartState(kReplayCutoffHz, &s);
   for (int j = 0; j < 2; ++j) EXPECT_EQ(s.q0[j], s.q[j]);
-  Plant twin(ExowheelMjcfPath(false));
-  twin.SetParams(p);
-  twin.FreeJointsAndTorque();
+  const std::unique_ptr<Plant> free_twin = FreeTwin(p);
+  Plant& twin = *free_twin;
   const ReplayRecord measured = Replay(twin, s, 0.5);
   ReplaySeries filtered = s;
   for (int j = 0; j < 2; ++j) filtered.q0[j] = LowPassOnTimeBase(s.t, s.q[j], kReplayCutoffHz, s.source);
