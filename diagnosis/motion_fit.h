@@ -14,9 +14,10 @@
 // the torque fit's effects, follows closer on the fit parts: a record of the twin's own joint modules
 // is held, MotionProblem::hold),
 // restarted from the measured state (the measured angle and its velocity derived at
-// DiagnoseOptions::replay_cutoff_hz, zero-phase; replay.h) every DiagnoseOptions::replay_horizon_s: multiple shooting, each
-// window scored on its samples after the restart. The fit part is the first 1 - holdout_fraction of
-// every record's time, the held-out part the rest; no window straddles the split.
+// DiagnoseOptions::replay_cutoff_hz, zero-phase; replay.h) every DiagnoseOptions::replay_horizon_s:
+// multiple shooting, each window scored on its samples after the restart. The fit part is the first
+// 1 - holdout_fraction of every record's time, the held-out part the rest; no window straddles the
+// split.
 // The torque reading is the input, so it is no output here (the twin's sensor reads the motor
 // torque, HJ15 eq. 8: the simulated reading would be the input itself); the outputs are the angles.
 // Output weights: w_rj = 1 / (the misfit level at joint j on record r's fit part: the lower RMS

@@ -11,15 +11,14 @@
 //  - restart state: the measured angle and its velocity (DeriveAngleRates: central differences of
 //    the angle low-passed by the zero-phase 2nd-order Butterworth at the cutoff), at the window's first
 //    sample. The angle is not low-passed: the filter's bias where the motion has content near the
-//    cutoff (a dead band's knocks, a strap's mode, the gait's harmonics) is held over the whole window,
-//    while the measured angle's own error is the encoder's noise (the clean closed-loop gait of S1 replayed by its own model:
-//    0.607 / 1.089 mrad RMS hip / knee restarted from the angle low-passed at 10 Hz, 0.570 / 0.972 from
-//    the measured one). The integrator is handed the velocity half a step earlier,
-//    qd - dt/2 qdd (qdd the derived acceleration, 0 where the series has none): MuJoCo's semi-implicit
-//    Euler steps q(t + dt) = q(t) + dt qd(t + dt), so the velocity it holds with q(t) is the mean over
-//    the step before, (q(t) - q(t - dt)) / dt = qd(t) - dt/2 qdd(t) + O(dt^2) (DESIGN.md "Sampling
-//    instant of a joint node"); the derived qd(t), a central difference, runs dt/2 qdd ahead of it, and
-//    that offset grows over the window (the real rig's twin swung by sums of sines, restarted from
+//    cutoff (a dead band's knocks, a strap's mode, the gait's harmonics) would be held over the whole
+//    window, while the measured angle's own error is the encoder's noise (tests/diagnosis/
+//    replay_test.cc, Replay.TheRestartAngleIsTheMeasuredOne). The integrator is handed the velocity
+//    half a step earlier, qd - dt/2 qdd (qdd the derived acceleration, 0 where the series has none):
+//    MuJoCo's semi-implicit Euler steps q(t + dt) = q(t) + dt qd(t + dt), so the velocity it holds
+//    with q(t) is the mean over the step before, (q(t) - q(t - dt)) / dt = qd(t) - dt/2 qdd(t) +
+//    O(dt^2) (DESIGN.md "Sampling instant of a joint node"); the derived qd(t), a central difference,
+//    runs dt/2 qdd ahead of it, and that offset grows over the window (the real rig's twin swung by sums of sines, restarted from
 //    its exact angles: 0.33 / 1.06 mrad RMS hip / knee half a step behind, 1.75 / 7.68 mrad at the
 //    derived velocity; tests/diagnosis/replay_test.cc).
 //    A dead band (backlash) restarts against the flank the rigid torque of the restart state's motion
