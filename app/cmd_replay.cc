@@ -35,7 +35,7 @@ std::string ErrorText(const ReplayScore& score, int j0) {
 
 CommandRunner RegisterReplay(CLI::App& app) {
   struct Opts {
-    std::string params, out, map, mjcf, input = "torque";
+    std::string params, out, map, mjcf, input = "torque", between = "linear";
     std::vector<std::string> measured;
     double horizon = 0.5, cutoff = kReplayCutoffHz;
   };
@@ -48,6 +48,10 @@ CommandRunner RegisterReplay(CLI::App& app) {
   sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs into the schema");
   sub->add_option("--input", o->input,
                   "torque (tau_R = -tau_S of the record, sensor effects inverted; default) or command (cmd_* columns)");
+  sub->add_option("--between-samples", o->between,
+                  "the input between samples: linear (interpolated, a rig's continuously sampled torque; default) "
+                  "or hold (each sample held until the next: the twin's own records, whose joint modules log the "
+                  "torque they apply over the coming step)");
   sub->add_option("--horizon", o->horizon, "seconds between restarts from the measured state (default 0.5)");
   sub->add_option("--cutoff", o->cutoff,
                   "Hz, the zero-phase 2nd-order Butterworth of the angle whose central differences give the restart "
@@ -57,6 +61,8 @@ CommandRunner RegisterReplay(CLI::App& app) {
     if (!*sub) return -1;
     if (o->input != "torque" && o->input != "command")
       throw InputError("replay --input: expected 'torque' or 'command', got '" + o->input + "'");
+    if (o->between != "linear" && o->between != "hold")
+      throw InputError("replay --between-samples: expected 'linear' or 'hold', got '" + o->between + "'");
     if (!(o->horizon > 0) || !std::isfinite(o->horizon))
       throw InputError("replay --horizon: expected a time > 0 s, got " + std::to_string(o->horizon));
     if (!(o->cutoff > 0) || !std::isfinite(o->cutoff))
@@ -79,6 +85,7 @@ CommandRunner RegisterReplay(CLI::App& app) {
         throw InputError(m + ": --horizon " + std::to_string(o->horizon) + " s is longer than the record (" +
                          std::to_string(data.t().back() - data.t().front()) + " s)");
       series.push_back(ReplaySeriesOf(data, fx, input, o->cutoff));
+      series.back().hold = o->between == "hold";
     }
 
     std::vector<double> col_t, col_q[2], col_sim[2], col_w, col_r;
@@ -109,6 +116,7 @@ CommandRunner RegisterReplay(CLI::App& app) {
     nlohmann::json j = {{"horizon_s", o->horizon},
                         {"windows", total.windows},
                         {"input", o->input},
+                        {"input_between_samples", o->between},
                         {"restart_state", "the measured angle and its velocity (central differences of the angle low-passed by a "
                                               "zero-phase 2nd-order Butterworth at " + std::to_string(o->cutoff) + " Hz, handed to the "
                                               "integrator half a step behind); a dead band on the flank "

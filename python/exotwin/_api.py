@@ -305,15 +305,16 @@ def diagnose(params, measured, fit="torque", out=None, holdout=None, map=None, c
         return result
 
 
-def replay(params, measured, out=None, map=None, input=None, horizon=None, cutoff=None, mjcf=None):
+def replay(params, measured, out=None, map=None, input=None, horizon=None, cutoff=None, mjcf=None,
+           between_samples=None):
     """`exotwin replay`: the twin (its effects in the plant) simulated forward on the records from the
     measured state every horizon s. Returns replay.json as a dict plus "series": replay.csv as
     {column: array} (t, q_*, q_*_sim, window, record)."""
     with _Out(out, "replay") as d:
         _command(_args("replay", [("--params", _path(params, "params")),
                                   ("--measured", _paths(measured, "measured")), ("--out", d), ("--map", map),
-                                  ("--input", input), ("--horizon", horizon), ("--cutoff", cutoff),
-                                  ("--mjcf", mjcf)]))
+                                  ("--input", input), ("--between-samples", between_samples),
+                                  ("--horizon", horizon), ("--cutoff", cutoff), ("--mjcf", mjcf)]))
         result = _json(os.path.join(d, "replay.json"))
         result["series"] = read_csv(os.path.join(d, "replay.csv"))
         return result

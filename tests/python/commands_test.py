@@ -39,11 +39,12 @@ def test_predict_and_replay_are_the_programs(tmp, record):
     assert list(p) == ["t", "tau_hip", "tau_knee"]
     assert all(same_bits(p[c], ref[c]) for c in ref)
 
-    r = exotwin.replay(params, [path], horizon=0.5)
-    cli("replay", "--params", params, "--measured", path, "--horizon", 0.5, "--out", tmp / "replay")
+    r = exotwin.replay(params, [path], horizon=0.5, between_samples="hold")
+    cli("replay", "--params", params, "--measured", path, "--horizon", 0.5, "--between-samples", "hold",
+        "--out", tmp / "replay")
     ref_json = json.loads((tmp / "replay" / "replay.json").read_text())
     series = r.pop("series")
-    assert r == ref_json
+    assert r == ref_json and r["input_between_samples"] == "hold"
     ref_csv = read_csv(tmp / "replay" / "replay.csv")
     assert all(same_bits(series[c], ref_csv[c]) for c in ref_csv)
 
