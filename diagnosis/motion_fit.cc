@@ -793,6 +793,23 @@ std::string Labels(const MotionProblem& P, const std::vector<int>& set) {
   return o.empty() ? "the model given" : o;
 }
 
+// A candidate's fitted value as the effect it names, in that effect's unit (EffectsOf: a strap's
+// stiffness 1 / compliance, a ripple's amplitude and phase); where its parameters name no effect (0, a
+// dead band or strap below the plant's floor, the constant input torque of a record driven by its
+// commands) the parameters themselves.
+std::string ValueText(const MotionProblem& P, const Candidate& cand, const Eigen::VectorXd& theta) {
+  Eigen::VectorXd only = Eigen::VectorXd::Zero(theta.size());
+  for (int k : cand.cols) only[k] = theta[k];
+  std::string o;
+  for (const Effect& e : P.EffectsOf(only)) {
+    o += (o.empty() ? "" : ", ") + NumberText(e.value, 4) + " " + e.unit;
+    if (e.fields.count("phase")) o += " (phase " + NumberText(e.fields.at("phase"), 3) + " rad)";
+  }
+  if (o.empty())
+    for (int k : cand.cols) o += (o.empty() ? "" : " ") + NumberText(theta[k], 4);
+  return o;
+}
+
 JointScore Score(double sse_before, double sse_after, double count) {
   count = std::max(count, 1.0);
   return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
@@ -1112,8 +1129,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     os << "round " << round + 1 << ": refined on the plant:";
     for (int c : chosen) {
       const Candidate& cand = cands[static_cast<size_t>(c)];
-      os << " " << cand.Label() << " =";
-      for (int k : cand.cols) os << " " << NumberText(theta[k], 4);
+      os << " " << cand.Label() << " = " << ValueText(P, cand, theta);
     }
     D.selection.push_back(os.str());
     std::vector<int> key = chosen;

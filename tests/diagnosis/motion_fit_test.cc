@@ -297,6 +297,16 @@ TEST(MotionFit, HiddenKneeStrapWithAHumanIsNamed) {
   // quasi-static deflection it rings, and a knee inertia_error (~0.005 kg m^2) stands in for that.
   ExpectNamed(d, {E("series_compliance", "knee", 600)}, 0.25);
   ExpectTorqueOnlyListed(d);
+  // The selection's refinements say the strap as it is named: its stiffness in N m/rad (the fit's
+  // parameter is the compliance 1 / k, ~1.7e-3 rad/(N m) here).
+  std::string refined;
+  for (const std::string& line : d.selection)
+    if (line.find("refined on the plant") != std::string::npos) refined = line;
+  const std::string key = "series_compliance(knee) = ";
+  const size_t at = refined.find(key);
+  ASSERT_NE(at, std::string::npos) << refined;
+  EXPECT_NEAR(std::stod(refined.substr(at + key.size())), 600, 0.25 * 600) << refined;
+  EXPECT_NE(refined.find(" N m/rad", at), std::string::npos) << refined;
 }
 
 TEST(MotionFit, HiddenKneeSensorDelayIsNamed) {
