@@ -18,9 +18,9 @@
 //    MuJoCo's semi-implicit Euler steps q(t + dt) = q(t) + dt qd(t + dt), so the velocity it holds
 //    with q(t) is the mean over the step before, (q(t) - q(t - dt)) / dt = qd(t) - dt/2 qdd(t) +
 //    O(dt^2) (DESIGN.md "Sampling instant of a joint node"); the derived qd(t), a central difference,
-//    runs dt/2 qdd ahead of it, and that offset grows over the window (the real rig's twin swung by sums of sines, restarted from
-//    its exact angles: 0.33 / 1.06 mrad RMS hip / knee half a step behind, 1.75 / 7.68 mrad at the
-//    derived velocity; tests/diagnosis/replay_test.cc).
+//    runs dt/2 qdd ahead of it, and that offset grows over the window (the real rig's twin swung by
+//    sums of sines, restarted from its exact angles: 0.33 / 1.06 mrad RMS hip / knee half a step
+//    behind, 1.75 / 7.68 mrad at the derived velocity; tests/diagnosis/replay_test.cc).
 //    A dead band (backlash) restarts against the flank the rigid torque of the restart state's motion
 //    (angle, velocity, acceleration) presses, what the gear transmits in contact (Plant::Reset's
 //    `qdd`). A strap (series compliance) restarts by a run-in: from the restart state run_in
