@@ -3,6 +3,8 @@
 
 #include <map>
 #include <memory>
+#include <mutex>
+#include <utility>
 
 #include "sim/mujoco_messages.h"
 
@@ -13,15 +15,25 @@ struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
 };
 
-// The kept models of this process by path (freed at exit).
-std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>>& Kept() {
-  static std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>> kept;
+// The kept models of this process by path, and their variants by (path, variant) (freed at exit).
+using KeptModels = std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>>;
+KeptModels& Kept() {
+  static KeptModels kept;
   return kept;
+}
+std::map<std::pair<std::string, std::string>, std::unique_ptr<mjModel, ModelDeleter>>& KeptVariants() {
+  static std::map<std::pair<std::string, std::string>, std::unique_ptr<mjModel, ModelDeleter>> kept;
+  return kept;
+}
+std::mutex& KeptMutex() {
+  static std::mutex m;
+  return m;
 }
 
 }  // namespace
 
 mjModel* LoadMjcfModel(const std::string& path, char* err, int err_size) {
+  std::lock_guard<std::mutex> lock(KeptMutex());
   KeepMujocoWarnings();
   const auto it = Kept().find(path);
   if (it != Kept().end()) {
@@ -34,6 +46,7 @@ mjModel* LoadMjcfModel(const std::string& path, char* err, int err_size) {
 }
 
 bool KeepMjcfModel(const std::string& path) {
+  std::lock_guard<std::mutex> lock(KeptMutex());
   if (Kept().count(path)) return true;
   KeepMujocoWarnings();
   char err[1000] = "";
@@ -45,6 +58,16 @@ bool KeepMjcfModel(const std::string& path) {
   }
   Kept()[path].reset(m);
   return true;
+}
+
+mjModel* LoadMjcfVariant(const std::string& path, const std::string& variant, const std::function<mjModel*()>& build) {
+  std::lock_guard<std::mutex> lock(KeptMutex());
+  const auto key = std::make_pair(path, variant);
+  const auto it = KeptVariants().find(key);
+  if (it != KeptVariants().end()) return mj_copyModel(nullptr, it->second.get());
+  mjModel* m = build();
+  if (m && Kept().count(path)) KeptVariants()[key].reset(mj_copyModel(nullptr, m));
+  return m;
 }
 
 }  // namespace exotwin

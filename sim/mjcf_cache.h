@@ -2,9 +2,11 @@
 // the same model (a sweep's workers, forked after the parent kept the model) copies it instead of
 // parsing and compiling the XML for every run. A copy (mj_copyModel) holds the same numbers as a
 // fresh load. A kept model is never reloaded: keep only files that do not change during the process.
+// Thread-safe.
 #pragma once
 #include <mujoco/mujoco.h>
 
+#include <functional>
 #include <string>
 
 namespace exotwin {
@@ -17,5 +19,11 @@ mjModel* LoadMjcfModel(const std::string& path, char* err, int err_size);
 // Loads path and keeps it for LoadMjcfModel; returns false (nothing kept) when it does not load
 // cleanly, so that the Plant reports the problem as without keeping.
 bool KeepMjcfModel(const std::string& path);
+
+// A new model of a variant of the MJCF file (an edit of its text, named by `variant`; the caller
+// owns it): a copy of the one kept for (path, variant) when there is one, else build()'s result
+// (which may throw), kept for (path, variant) when path itself is kept (KeepMjcfModel), so that a
+// process building the same edit many times compiles it once.
+mjModel* LoadMjcfVariant(const std::string& path, const std::string& variant, const std::function<mjModel*()>& build);
 
 }  // namespace exotwin

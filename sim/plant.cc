@@ -172,7 +172,12 @@ void Plant::BindModel() {
 void Plant::Rebuild(const InternalJoints& structure) {
   mjModel* m = nullptr;
   if (structure.any()) {
-    m = LoadMjcfText(path_, AddInternalJoints(ReadMjcfText(path_), path_, structure), "the model with internal hinges");
+    std::string variant = "internal hinges";  // one per structure
+    for (int j = 0; j < 2; ++j)
+      variant += " " + std::to_string(static_cast<int>(structure.kind[j])) + (structure.backlash[j] ? "b" : "s");
+    m = LoadMjcfVariant(path_, variant, [&] {
+      return LoadMjcfText(path_, AddInternalJoints(ReadMjcfText(path_), path_, structure), "the model with internal hinges");
+    });
   } else {
     char err[1000] = "";
     m = LoadMjcfModel(path_, err, sizeof(err));
