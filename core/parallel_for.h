@@ -15,6 +15,9 @@ namespace parallel_for_detail {
 inline thread_local bool in_worker = false;  // inside ParallelFor's work: nested calls run serially
 }  // namespace parallel_for_detail
 
+// True inside a ParallelFor item (where a nested ParallelFor runs serially).
+inline bool InsideParallelFor() { return parallel_for_detail::in_worker; }
+
 // Runs f(0) .. f(n - 1) on up to `threads` std::threads (the calling thread among them), each item once,
 // in no set order: f must write only what item i owns (results stored by index do not depend on the
 // thread count). A nested call from inside an item runs serially. The first exception is rethrown after

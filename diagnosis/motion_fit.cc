@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -402,6 +403,20 @@ MotionProblem::Rollout MotionProblem::Run(const Eigen::VectorXd& theta, Part par
   Rollout out;
   out.ok = true;
   const double H = opt_.replay_horizon_s;
+  // A rollout outside a ParallelFor item (the line searches, the scores) shares its windows with a
+  // second plant alike, built on the other thread when first needed: the same angles bit for bit.
+  std::unique_ptr<Plant> second;
+  const std::function<Plant&()> Second = [&]() -> Plant& {
+    if (!second) {
+      std::lock_guard<std::mutex> lock(BuildMutex());
+      second = MakeReplayPlant(p, "motion fit", opt_.mjcf);
+    }
+    return *second;
+  };
+  const bool split = !InsideParallelFor() && DiagnoseThreads(opt_) >= 2;
+  auto replay = [&](const ReplaySeries& s, size_t begin, size_t end) {
+    return split ? ReplayOnTwoPlants(*plant, Second, s, H, begin, end) : Replay(*plant, s, H, begin, end);
+  };
   for (size_t r = 0; r < rec_.size(); ++r) {
     const Record& R = *rec_[r];
     if (only >= 0 && static_cast<size_t>(only) != r) {
@@ -424,8 +439,8 @@ MotionProblem::Rollout MotionProblem::Run(const Eigen::VectorXd& theta, Part par
         for (size_t k = k0; k < k1; ++k)
           for (int j = 0; j < 2; ++j) q[static_cast<Eigen::Index>(j * m + k)] = rr.Sim(j, R.rows[k]);
       };
-      if (part != Part::kHeldOut) Take(Replay(*plant, s, H, 0, R.split), 0, R.fit_rows);
-      if (part != Part::kFit) Take(Replay(*plant, s, H, R.split, R.n), R.fit_rows, m);
+      if (part != Part::kHeldOut) Take(replay(s, 0, R.split), 0, R.fit_rows);
+      if (part != Part::kFit) Take(replay(s, R.split, R.n), R.fit_rows, m);
     } catch (const SimulationError&) {
       return {};
     }

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/parallel_for.h"
 #include "sim/plant_effects.h"
 
 namespace exotwin {
@@ -109,25 +110,33 @@ double ReplayRecord::Sim(int j, size_t i) const {
 
 int ReplayRecord::Window(size_t i) const { return i >= first && i - first < window.size() ? window[i - first] : -1; }
 
-ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin, size_t end,
-                    const std::vector<double>* tau_R) {
+namespace {
+
+// Replay's window starts over [begin, end): the first at begin, each next at the first sample at or
+// after the window's end, while a whole horizon fits before end.
+std::vector<size_t> WindowStarts(const std::vector<double>& t, double horizon_s, size_t begin, size_t end) {
+  std::vector<size_t> starts;
+  size_t start = begin;
+  while (start < end && t[end - 1] - t[start] >= horizon_s) {
+    starts.push_back(start);
+    start = static_cast<size_t>(std::lower_bound(t.begin() + static_cast<long>(start), t.begin() + static_cast<long>(end),
+                                                 t[start] + horizon_s - 1e-12) - t.begin());
+  }
+  return starts;
+}
+
+// Simulates window w (its first sample `start`, the part's samples below `end`) with `plant`, writing
+// the simulated angles and the window index of its samples into out (sim and window by the sample's
+// index less out->first). The window's result depends on nothing before it: the plant restarts from
+// the series' restart state (run-in included).
+void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>* u, double horizon_s, size_t start,
+                  size_t end, int w, ReplayRecord* out) {
   const std::vector<double>& t = s.t;
-  const std::vector<double>* u = tau_R ? tau_R : s.tau_R;
-  end = std::min(end, t.size());
-  if (!(horizon_s > 0)) throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s, expected > 0");
-  if (begin >= end || t[end - 1] - t[begin] < horizon_s)
-    throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s is longer than the part replayed (" +
-                     std::to_string(begin < end ? t[end - 1] - t[begin] : 0.0) + " s)");
-  ReplayRecord out;
-  out.source = s.source;
-  out.first = begin;
-  for (auto& v : out.sim) v.assign(end - begin, std::nan(""));
-  out.window.assign(end - begin, -1);
+  const size_t begin = out->first;
   const double dt = plant.timestep();
   // A strap's run-in (replay.h): its settling time, at most one horizon.
   const double run_in_s = std::min(horizon_s, plant.InternalSettlingTime());
-  size_t start = begin;
-  size_t in = begin;  // input interpolation: t[in] <= time < t[in + 1]
+  size_t in = start;  // input interpolation: t[in] <= time < t[in + 1]
   auto Input = [&](double time) -> Eigen::Vector2d {
     while (in + 1 < t.size() && t[in + 1] <= time) ++in;
     if (s.hold || in + 1 >= t.size() || time <= t[in]) return {u[0][in], u[1][in]};
@@ -142,58 +151,94 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
   auto StepVelocity = [&](size_t i) -> Eigen::Vector2d {
     return Eigen::Vector2d(s.qd0[0][i], s.qd0[1][i]) - 0.5 * dt * Acceleration(i);
   };
-  while (start < end && t[end - 1] - t[start] >= horizon_s) {
-    const double t0 = t[start], t_end = t0 + horizon_s;
-    const int w = static_cast<int>(out.score.windows);
-    // The run-in's first sample: run_in_s before t0, the series' first at the earliest.
-    const size_t r = run_in_s > 0 ? static_cast<size_t>(std::lower_bound(t.begin(), t.begin() + static_cast<long>(start),
-                                                                          t0 - run_in_s - 1e-12) - t.begin())
-                                  : start;
-    // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
-    // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
-    const Eigen::Vector2d qdd0 = Acceleration(r);
-    plant.Reset({s.q0[0][r], s.q0[1][r]}, StepVelocity(r), t[r], &qdd0);
-    if (r < start) {
-      // The measured joints follow the restart state's motion (linear between samples), each step
-      // driven by the input; the internal hinges move by their own dynamics.
-      in = r;
-      size_t k = r;
-      while (plant.time() < t0 - 0.5 * dt) {
-        const double time = plant.time();
-        while (k + 1 < start && t[k + 1] <= time) ++k;
-        const double a = std::clamp((time - t[k]) / (t[k + 1] - t[k]), 0.0, 1.0);
-        plant.Restate({s.q0[0][k] + a * (s.q0[0][k + 1] - s.q0[0][k]), s.q0[1][k] + a * (s.q0[1][k + 1] - s.q0[1][k])},
-                      StepVelocity(k) + a * (StepVelocity(k + 1) - StepVelocity(k)), time);
-        plant.Step(Input(time + 0.5 * dt));
-      }
-      plant.Restate({s.q0[0][start], s.q0[1][start]}, StepVelocity(start), t0);
+  const double t0 = t[start], t_end = t0 + horizon_s;
+  // The run-in's first sample: run_in_s before t0, the series' first at the earliest.
+  const size_t r = run_in_s > 0 ? static_cast<size_t>(std::lower_bound(t.begin(), t.begin() + static_cast<long>(start),
+                                                                        t0 - run_in_s - 1e-12) - t.begin())
+                                : start;
+  // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
+  // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
+  const Eigen::Vector2d qdd0 = Acceleration(r);
+  plant.Reset({s.q0[0][r], s.q0[1][r]}, StepVelocity(r), t[r], &qdd0);
+  if (r < start) {
+    // The measured joints follow the restart state's motion (linear between samples), each step
+    // driven by the input; the internal hinges move by their own dynamics.
+    in = r;
+    size_t k = r;
+    while (plant.time() < t0 - 0.5 * dt) {
+      const double time = plant.time();
+      while (k + 1 < start && t[k + 1] <= time) ++k;
+      const double a = std::clamp((time - t[k]) / (t[k + 1] - t[k]), 0.0, 1.0);
+      plant.Restate({s.q0[0][k] + a * (s.q0[0][k + 1] - s.q0[0][k]), s.q0[1][k] + a * (s.q0[1][k + 1] - s.q0[1][k])},
+                    StepVelocity(k) + a * (StepVelocity(k + 1) - StepVelocity(k)), time);
+      plant.Step(Input(time + 0.5 * dt));
     }
-    in = start;
-    Eigen::Vector2d q_prev = plant.q();
-    double time_prev = t0;
-    size_t i = start + 1;
-    for (; i < end && t[i] <= t_end + 1e-12; ++i) {
-      while (plant.time() < t[i] - 1e-12) {
-        q_prev = plant.q();
-        time_prev = plant.time();
-        plant.Step(Input(plant.time() + 0.5 * dt));
-      }
-      const double span = plant.time() - time_prev;
-      const double a = span > 0 ? (t[i] - time_prev) / span : 1.0;
-      const Eigen::Vector2d qs = q_prev + a * (plant.q() - q_prev);
-      for (int j = 0; j < 2; ++j) {
-        out.sim[j][i - begin] = qs[j];
-        out.score.sse[j] += (qs[j] - s.q[j][i]) * (qs[j] - s.q[j][i]);
-      }
-      out.window[i - begin] = w;
-      ++out.score.count;
-    }
-    ++out.score.windows;
-    // The next window starts at the first sample at or after t_end.
-    start = static_cast<size_t>(std::lower_bound(t.begin() + static_cast<long>(start), t.begin() + static_cast<long>(end),
-                                                 t_end - 1e-12) - t.begin());
+    plant.Restate({s.q0[0][start], s.q0[1][start]}, StepVelocity(start), t0);
   }
+  in = start;
+  Eigen::Vector2d q_prev = plant.q();
+  double time_prev = t0;
+  for (size_t i = start + 1; i < end && t[i] <= t_end + 1e-12; ++i) {
+    while (plant.time() < t[i] - 1e-12) {
+      q_prev = plant.q();
+      time_prev = plant.time();
+      plant.Step(Input(plant.time() + 0.5 * dt));
+    }
+    const double span = plant.time() - time_prev;
+    const double a = span > 0 ? (t[i] - time_prev) / span : 1.0;
+    const Eigen::Vector2d qs = q_prev + a * (plant.q() - q_prev);
+    for (int j = 0; j < 2; ++j) out->sim[j][i - begin] = qs[j];
+    out->window[i - begin] = w;
+  }
+}
+
+ReplayRecord ReplayOn(Plant& plant, const std::function<Plant&()>* second, const ReplaySeries& s, double horizon_s,
+                      size_t begin, size_t end, const std::vector<double>* tau_R) {
+  const std::vector<double>& t = s.t;
+  const std::vector<double>* u = tau_R ? tau_R : s.tau_R;
+  end = std::min(end, t.size());
+  if (!(horizon_s > 0)) throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s, expected > 0");
+  if (begin >= end || t[end - 1] - t[begin] < horizon_s)
+    throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s is longer than the part replayed (" +
+                     std::to_string(begin < end ? t[end - 1] - t[begin] : 0.0) + " s)");
+  ReplayRecord out;
+  out.source = s.source;
+  out.first = begin;
+  for (auto& v : out.sim) v.assign(end - begin, std::nan(""));
+  out.window.assign(end - begin, -1);
+  const std::vector<size_t> starts = WindowStarts(t, horizon_s, begin, end);
+  const size_t W = starts.size();
+  auto Windows = [&](Plant& p, size_t w0, size_t w1) {
+    for (size_t w = w0; w < w1; ++w) ReplayWindow(p, s, u, horizon_s, starts[w], end, static_cast<int>(w), &out);
+  };
+  if (second && W >= 2) {
+    ParallelFor(2, 2, [&](size_t half) {
+      if (half == 0) Windows(plant, 0, W / 2);
+      else Windows((*second)(), W / 2, W);
+    });
+  } else {
+    Windows(plant, 0, W);
+  }
+  // The score in sample order: the same sums whichever plant simulated which window.
+  for (size_t k = 0; k < out.window.size(); ++k) {
+    if (out.window[k] < 0) continue;
+    for (int j = 0; j < 2; ++j) out.score.sse[j] += (out.sim[j][k] - s.q[j][begin + k]) * (out.sim[j][k] - s.q[j][begin + k]);
+    ++out.score.count;
+  }
+  out.score.windows = W;
   return out;
+}
+
+}  // namespace
+
+ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin, size_t end,
+                    const std::vector<double>* tau_R) {
+  return ReplayOn(plant, nullptr, s, horizon_s, begin, end, tau_R);
+}
+
+ReplayRecord ReplayOnTwoPlants(Plant& plant, const std::function<Plant&()>& second, const ReplaySeries& s,
+                               double horizon_s, size_t begin, size_t end, const std::vector<double>* tau_R) {
+  return ReplayOn(plant, &second, s, horizon_s, begin, end, tau_R);
 }
 
 }  // namespace exotwin

@@ -36,6 +36,7 @@
 //    the restart, excluded); a last part shorter than the horizon is not run.
 //  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -122,5 +123,13 @@ std::unique_ptr<Plant> MakeReplayPlant(const LegParams& params, const std::strin
 // different threads.
 ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_t begin = 0,
                     size_t end = static_cast<size_t>(-1), const std::vector<double>* tau_R = nullptr);
+
+// Replay with the windows shared between two threads: the first half of the windows on `plant`
+// (this thread), the second on the plant second() returns, called on the other thread (where the
+// caller may build it). Since each window restarts from the series' restart state, the record is
+// Replay(plant, ...)'s bit for bit when the second plant is alike (same model, parameters and effects).
+ReplayRecord ReplayOnTwoPlants(Plant& plant, const std::function<Plant&()>& second, const ReplaySeries& s,
+                               double horizon_s, size_t begin = 0, size_t end = static_cast<size_t>(-1),
+                               const std::vector<double>* tau_R = nullptr);
 
 }  // namespace exotwin
