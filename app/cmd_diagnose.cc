@@ -77,7 +77,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
                     t.effect.value, t.effect.unit.c_str(),
                     t.simulated ? (": held-out simulated error " + NumberText(t.heldout_change_pct[0], 3) + " % hip, " +
                                    NumberText(t.heldout_change_pct[1], 3) + " % knee when added").c_str()
-                                : " (not carried by the forward plant)");
+                                : (" (" + t.why + ")").c_str());
       const int j0 = params.one_joint ? 1 : 0;
       for (int j = j0; j < 2; ++j)
         std::printf("diagnose: held-out simulated angle %s %.4f -> %.4f deg%s\n", j == 0 ? "hip" : "knee",

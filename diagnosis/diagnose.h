@@ -136,7 +136,10 @@ DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where);
 // held-out simulated error enough, or is not carried by the plant).
 struct TorqueOnlyEffect {
   Effect effect;                           // as the torque fit sized it
-  bool simulated = false;                  // false: the forward plant cannot carry it (muscle_activity)
+  bool simulated = false;                  // false: no rollout with it, for the reason in `why`
+  std::string why;                         // when not simulated: the forward plant cannot carry it
+                                           // (muscle_activity), the model given already carries one
+                                           // (no candidate), no sensor to correct, or its rollout failed
   double heldout_change_pct[2] = {0, 0};   // held-out simulated-angle SSE change per joint when added
                                            // at that value to the motion fit's effects, % (< 0: lower)
 };

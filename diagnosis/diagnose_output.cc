@@ -134,6 +134,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
     for (const auto& t : d.torque_only) {
       json x = effect(t.effect);
       x["simulated"] = t.simulated;
+      if (!t.simulated) x["why"] = t.why;
       if (t.simulated)
         for (int k = k0; k < 2; ++k) x["heldout_change_pct"][names[k]] = t.heldout_change_pct[k];
       j["torque_only"].push_back(x);

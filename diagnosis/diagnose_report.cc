@@ -126,7 +126,7 @@ std::string MotionReportHtml(const Diagnosis& d, const std::string& params_path,
           verdict = t.simulated ? "torque only: added at this value, the held-out simulated error changes by " +
                                       NumberText(t.heldout_change_pct[0], 3) + " % (hip), " +
                                       NumberText(t.heldout_change_pct[1], 3) + " % (knee)"
-                                : "torque only: not carried by the forward plant";
+                                : "torque only: " + t.why;
       o << "<tr><td>" << e.effect.name << (e.effect.axis.empty() ? "" : "." + e.effect.axis) << "</td><td>"
         << e.effect.joint << "</td><td>" << NumberText(e.effect.value, 4) << " " << HtmlEscape(e.effect.unit)
         << "</td><td>" << HtmlEscape(verdict) << "</td></tr>";

@@ -315,6 +315,21 @@ int MotionProblem::CandidateIndex(const std::string& name, const std::string& jo
   return -1;
 }
 
+std::string MotionProblem::WhyNoCandidate(const Effect& e) const {
+  if (CandidateIndex(e.name, e.joint, e.axis) >= 0) return "";
+  if (e.name == "muscle_activity") return "not carried by the forward plant";
+  if (e.name.rfind("sensor_", 0) == 0 && !reading_input_) return "the commands drive the plant: no torque reading to correct";
+  for (const Effect& g : params_.effects)
+    if (g.joint == e.joint && (g.name == e.name || ((e.name == "backlash" || e.name == "series_compliance") &&
+                                                    (g.name == "backlash" || g.name == "series_compliance"))))
+      return "the model given already carries a " + g.name + " at the " + g.joint + ": no candidate";
+  if (e.name == "series_compliance" && e.joint == "hip" && params_.human)
+    return "the plant carries a strap with a human at the knee only";
+  if (e.name == "passive_moment") return "no passive moment in this model (a two-joint model with a human carries it)";
+  if (params_.one_joint && e.joint == "hip") return "a one-joint model has no hip";
+  return "no candidate of the motion fit";
+}
+
 const std::vector<size_t>& MotionProblem::rows(size_t r) const { return rec_[r]->rows; }
 size_t MotionProblem::fit_rows(size_t r) const { return rec_[r]->fit_rows; }
 const Eigen::VectorXd& MotionProblem::measured(size_t r) const { return rec_[r]->q; }
@@ -1418,6 +1433,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     to.effect = e;
     Eigen::VectorXd x = theta;
     to.simulated = TorqueValues(P, e, &x);
+    if (!to.simulated) to.why = P.WhyNoCandidate(e);
     if (to.simulated) {
       for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
       tthetas.push_back(x);
@@ -1432,6 +1448,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     TorqueOnlyEffect& to = D.torque_only[tidx[k]];
     if (!tro[k].ok) {
       to.simulated = false;
+      to.why = "its rollout failed (the plant refused the values or diverged)";
       continue;
     }
     double s[2];

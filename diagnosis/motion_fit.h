@@ -145,6 +145,9 @@ class MotionProblem {
   const std::string& kind(int k) const { return kind_[static_cast<size_t>(k)]; }  // e.g. "backlash", "offset"
   // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
   int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
+  // Why effect e (as the torque fit names it) is no candidate, "" when it is one: the plant cannot
+  // carry it, the model given already carries one there, no torque reading to correct, ...
+  std::string WhyNoCandidate(const Effect& e) const;
   const PhysicalScale& scale() const { return scale_; }
   double qd_rms(int j) const { return qd_rms_[j]; }  // rad/s, RMS of the measured joint speed, every record
   double weight(int j) const { return w_[j]; }  // pooled over the records (the noise reported)

@@ -97,6 +97,39 @@ TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
 // with the torque fit's effects (here the damping: the lower one), recomputed from the two rollouts;
 // without a torque fit, the model given's. The pooled weight the same over both records, and Sse the
 // sum of the records' weighted squares.
+// Why a torque-fit effect is no candidate (diagnosis.json torque_only[].why) agrees with the candidate
+// set: "" exactly for a candidate; an effect the model given already carries, one the plant cannot
+// carry, a sensor effect where the commands drive and a hip on a one-joint model each say so.
+TEST(MotionFit, WhyAnEffectIsNoCandidateAgreesWithTheCandidates) {
+  const testing::ScopedTempDir tmp("motion_why");
+  Pendulum p = RestingPendulum(tmp.path());
+  Effect stiff;
+  stiff.name = "joint_stiffness", stiff.joint = "knee", stiff.value = 1.0, stiff.unit = "N m/rad";
+  stiff.fields["q0"] = 0;
+  p.params.effects.push_back(stiff);
+  DiagnoseOptions opt;
+  opt.threads = 2;
+  const MotionProblem P(p.params, {&p.data}, opt);
+  auto Why = [&](const std::string& name, const std::string& joint, const std::string& axis = "") {
+    Effect e;
+    e.name = name, e.joint = joint, e.axis = axis, e.value = 1;
+    return P.WhyNoCandidate(e);
+  };
+  for (const char* name : {"coulomb_friction", "viscous_friction", "inertia_error", "backlash", "series_compliance"}) {
+    EXPECT_GE(P.CandidateIndex(name, "knee"), 0) << name;
+    EXPECT_EQ(Why(name, "knee"), "") << name;
+  }
+  for (const char* name : {"sensor_offset", "sensor_gain", "sensor_delay"}) {  // the record's reading is all 0
+    EXPECT_EQ(P.CandidateIndex(name, "knee"), -1) << name;
+    EXPECT_EQ(Why(name, "knee"), "the commands drive the plant: no torque reading to correct") << name;
+  }
+  EXPECT_EQ(P.CandidateIndex("joint_stiffness", "knee"), -1);
+  EXPECT_EQ(Why("joint_stiffness", "knee"), "the model given already carries a joint_stiffness at the knee: no candidate");
+  EXPECT_EQ(Why("muscle_activity", "knee"), "not carried by the forward plant");
+  EXPECT_EQ(Why("coulomb_friction", "hip"), "a one-joint model has no hip");
+  EXPECT_EQ(Why("passive_moment", "knee"), "no passive moment in this model (a two-joint model with a human carries it)");
+}
+
 TEST(MotionFit, EachRecordIsWeightedByItsOwnMisfit) {
   const testing::ScopedTempDir tmp("motion_weights");
   const Pendulum p = RestingPendulum(tmp.path());
