@@ -5,6 +5,8 @@
 #   scripts/motion_fit_table.sh [EXOTWIN] [DURATION] [SEEDS]   (defaults: build/app/exotwin, 60, 1)
 # SEEDS > 1 repeats every case with seeds 1..SEEDS (the scenario's noise and subject draws).
 # env CASES: an extended regex on the case labels (e.g. CASES=none for the clean sweep over seeds).
+# env OFFSET: seconds cut from the start of each record before both fits (default 0): the windows then
+# restart at other phases of the gait (the gait's stride is 2 s, the windows 0.5 s).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 exe="${1:-$root/build/app/exotwin}"
@@ -48,6 +50,11 @@ for c in "${cases[@]}"; do
     sed "s/duration: 60/duration: $duration/" "$root/scenarios/gait_2kmh.yaml" > "$dir/s.yaml"
     [ -n "$effects" ] && echo "plant: {effects: [$effects]}" >> "$dir/s.yaml"
     "$exe" run "$dir/s.yaml" --seed "$seed" --out "$dir/run" > /dev/null 2>&1 || true
+    if [ -n "${OFFSET:-}" ]; then  # comments and header kept; data rows with t < first + OFFSET dropped
+      awk -F, -v off="$OFFSET" '/^#/ || !h { print; if (!/^#/) h = 1; next }
+        { if (t0 == "") t0 = $1; if ($1 - t0 >= off - 1e-9) print }' "$dir/run/measured.csv" > "$dir/run/cut.csv"
+      mv "$dir/run/cut.csv" "$dir/run/measured.csv"
+    fi
     t0=$(date +%s.%N)
     "$exe" diagnose --params "$root/examples/S1.yaml" --measured "$dir/run/measured.csv" --fit motion \
       --out "$dir/motion" > /dev/null

@@ -23,7 +23,8 @@ bool KeepMjcfModel(const std::string& path);
 // A new model of a variant of the MJCF file (an edit of its text, named by `variant`; the caller
 // owns it): a copy of the one kept for (path, variant) when there is one, else build()'s result
 // (which may throw), kept for (path, variant) when path itself is kept (KeepMjcfModel), so that a
-// process building the same edit many times compiles it once.
+// process building the same edit many times compiles it once. build() runs under the cache's lock:
+// it must not call this cache.
 mjModel* LoadMjcfVariant(const std::string& path, const std::string& variant, const std::function<mjModel*()>& build);
 
 }  // namespace exotwin
