@@ -342,6 +342,40 @@ TEST(MotionFit, HiddenKneeStrapWithAHumanIsNamed) {
   EXPECT_NE(refined.find(" N m/rad", at), std::string::npos) << refined;
 }
 
+// The record dir/run/measured.csv without its first `seconds` (comments and header kept): its
+// windows restart at other phases of the gait (stride 2 s, windows 0.5 s).
+MeasuredData CutStart(const std::string& dir, double seconds) {
+  std::ifstream in(dir + "/run/measured.csv");
+  std::string line, out;
+  bool header = false;
+  double t0 = std::nan("");
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || !header) {
+      header = header || (!line.empty() && line[0] != '#');
+      out += line + "\n";
+      continue;
+    }
+    const double t = std::stod(line.substr(0, line.find(',')));
+    if (std::isnan(t0)) t0 = t;
+    if (t - t0 >= seconds - 1e-9) out += line + "\n";
+  }
+  WriteText(dir + "/cut.csv", out);
+  return ReadMeasuredCsv(dir + "/cut.csv");
+}
+
+// The strap does not depend on where in the gait the windows restart (unlike a dead band, DESIGN.md
+// "The motion fit"): the same record with its first 0.25 s cut (every window restarts 0.25 s later in
+// the stride) names it alone within 25 %.
+TEST(MotionFit, HiddenKneeStrapIsNamedWhereverTheWindowsRestart) {
+  const testing::ScopedTempDir tmp("motion_strap_phase");
+  GaitRecord("[{name: series_compliance, joint: knee, value: 600}]", tmp.path());
+  const MeasuredData cut = CutStart(tmp.path(), 0.25);
+  ASSERT_NEAR(cut.t().front(), 0.251, 1e-9);
+  const Diagnosis d = MotionFit(cut);
+  Print("knee strap 600 N m/rad, the first 0.25 s cut", d);
+  ExpectNamed(d, {E("series_compliance", "knee", 600)}, 0.25);
+}
+
 TEST(MotionFit, HiddenKneeSensorDelayIsNamed) {
   const testing::ScopedTempDir tmp("motion_delay");
   const Diagnosis d = MotionFit(GaitRecord("[{name: sensor_delay, joint: knee, value: 0.005}]", tmp.path()));
