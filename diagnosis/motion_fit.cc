@@ -104,6 +104,15 @@ bool TorqueValues(const MotionProblem& P, const Effect& e, Eigen::VectorXd* thet
   return true;
 }
 
+// The effect of the model given that takes the place of candidate `name` at `joint` (the same effect;
+// a dead band or a strap for either: one internal hinge per joint), nullptr if none.
+const Effect* CarriedByModel(const LegParams& params, const std::string& name, const std::string& joint) {
+  auto hinge = [](const std::string& n) { return n == "backlash" || n == "series_compliance"; };
+  for (const Effect& e : params.effects)
+    if (e.joint == joint && (e.name == name || (hinge(name) && hinge(e.name)))) return &e;
+  return nullptr;
+}
+
 }  // namespace
 
 struct MotionProblem::Record {
@@ -160,14 +169,7 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
     ripple_f_.push_back(f);
     return static_cast<int>(lo_.size()) - 1;
   };
-  auto Has = [&](const std::string& name, int j) {
-    for (const Effect& e : params.effects)
-      if (e.joint == kJoint[j] &&
-          (e.name == name || ((name == "backlash" || name == "series_compliance") &&
-                              (e.name == "backlash" || e.name == "series_compliance"))))
-        return true;
-    return false;
-  };
+  auto Has = [&](const std::string& name, int j) { return CarriedByModel(params, name, kJoint[j]) != nullptr; };
   for (int j = j0; j < 2; ++j) {
     double qd2 = 0, qdev = 0, cnt = 0;
     std::vector<double> all_q;
@@ -319,10 +321,8 @@ std::string MotionProblem::WhyNoCandidate(const Effect& e) const {
   if (CandidateIndex(e.name, e.joint, e.axis) >= 0) return "";
   if (e.name == "muscle_activity") return "not carried by the forward plant";
   if (e.name.rfind("sensor_", 0) == 0 && !reading_input_) return "the commands drive the plant: no torque reading to correct";
-  for (const Effect& g : params_.effects)
-    if (g.joint == e.joint && (g.name == e.name || ((e.name == "backlash" || e.name == "series_compliance") &&
-                                                    (g.name == "backlash" || g.name == "series_compliance"))))
-      return "the model given already carries a " + g.name + " at the " + g.joint + ": no candidate";
+  if (const Effect* g = CarriedByModel(params_, e.name, e.joint))
+    return "the model given already carries a " + g->name + " at the " + g->joint + ": no candidate";
   if (e.name == "series_compliance" && e.joint == "hip" && params_.human)
     return "the plant carries a strap with a human at the knee only";
   if (e.name == "passive_moment") return "no passive moment in this model (a two-joint model with a human carries it)";

@@ -16,13 +16,14 @@ struct ModelDeleter {
 };
 
 // The kept models of this process by path, and their variants by (path, variant) (freed at exit).
-using KeptModels = std::map<std::string, std::unique_ptr<mjModel, ModelDeleter>>;
-KeptModels& Kept() {
-  static KeptModels kept;
+template <class Key>
+using KeptModels = std::map<Key, std::unique_ptr<mjModel, ModelDeleter>>;
+KeptModels<std::string>& Kept() {
+  static KeptModels<std::string> kept;
   return kept;
 }
-std::map<std::pair<std::string, std::string>, std::unique_ptr<mjModel, ModelDeleter>>& KeptVariants() {
-  static std::map<std::pair<std::string, std::string>, std::unique_ptr<mjModel, ModelDeleter>> kept;
+KeptModels<std::pair<std::string, std::string>>& KeptVariants() {
+  static KeptModels<std::pair<std::string, std::string>> kept;
   return kept;
 }
 std::mutex& KeptMutex() {
