@@ -90,13 +90,6 @@ TEST(MotionFit, JacobianOfAConstantTorqueIsThePendulumsClosedForm) {
   EXPECT_NEAR(P.ReplaysSimulated(), 2 * fit_share + 2, 1e-12);
 }
 
-// Output weights per record (motion_fit.h): two records of the pendulum swinging freely from 0.01 and
-// 0.05 rad with a viscous damping b = 0.5 N m s/rad the model given lacks (the small-angle closed form
-// q = A exp(-b t / 2I) cos(w_d t), w_d^2 = mgl / I - (b / 2I)^2). Each record's weight is 1 / its own
-// misfit level on the fit part, the lower RMS simulated-angle error of the model given and of the model
-// with the torque fit's effects (here the damping: the lower one), recomputed from the two rollouts;
-// without a torque fit, the model given's. The pooled weight the same over both records, and Sse the
-// sum of the records' weighted squares.
 // Why a torque-fit effect is no candidate (diagnosis.json torque_only[].why) agrees with the candidate
 // set: "" exactly for a candidate; an effect the model given already carries, one the plant cannot
 // carry, a sensor effect where the commands drive and a hip on a one-joint model each say so.
@@ -130,6 +123,13 @@ TEST(MotionFit, WhyAnEffectIsNoCandidateAgreesWithTheCandidates) {
   EXPECT_EQ(Why("passive_moment", "knee"), "no passive moment in this model (a two-joint model with a human carries it)");
 }
 
+// Output weights per record (motion_fit.h): two records of the pendulum swinging freely from 0.01 and
+// 0.05 rad with a viscous damping b = 0.5 N m s/rad the model given lacks (the small-angle closed form
+// q = A exp(-b t / 2I) cos(w_d t), w_d^2 = mgl / I - (b / 2I)^2). Each record's weight is 1 / its own
+// misfit level on the fit part, the lower RMS simulated-angle error of the model given and of the model
+// with the torque fit's effects (here the damping: the lower one), recomputed from the two rollouts;
+// without a torque fit, the model given's. The pooled weight the same over both records, and Sse the
+// sum of the records' weighted squares.
 TEST(MotionFit, EachRecordIsWeightedByItsOwnMisfit) {
   const testing::ScopedTempDir tmp("motion_weights");
   const Pendulum p = RestingPendulum(tmp.path());
