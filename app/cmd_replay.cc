@@ -35,7 +35,7 @@ std::string ErrorText(const ReplayScore& score, int j0) {
 
 CommandRunner RegisterReplay(CLI::App& app) {
   struct Opts {
-    std::string params, out, map, mjcf, input = "torque", between = "linear";
+    std::string params, out, map, mjcf, input = "torque", between = "linear", windows = "every";
     std::vector<std::string> measured;
     double horizon = 0.5, cutoff = kReplayCutoffHz;
   };
@@ -53,6 +53,9 @@ CommandRunner RegisterReplay(CLI::App& app) {
                   "or hold (each sample held until the next: the twin's own records, whose joint modules log the "
                   "torque they apply over the coming step)");
   sub->add_option("--horizon", o->horizon, "seconds between restarts from the measured state (default 0.5)");
+  sub->add_option("--windows", o->windows,
+                  "every (a window every horizon; default) or quiet (the motion fit's: restarted and scored where "
+                  "the measured motion has no fast content the restart velocity misses, e.g. a dead band's knocks)");
   sub->add_option("--cutoff", o->cutoff,
                   "Hz, the zero-phase 2nd-order Butterworth of the angle whose central differences give the restart "
                   "velocity (the restart angle is the measured one); default 10");
@@ -63,6 +66,8 @@ CommandRunner RegisterReplay(CLI::App& app) {
       throw InputError("replay --input: expected 'torque' or 'command', got '" + o->input + "'");
     if (o->between != "linear" && o->between != "hold")
       throw InputError("replay --between-samples: expected 'linear' or 'hold', got '" + o->between + "'");
+    if (o->windows != "every" && o->windows != "quiet")
+      throw InputError("replay --windows: expected 'every' or 'quiet', got '" + o->windows + "'");
     if (!(o->horizon > 0) || !std::isfinite(o->horizon))
       throw InputError("replay --horizon: expected a time > 0 s, got " + std::to_string(o->horizon));
     if (!(o->cutoff > 0) || !std::isfinite(o->cutoff))
@@ -86,6 +91,7 @@ CommandRunner RegisterReplay(CLI::App& app) {
                          std::to_string(data.t().back() - data.t().front()) + " s)");
       series.push_back(ReplaySeriesOf(data, fx, input, o->cutoff));
       series.back().hold = o->between == "hold";
+      series.back().quiet_windows = o->windows == "quiet";
     }
 
     std::vector<double> col_t, col_q[2], col_sim[2], col_w, col_r;
@@ -115,6 +121,7 @@ CommandRunner RegisterReplay(CLI::App& app) {
     }
     nlohmann::json j = {{"horizon_s", o->horizon},
                         {"windows", total.windows},
+                        {"windows_schedule", o->windows},
                         {"input", o->input},
                         {"input_between_samples", o->between},
                         {"restart_state", "the measured angle and its velocity (central differences of the angle low-passed by a "

@@ -185,8 +185,9 @@ struct DiagnoseOptions {
   bool simulate = true;          // step 6b (false: the torque analysis alone)
   double replay_horizon_s = 0.5; // step 6b: restart interval of the forward simulation, s
   double replay_cutoff_hz = kReplayCutoffHz;  // step 6b: filter of the restart state
-  DiagnoseFit fit = DiagnoseFit::kTorque;     // kMotion: diagnosis/motion_fit.h (windows of replay_horizon_s,
-                                              // restart state at replay_cutoff_hz)
+  DiagnoseFit fit = DiagnoseFit::kTorque;     // kMotion: diagnosis/motion_fit.h (quiet windows of
+                                              // replay_horizon_s, restart state at motion_cutoff_hz)
+  double motion_cutoff_hz = 40;  // the motion fit's restart-state filter, at most a tenth of a record's rate
   int threads = 0;  // threads for the replays (the motion fit's rollouts; the torque fit's rigid and
                     // extended twins side by side, step 6b); 0: every core. The result does not depend on it.
 };

@@ -50,6 +50,12 @@ double RmsAboutMean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : std::sqrt(s / static_cast<double>(v.size()));
 }
 
+// The restart state's cutoff of a record (motion_fit.h): DiagnoseOptions::motion_cutoff_hz, at most a
+// tenth of the record's sample rate (a fifth of its Nyquist frequency).
+double MotionCutoff(const DiagnoseOptions& opt, const MeasuredData& data) {
+  return std::min(opt.motion_cutoff_hz, 0.1 / ExamineSampling(data.t(), data.source).dt);
+}
+
 // The motion fit's checks of one record (motion_fit.h DiagnoseByMotion): returns the split (first
 // held-out sample) and whether the torque reading drives it (else cmd_*).
 size_t CheckMotionRecord(const LegParams& params, const MeasuredData& data, const DiagnoseOptions& opt, bool* by_reading) {
@@ -124,6 +130,7 @@ struct MotionProblem::Record {
   size_t n = 0, split = 0, samples = 0;
   std::vector<size_t> rows;         // scored sample indices, ascending (fit part first)
   size_t fit_rows = 0;
+  size_t windows[2] = {0, 0};       // Replay's windows on the fit and held-out parts
   Eigen::VectorXd q;                // measured angle on the rows: hip block, knee block
 };
 
@@ -149,7 +156,8 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
     R.by_reading = has_reading;
     if (!has_reading) reading_input_ = false;
     R.series = ReplaySeriesOf(*data, base_fx, has_reading ? ReplayInput::kTorque : ReplayInput::kCommand,
-                              opt.replay_cutoff_hz);
+                              MotionCutoff(opt, *data));
+    R.series.quiet_windows = true;  // motion_fit.h: windows that restart and run where the motion is quiet
     for (int j = 0; j < 2; ++j) {
       if (has_reading) R.reading[j] = j == 0 ? data->tau_hip() : data->tau_knee();
       else R.cmd[j] = R.series.tau_R[j];
@@ -239,6 +247,12 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
     for (size_t i = 0; i < R.n; ++i)
       if (a.Window(i) >= 0 || b.Window(i) >= 0) R.rows.push_back(i);
     R.fit_rows = static_cast<size_t>(std::lower_bound(R.rows.begin(), R.rows.end(), R.split) - R.rows.begin());
+    R.windows[0] = a.score.windows, R.windows[1] = b.score.windows;
+    if (R.fit_rows == 0 || R.fit_rows == R.rows.size())
+      throw InputError(R.source + ": the motion fit's windows of " + NumberText(H) + " s find no quiet stretch of at least " +
+                       NumberText(kReplayQuietShortest) + " s in its " + (R.fit_rows == 0 ? "fit" : "held-out") +
+                       " part (the measured angle's fast content, replay.h, exceeds " + NumberText(R.series.quiet_level, 4) +
+                       " rad/s throughout); expected a record whose motion is quiet somewhere in each part (a longer record)");
     const size_t m = R.rows.size();
     R.q.resize(static_cast<Eigen::Index>(2 * m));
     for (size_t k = 0; k < m; ++k)
@@ -333,6 +347,10 @@ std::string MotionProblem::WhyNoCandidate(const Effect& e) const {
 const std::vector<size_t>& MotionProblem::rows(size_t r) const { return rec_[r]->rows; }
 size_t MotionProblem::fit_rows(size_t r) const { return rec_[r]->fit_rows; }
 const Eigen::VectorXd& MotionProblem::measured(size_t r) const { return rec_[r]->q; }
+size_t MotionProblem::windows(size_t r, Part part) const {
+  const Record& R = *rec_[r];
+  return part == Part::kFit ? R.windows[0] : part == Part::kHeldOut ? R.windows[1] : R.windows[0] + R.windows[1];
+}
 
 std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const {
   std::vector<Effect> link, sensor;
@@ -904,9 +922,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   {
     double rows = 0, windows = 0;
     for (size_t r = 0; r < P.records(); ++r) {
-      const auto& t = records[r]->t();
       rows += static_cast<double>(P.rows(r).size());
-      windows += std::floor((t.back() - t.front()) / opt.replay_horizon_s);
+      windows += static_cast<double>(P.windows(r, Part::kBoth));
     }
     window_rows = rows / std::max(windows, 1.0);
   }
@@ -1341,7 +1358,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   // Scores: the given vs the extended twin, held-out parts and whole records left out (rad).
   SimulationScores& S = D.simulation;
   S.horizon_s = opt.replay_horizon_s;
-  S.cutoff_hz = opt.replay_cutoff_hz;
+  S.cutoff_hz = 0;
+  for (const MeasuredData* data : records) S.cutoff_hz = std::max(S.cutoff_hz, MotionCutoff(opt, *data));
   double sb[2] = {0, 0}, sa[2] = {0, 0}, cnt = 0, lb[2] = {0, 0}, la[2] = {0, 0}, lcnt = 0;
   // Each record left out in turn: the values one Gauss-Newton step from the final ones on the other
   // records' fit parts (the final refinement's Jacobian and residual; the round's linear model g_last
@@ -1366,7 +1384,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     RecordSse(P, at, r, Part::kHeldOut, a, &c);
     const auto& t = records[r]->t();
     const size_t split = P.rows(r)[P.fit_rows(r)];
-    rs.sim_split_windows = static_cast<size_t>(std::floor((t.back() - t[split]) / opt.replay_horizon_s + 1e-9));
+    rs.sim_split_windows = P.windows(r, Part::kHeldOut);
     for (int j = 0; j < 2; ++j) {
       rs.split[j] = rs.sim_split[j] = Score(b[j], a[j], c);
       sb[j] += b[j], sa[j] += a[j];
@@ -1382,7 +1400,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
         lb[j] += lb_r[j], la[j] += la_r[j];
       }
       lcnt += lc;
-      rs.sim_left_out_windows = static_cast<size_t>(std::floor((t.back() - t.front()) / opt.replay_horizon_s));
+      rs.sim_left_out_windows = P.windows(r, Part::kBoth);
       rs.left_out_effects = params.effects;
       const std::vector<Effect> fx = P.EffectsOf(loo_thetas[r]);
       rs.left_out_effects.insert(rs.left_out_effects.end(), fx.begin(), fx.end());
@@ -1413,9 +1431,11 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   {
     std::ostringstream os;
     os << "the model given and the motion fit's extended twin (their effects in the MuJoCo plant, joint limits off) "
-          "driven by the measured torque, restarted every " << NumberText(opt.replay_horizon_s)
-       << " s from the measured state (the measured angle and its velocity, derived at " << NumberText(opt.replay_cutoff_hz)
-       << " Hz, zero-phase 2nd-order Butterworth; a strap run in over its settling time), on the held-out parts"
+          "driven by the measured torque, in quiet windows of " << NumberText(opt.replay_horizon_s)
+       << " s (replay --windows quiet) restarted from the measured state (the measured angle and its velocity, derived at "
+       << NumberText(S.cutoff_hz)
+       << " Hz or a tenth of a record's sample rate, zero-phase 2nd-order Butterworth; a strap run in over its settling "
+          "time), on the held-out parts"
        << (loo ? " and on every whole record with the effects fitted on the others" : "");
     S.note = os.str();
   }
@@ -1520,8 +1540,10 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   D.split = T.split;
   std::ostringstream m;
   m << "motion fit: the candidate effects' values fitted by simulating the forward plant on the records (multiple "
-       "shooting: windows of " << NumberText(opt.replay_horizon_s) << " s restarted from the measured state, the measured angle and "
-       "its velocity derived at " << NumberText(opt.replay_cutoff_hz) << " Hz), driven by the recorded actuator torque ("
+       "shooting: quiet windows of " << NumberText(opt.replay_horizon_s) << " s, restarted from the measured state, the measured "
+       "angle and its velocity derived at " << NumberText(D.simulation.cutoff_hz) << " Hz, where the motion has no fast content "
+       "that velocity misses, a dead band's knocks, and scored up to the next; replay --windows quiet), driven by the recorded "
+       "actuator torque ("
     << (P.hold() ? "each sample held over the step" : "interpolated linearly between samples")
     << ", the closer of the two for the model given); outputs the "
        "angles weighted by 1 / the given twin's RMS simulated error per joint (" << NumberText(D.noise[0], 3) << " / "

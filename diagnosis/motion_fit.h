@@ -186,6 +186,7 @@ class MotionProblem {
   // Per record: scored sample indices, fit-part rows (the first fit_rows of them), measured angles.
   const std::vector<size_t>& rows(size_t r) const;
   size_t fit_rows(size_t r) const;
+  size_t windows(size_t r, Part part) const;  // Replay's windows of record r on that part (both: the sum)
   const Eigen::VectorXd& measured(size_t r) const;  // measured angle on the rows (rad), Simulate's layout
   // Weighted SSE of a rollout per joint, on the fit part or the held-out part.
   void Sse(const Rollout& ro, Part part, double sse[2]) const;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <utility>
 
 #include "core/error.h"
@@ -38,6 +39,31 @@ void SetRestartState(double cutoff_hz, ReplaySeries* out) {
     out->qd0[j] = std::move(rates.qd);
     out->qdd0[j] = std::move(rates.qdd);
   }
+  // The fast content (replay.h): |central difference - restart velocity| summed over the joints, then
+  // its largest within kReplayQuietSpan either side (a monotone queue of candidates for the maximum).
+  const std::vector<double>& t = out->t;
+  const size_t n = t.size();
+  std::vector<double> miss(n, 0.0);
+  for (size_t i = 0; i < n && n >= 2; ++i) {
+    const size_t a = i > 0 ? i - 1 : 0, b = i + 1 < n ? i + 1 : n - 1;
+    for (int j = 0; j < 2; ++j)
+      miss[i] += std::abs((out->q[j][b] - out->q[j][a]) / (t[b] - t[a]) - out->qd0[j][i]);
+  }
+  out->fast.assign(n, 0.0);
+  std::deque<size_t> top;  // indices of decreasing miss, within the span of the sample at hand
+  size_t next = 0;
+  for (size_t i = 0; i < n; ++i) {
+    for (; next < n && t[next] <= t[i] + kReplayQuietSpan + 1e-12; ++next) {
+      while (!top.empty() && miss[top.back()] <= miss[next]) top.pop_back();
+      top.push_back(next);
+    }
+    while (t[top.front()] < t[i] - kReplayQuietSpan - 1e-12) top.pop_front();
+    out->fast[i] = miss[top.front()];
+  }
+  std::vector<double> sorted = out->fast;
+  const size_t tenth = n / 10;
+  if (n > 0) std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(tenth), sorted.end());
+  out->quiet_level = n > 0 ? kReplayQuietFactor * sorted[tenth] : 0.0;
 }
 
 ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
@@ -112,20 +138,37 @@ int ReplayRecord::Window(size_t i) const { return i >= first && i - first < wind
 
 namespace {
 
-// Replay's window starts over [begin, end): the first at begin, each next at the first sample at or
-// after the window's end, while a whole horizon fits before end.
-std::vector<size_t> WindowStarts(const std::vector<double>& t, double horizon_s, size_t begin, size_t end) {
-  std::vector<size_t> starts;
-  size_t start = begin;
+}  // namespace
+
+std::vector<ReplayWindowSpan> ReplayWindows(const ReplaySeries& s, double horizon_s, size_t begin, size_t end) {
+  const std::vector<double>& t = s.t;
+  end = std::min(end, t.size());
+  const bool quiet = s.quiet_windows && s.fast.size() == t.size();
+  auto Quiet = [&](size_t i) { return !quiet || s.fast[i] <= s.quiet_level; };
+  // The window's restart: its first sample where that is quiet, else the least fast within half a horizon.
+  auto Restart = [&](size_t first) {
+    if (Quiet(first)) return first;
+    size_t best = first;
+    for (size_t i = first; i < end && t[i] <= t[first] + 0.5 * horizon_s + 1e-12; ++i)
+      if (s.fast[i] < s.fast[best]) best = i;
+    return best;
+  };
+  std::vector<ReplayWindowSpan> windows;
+  size_t start = begin < end ? Restart(begin) : end;
   while (start < end && t[end - 1] - t[start] >= horizon_s) {
-    starts.push_back(start);
+    size_t stop = start + 1;
+    while (stop < end && t[stop] <= t[start] + horizon_s + 1e-12 && Quiet(stop)) ++stop;
+    if (!quiet || t[stop - 1] - t[start] >= kReplayQuietShortest) windows.push_back({start, stop});
     start = static_cast<size_t>(std::lower_bound(t.begin() + static_cast<long>(start), t.begin() + static_cast<long>(end),
                                                  t[start] + horizon_s - 1e-12) - t.begin());
+    if (start < end) start = Restart(start);
   }
-  return starts;
+  return windows;
 }
 
-// Simulates window w (its first sample `start`, the part's samples below `end`) with `plant`, writing
+namespace {
+
+// Simulates window w (restarted at sample `start`, scored on its samples below `end` up to start + horizon_s) with `plant`, writing
 // the simulated angles and the window index of its samples into out (sim and window by the sample's
 // index less out->first). The window's result depends on nothing before it: the plant restarts from
 // the series' restart state (run-in included).
@@ -206,10 +249,10 @@ ReplayRecord ReplayOn(Plant& plant, const std::function<Plant&()>* second, const
   out.first = begin;
   for (auto& v : out.sim) v.assign(end - begin, std::nan(""));
   out.window.assign(end - begin, -1);
-  const std::vector<size_t> starts = WindowStarts(t, horizon_s, begin, end);
-  const size_t W = starts.size();
+  const std::vector<ReplayWindowSpan> spans = ReplayWindows(s, horizon_s, begin, end);
+  const size_t W = spans.size();
   auto Windows = [&](Plant& p, size_t w0, size_t w1) {
-    for (size_t w = w0; w < w1; ++w) ReplayWindow(p, s, u, horizon_s, starts[w], end, static_cast<int>(w), &out);
+    for (size_t w = w0; w < w1; ++w) ReplayWindow(p, s, u, horizon_s, spans[w].start, spans[w].stop, static_cast<int>(w), &out);
   };
   if (second && W >= 2) {
     ParallelFor(2, 2, [&](size_t half) {

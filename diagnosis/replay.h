@@ -34,6 +34,16 @@
 //  - windows: from the first sample, each window starts at the first sample at or after the previous
 //    window's start + horizon and is scored on its samples up to start + horizon (its first sample,
 //    the restart, excluded); a last part shorter than the horizon is not run.
+//    Quiet windows (ReplaySeries::quiet_windows, the motion fit's): where the motion has fast content
+//    that the restart velocity (derived at the cutoff) misses, a dead band's knocks above all, the
+//    restart state is wrong and the window's outcome chaotic for any model (a dead band's truth model
+//    replaying its own noise-free record: 1 deg RMS in the windows that restart in a knock, 0.1-0.2
+//    deg in the others; tests/diagnosis/replay_test.cc). So a window restarts at its first sample
+//    only where that is quiet (ReplaySeries::fast <= quiet_level), else at the sample of least fast
+//    content within half a horizon after it; it is scored up to start + horizon or up to its first
+//    sample that is not quiet (the knock it cannot carry the state through), and not at all where that
+//    leaves less than kReplayQuietShortest; the next window's first sample is the first at or after
+//    start + horizon. A series quiet throughout has the every-horizon windows.
 //  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
 #pragma once
 #include <functional>
@@ -61,10 +71,24 @@ struct ReplaySeries {
   // true, each sample held until the next (a zero-order hold: the twin's joint modules log the torque
   // they apply over the coming step, DESIGN.md "Sampling instant of a joint node").
   bool hold = false;
+  // Fast content of the measured motion at each sample (rad/s, SetRestartState): the largest, within
+  // kReplayQuietSpan s either side, of sum_j |the angle's central difference - the restart velocity|,
+  // what the restart velocity misses there (a dead band's knocks; the encoder's noise).
+  std::vector<double> fast;
+  // A sample is quiet where fast <= quiet_level: kReplayQuietFactor x the series' quietest tenth (the
+  // 10 % quantile of fast).
+  double quiet_level = 0;
+  // The window schedule (replay.h, "windows"): false, a window every horizon; true, quiet windows.
+  bool quiet_windows = false;
 };
 
 // The default cutoff of the restart state's filter, Hz.
 constexpr double kReplayCutoffHz = 10.0;
+// Quiet windows (ReplaySeries::quiet_windows): the span of the fast content's maximum (s, either side),
+// the quiet level's factor over the series' quietest tenth, the shortest window scored (s).
+constexpr double kReplayQuietSpan = 0.02;
+constexpr double kReplayQuietFactor = 10.0;
+constexpr double kReplayQuietShortest = 0.1;
 
 // tau_R on t from a measured reading tau_S with the sensor effects of fx inverted, in reverse order
 // of the model file (tau_S = (reading - offset) / (1 + gain); a delayed reading is read value s later,
@@ -83,9 +107,17 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
 // The same on a series whose source, t and q the caller filled (e.g. moved in, not copied): the restart
 // state and the input.
 void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s);
-// The restart state of a series whose source, t and q are filled (q0, qd0, qdd0 at cutoff_hz), the
-// rest kept. Throws InputError naming the source for a cutoff not below half the sample rate.
+// The restart state of a series whose source, t and q are filled (q0, qd0, qdd0 at cutoff_hz; fast
+// and quiet_level), the rest kept. Throws InputError naming the source for a cutoff not below half the
+// sample rate.
 void SetRestartState(double cutoff_hz, ReplaySeries* s);
+
+// One window of a replay: samples (start, stop) scored, restarted at start.
+struct ReplayWindowSpan {
+  size_t start = 0, stop = 0;
+};
+// The windows Replay simulates on samples [begin, end) of s (replay.h "windows"; s.quiet_windows).
+std::vector<ReplayWindowSpan> ReplayWindows(const ReplaySeries& s, double horizon_s, size_t begin, size_t end);
 
 struct ReplayScore {
   double sse[2] = {0, 0};  // sum of squared angle errors, rad^2

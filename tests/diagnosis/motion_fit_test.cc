@@ -179,7 +179,13 @@ TEST(MotionFit, EachRecordIsWeightedByItsOwnMisfit) {
       EXPECT_EQ(P.weight(r, 0), 0.0);  // the held hip of a one-joint device
       pooled[0] += e[0], pooled[1] += e[1], rows += static_cast<double>(mf), sse += e[0] / (rms[r] * rms[r]);
     }
-    EXPECT_GT(rms[1], 3 * rms[0]);  // the records' misfits differ, so the weights do
+    // The records' misfits differ, so the weights do: the model given's (the damped twin's are both
+    // near the angles' quantization, 1e-6 rad, in the quiet windows, which keep the restarts off the
+    // velocity filter's edges).
+    if (!with_torque_fit) {
+      EXPECT_GT(rms[1], 3 * rms[0]);
+    }
+    EXPECT_NE(P.weight(0, 1), P.weight(1, 1));
     const double level = with_torque_fit ? std::min(pooled[0], pooled[1]) : pooled[0];
     EXPECT_NEAR(P.weight(1), 1 / std::sqrt(level / rows), 1e-9 * P.weight(1));
     double s[2];
@@ -211,6 +217,20 @@ TEST(MotionFit, BadInputIsExit2NamingTheFileAndWhatWasExpected) {
   r = RunExotwin("diagnose --params " + d + "/pendulum.yaml --measured " + d + "/short.csv --fit motion --out " + d + "/o");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("short.csv: the motion fit's windows of 0.5 s do not fit the record"), std::string::npos)
+      << r.output;
+  // Knocks throughout: every 200 ms, 80 ms at rest then 120 ms of a 10 mrad jitter; the quiet
+  // stretches (the rest less the fast content's 20 ms span at either end) are 40 ms, below the 0.1 s a
+  // window needs (replay.h).
+  csv = "t,q_knee,tau_knee,cmd_knee\n";
+  for (int i = 0; i < 4000; ++i) {
+    const double q = i % 200 < 80 ? 0.0 : 0.01 * std::sin(static_cast<double>((i * 7919) % 104729));
+    csv += std::to_string(i * 1e-3) + "," + std::to_string(q) + ",0,0\n";
+  }
+  WriteText(d + "/knocks.csv", csv);
+  r = RunExotwin("diagnose --params " + d + "/pendulum.yaml --measured " + d + "/knocks.csv --fit motion --out " + d + "/o");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("knocks.csv: the motion fit's windows of 0.5 s find no quiet stretch of at least 0.1 s"),
+            std::string::npos)
       << r.output;
   // The same through the API.
   DiagnoseOptions opt;
@@ -297,16 +317,41 @@ TEST(MotionFit, HiddenKneeBacklashIsNamed) {
   EXPECT_LT(d.simulation.split[1].rmse_after, 0.5 * d.simulation.split[1].rmse_before);
 }
 
-// The narrowest hip dead band of issue 41's table: its cost is rough in the band's value (a closure
-// moves by whole physics steps), so the refinement probes it at a fraction of its size (motion_fit.h
-// step 4). Named alone within 20 % since each window restarts from the measured angle (replay.h):
-// restarted from the angle low-passed at 10 Hz, a knee viscous friction stood beside it and the band
-// came out 23 % short (0.00384; issue 41's closing note).
-TEST(MotionFit, HiddenHipBacklashOf5MilliradIsNamedAlone) {
-  const testing::ScopedTempDir tmp("motion_hip_backlash");
-  const Diagnosis d = MotionFit(GaitRecord("[{name: backlash, joint: hip, value: 0.005}]", tmp.path(), 60));
-  Print("hip backlash 0.005 rad", d);
-  ExpectNamed(d, {E("backlash", "hip", 0.005)}, 0.2);
+// The record dir/run/measured.csv without its first `seconds` (comments and header kept): its
+// windows restart at other phases of the gait (stride 2 s, windows 0.5 s).
+MeasuredData CutStart(const std::string& dir, double seconds) {
+  std::ifstream in(dir + "/run/measured.csv");
+  std::string line, out;
+  bool header = false;
+  double t0 = std::nan("");
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || !header) {
+      header = header || (!line.empty() && line[0] != '#');
+      out += line + "\n";
+      continue;
+    }
+    const double t = std::stod(line.substr(0, line.find(',')));
+    if (std::isnan(t0)) t0 = t;
+    if (t - t0 >= seconds - 1e-9) out += line + "\n";
+  }
+  WriteText(dir + "/cut.csv", out);
+  return ReadMeasuredCsv(dir + "/cut.csv");
+}
+
+// The widest hip dead band of issue 41's table, where the band's knocks are hardest: windows every
+// 0.5 s that restart or run through one are chaotic for any model, so which gait phases the windows
+// restarted at decided whether it was named (0.02787 with a knee strap beside it from the record's
+// start, an inertia error and a viscous friction instead with the first 0.25 s cut). In quiet
+// windows (replay.h) it is named alone within 20 % either way (measured: 0.02989 / 0.02993 rad).
+TEST(MotionFit, HiddenHipBacklashOf30MilliradIsNamedWhereverTheWindowsRestart) {
+  const testing::ScopedTempDir tmp("motion_hip_backlash_03");
+  const MeasuredData whole = GaitRecord("[{name: backlash, joint: hip, value: 0.03}]", tmp.path(), 60);
+  const Diagnosis d = MotionFit(whole);
+  Print("hip backlash 0.03 rad", d);
+  ExpectNamed(d, {E("backlash", "hip", 0.03)}, 0.2);
+  const Diagnosis cut = MotionFit(CutStart(tmp.path(), 0.25));
+  Print("hip backlash 0.03 rad, the first 0.25 s cut", cut);
+  ExpectNamed(cut, {E("backlash", "hip", 0.03)}, 0.2);
 }
 
 // A wider hip dead band on the same 60 s gait: a later round chose a knee strap beside it whose linear
@@ -342,30 +387,9 @@ TEST(MotionFit, HiddenKneeStrapWithAHumanIsNamed) {
   EXPECT_NE(refined.find(" N m/rad", at), std::string::npos) << refined;
 }
 
-// The record dir/run/measured.csv without its first `seconds` (comments and header kept): its
-// windows restart at other phases of the gait (stride 2 s, windows 0.5 s).
-MeasuredData CutStart(const std::string& dir, double seconds) {
-  std::ifstream in(dir + "/run/measured.csv");
-  std::string line, out;
-  bool header = false;
-  double t0 = std::nan("");
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || !header) {
-      header = header || (!line.empty() && line[0] != '#');
-      out += line + "\n";
-      continue;
-    }
-    const double t = std::stod(line.substr(0, line.find(',')));
-    if (std::isnan(t0)) t0 = t;
-    if (t - t0 >= seconds - 1e-9) out += line + "\n";
-  }
-  WriteText(dir + "/cut.csv", out);
-  return ReadMeasuredCsv(dir + "/cut.csv");
-}
-
-// The strap does not depend on where in the gait the windows restart (unlike a dead band, DESIGN.md
-// "The motion fit"): the same record with its first 0.25 s cut (every window restarts 0.25 s later in
-// the stride) names it alone within 25 %.
+// The strap does not depend on where in the gait the windows restart (its record is quiet throughout:
+// the every-0.5 s windows, DESIGN.md "The motion fit"): the same record with its first 0.25 s cut
+// (every window restarts 0.25 s later in the stride) names it alone within 25 %.
 TEST(MotionFit, HiddenKneeStrapIsNamedWhereverTheWindowsRestart) {
   const testing::ScopedTempDir tmp("motion_strap_phase");
   GaitRecord("[{name: series_compliance, joint: knee, value: 600}]", tmp.path());

@@ -48,6 +48,12 @@ def test_predict_and_replay_are_the_programs(tmp, record):
     ref_csv = read_csv(tmp / "replay" / "replay.csv")
     assert all(same_bits(series[c], ref_csv[c]) for c in ref_csv)
 
+    q = exotwin.replay(params, [path], between_samples="hold", windows="quiet")
+    cli("replay", "--params", params, "--measured", path, "--between-samples", "hold", "--windows", "quiet",
+        "--out", tmp / "quiet")
+    q.pop("series")
+    assert q == json.loads((tmp / "quiet" / "replay.json").read_text()) and q["windows_schedule"] == "quiet"
+
 
 def test_diagnose_names_the_hidden_effect(tmp, record):
     params, path, g = record
