@@ -136,10 +136,6 @@ double ReplayRecord::Sim(int j, size_t i) const {
 
 int ReplayRecord::Window(size_t i) const { return i >= first && i - first < window.size() ? window[i - first] : -1; }
 
-namespace {
-
-}  // namespace
-
 std::vector<ReplayWindowSpan> ReplayWindows(const ReplaySeries& s, double horizon_s, size_t begin, size_t end) {
   const std::vector<double>& t = s.t;
   end = std::min(end, t.size());
@@ -168,10 +164,10 @@ std::vector<ReplayWindowSpan> ReplayWindows(const ReplaySeries& s, double horizo
 
 namespace {
 
-// Simulates window w (restarted at sample `start`, scored on its samples below `end` up to start + horizon_s) with `plant`, writing
-// the simulated angles and the window index of its samples into out (sim and window by the sample's
-// index less out->first). The window's result depends on nothing before it: the plant restarts from
-// the series' restart state (run-in included).
+// Simulates window w (restarted at sample `start`, scored on its samples below `end` up to start +
+// horizon_s) with `plant`, writing the simulated angles and the window index of its samples into out
+// (sim and window by the sample's index less out->first). The window's result depends on nothing before
+// it: the plant restarts from the series' restart state (run-in included).
 void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>* u, double horizon_s, size_t start,
                   size_t end, int w, ReplayRecord* out) {
   const std::vector<double>& t = s.t;

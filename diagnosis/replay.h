@@ -36,9 +36,9 @@
 //    the restart, excluded); a last part shorter than the horizon is not run.
 //    Quiet windows (ReplaySeries::quiet_windows, the motion fit's): where the motion has fast content
 //    that the restart velocity (derived at the cutoff) misses, a dead band's knocks above all, the
-//    restart state is wrong and the window's outcome chaotic for any model (a dead band's truth model
-//    replaying its own noise-free record: 1 deg RMS in the windows that restart in a knock, 0.1-0.2
-//    deg in the others; tests/diagnosis/replay_test.cc). So a window restarts at its first sample
+//    restart state is wrong and the window's outcome chaotic for any model (a 0.03 rad hip band's
+//    truth twin replaying its own 20 s gait record: 0.78 deg RMS every 0.5 s, 0.009 deg in quiet
+//    windows; tests/app/replay_cli_test.cc, tests/diagnosis/replay_test.cc). So a window restarts at its first sample
 //    only where that is quiet (ReplaySeries::fast <= quiet_level), else at the sample of least fast
 //    content within half a horizon after it; it is scored up to start + horizon or up to its first
 //    sample that is not quiet (the knock it cannot carry the state through), and not at all where that
