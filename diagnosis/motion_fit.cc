@@ -1542,8 +1542,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   m << "motion fit: the candidate effects' values fitted by simulating the forward plant on the records (multiple "
        "shooting: quiet windows of " << NumberText(opt.replay_horizon_s) << " s, restarted from the measured state, the measured "
        "angle and its velocity derived at " << NumberText(D.simulation.cutoff_hz) << " Hz, where the motion has no fast content "
-       "that velocity misses, a dead band's knocks, and scored up to the next; replay --windows quiet), driven by the recorded "
-       "actuator torque ("
+       "that velocity misses, a dead band's knocks, and scored while it stays so; replay --windows quiet), driven by the "
+       "recorded actuator torque ("
     << (P.hold() ? "each sample held over the step" : "interpolated linearly between samples")
     << ", the closer of the two for the model given); outputs the "
        "angles weighted by 1 / the given twin's RMS simulated error per joint (" << NumberText(D.noise[0], 3) << " / "

@@ -14,8 +14,10 @@
 // the torque fit's effects, follows closer on the fit parts: a record of the twin's own joint modules
 // is held, MotionProblem::hold),
 // restarted from the measured state (the measured angle and its velocity derived at
-// DiagnoseOptions::replay_cutoff_hz, zero-phase; replay.h) every DiagnoseOptions::replay_horizon_s:
-// multiple shooting, each window scored on its samples after the restart. The fit part is the first
+// DiagnoseOptions::motion_cutoff_hz, at most a tenth of the record's sample rate, zero-phase; replay.h)
+// in quiet windows of DiagnoseOptions::replay_horizon_s (replay.h "windows": restarted and scored where
+// the motion has no fast content the restart velocity misses, a dead band's knocks): multiple shooting,
+// each window scored on its samples after the restart. The fit part is the first
 // 1 - holdout_fraction of every record's time, the held-out part the rest; no window straddles the
 // split.
 // The torque reading is the input, so it is no output here (the twin's sensor reads the motor
