@@ -308,13 +308,14 @@ def diagnose(params, measured, fit="torque", out=None, holdout=None, map=None, c
 def replay(params, measured, out=None, map=None, input=None, horizon=None, cutoff=None, mjcf=None,
            between_samples=None, windows=None):
     """`exotwin replay`: the twin (its effects in the plant) simulated forward on the records from the
-    measured state every horizon s (windows="quiet": the motion fit's quiet windows). Returns replay.json as a dict plus "series": replay.csv as
-    {column: array} (t, q_*, q_*_sim, window, record)."""
+    measured state every horizon s (windows="quiet": the motion fit's quiet windows). Returns
+    replay.json as a dict plus "series": replay.csv as {column: array} (t, q_*, q_*_sim, window, record)."""
     with _Out(out, "replay") as d:
         _command(_args("replay", [("--params", _path(params, "params")),
                                   ("--measured", _paths(measured, "measured")), ("--out", d), ("--map", map),
                                   ("--input", input), ("--between-samples", between_samples),
-                                  ("--windows", windows), ("--horizon", horizon), ("--cutoff", cutoff), ("--mjcf", mjcf)]))
+                                  ("--windows", windows), ("--horizon", horizon), ("--cutoff", cutoff),
+                                  ("--mjcf", mjcf)]))
         result = _json(os.path.join(d, "replay.json"))
         result["series"] = read_csv(os.path.join(d, "replay.csv"))
         return result

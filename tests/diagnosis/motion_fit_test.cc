@@ -179,13 +179,7 @@ TEST(MotionFit, EachRecordIsWeightedByItsOwnMisfit) {
       EXPECT_EQ(P.weight(r, 0), 0.0);  // the held hip of a one-joint device
       pooled[0] += e[0], pooled[1] += e[1], rows += static_cast<double>(mf), sse += e[0] / (rms[r] * rms[r]);
     }
-    // The records' misfits differ, so the weights do: the model given's (the damped twin's are both
-    // near the angles' quantization, 1e-6 rad, in the quiet windows, which keep the restarts off the
-    // velocity filter's edges).
-    if (!with_torque_fit) {
-      EXPECT_GT(rms[1], 3 * rms[0]);
-    }
-    EXPECT_NE(P.weight(0, 1), P.weight(1, 1));
+    EXPECT_GT(rms[1], 3 * rms[0]);  // the records' misfits differ, so the weights do
     const double level = with_torque_fit ? std::min(pooled[0], pooled[1]) : pooled[0];
     EXPECT_NEAR(P.weight(1), 1 / std::sqrt(level / rows), 1e-9 * P.weight(1));
     double s[2];
