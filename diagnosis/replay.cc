@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/parallel_for.h"
+#include "dsp/statistics.h"
 #include "sim/plant_effects.h"
 
 namespace exotwin {
@@ -61,9 +62,8 @@ void SetRestartState(double cutoff_hz, ReplaySeries* out) {
     out->fast[i] = miss[top.front()];
   }
   std::vector<double> sorted = out->fast;
-  const size_t tenth = n / 10;
-  if (n > 0) std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(tenth), sorted.end());
-  out->quiet_level = n > 0 ? kReplayQuietFactor * sorted[tenth] : 0.0;
+  std::sort(sorted.begin(), sorted.end());
+  out->quiet_level = n > 0 ? kReplayQuietFactor * Percentile(sorted, 0.1) : 0.0;
 }
 
 ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
