@@ -185,7 +185,6 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   WriteFileAtomic(base + "/subject.yaml", ModelToYaml(human.params, "exotwin table5: " + subject + " steps 3-4",
                                                       IdentificationYaml(human, iopt)));
   e.identified = human.params;
-
   Scenario gait = LoadStep(opt, "gait_2kmh.yaml", subject);
   gait.subject.passive = PassiveModel::kRiener1999;
   gait.human.behaviour = "relaxed";
@@ -194,6 +193,15 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   const double t_from = gait.protocol.ramp, t_to = t_from + opt.strides * gait.protocol.stride_period;
   gait.protocol.duration = t_to + kGaitTail;
   AddPlant(worn_fx, opt, true, &gait);
+  // The twin the subject's gait record came from (its steps 3-4 records too: the same subject and
+  // worn plant): the preset's exoskeleton and human, the passive model, the plant's effects with the
+  // subject's draws. With it, diagnose and replay on those records tell what identification gets
+  // wrong from what diagnosis does.
+  LegParams truth = ResolveSubject(gait);
+  truth.effects.insert(truth.effects.end(), gait.plant_effects.begin(), gait.plant_effects.end());
+  WriteFileAtomic(base + "/truth.yaml", ModelToYaml(truth, "exotwin table5: " + subject +
+                                                               ", the twin its worn records came from (seed " +
+                                                               std::to_string(opt.seed) + ")"));
   const std::string gdir = base + "/gait";
   RunInto(gait, gdir, subject + " gait", &run.failed_checks);
   const MeasuredData g = ReadRun(gdir).front();

@@ -66,7 +66,9 @@ struct Table5SubjectRun {
 };
 
 // Runs steps 1-4, identification and gait for one preset subject. Writes DIR/<subject>/exo.yaml and
-// subject.yaml (identified). Throws InputError on bad options, SimulationError on divergence.
+// subject.yaml (identified), and truth.yaml: the twin its worn records (steps 3-4, gait) came from, the
+// preset with its passive model and the plant's effects, the subject's draws resolved. Throws
+// InputError on bad options, SimulationError on divergence.
 Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Options& opt);
 
 // The effects of the plant a scenario of the protocol carries on top of its own: the device's in every

@@ -5,6 +5,7 @@
 // human side, the subject's own passive moment (drawn per subject) raises it further.
 #include "tests/temp_dir.h"
 #include "runner/table5_protocol.h"
+#include "formats/model_file.h"
 
 #include <gtest/gtest.h>
 
@@ -182,6 +183,31 @@ TEST(Table5Protocol, HumanSideRaisesTheErrorAndDiagnoseNamesThePassiveMoment) {
   EXPECT_LE(gait.rmse_after[0], 0.6 * gait.rmse_before[0]);
   const std::string md = Table5DiagnosisMarkdown(RealisticS1Options("human_side.yaml", tmp.path()), {run});
   EXPECT_NE(md.find("Drawn passive_moment (hip, seed 1): S1 -0.114."), std::string::npos) << md;
+
+  // S1/truth.yaml: the twin the worn records came from. Its parameters are examples/S1.yaml's (the
+  // preset written by hand), its effects the worn plant's in order (exowheel_realistic.yaml's sensor,
+  // then human_side.yaml's), the cv draws resolved: the hip's passive moment is the draw above.
+  const LegParams truth = ReadModelFile(tmp.path() + "/S1/truth.yaml");
+  const LegParams s1 = ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml");
+  ASSERT_TRUE(truth.human.has_value());
+  EXPECT_EQ(truth.L1, s1.L1);
+  EXPECT_EQ(truth.passive, s1.passive);
+  const double got[12] = {truth.exo.J1, truth.exo.J2, truth.exo.X1, truth.exo.X2, truth.exo.Y1, truth.exo.Y2,
+                          truth.human->J1, truth.human->J2, truth.human->X1, truth.human->X2, truth.human->Y1, truth.human->Y2};
+  const double want[12] = {s1.exo.J1, s1.exo.J2, s1.exo.X1, s1.exo.X2, s1.exo.Y1, s1.exo.Y2,
+                           s1.human->J1, s1.human->J2, s1.human->X1, s1.human->X2, s1.human->Y1, s1.human->Y2};
+  for (int k = 0; k < 12; ++k) EXPECT_NEAR(got[k], want[k], 1e-9) << "parameter " << k;
+  ASSERT_EQ(truth.effects.size(), 9u);  // 4 of the sensor, 5 of the human side
+  ASSERT_EQ(truth.effects.size(), run.plant_worn.size());
+  for (size_t k = 0; k < truth.effects.size(); ++k) {
+    EXPECT_EQ(truth.effects[k].name, run.plant_worn[k].name) << k;
+    EXPECT_EQ(truth.effects[k].joint, run.plant_worn[k].joint) << k;
+    EXPECT_NEAR(truth.effects[k].value, run.plant_worn[k].value, 1e-9) << k;
+    EXPECT_EQ(truth.effects[k].fields.count("cv"), 0u) << k;
+  }
+  EXPECT_EQ(truth.effects[6].name, "series_compliance");
+  EXPECT_EQ(truth.effects[6].value, 1100.0);
+  EXPECT_NEAR(truth.effects[7].value, drawn, 1e-9);
   EXPECT_NE(md.find("| passive_moment (hip) | drawn per subject | 1 |"), std::string::npos) << md;
 }
 
