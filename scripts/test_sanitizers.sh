@@ -52,6 +52,9 @@ SWEEPS="$SWEEPS|DiagnoseHiddenEffect\.EverySingleEffectIsNamedMeasuredAndRemoved
 SWEEPS="$SWEEPS|MotionFit\.HiddenKneeStrapWithAHumanIsNamed|MotionFit\.HiddenKneeSensorDelayIsNamed"
 SWEEPS="$SWEEPS|MotionFit\.KneeBacklashAndCoulombFrictionAreBothNamed|MotionFit\.HiddenHipBacklashOf30MilliradIsNamedWhereverTheWindowsRestart"
 SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone"
+#   The strap of Table 5's human side named from the true twin: a table5 subject run (the other
+#   Table5Protocol tests keep that path) and a motion fit (MotionFit's keep it).
+SWEEPS="$SWEEPS|Table5Protocol\.TheHumanSidesStrapShowsInTheGaitOfTheTrueTwin"
 #   The motion fits of real-rig records (each alone, and six together; the same paths on real data).
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnFiveOfSeven"
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfSixRecordsKeepsTheRotorInertiaTheSeventhNeeds"
