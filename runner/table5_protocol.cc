@@ -185,6 +185,7 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   WriteFileAtomic(base + "/subject.yaml", ModelToYaml(human.params, "exotwin table5: " + subject + " steps 3-4",
                                                       IdentificationYaml(human, iopt)));
   e.identified = human.params;
+
   Scenario gait = LoadStep(opt, "gait_2kmh.yaml", subject);
   gait.subject.passive = PassiveModel::kRiener1999;
   gait.human.behaviour = "relaxed";
