@@ -316,6 +316,25 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   all_rows_ = std::max(all_rows, 1.0);
 }
 
+void MotionProblem::WeightBy(const Rollout& ro) {
+  const int j0 = params_.one_joint ? 1 : 0;
+  double pooled[2] = {0, 0}, count = 0;
+  for (size_t r = 0; r < rec_.size(); ++r) {
+    const size_t m = rec_[r]->rows.size(), mf = rec_[r]->fit_rows;
+    count += static_cast<double>(mf);
+    for (int j = j0; j < 2; ++j) {
+      double e = 0;
+      for (size_t k = 0; k < mf; ++k) {
+        const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
+        e += std::pow(rec_[r]->q[i] - ro.q[r][i], 2);
+      }
+      pooled[j] += e;
+      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(e / std::max<double>(1, static_cast<double>(mf))), 1e-6);
+    }
+  }
+  for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(pooled[j] / std::max(count, 1.0)), 1e-6);
+}
+
 double MotionProblem::ReplaysSimulated() const {
   return static_cast<double>(rollouts_[static_cast<int>(Part::kFit)]) * fit_share_ +
          static_cast<double>(rollouts_[static_cast<int>(Part::kHeldOut)]) * (1 - fit_share_) +
@@ -889,7 +908,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   topt.simulate = false;
   Diagnosis T = Diagnose(params, records, topt);
 
-  const MotionProblem P(params, records, opt, T.effects);
+  MotionProblem P(params, records, opt, T.effects);
   const int n_par = P.parameters();
   const std::vector<Candidate>& cands = P.candidates();
   const bool loo = records.size() >= 2;
@@ -1317,11 +1336,21 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   if (!at.ok) throw SimulationError(0, "the motion fit's extended twin diverges on the records");
   Charge(kGate);
 
-  // 7. Values and intervals from the final Jacobian.
+  // 7. Values and intervals from the final Jacobian: the set's values refined once more with the
+  // weights of the extended twin's own misfit (motion_fit.h "Output weights").
   const std::vector<int> cols = ColumnsOf(cand_bank, chosen);
+  if (!chosen.empty()) {
+    const double before[2] = {P.weight(0), P.weight(1)};
+    P.WeightBy(at);
+    have_last = false;
+    std::string text = "values refined with the extended twin's misfit as the output weights:";
+    for (int j = params.one_joint ? 1 : 0; j < 2; ++j)
+      text += std::string(" ") + kJoint[j] + " " + NumberText(1 / P.weight(j), 4) + " rad (was " + NumberText(1 / before[j], 4) + ")";
+    D.selection.push_back(text);
+  }
   D.tau_eff = ResidualAutocorrelation(P, at, window_rows);
   if (!chosen.empty()) {
-    if (!have_last) last = Refine(P, cols, {theta});  // no step taken when theta is its own minimum
+    if (!have_last) last = Refine(P, cols, {theta});  // with the new weights (from theta, its band probes)
     theta = last.theta;
     at = P.Simulate(theta, Part::kBoth);
     Fit f;

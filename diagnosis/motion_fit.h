@@ -28,7 +28,8 @@
 // (the given twin's error at a joint it misses by a lacking friction, 28 deg at the real rig's knee
 // against 8 at its hip, overstates the level the fit ends at and tips the balance to the other joint);
 // per record, so that a chaotic record the twin cannot follow does not size the values alone; a
-// one-joint device's held hip: 0.
+// one-joint device's held hip: 0. The chosen set's final values are refined with the weights of the
+// extended twin's own misfit (step 7: feasible weighted least squares, one step).
 //
 // Candidates (MotionCandidates): every effect the plant carries, at every joint of the device:
 // coulomb_friction, viscous_friction, inertia_error, gravity_error (X, Y), joint_stiffness (two
@@ -87,7 +88,9 @@
 //     the effect) one Gauss-Newton step from its refined ones on the other records' fit parts
 //     (LeftOutThetas: a record's held-out end may lack the motion an effect shows in); one that passes
 //     neither is dropped (the weakest first) and the rest refined again;
-//  7. 95 % intervals from the final Jacobian: cov = s^2 (J'J)^-1, s^2 the fit part's residual variance
+//  7. the weights set from the extended twin's misfit (MotionProblem::WeightBy) and the set's values
+//     refined once more under them (step 4's refinement and band probes, from the current values);
+//     95 % intervals from the final Jacobian: cov = s^2 (J'J)^-1, s^2 the fit part's residual variance
 //     inflated by its autocorrelation length; every effect the torque fit names and the motion fit
 //     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings;
 //     the records left out (simulation.left_out) with the values LeftOutThetas gives at the final
@@ -153,7 +156,8 @@ class MotionProblem {
   const PhysicalScale& scale() const { return scale_; }
   double qd_rms(int j) const { return qd_rms_[j]; }  // rad/s, RMS of the measured joint speed, every record
   double weight(int j) const { return w_[j]; }  // pooled over the records (the noise reported)
-  // The weight of record r's rows at joint j: 1 / the given twin's RMS simulated-angle error there.
+  // The weight of record r's rows at joint j: 1 / the misfit level there (the constructor's: the lower
+  // RMS simulated-angle error of the model given and of the torque fit's twin; WeightBy's).
   double weight(size_t r, int j) const { return rw_[r][static_cast<size_t>(j)]; }
   size_t records() const { return rec_.size(); }
   // The input between samples (ReplaySeries::hold): the one under which the model given follows the
@@ -192,6 +196,10 @@ class MotionProblem {
   const Eigen::VectorXd& measured(size_t r) const;  // measured angle on the rows (rad), Simulate's layout
   // Weighted SSE of a rollout per joint, on the fit part or the held-out part.
   void Sse(const Rollout& ro, Part part, double sse[2]) const;
+  // The weights from the misfit of rollout `ro` (its fit parts simulated): w_rj = 1 / its RMS
+  // simulated-angle error on record r's fit part at joint j, the pooled w_j likewise (motion_fit.h
+  // "Output weights", step 7); a one-joint device's hip keeps 0.
+  void WeightBy(const Rollout& ro);
   // The simulation done so far, in replays of the records: every Simulate call counts the share of the
   // records' scored rows it simulates (a fit part alone: its share; both parts: 1).
   double ReplaysSimulated() const;

@@ -51,7 +51,7 @@ SWEEPS="$SWEEPS|DiagnoseHiddenEffect\.EverySingleEffectIsNamedMeasuredAndRemoved
 #   at load 10).
 SWEEPS="$SWEEPS|MotionFit\.HiddenKneeStrapWithAHumanIsNamed|MotionFit\.HiddenKneeSensorDelayIsNamed"
 SWEEPS="$SWEEPS|MotionFit\.KneeBacklashAndCoulombFrictionAreBothNamed|MotionFit\.HiddenHipBacklashOf30MilliradIsNamedWhereverTheWindowsRestart"
-SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone"
+SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone|MotionFit\.HiddenKneeBacklashOf5MilliradIsSizedWithTheExtendedTwinsWeights"
 #   The strap of Table 5's human side named from the true twin: a table5 subject run (the other
 #   Table5Protocol tests keep that path) and a motion fit (MotionFit's keep it).
 SWEEPS="$SWEEPS|Table5Protocol\.TheHumanSidesStrapShowsInTheGaitOfTheTrueTwin"
