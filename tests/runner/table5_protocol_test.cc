@@ -218,7 +218,7 @@ TEST(Table5Protocol, HumanSideRaisesTheErrorAndDiagnoseNamesThePassiveMoment) {
 // What hides the human side's strap from `table5 --diagnose --fit motion` (issue 41: named on 1 of 10
 // gait records with the identified model): not the gait record. S1's relaxed gait through the human side
 // (the 10 strides of `table5`), diagnosed by the motion fit with S1/truth.yaml less its strap, names the
-// strap alone, within 10 % of human_side.yaml's 1100 N m/rad (measured 1147; on S2-S10 1126-1154). The
+// strap alone, within 10 % of human_side.yaml's 1100 N m/rad (measured 1134; on S2-S10 1116-1154). The
 // identified model's knee (steps 3-4, HJ15 eq. 18-21 on a plant with the strap: X2 -4.6 % with the strap
 // alone in the plant) is what the strap loses to.
 TEST(Table5Protocol, TheHumanSidesStrapShowsInTheGaitOfTheTrueTwin) {
