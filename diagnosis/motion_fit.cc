@@ -290,49 +290,56 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   const Rollout& by_torque = rollouts[hold_][1];
   double count = 0, all_rows = 0;
   for (const auto& rp : rec_) count += static_cast<double>(rp->fit_rows), all_rows += static_cast<double>(rp->rows.size());
-  rw_.assign(rec_.size(), {0.0, 0.0});
+  std::vector<std::array<double, 2>> level(rec_.size());
   double pooled[2][2] = {{0, 0}, {0, 0}};  // [twin][joint]
-  std::vector<std::array<double, 4>> e(rec_.size(), {0, 0, 0, 0});  // [twin * 2 + joint]
   for (size_t r = 0; r < rec_.size(); ++r) {
-    const size_t m = rec_[r]->rows.size(), mf = rec_[r]->fit_rows;
-    for (int j = j0; j < 2; ++j)
-      for (size_t k = 0; k < mf; ++k) {
-        const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
-        e[r][static_cast<size_t>(j)] += std::pow(rec_[r]->q[i] - given.q[r][i], 2);
-        if (by_torque.ok) e[r][static_cast<size_t>(2 + j)] += std::pow(rec_[r]->q[i] - by_torque.q[r][i], 2);
-      }
-    for (int j = j0; j < 2; ++j) pooled[0][j] += e[r][static_cast<size_t>(j)], pooled[1][j] += e[r][static_cast<size_t>(2 + j)];
-  }
-  for (int j = 0; j < 2; ++j) {
-    const double sse = by_torque.ok ? std::min(pooled[0][j], pooled[1][j]) : pooled[0][j];
-    w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(sse / count), 1e-6);
-    for (size_t r = 0; r < rec_.size() && j >= j0; ++r) {
-      const double mf = std::max<double>(1, static_cast<double>(rec_[r]->fit_rows));
-      const double er = by_torque.ok ? std::min(e[r][static_cast<size_t>(j)], e[r][static_cast<size_t>(2 + j)]) : e[r][static_cast<size_t>(j)];
-      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(er / mf), 1e-6);
+    double e[2][2] = {{0, 0}, {INFINITY, INFINITY}}, n;  // [twin][joint]
+    RecordSse(given, r, Part::kFit, e[0], &n);
+    if (by_torque.ok) RecordSse(by_torque, r, Part::kFit, e[1], &n);
+    for (int j = 0; j < 2; ++j) {
+      level[r][static_cast<size_t>(j)] = std::min(e[0][j], e[1][j]);
+      pooled[0][j] += e[0][j], pooled[1][j] += e[1][j];
     }
   }
+  const double level_pooled[2] = {std::min(pooled[0][0], pooled[1][0]), std::min(pooled[0][1], pooled[1][1])};
+  SetWeights(level, level_pooled);
   fit_share_ = count / std::max(all_rows, 1.0);
   all_rows_ = std::max(all_rows, 1.0);
 }
 
-void MotionProblem::WeightBy(const Rollout& ro) {
+void MotionProblem::SetWeights(const std::vector<std::array<double, 2>>& sse, const double pooled[2]) {
   const int j0 = params_.one_joint ? 1 : 0;
-  double pooled[2] = {0, 0}, count = 0;
+  double count = 0;
+  rw_.assign(rec_.size(), {0.0, 0.0});
   for (size_t r = 0; r < rec_.size(); ++r) {
-    const size_t m = rec_[r]->rows.size(), mf = rec_[r]->fit_rows;
-    count += static_cast<double>(mf);
-    for (int j = j0; j < 2; ++j) {
-      double e = 0;
-      for (size_t k = 0; k < mf; ++k) {
-        const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
-        e += std::pow(rec_[r]->q[i] - ro.q[r][i], 2);
-      }
-      pooled[j] += e;
-      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(e / std::max<double>(1, static_cast<double>(mf))), 1e-6);
-    }
+    const double mf = std::max<double>(1, static_cast<double>(rec_[r]->fit_rows));
+    count += static_cast<double>(rec_[r]->fit_rows);
+    for (int j = j0; j < 2; ++j) rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(sse[r][static_cast<size_t>(j)] / mf), 1e-6);
   }
   for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(pooled[j] / std::max(count, 1.0)), 1e-6);
+}
+
+void MotionProblem::WeightBy(const Rollout& ro) {
+  std::vector<std::array<double, 2>> sse(rec_.size());
+  double pooled[2] = {0, 0}, n;
+  for (size_t r = 0; r < rec_.size(); ++r) {
+    RecordSse(ro, r, Part::kFit, sse[r].data(), &n);
+    pooled[0] += sse[r][0], pooled[1] += sse[r][1];
+  }
+  SetWeights(sse, pooled);
+}
+
+void MotionProblem::RecordSse(const Rollout& ro, size_t r, Part part, double sse[2], double* count) const {
+  const Record& R = *rec_[r];
+  const size_t m = R.rows.size();
+  const size_t k0 = part == Part::kHeldOut ? R.fit_rows : 0, k1 = part == Part::kFit ? R.fit_rows : m;
+  sse[0] = sse[1] = 0;
+  for (int j = 0; j < 2; ++j)
+    for (size_t k = k0; k < k1; ++k) {
+      const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
+      sse[j] += std::pow(R.q[i] - ro.q[r][i], 2);
+    }
+  *count = static_cast<double>(k1 - k0);
 }
 
 double MotionProblem::ReplaysSimulated() const {
@@ -884,17 +891,6 @@ JointScore Score(double sse_before, double sse_after, double count) {
 }
 
 // Unweighted SSE (rad^2) of one record's part per joint, and its rows.
-void RecordSse(const MotionProblem& P, const MotionProblem::Rollout& ro, size_t r, Part part, double sse[2], double* count) {
-  const size_t m = P.rows(r).size();
-  const size_t k0 = part == Part::kHeldOut ? P.fit_rows(r) : 0, k1 = part == Part::kFit ? P.fit_rows(r) : m;
-  sse[0] = sse[1] = 0;
-  for (int j = 0; j < 2; ++j)
-    for (size_t k = k0; k < k1; ++k) {
-      const Eigen::Index i = static_cast<Eigen::Index>(j * m + k);
-      sse[j] += std::pow(P.measured(r)[i] - ro.q[r][i], 2);
-    }
-  *count = static_cast<double>(k1 - k0);
-}
 
 }  // namespace
 
@@ -1292,7 +1288,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
           std::array<double, 2> sum = {0, 0};
           for (size_t r = 0; r < lro.size() && std::isfinite(sum[0]); ++r) {
             double a[2] = {NAN, NAN}, n;
-            if (lro[r].ok) RecordSse(P, lro[r], r, Part::kBoth, a, &n);
+            if (lro[r].ok) P.RecordSse(lro[r], r, Part::kBoth, a, &n);
             sum[0] += a[0], sum[1] += a[1];
           }
           left_out[set] = sum;
@@ -1409,8 +1405,8 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     rs.source = records[r]->source;
     rs.samples = records[r]->size();
     double b[2], a[2], c;
-    RecordSse(P, given, r, Part::kHeldOut, b, &c);
-    RecordSse(P, at, r, Part::kHeldOut, a, &c);
+    P.RecordSse(given, r, Part::kHeldOut, b, &c);
+    P.RecordSse(at, r, Part::kHeldOut, a, &c);
     const auto& t = records[r]->t();
     const size_t split = P.rows(r)[P.fit_rows(r)];
     rs.sim_split_windows = P.windows(r, Part::kHeldOut);
@@ -1421,9 +1417,9 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     cnt += c;
     if (loo) {
       double lb_r[2], la_r[2], lc;
-      RecordSse(P, given, r, Part::kBoth, lb_r, &lc);
+      P.RecordSse(given, r, Part::kBoth, lb_r, &lc);
       if (!loo_ro[r].ok) throw SimulationError(0, rs.source + ": the effects fitted on the other records diverge on it");
-      RecordSse(P, loo_ro[r], r, Part::kBoth, la_r, &lc);
+      P.RecordSse(loo_ro[r], r, Part::kBoth, la_r, &lc);
       for (int j = 0; j < 2; ++j) {
         rs.left_out[j] = rs.sim_left_out[j] = Score(lb_r[j], la_r[j], lc);
         lb[j] += lb_r[j], la[j] += la_r[j];
@@ -1537,13 +1533,13 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       double tb[2] = {0, 0}, ta[2] = {0, 0}, tc = 0, ltb[2] = {0, 0}, lta[2] = {0, 0}, ltc = 0;
       for (size_t r = 0; r < P.records(); ++r) {
         double b[2], a[2], c;
-        RecordSse(P, given, r, Part::kHeldOut, b, &c);
-        RecordSse(P, t_ro, r, Part::kHeldOut, a, &c);
+        P.RecordSse(given, r, Part::kHeldOut, b, &c);
+        P.RecordSse(t_ro, r, Part::kHeldOut, a, &c);
         for (int j = 0; j < 2; ++j) tb[j] += b[j], ta[j] += a[j];
         tc += c;
         if (!loo) continue;
-        RecordSse(P, given, r, Part::kBoth, b, &c);
-        RecordSse(P, t_loo_ro[r], r, Part::kBoth, a, &c);
+        P.RecordSse(given, r, Part::kBoth, b, &c);
+        P.RecordSse(t_loo_ro[r], r, Part::kBoth, a, &c);
         for (int j = 0; j < 2; ++j) ltb[j] += b[j], lta[j] += a[j];
         ltc += c;
       }

@@ -196,6 +196,8 @@ class MotionProblem {
   const Eigen::VectorXd& measured(size_t r) const;  // measured angle on the rows (rad), Simulate's layout
   // Weighted SSE of a rollout per joint, on the fit part or the held-out part.
   void Sse(const Rollout& ro, Part part, double sse[2]) const;
+  // Unweighted SSE of a rollout per joint on part `part` of record r (rad^2), and that part's rows.
+  void RecordSse(const Rollout& ro, size_t r, Part part, double sse[2], double* count) const;
   // The weights from the misfit of rollout `ro` (its fit parts simulated): w_rj = 1 / its RMS
   // simulated-angle error on record r's fit part at joint j, the pooled w_j likewise (motion_fit.h
   // "Output weights", step 7); a one-joint device's hip keeps 0.
@@ -207,6 +209,9 @@ class MotionProblem {
  private:
   struct Record;
   Rollout Run(const Eigen::VectorXd& theta, Part part, int only) const;  // only >= 0: that record alone
+  // rw_ and w_ = 1 / the RMS of per-record fit-part SSEs `sse` and of the pooled `pooled` (rad^2);
+  // a one-joint device's hip: 0.
+  void SetWeights(const std::vector<std::array<double, 2>>& sse, const double pooled[2]);
   LegParams params_;
   DiagnoseOptions opt_;
   std::vector<std::unique_ptr<Record>> rec_;
