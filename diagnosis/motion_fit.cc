@@ -314,7 +314,8 @@ void MotionProblem::SetWeights(const std::vector<std::array<double, 2>>& sse, co
   for (size_t r = 0; r < rec_.size(); ++r) {
     const double mf = std::max<double>(1, static_cast<double>(rec_[r]->fit_rows));
     count += static_cast<double>(rec_[r]->fit_rows);
-    for (int j = j0; j < 2; ++j) rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(sse[r][static_cast<size_t>(j)] / mf), 1e-6);
+    for (int j = j0; j < 2; ++j)
+      rw_[r][static_cast<size_t>(j)] = 1.0 / std::max(std::sqrt(sse[r][static_cast<size_t>(j)] / mf), 1e-6);
   }
   for (int j = 0; j < 2; ++j) w_[j] = j < j0 ? 0.0 : 1.0 / std::max(std::sqrt(pooled[j] / std::max(count, 1.0)), 1e-6);
 }
@@ -889,8 +890,6 @@ JointScore Score(double sse_before, double sse_after, double count) {
   return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
           sse_before > 0 ? 100 * (1 - std::sqrt(sse_after / sse_before)) : 0};
 }
-
-// Unweighted SSE (rad^2) of one record's part per joint, and its rows.
 
 }  // namespace
 
