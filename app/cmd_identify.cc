@@ -72,7 +72,7 @@ struct IdentifyOpts {
     std::vector<std::string> measured, thresholds;
     std::string known, map, out, passive = "riener1999", cutoff = "20";
     double L1 = 0.0, emg_reference = 2.0, emg_envelope = 0.0, trim = 0.1;
-    bool friction = false;
+    bool friction = false, knee_cuff = false;
 };
 
 // identify's one-joint case (DESIGN.md "One-joint devices"): I and mgl (with --friction R and C) from
@@ -122,6 +122,9 @@ CommandRunner RegisterIdentify(CLI::App& app) {
                   "derivative filter cutoff in Hz, or 'auto' (chosen from the data by held-out "
                   "prediction error over every file); default 20 (Hwang & Jeon sec. 3.2)");
   sub->add_option("--trim", o->trim, "s dropped at both ends of every file (default 0.1)");
+  sub->add_flag("--knee-cuff", o->knee_cuff,
+                "steps 3-4: fit the knee cuff's compliance (a strap stiffer than 100 N m/rad) with the "
+                "human's segments; default: a rigid cuff, as the paper");
   sub->add_flag("--friction", o->friction,
                 "one-joint records: identify the device's R and C too (HKS05 eq. 4), besides I and mgl");
   return [sub, o]() -> int {
@@ -129,10 +132,13 @@ CommandRunner RegisterIdentify(CLI::App& app) {
     IdentificationOptions opt;
     opt.passive = o->passive == "none" ? PassiveModel::kNone : PassiveModel::kRiener1999;
     opt.trim_s = o->trim;
+    if (o->knee_cuff) opt.max_knee_compliance = kKneeCuffMaxCompliance;
     opt.selection.reference_s = o->emg_reference;
     opt.selection.envelope_s = o->emg_envelope;
     for (const std::string& t : o->thresholds) ParseThreshold(t, &opt.selection.thresholds);
     if (!(o->trim >= 0)) throw InputError("--trim: expected a time >= 0 s");
+    if (o->knee_cuff && o->known.empty())
+      throw InputError("--knee-cuff: the knee cuff is the human's (steps 3-4), expected --known MODEL.yaml");
     if (!(o->emg_reference > 0)) throw InputError("--emg-reference: expected a time > 0 s");
     if (!(o->emg_envelope >= 0)) throw InputError("--emg-envelope: expected a time >= 0 s");
     if (o->L1 != 0.0 && !(o->L1 > 0.1 && o->L1 < 1.0))

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "core/error.h"
+#include "core/materiality.h"
 #include "core/units.h"
 #include "model/passive_torque.h"
 #include "model/regressors.h"
@@ -56,8 +57,23 @@ IdConfiguration ClassifyConfiguration(const MeasuredData& data, const Identifica
 }
 
 void AppendSamples(const MeasuredData& data, bool select_passive, const IdentificationOptions& opt,
-                   IdentificationSamples* into) {
+                   IdentificationSamples* into, const LegParams* exo) {
   const Kinematics kin = DeriveKinematics(data, opt.cutoff_hz);
+  // The cuff torque tau_C and its rates by the angles' own chain: the human's knee angle q - c tau_C
+  // then has the rates qd - c tau_C', qdd - c tau_C'' exactly (the chain is linear), for any c.
+  std::vector<double> tau_c;
+  AngleRates tau_c_rates;
+  if (exo) {
+    const Vector6 exo_v = ToVector(exo->exo);
+    tau_c.resize(data.size());
+    for (size_t i = 0; i < data.size(); ++i) {
+      const Matrix26 Y = FullRegressor(exo->L1, exo->g, {kin.q[0][i], kin.q[1][i]},
+                                       {kin.qd[0][i], kin.qd[1][i]}, {kin.qdd[0][i], kin.qdd[1][i]});
+      tau_c[i] = -data.tau_knee()[i] - Y.row(1).dot(exo_v);  // u_knee = tau_R = -tau_S, HJ15 eq. 8
+    }
+    tau_c_rates = DeriveAngleRates(ExamineSampling(data.t(), data.source), data.t(), tau_c, opt.cutoff_hz,
+                                   data.source);
+  }
   std::vector<char> keep(data.size(), 1);
   if (select_passive) keep = SelectPassiveSamples(data, opt.selection).passive;
   const double t0 = data.t().front() + opt.trim_s, t1 = data.t().back() - opt.trim_s;
@@ -73,6 +89,11 @@ void AppendSamples(const MeasuredData& data, bool select_passive, const Identifi
     }
     into->u[0].push_back(-data.tau_hip()[i]);  // tau_R = -tau_S, HJ15 eq. 8
     into->u[1].push_back(-data.tau_knee()[i]);
+    if (exo) {
+      into->tau_c.push_back(tau_c[i]);
+      into->tau_c_d.push_back(tau_c_rates.qd[i]);
+      into->tau_c_dd.push_back(tau_c_rates.qdd[i]);
+    }
   }
   if (into->size() == before)
     throw InputError(data.source + ": no usable sample after trimming " + FormatNumber("%g", opt.trim_s) +
@@ -106,7 +127,8 @@ StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, Pass
 }
 
 StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, double g,
-                       const Vector6& known, PassiveModel passive, const Eigen::Matrix3d* known_cov) {
+                       const Vector6& known, PassiveModel passive, const Eigen::Matrix3d* known_cov,
+                       const KneeCuff* cuff) {
   const bool knee_row = step == 1 || step == 3;
   const int row = knee_row ? 1 : 0;
   const int held = knee_row ? 0 : 1;
@@ -119,6 +141,9 @@ StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, doub
   e.samples_total = s.total;
   e.sources = s.sources;
   if (n < 3) throw InputError("step " + std::to_string(step) + ": fewer than 3 samples");
+  const double c = human && cuff ? cuff->compliance : 0.0;
+  if (c > 0 && s.tau_c.size() != n)
+    throw std::logic_error("SolveStep: a compliant cuff needs samples prepared with the exoskeleton");
 
   // Rows (u*, w) are kept for an exact residual pass (the shortcut u'u - 2 phi'W'u + phi'W'W phi
   // cancels down to ~1e-6 N m RMS). W'A (A = the known distal columns) for the propagated covariance.
@@ -129,8 +154,18 @@ StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, doub
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d q(s.q[0][i], s.q[1][i]), qd(s.qd[0][i], s.qd[1][i]),
         qdd(s.qdd[0][i], s.qdd[1][i]);
-    const Matrix26 Y = FullRegressor(L1, g, q, qd, qdd);
-    const StepRow sr = RowFromRegressor(step, Y, known, passive, q, s.u[row][i]);
+    Matrix26 Y = FullRegressor(L1, g, q, qd, qdd);
+    StepRow sr;
+    if (c > 0) {
+      // The exoskeleton's row at the measured state, the human's at q - c tau_C (KneeCuff).
+      const double u_human = s.u[row][i] - Y.row(row).dot(cuff->exo);
+      const Eigen::Vector2d qh(q[0], q[1] - c * s.tau_c[i]), qdh(qd[0], qd[1] - c * s.tau_c_d[i]),
+          qddh(qdd[0], qdd[1] - c * s.tau_c_dd[i]);
+      Y = FullRegressor(L1, g, qh, qdh, qddh);
+      sr = RowFromRegressor(step, Y, known - cuff->exo, passive, qh, u_human);
+    } else {
+      sr = RowFromRegressor(step, Y, known, passive, q, s.u[row][i]);
+    }
     rows.row(i) << sr.w.transpose(), sr.u_star;
     WtW.selfadjointView<Eigen::Lower>().rankUpdate(sr.w);
     Wtu += sr.w * sr.u_star;
@@ -186,18 +221,63 @@ IdentificationResult IdentifyExo(const IdentificationSamples& knee, const Identi
 }
 
 IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
-                                   const LegParams& known, PassiveModel passive) {
+                                   const LegParams& known, PassiveModel passive, double max_knee_compliance) {
   IdentificationResult r;
   r.params = known;
   r.params.human.reset();
   r.params.effects.clear();
-  const StepEstimate s3 = SolveStep(3, knee, known.L1, known.g, ToVector(known.exo), passive);
+  KneeCuff cuff;
+  cuff.exo = ToVector(known.exo);
+  auto step3 = [&](double c) {
+    cuff.compliance = c;
+    return SolveStep(3, knee, known.L1, known.g, ToVector(known.exo), passive, nullptr, &cuff);
+  };
+  StepEstimate s3 = step3(0.0);
+  r.rigid_cuff_residual_rms = s3.residual_rms;
+  if (max_knee_compliance > 0 && knee.tau_c.size() == knee.size() && hip.tau_c.size() == hip.size()) {
+    // Golden-section search of step 3's residual over c in [0, max] (unimodal: the residual grows
+    // with the distance of c from the strap's, about |c - c*|, once the deflection dominates it), to
+    // 1e-4 of max (0.1 % of a 1100 N m/rad strap's compliance at max 0.01).
+    const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+    double a = 0, b = max_knee_compliance;
+    double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
+    double f1 = step3(x1).residual_rms, f2 = step3(x2).residual_rms;
+    const double tolerance = 1e-4 * max_knee_compliance;
+    while (b - a > tolerance) {
+      if (f1 <= f2) {
+        b = x2, x2 = x1, f2 = f1;
+        x1 = b - phi * (b - a);
+        f1 = step3(x1).residual_rms;
+      } else {
+        a = x1, x1 = x2, f1 = f2;
+        x2 = a + phi * (b - a);
+        f2 = step3(x2).residual_rms;
+      }
+    }
+    const StepEstimate best = step3(0.5 * (a + b));
+    // Material only: the cuff's RMS deflection at least kMaterialShare of the knee angle's RMS about
+    // its mean (the motion fit's materiality of a strap, diagnosis/diagnose_select.cc).
+    double tau_c2 = 0, q_sum = 0, q2 = 0;
+    for (size_t i = 0; i < knee.size(); ++i) {
+      tau_c2 += knee.tau_c[i] * knee.tau_c[i];
+      q_sum += knee.q[1][i];
+      q2 += knee.q[1][i] * knee.q[1][i];
+    }
+    const double n = static_cast<double>(knee.size()), q_mean = q_sum / n;
+    const double deflection_rms = cuff.compliance * std::sqrt(tau_c2 / n);
+    const double angle_rms = std::sqrt(std::max(0.0, q2 / n - q_mean * q_mean));
+    if (deflection_rms >= kMaterialShare * angle_rms && best.residual_rms < s3.residual_rms) {
+      s3 = best;
+      r.knee_compliance = cuff.compliance;
+    }
+  }
+  cuff.compliance = r.knee_compliance;
   LumpedParams h;
   h.J2 = s3.phi[0];
   h.X2 = s3.phi[1];
   h.Y2 = s3.phi[2];
   const StepEstimate s4 =
-      SolveStep(4, hip, known.L1, known.g, ToVector(known.exo) + ToVector(h), passive, &s3.cov);
+      SolveStep(4, hip, known.L1, known.g, ToVector(known.exo) + ToVector(h), passive, &s3.cov, &cuff);
   h.J1 = s4.phi[0];
   h.X1 = s4.phi[1];
   h.Y1 = s4.phi[2];
@@ -215,7 +295,7 @@ IdentificationResult Identify(const std::vector<MeasuredData>& files, const LegP
   const bool human = known != nullptr;
   for (const MeasuredData& f : files) {
     const IdConfiguration c = ClassifyConfiguration(f, opt);
-    AppendSamples(f, human, opt, c == IdConfiguration::kKneeSwing ? &knee : &hip);
+    AppendSamples(f, human, opt, c == IdConfiguration::kKneeSwing ? &knee : &hip, known);
   }
   auto missing = [&](IdConfiguration c) {
     std::string got;
@@ -226,7 +306,7 @@ IdentificationResult Identify(const std::vector<MeasuredData>& files, const LegP
   };
   if (knee.size() == 0) missing(IdConfiguration::kKneeSwing);
   if (hip.size() == 0) missing(IdConfiguration::kHipSwing);
-  if (human) return IdentifyHuman(knee, hip, *known, opt.passive);
+  if (human) return IdentifyHuman(knee, hip, *known, opt.passive, opt.max_knee_compliance);
   return IdentifyExo(knee, hip, L1, 9.81);
 }
 
@@ -272,6 +352,16 @@ std::string IdentificationYaml(const IdentificationResult& r, const Identificati
     if (opt.selection.envelope_s > 0)
       os << " (moving average " << Num(opt.selection.envelope_s) << " s)";
     os << "; all samples when a file has no emg_* column\"\n";
+    if (opt.max_knee_compliance > 0) {
+      os << "  knee_cuff: \"the human's knee angle is the exoskeleton's less c tau_C, c in [0, "
+         << Num(opt.max_knee_compliance) << "] rad/N m by step 3's residual, kept where material\"\n";
+      os << "  knee_cuff_compliance: " << Num(r.knee_compliance) << "   # rad/N m";
+      if (r.knee_compliance > 0) os << ", a strap of " << Num(1.0 / r.knee_compliance) << " N m/rad";
+      os << "\n";
+      os << "  rigid_cuff_step3_residual_rms: " << Num(r.rigid_cuff_residual_rms) << "   # N m\n";
+    } else {
+      os << "  knee_cuff: \"rigid (Hwang & Jeon 2015 as published)\"\n";
+    }
   }
   os << "  condition_number: \"2-norm condition number of the column-scaled regressor W D\"\n";
   os << "  std_error: \"sqrt(diag(sigma^2 (W'W)^-1)) (+ propagated step-1/3 uncertainty in steps 2/4); "

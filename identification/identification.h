@@ -50,7 +50,12 @@ struct IdentificationOptions {
   double cutoff_hz = 20.0;      // Hz, zero-phase Butterworth of the derivatives (sec. 3.2)
   PassiveModel passive = PassiveModel::kRiener1999;  // P^ subtracted in steps 3-4 (HJ15 eq. 16-17)
   PassiveSelectionOptions selection;                 // HJ15 eq. 13, human steps only
+  // Steps 3-4: the largest compliance (rad/N m) of the knee cuff IdentifyHuman fits; 0 = a rigid cuff,
+  // HJ15 as published (`identify --knee-cuff`: kKneeCuffMaxCompliance).
+  double max_knee_compliance = 0;
 };
+// The knee cuff search's bound: any strap stiffer than 100 N m/rad.
+constexpr double kKneeCuffMaxCompliance = 0.01;
 
 // Range (min, max, mean; rad) of both joints of a file.
 struct JointRanges {
@@ -68,15 +73,20 @@ struct IdentificationSamples {
   IdConfiguration config = IdConfiguration::kKneeSwing;
   std::vector<std::string> sources;
   std::vector<double> q[2], qd[2], qdd[2], u[2];
+  // Steps 3-4, prepared with the known exoskeleton: the torque the knee cuff carries to the human's
+  // lower leg, tau_C = u_knee - the exoskeleton's knee row at the measured state (N m; HJ15 eq. 8 split
+  // at the cuff), as recorded and its two rates by the angles' derivative chain. Empty otherwise.
+  std::vector<double> tau_c, tau_c_d, tau_c_dd;
   size_t total = 0;  // samples in the files before trimming and selection
   size_t size() const { return u[0].size(); }
 };
 
 // Appends the samples of one file (derivatives by DeriveKinematics with opt.cutoff_hz, trim at both
-// ends; with select_passive, only samples passing HJ15 eq. 13). Precondition: data is of configuration
-// into->config (use ClassifyConfiguration). Throws InputError if the trim leaves nothing.
+// ends; with select_passive, only samples passing HJ15 eq. 13). With `exo` (steps 3-4: L1, g and the
+// identified exoskeleton), also the cuff torque tau_C and its rates. Precondition: data is of
+// configuration into->config (use ClassifyConfiguration). Throws InputError if the trim leaves nothing.
 void AppendSamples(const MeasuredData& data, bool select_passive, const IdentificationOptions& opt,
-                   IdentificationSamples* into);
+                   IdentificationSamples* into, const LegParams* exo = nullptr);
 
 // One row u* = w' phi (HJ15 eq. 18) of step 1..4 from the full regressor at any state (q, qd, qdd) with
 // actuator torque u (N m, the moving joint's tau_R): w = the moving joint's row of FullRegressor at
@@ -85,6 +95,15 @@ void AppendSamples(const MeasuredData& data, bool select_passive, const Identifi
 StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, PassiveModel passive,
                        const Eigen::Vector2d& q, const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd,
                        double u);
+
+// A compliant knee cuff in steps 3-4 (DESIGN.md series_compliance: the strap between the exoskeleton's
+// lower leg and the human's). The human's knee angle is the exoskeleton's less compliance x tau_C (its
+// rates likewise, the samples' tau_c_d, tau_c_dd), the human's rows (unknown, known distal, passive
+// P^) are evaluated at the human's state and the exoskeleton's known row at the measured one.
+struct KneeCuff {
+  double compliance = 0;        // rad/N m (1 / the strap's stiffness); 0 = rigid
+  Vector6 exo = Vector6::Zero();  // the exoskeleton's part of `known` (model/regressors.h layout)
+};
 
 // Result of one step (HJ15 eq. 18-21).
 struct StepEstimate {
@@ -102,24 +121,36 @@ struct StepEstimate {
 
 // One step on prepared samples. `known` holds every parameter already known in the layout of
 // model/regressors.h ([J1 J2 X1 X2 Y1 Y2] of the combined system, the unknown entries zero);
-// `known_cov` (may be null) the covariance of the known distal [J2 X2 Y2] (steps 2 and 4).
-// Precondition: samples.size() >= 3; throws InputError if the regressor is rank deficient.
+// `known_cov` (may be null) the covariance of the known distal [J2 X2 Y2] (steps 2 and 4); `cuff` (may
+// be null; steps 3-4) a compliant knee cuff. Precondition: samples.size() >= 3, and samples' tau_c
+// filled where cuff->compliance > 0; throws InputError if the regressor is rank deficient.
 StepEstimate SolveStep(int step, const IdentificationSamples& samples, double L1, double g,
                        const Vector6& known, PassiveModel passive,
-                       const Eigen::Matrix3d* known_cov = nullptr);
+                       const Eigen::Matrix3d* known_cov = nullptr, const KneeCuff* cuff = nullptr);
 
 struct IdentificationResult {
   LegParams params;                // exo (+ human, passive) identified; L1, g as used
   std::vector<StepEstimate> steps;  // steps 1-2 or 3-4
+  // Steps 3-4: the knee cuff's compliance both steps used (rad/N m, 0 = rigid) and step 3's residual
+  // RMS (N m) with a rigid cuff, HJ15 as published. The identified model (params) stays rigid: the
+  // cuff is for `diagnose` to name from motion.
+  double knee_compliance = 0, rigid_cuff_residual_rms = 0;
 };
 
 // Steps 1-2: the exoskeleton alone from the knee-swing and hip-swing samples. L1 (m), g (m/s^2).
 IdentificationResult IdentifyExo(const IdentificationSamples& knee, const IdentificationSamples& hip,
                                  double L1, double g);
 
-// Steps 3-4: the human with known.exo, known.L1, known.g; P^ = `passive`.
+// Steps 3-4: the human with known.exo, known.L1, known.g; P^ = `passive`. With max_knee_compliance > 0
+// (and the samples' tau_c filled) the knee cuff's compliance c in [0, max] is fitted first: the one
+// that minimizes step 3's residual (golden-section search to 1e-4 of max; kept where its RMS deflection
+// is material, core/materiality.h, against the knee angle's RMS about its mean), then
+// steps 3 and 4 are solved with it. A strap's deflection, tau_C / k, otherwise biases the human's
+// knee segment (X2 -4.6 % at 1100 N m/rad on S1): the regressor would be evaluated at the
+// exoskeleton's angle instead of the human's.
 IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
-                                   const LegParams& known, PassiveModel passive);
+                                   const LegParams& known, PassiveModel passive,
+                                   double max_knee_compliance = 0);
 
 // Whole pipeline on files (any order, one or more per configuration): classifies, prepares, solves.
 // known == nullptr: steps 1-2 with thigh length L1; else steps 3-4 with known->exo (L1 from known).

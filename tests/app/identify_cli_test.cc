@@ -10,6 +10,7 @@
 #include "formats/csv_table.h"
 #include "identification/identification_data.h"
 #include "formats/model_file.h"
+#include "model/regressors.h"
 #include "core/units.h"
 #include "tests/app/cli_test_util.h"
 
@@ -91,6 +92,27 @@ TEST_F(IdentifyCli, ExoThenHumanWithKnown) {
   for (const char* key : {"identification:", "segment: H2", "segment: H1", "std_error:",
                           "condition_number:", "passive_selection:"})
     EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
+}
+
+// --knee-cuff on records without a strap (the synthetic protocol is rigid): no material compliance,
+// the same human as without it (table5_protocol_test checks a strap); without
+// --known (the exoskeleton's steps) it is bad input.
+TEST_F(IdentifyCli, KneeCuffKeepsARigidCuffRigid) {
+  const auto r0 = RunExotwin("identify --measured " + D() + "/exo --L1 0.41 --out " + D() + "/exo_k.yaml");
+  ASSERT_EQ(r0.exit_code, 0) << r0.output;
+  const std::string human = "identify --measured " + D() + "/human --known " + D() + "/exo_k.yaml --out ";
+  const auto r1 = RunExotwin(human + D() + "/rigid.yaml");
+  const auto r2 = RunExotwin(human + D() + "/cuff.yaml --knee-cuff");
+  ASSERT_EQ(r1.exit_code, 0) << r1.output;
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  const LegParams a = ReadModelFile(D() + "/rigid.yaml"), b = ReadModelFile(D() + "/cuff.yaml");
+  ASSERT_TRUE(a.human.has_value() && b.human.has_value());
+  EXPECT_EQ(ToVector(*a.human), ToVector(*b.human));
+  std::ifstream in(D() + "/cuff.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("knee_cuff_compliance: 0   # rad/N m\n"), std::string::npos) << text;
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/exo --knee-cuff --out " + D() + "/x.yaml"),
+                 "--knee-cuff");
 }
 
 // --cutoff: a number sets the derivative filter (the file records it), 'auto' chooses it from the
