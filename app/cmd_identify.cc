@@ -72,7 +72,7 @@ struct IdentifyOpts {
     std::vector<std::string> measured, thresholds;
     std::string known, map, out, passive = "riener1999", cutoff = "20";
     double L1 = 0.0, emg_reference = 2.0, emg_envelope = 0.0, trim = 0.1;
-    bool friction = false, knee_cuff = false;
+    bool friction = false, knee_cuff = false, subject_passive = false;
 };
 
 // identify's one-joint case (DESIGN.md "One-joint devices"): I and mgl (with --friction R and C) from
@@ -125,6 +125,9 @@ CommandRunner RegisterIdentify(CLI::App& app) {
   sub->add_flag("--knee-cuff", o->knee_cuff,
                 "steps 3-4: fit the knee cuff's compliance (a strap stiffer than 100 N m/rad) with the "
                 "human's segments; default: a rigid cuff, as the paper");
+  sub->add_flag("--subject-passive", o->subject_passive,
+                "steps 3-4: fit the subject's factor on the passive model and the limb's damping per joint "
+                "(the model carries them as passive_moment and viscous_friction); default: as the paper");
   sub->add_flag("--friction", o->friction,
                 "one-joint records: identify the device's R and C too (HKS05 eq. 4), besides I and mgl");
   return [sub, o]() -> int {
@@ -132,13 +135,18 @@ CommandRunner RegisterIdentify(CLI::App& app) {
     IdentificationOptions opt;
     opt.passive = o->passive == "none" ? PassiveModel::kNone : PassiveModel::kRiener1999;
     opt.trim_s = o->trim;
-    if (o->knee_cuff) opt.max_knee_compliance = kKneeCuffMaxCompliance;
+    if (o->knee_cuff) opt.human_side.max_knee_compliance = kKneeCuffMaxCompliance;
+    opt.human_side.subject_passive = o->subject_passive;
     opt.selection.reference_s = o->emg_reference;
     opt.selection.envelope_s = o->emg_envelope;
     for (const std::string& t : o->thresholds) ParseThreshold(t, &opt.selection.thresholds);
     if (!(o->trim >= 0)) throw InputError("--trim: expected a time >= 0 s");
     if (o->knee_cuff && o->known.empty())
       throw InputError("--knee-cuff: the knee cuff is the human's (steps 3-4), expected --known MODEL.yaml");
+    if (o->subject_passive && o->known.empty())
+      throw InputError("--subject-passive: the passive moment is the human's (steps 3-4), expected --known MODEL.yaml");
+    if (o->subject_passive && o->passive == "none")
+      throw InputError("--subject-passive: fits the subject's factor on the passive model, expected --passive riener1999");
     if (!(o->emg_reference > 0)) throw InputError("--emg-reference: expected a time > 0 s");
     if (!(o->emg_envelope >= 0)) throw InputError("--emg-envelope: expected a time >= 0 s");
     if (o->L1 != 0.0 && !(o->L1 > 0.1 && o->L1 < 1.0))

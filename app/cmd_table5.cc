@@ -1,5 +1,6 @@
 // `exotwin table5 [--subjects S1,...] [--strides 10] [--out DIR] [--trials N] [--trial-duration S]
-//  [--plant FILE] [--plant-worn FILE | --realistic] [--seed N] [--knee-cuff] [--diagnose [--fit torque|motion]]`:
+//  [--plant FILE] [--plant-worn FILE | --realistic] [--seed N] [--knee-cuff] [--subject-passive]
+//  [--diagnose [--fit torque|motion]]`:
 // Hwang & Jeon 2015 Tables 3-5 reproduced by the twin, side by side with the paper (identification
 // steps 1-4 and relaxed gait through the closed loop, per subject; runner/table5_protocol.h), optionally
 // through a plant with effects (the realistic EXOwheel of data/plants/) and with diagnose on the
@@ -38,7 +39,7 @@ CommandRunner RegisterTable5(CLI::App& app) {
     int strides = 10, trials = 5;
     uint64_t seed = 1;
     double trial_duration = 40.0;
-    bool drop_logs = false, realistic = false, diagnose = false, knee_cuff = false;
+    bool drop_logs = false, realistic = false, diagnose = false, knee_cuff = false, subject_passive = false;
     std::string fit = "torque";
   };
   auto o = std::make_shared<Opts>();
@@ -62,6 +63,9 @@ CommandRunner RegisterTable5(CLI::App& app) {
                   "seed of the per-subject draws of a plant effect with a cv field (passive_moment; default 1)");
   sub->add_flag("--knee-cuff", o->knee_cuff,
                 "steps 3-4 fit the knee cuff's compliance with the human's segments (identify --knee-cuff)");
+  sub->add_flag("--subject-passive", o->subject_passive,
+                "steps 3-4 fit the subject's factor on the passive model and the limb's damping (identify "
+                "--subject-passive)");
   sub->add_flag("--diagnose", o->diagnose,
                 "diagnose the gait and the steps 3-4 records with the identified rigid model (a section of the output)");
   sub->add_option("--fit", o->fit,
@@ -86,6 +90,7 @@ CommandRunner RegisterTable5(CLI::App& app) {
     Table5PlantEffects(opt, true);  // reads both files up front: a bad file is exit 2 before any run
     opt.diagnose = o->diagnose;
     opt.knee_cuff = o->knee_cuff;
+    opt.subject_passive = o->subject_passive;
     opt.gait_fit = ParseDiagnoseFit(o->fit, "table5 --fit");
     if (opt.gait_fit == DiagnoseFit::kMotion && !o->diagnose)
       throw InputError("table5 --fit motion: expected --diagnose with it");

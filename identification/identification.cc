@@ -126,9 +126,14 @@ StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, Pass
   return RowFromRegressor(step, FullRegressor(L1, g, q, qd, qdd), known, passive, q, u);
 }
 
-StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, double g,
-                       const Vector6& known, PassiveModel passive, const Eigen::Matrix3d* known_cov,
-                       const KneeCuff* cuff) {
+namespace {
+
+// SolveStep with M unknown columns: the paper's three, then (subject_passive) P^'s row and the velocity.
+template <int M>
+StepEstimate SolveColumns(int step, const IdentificationSamples& s, double L1, double g, const Vector6& known,
+                          PassiveModel passive, const Eigen::Matrix3d* known_cov, const HumanSideRows* extra) {
+  using MatM = Eigen::Matrix<double, M, M>;
+  using VecM = Eigen::Matrix<double, M, 1>;
   const bool knee_row = step == 1 || step == 3;
   const int row = knee_row ? 1 : 0;
   const int held = knee_row ? 0 : 1;
@@ -140,66 +145,97 @@ StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, doub
   e.samples_used = n;
   e.samples_total = s.total;
   e.sources = s.sources;
-  if (n < 3) throw InputError("step " + std::to_string(step) + ": fewer than 3 samples");
-  const double c = human && cuff ? cuff->compliance : 0.0;
+  if (n < static_cast<size_t>(M))
+    throw InputError("step " + std::to_string(step) + ": fewer than " + std::to_string(M) + " samples");
+  const double c = human && extra ? extra->knee_compliance : 0.0;
   if (c > 0 && s.tau_c.size() != n)
     throw std::logic_error("SolveStep: a compliant cuff needs samples prepared with the exoskeleton");
+  // With the subject's factor on P^ a column, P^ is not subtracted from the row.
+  const PassiveModel subtracted = M > 3 ? PassiveModel::kNone : passive;
 
   // Rows (u*, w) are kept for an exact residual pass (the shortcut u'u - 2 phi'W'u + phi'W'W phi
   // cancels down to ~1e-6 N m RMS). W'A (A = the known distal columns) for the propagated covariance.
-  Eigen::Matrix<double, Eigen::Dynamic, 4> rows(n, 4);  // [w' u*]
-  Eigen::Matrix3d WtW = Eigen::Matrix3d::Zero(), WtA = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d Wtu = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, Eigen::Dynamic, M + 1> rows(n, M + 1);  // [w' u*]
+  MatM WtW = MatM::Zero();
+  Eigen::Matrix<double, M, 3> WtA = Eigen::Matrix<double, M, 3>::Zero();
+  VecM Wtu = VecM::Zero();
   double held_sum = 0;
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d q(s.q[0][i], s.q[1][i]), qd(s.qd[0][i], s.qd[1][i]),
-        qdd(s.qdd[0][i], s.qdd[1][i]);
-    Matrix26 Y = FullRegressor(L1, g, q, qd, qdd);
-    StepRow sr;
-    if (c > 0) {
-      // The exoskeleton's row at the measured state, the human's at q - c tau_C (KneeCuff).
-      const double u_human = s.u[row][i] - Y.row(row).dot(cuff->exo);
-      const Eigen::Vector2d qh(q[0], q[1] - c * s.tau_c[i]), qdh(qd[0], qd[1] - c * s.tau_c_d[i]),
-          qddh(qdd[0], qdd[1] - c * s.tau_c_dd[i]);
-      Y = FullRegressor(L1, g, qh, qdh, qddh);
-      sr = RowFromRegressor(step, Y, known - cuff->exo, passive, qh, u_human);
-    } else {
-      sr = RowFromRegressor(step, Y, known, passive, q, s.u[row][i]);
-    }
-    rows.row(i) << sr.w.transpose(), sr.u_star;
-    WtW.selfadjointView<Eigen::Lower>().rankUpdate(sr.w);
-    Wtu += sr.w * sr.u_star;
-    if (known_cov) WtA += sr.w * Eigen::RowVector3d(Y(row, 1), Y(row, 3), Y(row, 5));
+    Eigen::Vector2d q(s.q[0][i], s.q[1][i]), qd(s.qd[0][i], s.qd[1][i]), qdd(s.qdd[0][i], s.qdd[1][i]);
     held_sum += q[held];
+    Matrix26 Y = FullRegressor(L1, g, q, qd, qdd);
+    double u = s.u[row][i];
+    Vector6 known_here = known;
+    if (c > 0) {
+      // The exoskeleton's row at the measured state, the human's at q - c tau_C (HumanSideRows).
+      u -= Y.row(row).dot(extra->exo);
+      known_here -= extra->exo;
+      q[1] -= c * s.tau_c[i];
+      qd[1] -= c * s.tau_c_d[i];
+      qdd[1] -= c * s.tau_c_dd[i];
+      Y = FullRegressor(L1, g, q, qd, qdd);
+    }
+    const StepRow sr = RowFromRegressor(step, Y, known_here, subtracted, q, u);
+    VecM w;
+    w.template head<3>() = sr.w;
+    if constexpr (M > 3) {
+      w[3] = PassiveElasticTorque(passive, q)[row];
+      w[4] = qd[row];
+    }
+    rows.row(i) << w.transpose(), sr.u_star;
+    WtW.template selfadjointView<Eigen::Lower>().rankUpdate(w);
+    Wtu += w * sr.u_star;
+    if (known_cov) WtA += w * Eigen::RowVector3d(Y(row, 1), Y(row, 3), Y(row, 5));
   }
-  WtW = WtW.selfadjointView<Eigen::Lower>();
+  WtW = WtW.template selfadjointView<Eigen::Lower>();
   e.held_mean = held_sum / static_cast<double>(n);
 
-  Eigen::Vector3d d;
-  for (int c = 0; c < 3; ++c) d[c] = WtW(c, c) > 0 ? 1.0 / std::sqrt(WtW(c, c)) : 0.0;
-  const Eigen::Matrix3d S = d.asDiagonal() * WtW * d.asDiagonal();  // (W D)'(W D)
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(S, Eigen::EigenvaluesOnly);
-  const double lmin = eig.eigenvalues()[0], lmax = eig.eigenvalues()[2];
+  VecM d;
+  for (int k = 0; k < M; ++k) d[k] = WtW(k, k) > 0 ? 1.0 / std::sqrt(WtW(k, k)) : 0.0;
+  const MatM S = d.asDiagonal() * WtW * d.asDiagonal();  // (W D)'(W D)
+  const Eigen::SelfAdjointEigenSolver<MatM> eig(S, Eigen::EigenvaluesOnly);
+  const double lmin = eig.eigenvalues()[0], lmax = eig.eigenvalues()[M - 1];
   if (!(lmin > 1e-14 * lmax) || d.minCoeff() == 0.0)
     throw InputError("step " + std::to_string(step) + " (" + e.segment +
                      "): the regressor is rank deficient, expected an exciting motion (several "
                      "harmonics over a wide range) of the moving joint");
   e.condition_number = std::sqrt(lmax / lmin);
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(S);
-  e.phi = d.asDiagonal() * ldlt.solve(d.asDiagonal() * Wtu);  // HJ15 eq. 21
+  const Eigen::LDLT<MatM> ldlt(S);
+  const VecM b = d.asDiagonal() * ldlt.solve(d.asDiagonal() * Wtu);  // HJ15 eq. 21
+  e.phi = b.template head<3>();
 
-  const double rss = (rows.col(3) - rows.leftCols<3>() * e.phi).squaredNorm();
+  const double rss = (rows.col(M) - rows.template leftCols<M>() * b).squaredNorm();
   e.residual_rms = std::sqrt(rss / static_cast<double>(n));
-  const double sigma2 = n > 3 ? rss / static_cast<double>(n - 3) : 0.0;
-  const Eigen::Matrix3d Sinv = ldlt.solve(Eigen::Matrix3d::Identity());
-  const Eigen::Matrix3d WtWinv = d.asDiagonal() * Sinv * d.asDiagonal();
-  e.cov = sigma2 * WtWinv;
+  const double sigma2 = n > static_cast<size_t>(M) ? rss / static_cast<double>(n - M) : 0.0;
+  const MatM Sinv = ldlt.solve(MatM::Identity());
+  const MatM WtWinv = d.asDiagonal() * Sinv * d.asDiagonal();
+  MatM cov = sigma2 * WtWinv;
   if (known_cov) {
-    const Eigen::Matrix3d G = WtWinv * WtA;
-    e.cov += G * (*known_cov) * G.transpose();
+    const Eigen::Matrix<double, M, 3> G = WtWinv * WtA;
+    cov += G * (*known_cov) * G.transpose();
   }
-  for (int c = 0; c < 3; ++c) e.se[c] = std::sqrt(std::max(0.0, e.cov(c, c)));
+  e.cov = cov.template topLeftCorner<3, 3>();
+  for (int k = 0; k < 3; ++k) e.se[k] = std::sqrt(std::max(0.0, e.cov(k, k)));
+  if constexpr (M > 3) {
+    e.passive_factor = b[3];
+    e.passive_factor_se = std::sqrt(std::max(0.0, cov(3, 3)));
+    e.damping = b[4];
+    e.damping_se = std::sqrt(std::max(0.0, cov(4, 4)));
+  }
   return e;
+}
+
+}  // namespace
+
+StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, double g, const Vector6& known,
+                       PassiveModel passive, const Eigen::Matrix3d* known_cov, const HumanSideRows* rows) {
+  if (step >= 3 && rows && rows->subject_passive) {
+    if (passive == PassiveModel::kNone)
+      throw InputError("step " + std::to_string(step) +
+                       ": the subject's factor on the passive model needs one, expected riener1999");
+    return SolveColumns<5>(step, s, L1, g, known, passive, known_cov, rows);
+  }
+  return SolveColumns<3>(step, s, L1, g, known, passive, known_cov, rows);
 }
 
 IdentificationResult IdentifyExo(const IdentificationSamples& knee, const IdentificationSamples& hip,
@@ -221,28 +257,30 @@ IdentificationResult IdentifyExo(const IdentificationSamples& knee, const Identi
 }
 
 IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
-                                   const LegParams& known, PassiveModel passive, double max_knee_compliance) {
+                                   const LegParams& known, PassiveModel passive, const HumanSideFit& fit) {
   IdentificationResult r;
   r.params = known;
   r.params.human.reset();
   r.params.effects.clear();
-  KneeCuff cuff;
-  cuff.exo = ToVector(known.exo);
+  HumanSideRows rows;
+  rows.exo = ToVector(known.exo);
+  rows.subject_passive = fit.subject_passive;
   auto step3 = [&](double c) {
-    cuff.compliance = c;
-    return SolveStep(3, knee, known.L1, known.g, ToVector(known.exo), passive, nullptr, &cuff);
+    rows.knee_compliance = c;
+    return SolveStep(3, knee, known.L1, known.g, ToVector(known.exo), passive, nullptr, &rows);
   };
   StepEstimate s3 = step3(0.0);
   r.rigid_cuff_residual_rms = s3.residual_rms;
-  if (max_knee_compliance > 0 && knee.tau_c.size() == knee.size() && hip.tau_c.size() == hip.size()) {
+  const double c_max = fit.max_knee_compliance;
+  if (c_max > 0 && knee.tau_c.size() == knee.size() && hip.tau_c.size() == hip.size()) {
     // Golden-section search of step 3's residual over c in [0, max] (unimodal: the residual grows
     // with the distance of c from the strap's, about |c - c*|, once the deflection dominates it), to
     // 1e-4 of max (0.1 % of a 1100 N m/rad strap's compliance at max 0.01).
     const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-    double a = 0, b = max_knee_compliance;
+    double a = 0, b = c_max;
     double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
     double f1 = step3(x1).residual_rms, f2 = step3(x2).residual_rms;
-    const double tolerance = 1e-4 * max_knee_compliance;
+    const double tolerance = 1e-4 * c_max;
     while (b - a > tolerance) {
       if (f1 <= f2) {
         b = x2, x2 = x1, f2 = f1;
@@ -264,25 +302,32 @@ IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const Iden
       q2 += knee.q[1][i] * knee.q[1][i];
     }
     const double n = static_cast<double>(knee.size()), q_mean = q_sum / n;
-    const double deflection_rms = cuff.compliance * std::sqrt(tau_c2 / n);
+    const double deflection_rms = rows.knee_compliance * std::sqrt(tau_c2 / n);
     const double angle_rms = std::sqrt(std::max(0.0, q2 / n - q_mean * q_mean));
     if (deflection_rms >= kMaterialShare * angle_rms && best.residual_rms < s3.residual_rms) {
       s3 = best;
-      r.knee_compliance = cuff.compliance;
+      r.knee_compliance = rows.knee_compliance;
     }
   }
-  cuff.compliance = r.knee_compliance;
+  rows.knee_compliance = r.knee_compliance;
   LumpedParams h;
   h.J2 = s3.phi[0];
   h.X2 = s3.phi[1];
   h.Y2 = s3.phi[2];
   const StepEstimate s4 =
-      SolveStep(4, hip, known.L1, known.g, ToVector(known.exo) + ToVector(h), passive, &s3.cov, &cuff);
+      SolveStep(4, hip, known.L1, known.g, ToVector(known.exo) + ToVector(h), passive, &s3.cov, &rows);
   h.J1 = s4.phi[0];
   h.X1 = s4.phi[1];
   h.Y1 = s4.phi[2];
   r.params.human = h;
   r.params.passive = passive;
+  if (fit.subject_passive) {
+    const std::pair<const char*, const StepEstimate*> per_joint[2] = {{"hip", &s4}, {"knee", &s3}};
+    for (const auto& [joint, st] : per_joint) {
+      r.params.effects.push_back({"passive_moment", joint, st->passive_factor - 1.0, "relative", {}, ""});
+      r.params.effects.push_back({"viscous_friction", joint, st->damping, "N m s/rad", {}, ""});
+    }
+  }
   r.steps = {s3, s4};
   return r;
 }
@@ -306,7 +351,7 @@ IdentificationResult Identify(const std::vector<MeasuredData>& files, const LegP
   };
   if (knee.size() == 0) missing(IdConfiguration::kKneeSwing);
   if (hip.size() == 0) missing(IdConfiguration::kHipSwing);
-  if (human) return IdentifyHuman(knee, hip, *known, opt.passive, opt.max_knee_compliance);
+  if (human) return IdentifyHuman(knee, hip, *known, opt.passive, opt.human_side);
   return IdentifyExo(knee, hip, L1, 9.81);
 }
 
@@ -352,9 +397,9 @@ std::string IdentificationYaml(const IdentificationResult& r, const Identificati
     if (opt.selection.envelope_s > 0)
       os << " (moving average " << Num(opt.selection.envelope_s) << " s)";
     os << "; all samples when a file has no emg_* column\"\n";
-    if (opt.max_knee_compliance > 0) {
+    if (opt.human_side.max_knee_compliance > 0) {
       os << "  knee_cuff: \"the human's knee angle is the exoskeleton's less c tau_C, c in [0, "
-         << Num(opt.max_knee_compliance) << "] rad/N m by step 3's residual, kept where material\"\n";
+         << Num(opt.human_side.max_knee_compliance) << "] rad/N m by step 3's residual, kept where material\"\n";
       os << "  knee_cuff_compliance: " << Num(r.knee_compliance) << "   # rad/N m";
       if (r.knee_compliance > 0) os << ", a strap of " << Num(1.0 / r.knee_compliance) << " N m/rad";
       os << "\n";
@@ -378,6 +423,11 @@ std::string IdentificationYaml(const IdentificationResult& r, const Identificati
     os << "      residual_rms: " << Num(s.residual_rms) << "   # N m\n";
     os << "      held_joint_mean_deg: " << Num(s.held_mean * kDegPerRad) << "   # "
        << (knee ? "hip" : "knee") << "\n";
+    if (opt.human_side.subject_passive && s.step >= 3) {
+      os << "      passive_factor: " << Num(s.passive_factor) << "   # on " << PassiveModelName(opt.passive)
+         << ", std_error " << Num(s.passive_factor_se) << "\n";
+      os << "      damping: " << Num(s.damping) << "   # N m s/rad, std_error " << Num(s.damping_se) << "\n";
+    }
     os << "      samples_used: " << s.samples_used << "\n";
     os << "      samples_total: " << s.samples_total << "\n";
     os << "      files: [";

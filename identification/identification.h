@@ -39,6 +39,17 @@
 
 namespace exotwin {
 
+// What steps 3-4 fit beyond the paper's rows (all off: Hwang & Jeon 2015 as published). The
+// subject's own passive moment and damping: HJ15 subtracts a population curve P^ (eq. 16-17) and
+// neglects the relaxed limb's damping; a subject's curve is its own (Silder et al. 2007 fit one per
+// subject). The knee cuff: HJ15's rows take the human's knee angle for the encoder's.
+struct HumanSideFit {
+  double max_knee_compliance = 0;  // rad/N m, the knee cuff's search bound (`--knee-cuff`); 0 = rigid
+  bool subject_passive = false;    // per step, the subject's factor on P^ and the link side's damping
+};
+// The knee cuff search's bound: any strap stiffer than 100 N m/rad.
+constexpr double kKneeCuffMaxCompliance = 0.01;
+
 enum class IdConfiguration { kKneeSwing, kHipSwing };
 // "knee swing (hip held)" / "hip swing (knee held)".
 const char* ConfigurationName(IdConfiguration c);
@@ -50,12 +61,8 @@ struct IdentificationOptions {
   double cutoff_hz = 20.0;      // Hz, zero-phase Butterworth of the derivatives (sec. 3.2)
   PassiveModel passive = PassiveModel::kRiener1999;  // P^ subtracted in steps 3-4 (HJ15 eq. 16-17)
   PassiveSelectionOptions selection;                 // HJ15 eq. 13, human steps only
-  // Steps 3-4: the largest compliance (rad/N m) of the knee cuff IdentifyHuman fits; 0 = a rigid cuff,
-  // HJ15 as published (`identify --knee-cuff`: kKneeCuffMaxCompliance).
-  double max_knee_compliance = 0;
+  HumanSideFit human_side;                           // steps 3-4 beyond the paper (default: none)
 };
-// The knee cuff search's bound: any strap stiffer than 100 N m/rad.
-constexpr double kKneeCuffMaxCompliance = 0.01;
 
 // Range (min, max, mean; rad) of both joints of a file.
 struct JointRanges {
@@ -96,13 +103,17 @@ StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, Pass
                        const Eigen::Vector2d& q, const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd,
                        double u);
 
-// A compliant knee cuff in steps 3-4 (DESIGN.md series_compliance: the strap between the exoskeleton's
-// lower leg and the human's). The human's knee angle is the exoskeleton's less compliance x tau_C (its
-// rates likewise, the samples' tau_c_d, tau_c_dd), the human's rows (unknown, known distal, passive
-// P^) are evaluated at the human's state and the exoskeleton's known row at the measured one.
-struct KneeCuff {
-  double compliance = 0;        // rad/N m (1 / the strap's stiffness); 0 = rigid
+// Steps 3-4's rows beyond the paper's. A compliant knee cuff (DESIGN.md series_compliance: the strap
+// between the exoskeleton's lower leg and the human's): the human's knee angle is the exoskeleton's
+// less knee_compliance x tau_C (its rates likewise, the samples' tau_c_d, tau_c_dd), the human's rows
+// (unknown, known distal, passive P^) are evaluated at the human's state and the exoskeleton's known
+// row at the measured one. subject_passive: two more unknown columns, P^'s row at the human's state
+// (its coefficient the subject's factor on P^, instead of P^ subtracted) and the human's velocity of
+// the moving joint (the link side's viscous damping, N m s/rad).
+struct HumanSideRows {
+  double knee_compliance = 0;     // rad/N m (1 / the strap's stiffness); 0 = rigid
   Vector6 exo = Vector6::Zero();  // the exoskeleton's part of `known` (model/regressors.h layout)
+  bool subject_passive = false;
 };
 
 // Result of one step (HJ15 eq. 18-21).
@@ -112,7 +123,10 @@ struct StepEstimate {
   Eigen::Vector3d phi = Eigen::Vector3d::Zero();  // [J, X, Y]: kg m^2, kg m, kg m
   Eigen::Vector3d se = Eigen::Vector3d::Zero();   // standard errors, same units
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  // covariance of phi
-  double condition_number = 0;                   // of the column-scaled regressor
+  double condition_number = 0;                   // of the column-scaled regressor (all its columns)
+  // HumanSideRows::subject_passive: the subject's factor on P^ and the damping (N m s/rad), with
+  // their standard errors; else 1 and 0, not fitted.
+  double passive_factor = 1, passive_factor_se = 0, damping = 0, damping_se = 0;
   double residual_rms = 0;                       // N m
   double held_mean = 0;                          // rad, mean angle of the held joint
   size_t samples_used = 0, samples_total = 0;
@@ -121,19 +135,21 @@ struct StepEstimate {
 
 // One step on prepared samples. `known` holds every parameter already known in the layout of
 // model/regressors.h ([J1 J2 X1 X2 Y1 Y2] of the combined system, the unknown entries zero);
-// `known_cov` (may be null) the covariance of the known distal [J2 X2 Y2] (steps 2 and 4); `cuff` (may
-// be null; steps 3-4) a compliant knee cuff. Precondition: samples.size() >= 3, and samples' tau_c
-// filled where cuff->compliance > 0; throws InputError if the regressor is rank deficient.
+// `known_cov` (may be null) the covariance of the known distal [J2 X2 Y2] (steps 2 and 4); `rows` (may
+// be null; steps 3-4) the rows beyond the paper's. Precondition: samples.size() >= 3 (5 with
+// subject_passive), and samples' tau_c filled where rows->knee_compliance > 0; throws InputError if
+// the regressor is rank deficient.
 StepEstimate SolveStep(int step, const IdentificationSamples& samples, double L1, double g,
                        const Vector6& known, PassiveModel passive,
-                       const Eigen::Matrix3d* known_cov = nullptr, const KneeCuff* cuff = nullptr);
+                       const Eigen::Matrix3d* known_cov = nullptr, const HumanSideRows* rows = nullptr);
 
 struct IdentificationResult {
   LegParams params;                // exo (+ human, passive) identified; L1, g as used
   std::vector<StepEstimate> steps;  // steps 1-2 or 3-4
   // Steps 3-4: the knee cuff's compliance both steps used (rad/N m, 0 = rigid) and step 3's residual
-  // RMS (N m) with a rigid cuff, HJ15 as published. The identified model (params) stays rigid: the
-  // cuff is for `diagnose` to name from motion.
+  // RMS (N m) with a rigid cuff. The identified model (params) carries no strap: the cuff is for
+  // `diagnose` to name from motion. With subject_passive, params.effects carry the subject's
+  // passive_moment (factor - 1) and viscous_friction per joint (steps 3 and 4's).
   double knee_compliance = 0, rigid_cuff_residual_rms = 0;
 };
 
@@ -141,16 +157,17 @@ struct IdentificationResult {
 IdentificationResult IdentifyExo(const IdentificationSamples& knee, const IdentificationSamples& hip,
                                  double L1, double g);
 
-// Steps 3-4: the human with known.exo, known.L1, known.g; P^ = `passive`. With max_knee_compliance > 0
-// (and the samples' tau_c filled) the knee cuff's compliance c in [0, max] is fitted first: the one
+// Steps 3-4: the human with known.exo, known.L1, known.g; P^ = `passive`; `fit` beyond the paper.
+// With fit.subject_passive every step has the two more columns of HumanSideRows (P^ must not be
+// kNone). With fit.max_knee_compliance > 0 (and the samples' tau_c filled) the knee cuff's
+// compliance c in [0, max] is fitted first: the one
 // that minimizes step 3's residual (golden-section search to 1e-4 of max; kept where its RMS deflection
 // is material, core/materiality.h, against the knee angle's RMS about its mean), then
 // steps 3 and 4 are solved with it. A strap's deflection, tau_C / k, otherwise biases the human's
 // knee segment (X2 -4.6 % at 1100 N m/rad on S1): the regressor would be evaluated at the
 // exoskeleton's angle instead of the human's.
 IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
-                                   const LegParams& known, PassiveModel passive,
-                                   double max_knee_compliance = 0);
+                                   const LegParams& known, PassiveModel passive, const HumanSideFit& fit = {});
 
 // Whole pipeline on files (any order, one or more per configuration): classifies, prepares, solves.
 // known == nullptr: steps 1-2 with thigh length L1; else steps 3-4 with known->exo (L1 from known).

@@ -181,7 +181,8 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   WriteFileAtomic(base + "/exo.yaml", ModelToYaml(exo.params, "exotwin table5: " + subject + " steps 1-2",
                                                   IdentificationYaml(exo, iopt)));
   LegParams known = exo.params;
-  if (opt.knee_cuff) iopt.max_knee_compliance = kKneeCuffMaxCompliance;
+  if (opt.knee_cuff) iopt.human_side.max_knee_compliance = kKneeCuffMaxCompliance;
+  iopt.human_side.subject_passive = opt.subject_passive;
   const IdentificationResult human = Identify(human_files, &known, preset.L1, iopt);
   WriteFileAtomic(base + "/subject.yaml", ModelToYaml(human.params, "exotwin table5: " + subject + " steps 3-4",
                                                       IdentificationYaml(human, iopt)));

@@ -29,7 +29,8 @@ struct Table5Options {
   std::string plant_file;       // the device's: every scenario (steps 1-4 and gait); "" = none
   std::string plant_worn_file;  // the worn leg's: where the subject wears the exoskeleton (steps 3-4, gait)
   bool diagnose = false;        // diagnose the gait and the steps 3-4 records with the identified model
-  bool knee_cuff = false;       // steps 3-4 fit the knee cuff's compliance (identification.h KneeCuff)
+  bool knee_cuff = false;        // steps 3-4 fit the knee cuff's compliance (identification.h HumanSideFit)
+  bool subject_passive = false;  // steps 3-4 fit the subject's factor on P^ and the limb's damping
   // The gait records' fit (diagnosis/diagnose.h DiagnoseFit): kMotion sizes the effects by simulating the
   // forward plant on the gait (diagnosis/motion_fit.h; a strap or a dead band shows in the motion). The
   // steps 3-4 records (quasi-static identification trials, trials x trial_duration s each) keep the

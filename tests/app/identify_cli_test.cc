@@ -113,6 +113,9 @@ TEST_F(IdentifyCli, KneeCuffKeepsARigidCuffRigid) {
   EXPECT_NE(text.find("knee_cuff_compliance: 0   # rad/N m\n"), std::string::npos) << text;
   ExpectBadInput(RunExotwin("identify --measured " + D() + "/exo --knee-cuff --out " + D() + "/x.yaml"),
                  "--knee-cuff");
+  ExpectBadInput(RunExotwin("identify --measured " + D() + "/exo --subject-passive --out " + D() + "/x.yaml"),
+                 "--subject-passive");
+  ExpectBadInput(RunExotwin(human + D() + "/x.yaml --subject-passive --passive none"), "--passive riener1999");
 }
 
 // --cutoff: a number sets the derivative filter (the file records it), 'auto' chooses it from the

@@ -30,7 +30,11 @@ LegParams S1() {
 
 // Noise-free closed-form recording of one configuration: the moving joint follows a multi-sine, the
 // held joint wobbles by `wobble` rad around 90 / -90 deg (as a PD-held joint does), tau_S = -tau_R.
-MeasuredData ClosedFormRecording(const LegParams& p, bool knee_swing, double wobble, double T = 20) {
+// With `passive_factor` and `damping` (per joint, hip then knee) the subject's own passive moment,
+// factor x P^, and a viscous damping act on top of p (the actuator carries them).
+MeasuredData ClosedFormRecording(const LegParams& p, bool knee_swing, double wobble, double T = 20,
+                                 const Eigen::Vector2d& passive_factor = Eigen::Vector2d::Ones(),
+                                 const Eigen::Vector2d& damping = Eigen::Vector2d::Zero()) {
   CsvTable tab;
   tab.names = {"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "qd_hip", "qd_knee", "qdd_hip", "qdd_knee"};
   tab.columns.assign(tab.names.size(), {});
@@ -49,7 +53,10 @@ MeasuredData ClosedFormRecording(const LegParams& p, bool knee_swing, double wob
     q[h] = held + wobble * std::sin(3.3 * t);
     qd[h] = wobble * 3.3 * std::cos(3.3 * t);
     qdd[h] = -wobble * 3.3 * 3.3 * std::sin(3.3 * t);
-    const Eigen::Vector2d tau_R = ActuatorTorque(p, q, qd, qdd);
+    const Eigen::Vector2d tau_R = ActuatorTorque(p, q, qd, qdd) +
+                                  (passive_factor - Eigen::Vector2d::Ones()).cwiseProduct(
+                                      PassiveElasticTorque(p.passive, q)) +
+                                  damping.cwiseProduct(qd);
     const double row[9] = {t, q[0], q[1], -tau_R[0], -tau_R[1], qd[0], qd[1], qdd[0], qdd[1]};
     for (int c = 0; c < 9; ++c) tab.columns[c].push_back(row[c]);
   }
@@ -151,6 +158,48 @@ TEST(Identification, ExactRecoveryWithImperfectlyHeldJoint) {
   EXPECT_GT(std::abs(phi[0] - truth.human->J2) + std::abs(phi[1] - truth.human->X2) +
                 std::abs(phi[2] - truth.human->Y2),
             1e-3);
+}
+
+// HumanSideFit::subject_passive on noise-free data of a subject whose passive moment is 1.3 / 0.8 x P^
+// (hip / knee) with a damping of 0.2 / 0.1 N m s/rad: the segments to round-off, the factors and the
+// damping as the effects of the model written (passive_moment = factor - 1); the paper's rows, which
+// subtract P^ and neglect the damping, miss the segments by more than 1 %.
+TEST(Identification, SubjectPassiveRecoversTheSubjectsFactorAndDamping) {
+  const LegParams truth = S1();
+  LegParams exo_only = truth;
+  exo_only.human.reset();
+  exo_only.passive = PassiveModel::kNone;
+  const double wobble = 2.0 * kRadPerDeg;
+  const IdentificationResult rx =
+      Identify({ClosedFormRecording(exo_only, false, wobble), ClosedFormRecording(exo_only, true, wobble)},
+               nullptr, truth.L1);
+  const Eigen::Vector2d factor(1.3, 0.8), damping(0.2, 0.1);
+  const std::vector<MeasuredData> files = {ClosedFormRecording(truth, true, wobble, 20, factor, damping),
+                                           ClosedFormRecording(truth, false, wobble, 20, factor, damping)};
+  IdentificationOptions opt;
+  opt.human_side.subject_passive = true;
+  const IdentificationResult r = Identify(files, &rx.params, 0, opt);
+  ASSERT_TRUE(r.params.human.has_value());
+  ExpectNear(*r.params.human, *truth.human, 1e-7);
+  ASSERT_EQ(r.params.effects.size(), 4u);
+  for (int j = 0; j < 2; ++j) {
+    const char* joint = j ? "knee" : "hip";
+    const Effect& pm = r.params.effects[2 * j];
+    const Effect& vf = r.params.effects[2 * j + 1];
+    EXPECT_EQ(pm.name, "passive_moment");
+    EXPECT_EQ(pm.joint, joint);
+    EXPECT_NEAR(pm.value, factor[j] - 1, 1e-7) << joint;
+    EXPECT_EQ(vf.name, "viscous_friction");
+    EXPECT_EQ(vf.joint, joint);
+    EXPECT_NEAR(vf.value, damping[j], 1e-7) << joint;
+  }
+  EXPECT_LT(r.steps[0].residual_rms, 1e-8);
+  const std::string yaml = IdentificationYaml(r, opt);
+  EXPECT_NE(yaml.find("passive_factor: "), std::string::npos) << yaml;
+
+  const IdentificationResult paper = Identify(files, &rx.params, 0);
+  EXPECT_GT(std::abs(paper.params.human->X2 / truth.human->X2 - 1), 0.01) << paper.params.human->X2;
+  EXPECT_TRUE(paper.params.effects.empty());
 }
 
 // The scaled normal equations give the least-squares solution of a QR of the stacked regressor.
