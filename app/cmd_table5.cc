@@ -67,7 +67,7 @@ CommandRunner RegisterTable5(CLI::App& app) {
                 "steps 3-4 fit the subject's factor on the passive model and the limb's damping (identify "
                 "--subject-passive)");
   sub->add_flag("--diagnose", o->diagnose,
-                "diagnose the gait and the steps 3-4 records with the identified rigid model (a section of the output)");
+                "diagnose the gait and the steps 3-4 records with the identified model (a section of the output)");
   sub->add_option("--fit", o->fit,
                   "with --diagnose, the gait records' fit: torque (default) or motion (the forward plant simulated on "
                   "the gait, diagnosis/motion_fit.h); the steps 3-4 records keep the torque fit");

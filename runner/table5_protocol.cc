@@ -210,7 +210,10 @@ Table5SubjectRun RunTable5Subject(const std::string& subject, const Table5Option
   const MeasuredData g = ReadRun(gdir).front();
   ComputeTable5Rmse(g, t_from, t_to, preset.weight, preset.L2, &e);
   if (opt.diagnose) {
-    const LegParams model = Table5ParameterSets(e.identified, preset.weight, preset.L2)[0];
+    // The identified model as subject.yaml has it: the rigid set, riener1999, and what steps 3-4
+    // identified beyond the paper (--subject-passive: the subject's passive factor and damping).
+    LegParams model = Table5ParameterSets(e.identified, preset.weight, preset.L2)[0];
+    model.effects = e.identified.effects;
     run.diagnoses.push_back(DiagnoseRecords("gait", model, {&g}, opt.gait_fit));
     std::vector<const MeasuredData*> steps34;
     for (const MeasuredData& f : human_files) steps34.push_back(&f);
@@ -266,7 +269,7 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
   bool any = false;
   for (const Table5SubjectRun& r : runs) any = any || !r.diagnoses.empty();
   if (!any) return s;
-  s += "\n## diagnose on the twin's own records, with the identified rigid model\n\n";
+  s += "\n## diagnose on the twin's own records, with the identified model\n\n";
   s += "Per record set: the effects named (value [95 % interval], deviation from the plant's value of that "
        "effect at that joint), and the held-out RMS error (diagnose's last 30 %) of the identified twin -> the "
        "extended twin: of the filtered torque (N m) where the records are diagnosed by the torque fit, of the "
@@ -291,17 +294,21 @@ std::string Table5DiagnosisMarkdown(const Table5Options& opt, const std::vector<
         const Effect& e = d.named[i];
         s += (i ? "; " : "") + e.name + " (" + e.joint + ") " + FormatNumber("%.3g", e.value) + " [" +
              FormatNumber("%.3g", d.ci[i].first) + ", " + FormatNumber("%.3g", d.ci[i].second) + "]";
-        double set = 0;
+        // The model's own value of that effect (--subject-passive) adds to the named one.
+        double set = 0, own = 0;
+        const bool has_own = SetValue(r.entry.identified.effects, e.name, e.joint, &own);
+        const double total = e.value + own;
+        if (has_own) s += " (with the model's own " + FormatNumber("%.3g", own) + ": " + FormatNumber("%.3g", total) + ")";
         if (SetValue(r.plant_worn, e.name, e.joint, &set) && set != 0)
-          s += " (" + FormatNumber("%+.0f", 100.0 * (e.value - set) / set) + " % of the plant's " + FormatNumber("%g", set) + ")";
+          s += " (" + FormatNumber("%+.0f", 100.0 * (total - set) / set) + " % of the plant's " + FormatNumber("%g", set) + ")";
         else
           s += " (not in the plant)";
         if (d.records == "gait") {
           const std::string key = e.name + " (" + e.joint + ")";
           auto it = std::find_if(named_gait.begin(), named_gait.end(), [&](const auto& p) { return p.first == key; });
           if (it == named_gait.end()) it = named_gait.insert(named_gait.end(), {key, Acc{}});
-          it->second.sum += e.value;
-          it->second.abs_dev += std::abs(e.value - set);
+          it->second.sum += total;
+          it->second.abs_dev += std::abs(total - set);
           ++it->second.n;
         }
       }

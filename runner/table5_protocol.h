@@ -43,7 +43,8 @@ struct Table5Options {
 };
 
 // `diagnose` (diagnosis/diagnose.h, default options) on one set of a subject's records, with the
-// identified rigid model (Table5Entry::identified, passive riener1999, no effects).
+// identified model (Table5Entry::identified, passive riener1999, and the effects steps 3-4 identified:
+// with subject_passive, the subject's passive factor and damping; else none).
 struct Table5Diagnosis {
   std::string records;                  // "gait" or "steps 3-4"
   DiagnoseFit fit = DiagnoseFit::kTorque;

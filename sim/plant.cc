@@ -518,9 +518,12 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   if (!std::isfinite(tau_R[0]) || !std::isfinite(tau_R[1]) || !std::isfinite(tau_ext[0]) ||
       !std::isfinite(tau_ext[1]))
     throw SimulationError(d_->time, "non-finite torque command");
-  // On the part behind the internal hinges (at the followers' angles q + internal_q): tau_ext and P.
+  // On the part behind the internal hinges (at the followers' angles q + internal_q): tau_ext, P and the
+  // subject's passive_moment.
   Eigen::Vector2d applied = tau_ext;
-  if (params_.human) applied -= PassiveElasticTorque(params_.passive, structure_.any() ? q() + internal_q() : q());
+  const Eigen::Vector2d q_follower = structure_.any() ? q() + internal_q() : q();
+  if (params_.human) applied -= PassiveElasticTorque(params_.passive, q_follower);
+  if (!fx_.applied.empty()) applied += fx_.SubjectPassiveForce(q_follower);
   for (int j = 0; j < 2; ++j)
     if (in_v_[j] >= 0) d_->qfrc_applied[in_v_[j]] = applied[j];
   if (!fx_.applied.empty()) applied += fx_.AppliedForce(q());

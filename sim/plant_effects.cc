@@ -30,8 +30,11 @@ double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q) {
 Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
                                     const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
   if (!params.human) return ActuatorTorque(params, q, qd, qdd);
-  return RigidInverseDynamics(*params.human, params.L1, params.g, q, qd, qdd) +
-         PassiveElasticTorque(params.passive, q);
+  Eigen::Vector2d tau = RigidInverseDynamics(*params.human, params.L1, params.g, q, qd, qdd) +
+                        PassiveElasticTorque(params.passive, q);
+  for (const Effect& e : params.effects)  // the subject's passive moment acts on the human's segments
+    if (e.name == "passive_moment") tau[e.joint == "hip" ? 0 : 1] += PassiveMomentTorque(e, q);
+  return tau;
 }
 
 Eigen::Vector2d CompliantAngle(const LegParams& params, int j, double k, const Eigen::Vector2d& q,
@@ -60,6 +63,13 @@ bool PlantEffects::link_empty() const {
   return applied.empty();
 }
 
+Eigen::Vector2d PlantEffects::SubjectPassiveForce(const Eigen::Vector2d& q_follower) const {
+  Eigen::Vector2d f = Eigen::Vector2d::Zero();
+  for (const Effect& e : applied)
+    if (e.name == "passive_moment") f[e.joint == "hip" ? 0 : 1] -= PassiveMomentTorque(e, q_follower);
+  return f;
+}
+
 bool PlantEffects::has_internal_joints() const {
   return backlash[0] != 0 || backlash[1] != 0 || compliance[0] != 0 || compliance[1] != 0;
 }
@@ -72,7 +82,7 @@ Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q) const {
     if (e.name == "gravity_error") {
       f -= GravityErrorTorque(e, g, q);
     } else if (e.name == "passive_moment") {
-      f[e.joint == "hip" ? 0 : 1] -= PassiveMomentTorque(e, q);
+      continue;  // SubjectPassiveForce
     } else {
       const int j = e.joint == "hip" ? 0 : 1;
       f[j] -= TorqueRippleTorque(e, q[j]);

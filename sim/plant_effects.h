@@ -20,8 +20,9 @@
 //    with X or Y changed) does not carry; the applied force keeps forward and inverse one model.
 //  - torque_ripple     -> an applied generalized force -value sin(2 pi k q + phase).
 //  - passive_moment    -> an applied generalized force -value P_j(q) (PassiveMomentTorque): the subject's
-//    passive moment off Riener & Edrich's population curves by the factor 1 + value, at the measured
-//    joint's angles (with a knee strap, not at the human's: they differ by the strap's deflection).
+//    passive moment off Riener & Edrich's population curves by the factor 1 + value. It is the human's,
+//    as P^ itself: it acts where P^ acts (behind a strap, on the human's segments, at the human's
+//    angles; SubjectPassiveForce), and the strap carries it (CompliantPartTorque).
 //  - sensor_offset, sensor_gain, sensor_delay act where the reading tau_S is formed, not on the
 //    link: PlantEffects::sensor holds them for that reader (diagnosis/replay.h inverts them).
 //  - backlash and series_compliance: an internal hinge in the MJCF (Plant::CarryEffects rebuilds the
@@ -93,8 +94,13 @@ struct PlantEffects {
   bool empty() const;
   bool link_empty() const;          // no effect on the link (only sensor effects, or none)
   bool has_internal_joints() const; // backlash or series_compliance: the MJCF gains hinges
-  // The generalized force (N m) of `applied` at q: minus the torques the actuator needs for them.
+  // The generalized force (N m) of `applied` at q: minus the torques the actuator needs for them
+  // (gravity_error, torque_ripple; passive_moment is SubjectPassiveForce's).
   Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q) const;
+  // The generalized force (N m) of the passive_moment effects of `applied` at the human's angles
+  // q_follower (behind a strap or dead band: q + the internal hinges' angles): where Riener & Edrich's
+  // P^ acts, on the human's segments.
+  Eigen::Vector2d SubjectPassiveForce(const Eigen::Vector2d& q_follower) const;
 };
 
 // Sorts `params.effects` into the plant's form. Throws InputError naming `source`, the effect

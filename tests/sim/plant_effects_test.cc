@@ -124,10 +124,12 @@ TEST(PlantEffects, PassiveMomentIsAFactorOnRienerEdrich) {
   const Eigen::Vector2d q0(0.0, 0.0);
   EXPECT_NEAR(PassiveMomentTorque(MakeEffect("passive_moment", "knee", 0.5), q0), 0.5 * 10.4, 0.03);
   EXPECT_NEAR(PassiveMomentTorque(MakeEffect("passive_moment", "hip", -0.3), q0), -0.3 * -8.6, 0.03);
-  // The plant carries it as an applied force of minus that torque; out of (0, 3] times Riener's: refused.
+  // The plant carries it as an applied force of minus that torque, at the human's angles (where P^
+  // acts), apart from the joint's applied forces; out of (0, 3] times Riener's: refused.
   LegParams p = RealRigModel();
   p.effects = {MakeEffect("passive_moment", "knee", 0.5)};
-  EXPECT_NEAR(ToPlantEffects(p, "m.yaml").AppliedForce(q0)[1], -5.2, 0.03);
+  EXPECT_NEAR(ToPlantEffects(p, "m.yaml").SubjectPassiveForce(q0)[1], -5.2, 0.03);
+  EXPECT_EQ(ToPlantEffects(p, "m.yaml").AppliedForce(q0)[1], 0.0);
   for (double v : {-1.0, 2.5}) {
     p.effects = {MakeEffect("passive_moment", "hip", v)};
     EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError) << v;
