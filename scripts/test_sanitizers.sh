@@ -54,7 +54,7 @@ SWEEPS="$SWEEPS|MotionFit\.KneeBacklashAndCoulombFrictionAreBothNamed|MotionFit\
 SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone|MotionFit\.HiddenKneeBacklashOf5MilliradIsSizedWithTheExtendedTwinsWeights"
 #   The strap of Table 5's human side named from the true twin: a table5 subject run (the other
 #   Table5Protocol tests keep that path) and a motion fit (MotionFit's keep it).
-SWEEPS="$SWEEPS|Table5Protocol\.TheHumanSidesStrapShowsInTheGaitOfTheTrueTwin"
+SWEEPS="$SWEEPS|Table5Protocol\.TheHumanSidesStrapIsNamedInTheGaitWithTheTrueAndTheIdentifiedTwin"
 #   The motion fits of real-rig records (each alone, and six together; the same paths on real data).
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnFiveOfSeven"
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfSixRecordsKeepsTheRotorInertiaTheSeventhNeeds"

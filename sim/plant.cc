@@ -464,12 +464,15 @@ void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t,
     LegParams rigid = params_;
     rigid.effects.clear();
     const Eigen::Vector2d tau = ActuatorTorque(rigid, q, qd, qdd ? *qdd : Eigen::Vector2d::Zero());
+    LegParams strapped = rigid;  // a strap carries the subject's passive moment too (CompliantPartTorque)
+    for (const Effect& e : fx_.applied)
+      if (e.name == "passive_moment") strapped.effects.push_back(e);
     for (int j = 0; j < 2; ++j) {
       if (in_q_[j] < 0) continue;
       d_->qpos[in_q_[j]] =
           structure_.backlash[j]
               ? -0.5 * fx_.backlash[j] * std::tanh(tau[j] / kBacklashTorqueWidth)
-              : CompliantAngle(rigid, j, fx_.compliance[j], q, qd, qdd ? *qdd : Eigen::Vector2d::Zero())[j] - q[j];
+              : CompliantAngle(strapped, j, fx_.compliance[j], q, qd, qdd ? *qdd : Eigen::Vector2d::Zero())[j] - q[j];
     }
   }
   if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;

@@ -63,6 +63,14 @@ MeasuredData ClosedFormRecording(const LegParams& p, bool knee_swing, double wob
   return MakeMeasuredData(tab, knee_swing ? "knee.csv" : "hip.csv");
 }
 
+// Both configurations of the exoskeleton alone (steps 1-2) of `truth`, as ClosedFormRecording.
+std::vector<MeasuredData> ExoRecordings(const LegParams& truth, double wobble) {
+  LegParams exo_only = truth;
+  exo_only.human.reset();
+  exo_only.passive = PassiveModel::kNone;
+  return {ClosedFormRecording(exo_only, false, wobble), ClosedFormRecording(exo_only, true, wobble)};
+}
+
 void ExpectNear(const LumpedParams& a, const LumpedParams& b, double tol) {
   EXPECT_NEAR(a.J1, b.J1, tol);
   EXPECT_NEAR(a.J2, b.J2, tol);
@@ -119,12 +127,8 @@ TEST(Identification, GeneralRowsEqualPaperStepRowsWhenHeld) {
 // to round-off; the paper's rows (which assume the joint exactly still) would not.
 TEST(Identification, ExactRecoveryWithImperfectlyHeldJoint) {
   const LegParams truth = S1();
-  LegParams exo_only = truth;
-  exo_only.human.reset();
-  exo_only.passive = PassiveModel::kNone;
   const double wobble = 2.0 * kRadPerDeg;
-  std::vector<MeasuredData> exo_files = {ClosedFormRecording(exo_only, false, wobble),
-                                         ClosedFormRecording(exo_only, true, wobble)};
+  const std::vector<MeasuredData> exo_files = ExoRecordings(truth, wobble);
   IdentificationOptions opt;
   const IdentificationResult rx = Identify(exo_files, nullptr, truth.L1, opt);
   ExpectNear(rx.params.exo, truth.exo, 1e-9);
@@ -166,13 +170,8 @@ TEST(Identification, ExactRecoveryWithImperfectlyHeldJoint) {
 // subtract P^ and neglect the damping, miss the segments by more than 1 %.
 TEST(Identification, SubjectPassiveRecoversTheSubjectsFactorAndDamping) {
   const LegParams truth = S1();
-  LegParams exo_only = truth;
-  exo_only.human.reset();
-  exo_only.passive = PassiveModel::kNone;
   const double wobble = 2.0 * kRadPerDeg;
-  const IdentificationResult rx =
-      Identify({ClosedFormRecording(exo_only, false, wobble), ClosedFormRecording(exo_only, true, wobble)},
-               nullptr, truth.L1);
+  const IdentificationResult rx = Identify(ExoRecordings(truth, wobble), nullptr, truth.L1);
   const Eigen::Vector2d factor(1.3, 0.8), damping(0.2, 0.1);
   const std::vector<MeasuredData> files = {ClosedFormRecording(truth, true, wobble, 20, factor, damping),
                                            ClosedFormRecording(truth, false, wobble, 20, factor, damping)};

@@ -86,25 +86,33 @@ TEST(InternalJoints, HeldAtRestThePlantIsTheRigidOne) {
 
 // At rest under the static torque the strap deflects by the quasi-static closed form and stays there:
 // q_c = q - tau_C(q_c) / k with tau_C the gravity torque of the part behind it (HJ15 eq. 7; the
-// compliant part's P(q) included for a human). The dead band's link rests on the loaded flank.
+// compliant part's P(q) included for a human, and the subject's passive_moment with it: the strap
+// carries the human's passive moment). The dead band's link rests on the loaded flank.
 TEST(InternalJoints, AtRestTheStrapDeflectsByTheStaticTorqueOverK) {
   const Eigen::Vector2d q(0.5, -0.6), zero = Eigen::Vector2d::Zero();
-  for (const bool human : {false, true}) {
+  for (const int kind : {0, 1, 2}) {  // real rig; S1; S1 with its own passive moment (x 1.5 / x 0.7)
+    const bool human = kind > 0;
     LegParams p = human ? S1() : RealRigModel();
     const double k = human ? 300 : 20;
     p.effects = {MakeEffect("series_compliance", "knee", k)};
+    if (kind == 2)
+      p.effects.insert(p.effects.end(),
+                       {MakeEffect("passive_moment", "knee", 0.5), MakeEffect("passive_moment", "hip", -0.3)});
     auto plant = Carrying(p);
     plant->FreeJointsAndTorque();
     plant->Reset(q, zero);
     const double expected = CompliantAngle(p, 1, k, q, zero, zero)[1] - q[1];
     EXPECT_GT(std::abs(expected), 1e-3);
     EXPECT_NEAR(plant->internal_q()[1], expected, 1e-9);
-    // The static torque: the driven part at q, the part behind the strap at its deflected angle.
+    // The static torque: the driven part at q, the part behind the strap (with the subject's passive
+    // moment) at its deflected angle.
     const Eigen::Vector2d qc = CompliantAngle(p, 1, k, q, zero, zero);
-    const Eigen::Vector2d hold =
-        ActuatorTorque(p, q, zero, zero) + CompliantPartTorque(p, qc, zero, zero) - CompliantPartTorque(p, q, zero, zero);
+    LegParams bare = p;
+    bare.effects.clear();
+    const Eigen::Vector2d hold = ActuatorTorque(bare, q, zero, zero) - CompliantPartTorque(bare, q, zero, zero) +
+                                 CompliantPartTorque(p, qc, zero, zero);
     for (int i = 0; i < 500; ++i) plant->Step(hold);
-    EXPECT_NEAR(plant->internal_q()[1], expected, 1e-6) << (human ? "S1" : "real rig");
+    EXPECT_NEAR(plant->internal_q()[1], expected, 1e-6) << kind;
     EXPECT_LT((plant->q() - q).norm(), 1e-6);
   }
   LegParams p = RealRigModel();
