@@ -128,7 +128,8 @@ StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, Pass
 
 namespace {
 
-// SolveStep with M unknown columns: the paper's three, then (subject_passive) P^'s row and the velocity.
+// SolveStep with M unknown columns: the paper's three, then (subject_passive) P^'s row (M >= 4) and the
+// velocity (M = 5).
 template <int M>
 StepEstimate SolveColumns(int step, const IdentificationSamples& s, double L1, double g, const Vector6& known,
                           PassiveModel passive, const Eigen::Matrix3d* known_cov, const HumanSideRows* extra) {
@@ -178,10 +179,8 @@ StepEstimate SolveColumns(int step, const IdentificationSamples& s, double L1, d
     const StepRow sr = RowFromRegressor(step, Y, known_here, subtracted, q, u);
     VecM w;
     w.template head<3>() = sr.w;
-    if constexpr (M > 3) {
-      w[3] = PassiveElasticTorque(passive, q)[row];
-      w[4] = qd[row];
-    }
+    if constexpr (M > 3) w[3] = PassiveElasticTorque(passive, q)[row];
+    if constexpr (M > 4) w[4] = qd[row];
     rows.row(i) << w.transpose(), sr.u_star;
     WtW.template selfadjointView<Eigen::Lower>().rankUpdate(w);
     Wtu += w * sr.u_star;
@@ -219,6 +218,8 @@ StepEstimate SolveColumns(int step, const IdentificationSamples& s, double L1, d
   if constexpr (M > 3) {
     e.passive_factor = b[3];
     e.passive_factor_se = std::sqrt(std::max(0.0, cov(3, 3)));
+  }
+  if constexpr (M > 4) {
     e.damping = b[4];
     e.damping_se = std::sqrt(std::max(0.0, cov(4, 4)));
   }
@@ -233,7 +234,9 @@ StepEstimate SolveStep(int step, const IdentificationSamples& s, double L1, doub
     if (passive == PassiveModel::kNone)
       throw InputError("step " + std::to_string(step) +
                        ": the subject's factor on the passive model needs one, expected riener1999");
-    return SolveColumns<5>(step, s, L1, g, known, passive, known_cov, rows);
+    // A damping must not feed energy (a plant refuses it): below 0 it is held at 0.
+    const StepEstimate e = SolveColumns<5>(step, s, L1, g, known, passive, known_cov, rows);
+    return e.damping >= 0 ? e : SolveColumns<4>(step, s, L1, g, known, passive, known_cov, rows);
   }
   return SolveColumns<3>(step, s, L1, g, known, passive, known_cov, rows);
 }

@@ -109,7 +109,8 @@ StepRow GeneralStepRow(int step, double L1, double g, const Vector6& known, Pass
 // (unknown, known distal, passive P^) are evaluated at the human's state and the exoskeleton's known
 // row at the measured one. subject_passive: two more unknown columns, P^'s row at the human's state
 // (its coefficient the subject's factor on P^, instead of P^ subtracted) and the human's velocity of
-// the moving joint (the link side's viscous damping, N m s/rad).
+// the moving joint (the link side's viscous damping, N m s/rad; where it comes out negative it is held
+// at 0 and the step solved without it: a negative damping would feed energy, and a plant refuses it).
 struct HumanSideRows {
   double knee_compliance = 0;     // rad/N m (1 / the strap's stiffness); 0 = rigid
   Vector6 exo = Vector6::Zero();  // the exoskeleton's part of `known` (model/regressors.h layout)

@@ -196,6 +196,15 @@ TEST(Identification, SubjectPassiveRecoversTheSubjectsFactorAndDamping) {
   const std::string yaml = IdentificationYaml(r, opt);
   EXPECT_NE(yaml.find("passive_factor: "), std::string::npos) << yaml;
 
+  // A negative damping (energy fed in) is not a plant's: held at 0, the knee step solved without it.
+  const IdentificationResult fed = Identify({ClosedFormRecording(truth, true, wobble, 20, factor, {0.2, -0.05}),
+                                             ClosedFormRecording(truth, false, wobble, 20, factor, {0.2, -0.05})},
+                                            &rx.params, 0, opt);
+  ASSERT_EQ(fed.params.effects.size(), 4u);
+  EXPECT_EQ(fed.params.effects[3].name, "viscous_friction");
+  EXPECT_EQ(fed.params.effects[3].value, 0.0);
+  EXPECT_NEAR(fed.params.effects[1].value, 0.2, 1e-3);
+
   const IdentificationResult paper = Identify(files, &rx.params, 0);
   EXPECT_GT(std::abs(paper.params.human->X2 / truth.human->X2 - 1), 0.01) << paper.params.human->X2;
   EXPECT_TRUE(paper.params.effects.empty());
