@@ -21,8 +21,8 @@
 
 #include <Eigen/Core>
 
-#include "diagnosis/diagnose.h"
 #include "core/materiality.h"
+#include "diagnosis/diagnose.h"
 #include "diagnosis/diagnose_columns.h"
 
 namespace exotwin {
@@ -30,8 +30,8 @@ namespace exotwin {
 constexpr double kBicMargin = 10.0;       // BIC drop needed to name an effect (strong evidence)
 constexpr double kMinHeldoutGain = 0.05;  // held-out SSE drop needed per added effect (fraction)
 constexpr double kMinT = 4.0;             // |coefficient| / standard error
-constexpr double kParsimony = 0.05;
-constexpr double kMinTorqueShare = kMaterialShare;  // and by at least (this share of the torque's RMS)^2       // held-out SSE margin a richer explanation must win by
+constexpr double kParsimony = 0.05;       // held-out SSE margin a richer explanation must win by
+constexpr double kMinTorqueShare = kMaterialShare;  // and by at least (this share of the torque's RMS)^2
 
 // Gram matrices of the weighted columns: train / held-out rows (time split) pooled over records,
 // and every record's whole rows (for leave-one-record-out).

@@ -160,13 +160,12 @@ IdentificationResult IdentifyExo(const IdentificationSamples& knee, const Identi
 
 // Steps 3-4: the human with known.exo, known.L1, known.g; P^ = `passive`; `fit` beyond the paper.
 // With fit.subject_passive every step has the two more columns of HumanSideRows (P^ must not be
-// kNone). With fit.max_knee_compliance > 0 (and the samples' tau_c filled) the knee cuff's
-// compliance c in [0, max] is fitted first: the one
-// that minimizes step 3's residual (golden-section search to 1e-4 of max; kept where its RMS deflection
-// is material, core/materiality.h, against the knee angle's RMS about its mean), then
-// steps 3 and 4 are solved with it. A strap's deflection, tau_C / k, otherwise biases the human's
-// knee segment (X2 -4.6 % at 1100 N m/rad on S1): the regressor would be evaluated at the
-// exoskeleton's angle instead of the human's.
+// kNone). With fit.max_knee_compliance > 0 (and the samples' tau_c filled) the knee cuff's compliance
+// c in [0, max] is fitted first: the one that minimizes step 3's residual (golden-section search to
+// 1e-4 of max; kept where its RMS deflection is material, core/materiality.h, against the knee angle's
+// RMS about its mean), then steps 3 and 4 are solved with it. A strap's deflection, tau_C / k,
+// otherwise biases the human's knee segment (X2 -4.6 % at 1100 N m/rad on S1): the regressor would be
+// evaluated at the exoskeleton's angle instead of the human's.
 IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const IdentificationSamples& hip,
                                    const LegParams& known, PassiveModel passive, const HumanSideFit& fit = {});
 
