@@ -343,7 +343,9 @@ IdentificationResult Identify(const std::vector<MeasuredData>& files, const LegP
   const bool human = known != nullptr;
   for (const MeasuredData& f : files) {
     const IdConfiguration c = ClassifyConfiguration(f, opt);
-    AppendSamples(f, human, opt, c == IdConfiguration::kKneeSwing ? &knee : &hip, known);
+    // tau_C only where the knee cuff is fitted.
+    AppendSamples(f, human, opt, c == IdConfiguration::kKneeSwing ? &knee : &hip,
+                  human && opt.human_side.max_knee_compliance > 0 ? known : nullptr);
   }
   auto missing = [&](IdConfiguration c) {
     std::string got;

@@ -80,9 +80,10 @@ struct IdentificationSamples {
   IdConfiguration config = IdConfiguration::kKneeSwing;
   std::vector<std::string> sources;
   std::vector<double> q[2], qd[2], qdd[2], u[2];
-  // Steps 3-4, prepared with the known exoskeleton: the torque the knee cuff carries to the human's
-  // lower leg, tau_C = u_knee - the exoskeleton's knee row at the measured state (N m; HJ15 eq. 8 split
-  // at the cuff), as recorded and its two rates by the angles' derivative chain. Empty otherwise.
+  // Steps 3-4 with the knee cuff fitted, prepared with the known exoskeleton: the torque the knee cuff
+  // carries to the human's lower leg, tau_C = u_knee - the exoskeleton's knee row at the measured state
+  // (N m; HJ15 eq. 8 split at the cuff), as recorded and its two rates by the angles' derivative chain.
+  // Empty otherwise.
   std::vector<double> tau_c, tau_c_d, tau_c_dd;
   size_t total = 0;  // samples in the files before trimming and selection
   size_t size() const { return u[0].size(); }

@@ -44,6 +44,17 @@ Effect Fx(const std::string& name, const std::string& joint, double value) {
   return e;
 }
 
+// The knee cuff's compliance (rad/N m) a subject.yaml's identification block gives (identify
+// --knee-cuff); -1 with a test failure when it gives none.
+double KneeCuffCompliance(const std::string& subject_yaml) {
+  std::ifstream f(subject_yaml);
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("  knee_cuff_compliance: ", 0) == 0) return std::stod(line.substr(24));
+  ADD_FAILURE() << subject_yaml << ": no knee_cuff_compliance";
+  return -1.0;
+}
+
 void ExpectPattern(const Table5JointRmse& r, const std::string& what) {
   for (double v : {r.identified, r.deleva, r.dempster}) {
     EXPECT_TRUE(std::isfinite(v)) << what;
@@ -288,12 +299,7 @@ TEST(Table5Protocol, TheKneeCuffFitCarriesTheStrapThroughStepsThreeAndFour) {
     return r.entry;
   };
   auto cuff_compliance = [&](const std::string& name) {
-    std::ifstream f(tmp.path() + "/" + name + "/S1/subject.yaml");
-    std::string line;
-    while (std::getline(f, line))
-      if (line.rfind("  knee_cuff_compliance: ", 0) == 0) return std::stod(line.substr(24));
-    ADD_FAILURE() << name << ": no knee_cuff_compliance in subject.yaml";
-    return -1.0;
+    return KneeCuffCompliance(tmp.path() + "/" + name + "/S1/subject.yaml");
   };
   const Table5Entry rigid = run(true, false, "rigid"), cuff = run(true, true, "cuff");
   const LumpedParams& truth = *cuff.truth.human;
@@ -345,11 +351,7 @@ TEST(Table5Protocol, TheHumanSidesPassiveMomentDampingAndCuffAreIdentified) {
     EXPECT_NEAR(damping->value, joint == std::string("hip") ? 0.2 : 0.1,
                 joint == std::string("hip") ? 0.02 : 0.01) << joint;
   }
-  std::ifstream f(tmp.path() + "/fit/S1/subject.yaml");
-  std::string line;
-  double c = 0;
-  while (std::getline(f, line))
-    if (line.rfind("  knee_cuff_compliance: ", 0) == 0) c = std::stod(line.substr(24));
+  const double c = KneeCuffCompliance(tmp.path() + "/fit/S1/subject.yaml");
   ASSERT_GT(c, 0.0);
   EXPECT_NEAR(1.0 / c, 1100.0, 0.35 * 1100.0);
 
