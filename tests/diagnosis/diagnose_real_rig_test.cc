@@ -171,13 +171,12 @@ TEST(DiagnoseRealRig, EveryRecordAloneNamesNothingImplausible) {
 // part is 3 s: the fit's rounds linearize at different values and may end on a worse set than an
 // earlier round's; the set of the lowest exact BIC is kept (motion_fit.h step 5). Every Coulomb value
 // inside the makers' scale (the torque fit's test above), and the extended twin moves closer to the rig
-// on every record's held-out part at both joints. Measured with the restart state at 40 Hz
-// (DiagnoseOptions::motion_cutoff_hz): 5 of 7 (hip / knee 0.120 / 0.160, 0.161 / 0.132, 0.150 / 0.134,
-// 0.157 / 0.160, 0.128 / 0.156 N m; record 04 a viscous knee, its hip Coulomb dropped by the exact
-// gate; record 11, the jittered one, a knee Coulomb alone); at 10 Hz 6 of 7, where the hidden-effect
-// table's dead bands were named at few gait phases (DESIGN.md "The motion fit"). The target is not
-// met; this guards the 5.
-TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnFiveOfSeven) {
+// on every record's held-out part at both joints. Measured: 6 of 7 (hip / knee 0.120 / 0.160, 0.161 /
+// 0.132, 0.150 / 0.134, 0.147 / 0.156, 0.128 / 0.156, 0.085 / 0.167 N m; record 04 a viscous knee, its
+// hip Coulomb dropped by the exact gate). Record 11 (a swing-up after 4 s of small swings) names its
+// hip Coulomb only as the torque fit's effect put to the plant (motion_fit.h step 5: -57 % held-out
+// hip error at the torque fit's 0.145 N m, exact BIC -0.03 -> -8.9 refined); without that step, 5 of 7.
+TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfSeven) {
   if (!HaveData()) GTEST_SKIP() << kDir << " not found (shared/data beside the project)";
   const LegParams model = RigModel();
   DiagnoseOptions opt;
@@ -198,7 +197,7 @@ TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnFiveOf
       EXPECT_LT(d.simulation.split[j].rmse_after, d.simulation.split[j].rmse_before) << r.source << " joint " << j;
     }
   }
-  EXPECT_GE(both, 5);
+  EXPECT_GE(both, 6);
 }
 
 // The motion fit of several records keeps an effect that moves the records left out, not only the
