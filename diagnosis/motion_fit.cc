@@ -1097,21 +1097,44 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   // 0.5 s of simulated motion. A torque fit's stand-in for an effect the torque cannot see (a ripple
   // for a dead band, 0.5-4.5 N m on the gait) moves the held-out motion away and is not tried.
   auto ConfirmTorqueNamed = [&]() {
-    for (const DiagnosedEffect& d : T.effects) {
-      const int c = P.CandidateIndex(d.effect.name, d.effect.joint, d.effect.name == "gravity_error" ? d.effect.axis : "");
+    // Each effect's trial at the current values; all remaining ones simulated together (in parallel)
+    // whenever the set changes.
+    std::vector<int> cand_of(T.effects.size(), -1);
+    std::vector<Eigen::VectorXd> trial(T.effects.size());
+    std::vector<MotionProblem::Rollout> trial_ro(T.effects.size());
+    std::vector<char> simulated(T.effects.size(), 0);
+    for (size_t e = 0; e < T.effects.size(); ++e) {
+      const Effect& fx = T.effects[e].effect;
+      cand_of[e] = P.CandidateIndex(fx.name, fx.joint, fx.name == "gravity_error" ? fx.axis : "");
+    }
+    for (size_t e = 0; e < T.effects.size(); ++e) {
+      const int c = cand_of[e];
       if (c < 0 || std::find(chosen.begin(), chosen.end(), c) != chosen.end()) continue;
+      if (!simulated[e]) {
+        std::vector<size_t> batch;
+        std::vector<Eigen::VectorXd> xs;
+        for (size_t f = e; f < T.effects.size(); ++f) {
+          if (cand_of[f] < 0 || std::find(chosen.begin(), chosen.end(), cand_of[f]) != chosen.end()) continue;
+          Eigen::VectorXd x = theta;
+          if (!TorqueValues(P, T.effects[f].effect, &x)) continue;
+          for (int k : cands[static_cast<size_t>(cand_of[f])].cols) x[k] = std::clamp(x[k], P.lower(k), P.upper(k));
+          trial[f] = x;
+          batch.push_back(f);
+          xs.push_back(x);
+        }
+        const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(xs, Part::kHeldOut);
+        for (size_t b = 0; b < batch.size(); ++b) trial_ro[batch[b]] = ro[b], simulated[batch[b]] = 1;
+        if (!simulated[e]) continue;  // the plant cannot carry the torque fit's value
+      }
       const Candidate& cand = cands[static_cast<size_t>(c)];
-      Eigen::VectorXd x = theta;
-      if (!TorqueValues(P, d.effect, &x)) continue;
-      for (int k : cand.cols) x[k] = std::clamp(x[k], P.lower(k), P.upper(k));
+      const Eigen::VectorXd& x = trial[e];
       double te_now[2], te_x[2] = {INFINITY, INFINITY};
       P.Sse(at, Part::kHeldOut, te_now);
-      const MotionProblem::Rollout rt = P.Simulate(x, Part::kHeldOut);
-      if (rt.ok) P.Sse(rt, Part::kHeldOut, te_x);
+      if (trial_ro[e].ok) P.Sse(trial_ro[e], Part::kHeldOut, te_x);
       const double gain = te_now[cand.joint] > 0 ? 1 - te_x[cand.joint] / te_now[cand.joint] : 0.0;
-      std::string text = "the torque fit's " + cand.Label() + " = " +
-                         ValueText(P, cand, x) + " added to " + Labels(P, chosen) + ": held-out simulated error at the " +
-                         kJoint[cand.joint] + " " + NumberText(-100 * gain, 3) + " %";
+      std::string text = "the torque fit's " + cand.Label() + " = " + ValueText(P, cand, x) + " added to " +
+                         Labels(P, chosen) + ": held-out simulated error at the " + kJoint[cand.joint] + " " +
+                         NumberText(-100 * gain, 3) + " %";
       if (!(gain >= kMinHeldoutGain)) {
         D.selection.push_back(text + " (needed -" + NumberText(100 * kMinHeldoutGain) + " %), not taken");
         continue;
@@ -1129,6 +1152,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
       MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);
       if (!rx.ok) continue;
       chosen = set, theta = rf.theta, at = std::move(rx);
+      std::fill(simulated.begin(), simulated.end(), 0);  // the trials of the rest, at the new values
     }
   };
   for (int round = 0; round < kMotionOuterSteps; ++round) {
