@@ -1092,10 +1092,9 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   // same fit parts), is tried further where it lowers the held-out simulated error at its joint by
   // kMinHeldoutGain; then refined with the set from there, taken where the exact fit-part BIC is lower.
   // The torque residual has weighed it already (the BIC margin, held-out gains, |t|); the plant has to
-  // agree, not to find it again: a record whose fit part barely moves a joint (the real rig's record
-  // 11, a swing-up after small swings) shows the joint's friction in the torque but only weakly in
-  // 0.5 s of simulated motion. A torque fit's stand-in for an effect the torque cannot see (a ripple
-  // for a dead band, 0.5-4.5 N m on the gait) moves the held-out motion away and is not tried.
+  // agree, not to find it again: where the fit part barely moves a joint, its friction shows in the
+  // torque but only weakly in 0.5 s windows of simulated motion. A torque fit's stand-in for an effect
+  // the torque cannot see (a ripple for a dead band) moves the held-out motion away and is not refined.
   auto ConfirmTorqueNamed = [&]() {
     // Each effect's trial at the current values; all remaining ones simulated together (in parallel)
     // whenever the set changes.
