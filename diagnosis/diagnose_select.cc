@@ -400,13 +400,6 @@ bool Admissible(const Candidate& c, const Fit& f, const PhysicalScale& s) {
   return significant && Plausible(ToEffect(c, f), s);
 }
 
-bool Conflicts(const Candidate& a, const Candidate& b) {
-  if (a.name == b.name && a.joint == b.joint) return true;  // gravity X and Y: one at a time
-  for (int x : a.cols)
-    if (std::find(b.cols.begin(), b.cols.end(), x) != b.cols.end()) return true;  // nested (offset)
-  return false;
-}
-
 bool AllAdmissible(const ColumnBank& bank, const std::vector<int>& set, const Fit& f, const PhysicalScale& s) {
   if (!f.ok) return false;
   for (int c : set)
@@ -421,6 +414,13 @@ std::string Label(const ColumnBank& bank, const std::vector<int>& set) {
 }
 
 }  // namespace
+
+bool Conflicts(const Candidate& a, const Candidate& b) {
+  if (a.name == b.name && a.joint == b.joint) return true;  // gravity X and Y: one at a time
+  for (int x : a.cols)
+    if (std::find(b.cols.begin(), b.cols.end(), x) != b.cols.end()) return true;  // nested (offset)
+  return false;
+}
 
 std::vector<int> SelectEffects(const ColumnBank& bank, const Grams& g, const PhysicalScale& scale,
                                int max_effects, bool loo, Fit* fit, SelectionTrace* trace) {

@@ -126,6 +126,10 @@ DiagnosedEffect ToEffect(const Candidate& c, const Eigen::VectorXd& coef, const 
 // Inside its physical range? (Sign constraints, DESIGN.md's table of ranges.) `why` says why not.
 bool Plausible(const DiagnosedEffect& e, const PhysicalScale& s, std::string* why = nullptr);
 
+// Two candidates that cannot be named together: the same effect at the same joint (gravity_error's X
+// and Y axes, one at a time) or a shared column (joint_stiffness's offset and sensor_offset).
+bool Conflicts(const Candidate& a, const Candidate& b);
+
 struct SelectionTrace {
   std::vector<std::string> steps;  // in words: what was added or removed, and the scores
 };

@@ -1090,12 +1090,19 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   // The torque fit's effects put to the plant (motion_fit.h step 5): each effect the torque fit names
   // that is a candidate and not chosen, added to the set at the torque fit's value (fitted on the
   // same fit parts), is tried further where it lowers the held-out simulated error at its joint by
-  // kMinHeldoutGain; then refined with the set from there, taken where the exact fit-part BIC is lower.
-  // The torque residual has weighed it already (the BIC margin, held-out gains, |t|); the plant has to
-  // agree, not to find it again: where the fit part barely moves a joint, its friction shows in the
-  // torque but only weakly in 0.5 s windows of simulated motion. A torque fit's stand-in for an effect
-  // the torque cannot see (a ripple for a dead band) moves the held-out motion away and is not refined.
+  // kMinHeldoutGain; then refined with the set from there, taken where the exact fit-part BIC is
+  // lower. One that conflicts with a chosen effect (Conflicts: the other gravity axis, a shared
+  // offset) is not tried. The torque residual has weighed it already (the BIC margin, held-out gains,
+  // |t|); the plant has to agree, not to find it again: where the fit part barely moves a joint, its
+  // friction shows in the torque but only weakly in 0.5 s windows of simulated motion. A torque fit's
+  // stand-in for an effect the torque cannot see (a ripple for a dead band) moves the held-out motion
+  // away and is not refined.
   auto ConfirmTorqueNamed = [&]() {
+    auto eligible = [&](int c) {
+      return c >= 0 && std::none_of(chosen.begin(), chosen.end(), [&](int s) {
+               return Conflicts(cands[static_cast<size_t>(s)], cands[static_cast<size_t>(c)]);
+             });
+    };
     // Each effect's trial at the current values; all remaining ones simulated together (in parallel)
     // whenever the set changes.
     std::vector<int> cand_of(T.effects.size(), -1);
@@ -1108,12 +1115,12 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
     }
     for (size_t e = 0; e < T.effects.size(); ++e) {
       const int c = cand_of[e];
-      if (c < 0 || std::find(chosen.begin(), chosen.end(), c) != chosen.end()) continue;
+      if (!eligible(c)) continue;
       if (!simulated[e]) {
         std::vector<size_t> batch;
         std::vector<Eigen::VectorXd> xs;
         for (size_t f = e; f < T.effects.size(); ++f) {
-          if (cand_of[f] < 0 || std::find(chosen.begin(), chosen.end(), cand_of[f]) != chosen.end()) continue;
+          if (!eligible(cand_of[f])) continue;
           Eigen::VectorXd x = theta;
           if (!TorqueValues(P, T.effects[f].effect, &x)) continue;
           for (int k : cands[static_cast<size_t>(cand_of[f])].cols) x[k] = std::clamp(x[k], P.lower(k), P.upper(k));
@@ -1123,17 +1130,21 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
         }
         const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(xs, Part::kHeldOut);
         for (size_t b = 0; b < batch.size(); ++b) trial_ro[batch[b]] = ro[b], simulated[batch[b]] = 1;
-        if (!simulated[e]) continue;  // the plant cannot carry the torque fit's value
+        if (!simulated[e]) continue;  // TorqueValues: no candidate value stands for it
       }
       const Candidate& cand = cands[static_cast<size_t>(c)];
       const Eigen::VectorXd& x = trial[e];
-      double te_now[2], te_x[2] = {INFINITY, INFINITY};
-      P.Sse(at, Part::kHeldOut, te_now);
-      if (trial_ro[e].ok) P.Sse(trial_ro[e], Part::kHeldOut, te_x);
-      const double gain = te_now[cand.joint] > 0 ? 1 - te_x[cand.joint] / te_now[cand.joint] : 0.0;
       std::string text = "the torque fit's " + cand.Label() + " = " + ValueText(P, cand, x) + " added to " +
-                         Labels(P, chosen) + ": held-out simulated error at the " + kJoint[cand.joint] + " " +
-                         NumberText(-100 * gain, 3) + " %";
+                         Labels(P, chosen) + ": ";
+      if (!trial_ro[e].ok) {
+        D.selection.push_back(text + "the plant cannot simulate it, not taken");
+        continue;
+      }
+      double te_now[2], te_x[2];
+      P.Sse(at, Part::kHeldOut, te_now);
+      P.Sse(trial_ro[e], Part::kHeldOut, te_x);
+      const double gain = te_now[cand.joint] > 0 ? 1 - te_x[cand.joint] / te_now[cand.joint] : 0.0;
+      text += "held-out simulated error at the " + std::string(kJoint[cand.joint]) + " " + NumberText(-100 * gain, 3) + " %";
       if (!(gain >= kMinHeldoutGain)) {
         D.selection.push_back(text + " (needed -" + NumberText(100 * kMinHeldoutGain) + " %), not taken");
         continue;

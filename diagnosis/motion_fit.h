@@ -80,7 +80,8 @@
 //     viscous friction exchanged for a Coulomb one at its joint and the other way round, refined
 //     from the value of the same power at the joint's RMS speed (c = b qd_rms) and the torque fit's,
 //     taken where the exact fit-part BIC is lower; then the torque fit's effects put to the plant:
-//     each effect the torque fit names (step 1) that is a candidate and not chosen, added at the torque
+//     each effect the torque fit names (step 1) that is a candidate and conflicts with no chosen one
+//     (diagnose_select.h Conflicts), added at the torque
 //     fit's value, is refined with the set where it lowers the held-out simulated error at its joint
 //     by kMinHeldoutGain, and taken where the refined set's exact fit-part BIC is lower (the torque
 //     residual has weighed it; the plant has to agree, not to find it again);
