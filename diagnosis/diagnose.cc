@@ -83,9 +83,9 @@ struct Rec {
     for (size_t i = 0; i < e.size(); ++i) e[i] = raw[j][i] - tau_S[j][i];
     return Filter(std::move(e));
   }
-  std::function<void(std::vector<double>&)> FilterFn() const {
+  ColumnFilter FilterFn() const {
     if (!(hz > 0)) return {};
-    return [this](std::vector<double>& x) { x = Filter(std::move(x)); };
+    return [this](std::vector<double>* const* xs, size_t count) { low->Apply(xs, count); };
   }
   // The measured tau_S of joint j on kin.t's samples (raw[j]'s n values), for the last user of raw:
   // the column taken over, cut in place, else a copy. raw[j] is left null.

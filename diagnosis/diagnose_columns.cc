@@ -40,45 +40,66 @@ int NewColumn(ColumnBank& b) {
   return c;
 }
 
-// Appends one column given as (hip row value, knee row value) per fit row.
-template <class F>
-int AddColumn(ColumnBank& b, const double w[2], F f) {
-  const size_t m = b.sample.size();
-  const int c = NewColumn(b);
-  if (b.filter) {
-    std::vector<double> v[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
-    ForEachSample(b, b.n, [&](size_t i) {
-      const Eigen::Vector2d x = f(i);
-      v[0][i] = x[0], v[1][i] = x[1];
-    });
-    SetColumn(b, c, w, v);
-    return c;
-  }
-  for (size_t k = 0; k < m; ++k) {
-    const Eigen::Vector2d v = f(b.sample[k]);
-    b.X(k, c) = w[0] * v[0];
-    b.X(m + k, c) = w[1] * v[1];
-  }
-  return c;
+// The bank's low-pass of *xs[0 .. count) in place: the all-zero ones left as they are (the low-pass of
+// zeros is zero), the others interleaved at least two to a thread (dsp::FiltFiltInPlace of several:
+// each signal the same bits as filtered alone).
+void FilterColumns(const ColumnBank& b, std::vector<double>* const* xs, size_t count) {
+  if (!b.filter) return;
+  std::vector<std::vector<double>*> nonzero;
+  for (size_t k = 0; k < count; ++k)
+    if (std::any_of(xs[k]->begin(), xs[k]->end(), [](double v) { return v != 0.0; })) nonzero.push_back(xs[k]);
+  const size_t T = std::clamp<size_t>(nonzero.size() / 2, 1, static_cast<size_t>(std::max(1, b.threads)));
+  ParallelFor(T, static_cast<int>(T), [&](size_t h) {
+    const size_t e0 = h * nonzero.size() / T, e1 = (h + 1) * nonzero.size() / T;
+    if (e1 > e0) b.filter(nonzero.data() + e0, e1 - e0);
+  });
 }
 
-// x filtered in place by the bank's filter, unless x is all zero (the low-pass of zeros is zero).
-void FilterColumn(const ColumnBank& b, std::vector<double>& x) {
-  if (!b.filter) return;
-  for (double v : x)
-    if (v != 0.0) {
-      b.filter(x);
-      return;
-    }
+// Columns evaluated on every sample of a record, waiting for the bank's low-pass: filtered kPending at
+// a time (FilterColumns), then each placed in the bank by its callback, in the order added. The
+// record-long temporaries are at most kPending. Without a filter a column is placed at once.
+class PendingColumns {
+ public:
+  static constexpr size_t kPending = 4;
+  explicit PendingColumns(ColumnBank& b) : b_(b) { xs_.reserve(kPending), place_.reserve(kPending); }
+  ColumnBank& bank() { return b_; }
+  size_t size() const { return xs_.size(); }
+  void Add(std::vector<double> x, std::function<void(const std::vector<double>&)> place) {
+    if (!b_.filter) return place(x);
+    xs_.push_back(std::move(x));
+    place_.push_back(std::move(place));
+    if (xs_.size() >= kPending) Flush();
+  }
+  void Flush() {
+    std::vector<std::vector<double>*> p;
+    for (std::vector<double>& x : xs_) p.push_back(&x);
+    FilterColumns(b_, p.data(), p.size());
+    for (size_t k = 0; k < xs_.size(); ++k) place_[k](xs_[k]);
+    xs_.clear();
+    place_.clear();
+  }
+
+ private:
+  ColumnBank& b_;
+  std::vector<std::vector<double>> xs_;
+  std::vector<std::function<void(const std::vector<double>&)>> place_;
+};
+
+// Joint j's rows of column c from per-sample values x (filtered), weighted by w[j].
+void PlaceJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vector<double>& x) {
+  const size_t m = b.sample.size();
+  for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * x[b.sample[k]];
 }
 
 // Fills the bank's columns c1 and c2 from f(i, &v1, &v2), two (hip row value, knee row value) of one
-// sample, as AddColumn fills one column from its f(i).
+// sample, as SetColumn stores per-sample values.
 template <class F>
-void AddColumnPair(ColumnBank& b, const double w[2], int c1, int c2, F f) {
+void AddColumnPair(PendingColumns& p, const double w[2], int c1, int c2, F f) {
+  ColumnBank& b = p.bank();
   const size_t m = b.sample.size();
   Eigen::Vector2d x1, x2;
   if (b.filter) {
+    p.Flush();  // the pending columns' temporaries gone before these four
     std::vector<double> v1[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
     std::vector<double> v2[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
     ForEachSample(b, b.n, [&](size_t i) {
@@ -86,9 +107,10 @@ void AddColumnPair(ColumnBank& b, const double w[2], int c1, int c2, F f) {
       f(i, &y1, &y2);
       v1[0][i] = y1[0], v1[1][i] = y1[1], v2[0][i] = y2[0], v2[1][i] = y2[1];
     });
-    SetColumn(b, c1, w, v1);
-    for (auto& v : v1) std::vector<double>().swap(v);
-    SetColumn(b, c2, w, v2);
+    for (int j = 0; j < 2; ++j)
+      p.Add(std::move(v1[j]), [&b, w, c1, j](const std::vector<double>& x) { PlaceJointRows(b, c1, w, j, x); });
+    for (int j = 0; j < 2; ++j)
+      p.Add(std::move(v2[j]), [&b, w, c2, j](const std::vector<double>& x) { PlaceJointRows(b, c2, w, j, x); });
     return;
   }
   for (size_t k = 0; k < m; ++k) {
@@ -156,25 +178,29 @@ void SetJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vec
   }
 }
 
-// Column c as SetColumn stores per-sample values x[i] on joint j's rows (0 on the other's); returns
-// x, filtered as the column's rows are, on the fit rows (before the weight).
-std::vector<double> SetJointColumn(ColumnBank& b, int c, const double w[2], int j, std::vector<double> x) {
-  FilterColumn(b, x);
-  std::vector<double> rows(b.sample.size());
-  for (size_t k = 0; k < rows.size(); ++k) rows[k] = x[b.sample[k]];
-  SetJointRows(b, c, w, j, rows);
-  return rows;
+// Column c as SetColumn stores per-sample values x[i] on joint j's rows (0 on the other's), once
+// filtered; rows_out (optional): x filtered, on the fit rows (before the weight).
+void SetJointColumn(PendingColumns& p, int c, const double w[2], int j, std::vector<double> x,
+                    std::vector<double>* rows_out = nullptr) {
+  ColumnBank& b = p.bank();
+  p.Add(std::move(x), [&b, w, c, j, rows_out](const std::vector<double>& filtered) {
+    std::vector<double> rows(b.sample.size());
+    for (size_t k = 0; k < rows.size(); ++k) rows[k] = filtered[b.sample[k]];
+    SetJointRows(b, c, w, j, rows);
+    if (rows_out) *rows_out = std::move(rows);
+  });
 }
 
 // Appends a column of joint j alone: g(i) on its joint-j rows, zero on the other joint's (the column
-// AddColumn gives for (g(i), 0) or (0, g(i)), with one record-long temporary instead of two).
+// SetColumn gives for (g(i), 0) or (0, g(i)), with one record-long temporary instead of two).
 template <class G>
-int AddJointColumn(ColumnBank& b, const double w[2], int j, G g) {
+int AddJointColumn(PendingColumns& p, const double w[2], int j, G g) {
+  ColumnBank& b = p.bank();
   const int c = NewColumn(b);
   if (b.filter) {
     std::vector<double> x(b.n);
     ForEachSample(b, b.n, [&](size_t i) { x[i] = g(i); });
-    SetJointColumn(b, c, w, j, std::move(x));
+    SetJointColumn(p, c, w, j, std::move(x));
     return c;
   }
   const size_t m = b.sample.size();
@@ -185,18 +211,19 @@ int AddJointColumn(ColumnBank& b, const double w[2], int j, G g) {
   return c;
 }
 
-// Appends a column whose hip and knee rows hold the same g(i) (the column AddColumn gives for
+// Appends a column whose hip and knee rows hold the same g(i) (the column SetColumn gives for
 // (g(i), g(i)): both rows filtered alike, from one record-long temporary).
 template <class G>
-int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
+int AddBothJointsColumn(PendingColumns& p, const double w[2], G g) {
+  ColumnBank& b = p.bank();
   const int c = NewColumn(b);
   const size_t m = b.sample.size();
   if (b.filter) {
     std::vector<double> x(b.n);
     ForEachSample(b, b.n, [&](size_t i) { x[i] = g(i); });
-    FilterColumn(b, x);
-    for (int j = 0; j < 2; ++j)
-      for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * x[b.sample[k]];
+    p.Add(std::move(x), [&b, w, c](const std::vector<double>& filtered) {
+      for (int j = 0; j < 2; ++j) PlaceJointRows(b, c, w, j, filtered);
+    });
     return c;
   }
   for (size_t k = 0; k < m; ++k) {
@@ -210,17 +237,15 @@ int AddBothJointsColumn(ColumnBank& b, const double w[2], G g) {
 }  // namespace
 
 void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]) {
-  const size_t m = b.sample.size();
-  for (int j = 0; j < 2; ++j) {
-    FilterColumn(b, v[j]);
-    for (size_t k = 0; k < m; ++k) b.X(j * m + k, c) = w[j] * v[j][b.sample[k]];
-  }
+  std::vector<double>* xs[2] = {&v[0], &v[1]};
+  FilterColumns(b, xs, 2);
+  for (int j = 0; j < 2; ++j) PlaceJointRows(b, c, w, j, v[j]);
 }
 
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         const std::vector<double> tau_S[2],
                         std::vector<double> resid[2], const double w[2], size_t split,
-                        size_t max_rows, std::function<void(std::vector<double>&)> filter, int threads) {
+                        size_t max_rows, ColumnFilter filter, int threads) {
   ColumnBank b;
   b.threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const size_t n = kin.t.size();
@@ -248,7 +273,8 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
   const double g = params.g;
   // The envelope columns are the same at both joints but for the rows they fill: the hip's are kept
   // on the fit rows (filtered, unweighted) for the knee's.
-  std::vector<std::vector<double>> envelope_rows;
+  std::vector<std::vector<double>> envelope_rows(kin.emg.size());
+  PendingColumns pc(b);
   // Its columns per joint: offset, Coulomb, viscous, inertia, gravity X and Y, stiffness, backlash,
   // strap, gain, delay, [passive moment], one per EMG channel (NewColumn grows X if more).
   b.X.resize(2 * m, 2 * (11 + (params.human && !params.one_joint ? 1 : 0) + static_cast<long>(kin.emg.size())));
@@ -259,10 +285,10 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       b.candidates.push_back(c);
       return &b.candidates.back();
     };
-    const int off = AddJointColumn(b, w, j, [&](size_t) { return 1.0; });
-    add("coulomb_friction", {AddJointColumn(b, w, j, [&](size_t i) { return -Sign(kin.qd[j][i]); })});
-    add("viscous_friction", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.qd[j][i]; })});
-    add("inertia_error", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.qdd[j][i]; })});
+    const int off = AddJointColumn(pc, w, j, [&](size_t) { return 1.0; });
+    add("coulomb_friction", {AddJointColumn(pc, w, j, [&](size_t i) { return -Sign(kin.qd[j][i]); })});
+    add("viscous_friction", {AddJointColumn(pc, w, j, [&](size_t i) { return -kin.qd[j][i]; })});
+    add("inertia_error", {AddJointColumn(pc, w, j, [&](size_t i) { return -kin.qdd[j][i]; })});
     for (const char* axis : {"X", "Y"}) {
       const bool is_x = axis[0] == 'X';
       // The hip's angle moves the hip rows only; the thigh + shank angle both joints' rows alike.
@@ -270,21 +296,21 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
         const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
         return -g * (is_x ? std::sin(ang) : std::cos(ang));
       };
-      add("gravity_error", {j == 0 ? AddJointColumn(b, w, 0, G) : AddBothJointsColumn(b, w, G)}, axis);
+      add("gravity_error", {j == 0 ? AddJointColumn(pc, w, 0, G) : AddBothJointsColumn(pc, w, G)}, axis);
     }
-    add("joint_stiffness", {AddJointColumn(b, w, j, [&](size_t i) { return -kin.q[j][i]; }), off});
+    add("joint_stiffness", {AddJointColumn(pc, w, j, [&](size_t i) { return -kin.q[j][i]; }), off});
     // The subject's passive moment off Riener & Edrich's curves by a factor: Delta tau_S = -value P_j(q)
     // (a two-joint model with a human only: the curves are a human leg's in HJ15's two-joint angles).
     if (params.human && !params.one_joint) {
       Effect unit_passive;
       unit_passive.joint = j == 0 ? "hip" : "knee", unit_passive.value = 1.0;
-      add("passive_moment", {AddJointColumn(b, w, j, [&](size_t i) { return -PassiveMomentTorque(unit_passive, Q(i)); })});
+      add("passive_moment", {AddJointColumn(pc, w, j, [&](size_t i) { return -PassiveMomentTorque(unit_passive, Q(i)); })});
     }
     // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b). Straps: Delta tau_S =
     // (1/k) dtau_C/dq_j tau_C,j (first order in 1/k). Both columns in one pass over the samples.
     {
       const int cb = NewColumn(b), cs = NewColumn(b);
-      AddColumnPair(b, w, cb, cs, [&](size_t i, Eigen::Vector2d* backlash, Eigen::Vector2d* strap) {
+      AddColumnPair(pc, w, cb, cs, [&](size_t i, Eigen::Vector2d* backlash, Eigen::Vector2d* strap) {
         const NearTorques t = TorquesNear(rigid, total, j, Q(i), QD(i), QDD(i));
         const Eigen::Vector2d d = (t.R[1] - t.R[2]) / 2e-5;
         *backlash = Eigen::Vector2d(0.5 * std::tanh(t.R[0][j] / kBacklashTorqueWidth) * d);
@@ -295,9 +321,9 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       add("series_compliance", {cs});
     }
     add("sensor_offset", {off});
-    add("sensor_gain", {AddJointColumn(b, w, j, [&](size_t i) { return tau_S[j][i]; })});
+    add("sensor_gain", {AddJointColumn(pc, w, j, [&](size_t i) { return tau_S[j][i]; })});
     // Time derivative of the predicted reading (for the delay), central differences on the record.
-    add("sensor_delay", {AddJointColumn(b, w, j, [&](size_t i) {
+    add("sensor_delay", {AddJointColumn(pc, w, j, [&](size_t i) {
           const size_t a = i == 0 ? 0 : i - 1, c = i + 1 < n ? i + 1 : n - 1;
           return -((tau_S[j][c] - tau_S[j][a]) / (kin.t[c] - kin.t[a]));
         })});
@@ -306,10 +332,11 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       std::vector<std::string> chans;
       for (const auto& ch : kin.emg) {
         if (j == 0) {
+          if (pc.size() >= 2) pc.Flush();  // the envelope's own record-long temporaries come next
           std::vector<double> x = EmgEnvelope(kin.t, ch.second);
           for (double& v : x) v = -v;
           cols.push_back(NewColumn(b));
-          envelope_rows.push_back(SetJointColumn(b, cols.back(), w, 0, std::move(x)));
+          SetJointColumn(pc, cols.back(), w, 0, std::move(x), &envelope_rows[chans.size()]);
         } else {
           const int c = NewColumn(b);
           SetJointRows(b, c, w, j, envelope_rows[chans.size()]);
@@ -319,6 +346,7 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       }
       add("muscle_activity", cols)->channels = chans;
     }
+    pc.Flush();  // the hip's envelope rows are the knee's
   }
   b.X.conservativeResize(Eigen::NoChange, b.used);
   return b;
@@ -326,7 +354,10 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
 
 void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
                          const std::vector<Eigen::VectorXd>& targets) {
-  for (int j = 0; j < 2; ++j) {
+  // The frequency of each joint, searched on the two joints' threads at once (each search reads only).
+  double found[2];
+  ParallelFor(2, banks[0].threads, [&](size_t jj) {
+    const int j = static_cast<int>(jj);
     auto sse = [&](double f) {
       double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
       for (size_t r = 0; r < banks.size(); ++r) {
@@ -357,7 +388,10 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       const double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo);
       if (sse(x1) < sse(x2)) hi = x2; else lo = x1;
     }
-    const double f = 0.5 * (lo + hi);
+    found[j] = 0.5 * (lo + hi);
+  });
+  for (int j = 0; j < 2; ++j) {
+    const double f = found[j];
     for (size_t r = 0; r < banks.size(); ++r) {
       ColumnBank& b = banks[r];
       const size_t m = b.sample.size();
@@ -375,14 +409,14 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       b.X.col(c0 + 1).setZero();
       const size_t n = kins[r]->t.size();
       const double ww[2] = {j == 0 ? w : 0.0, j == 1 ? w : 0.0};
-      for (int k = 0; k < 2; ++k) {  // -sin, then -cos: joint j's rows (the other joint's are zero)
-        std::vector<double> v(n);
-        ForEachSample(b, n, [&](size_t i) {
-          const double x = 2 * M_PI * f * kins[r]->q[j][i];
-          v[i] = k == 0 ? -std::sin(x) : -std::cos(x);
-        });
-        SetJointColumn(b, c0 + k, ww, j, std::move(v));
-      }
+      PendingColumns pc(b);
+      std::vector<double> v[2] = {std::vector<double>(n), std::vector<double>(n)};
+      ForEachSample(b, n, [&](size_t i) {  // -sin, -cos: joint j's rows (the other joint's are zero)
+        const double x = 2 * M_PI * f * kins[r]->q[j][i];
+        v[0][i] = -std::sin(x), v[1][i] = -std::cos(x);
+      });
+      for (int k = 0; k < 2; ++k) SetJointColumn(pc, c0 + k, ww, j, std::move(v[k]));
+      pc.Flush();
       Candidate c;
       c.name = "torque_ripple", c.joint = j, c.cols = {c0, c0 + 1}, c.ripple_f = f;
       b.candidates.push_back(c);

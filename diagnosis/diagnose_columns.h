@@ -22,6 +22,10 @@ struct Candidate {
   std::string Label() const;          // e.g. "gravity_error.Y(knee)"
 };
 
+// A low-pass of *xs[0 .. count) in place (n samples each), each signal the same bits as filtered alone;
+// called from up to ColumnBank::threads threads at once on disjoint signals.
+using ColumnFilter = std::function<void(std::vector<double>* const* xs, size_t count)>;
+
 // Columns on the fit rows. Row layout: X has 2 m rows, hip rows 0..m-1 then knee rows m..2m-1;
 // rows are weighted by 1/noise of their joint (so the stacked least squares are balanced).
 struct ColumnBank {
@@ -33,7 +37,7 @@ struct ColumnBank {
   int used = 0;                // columns in use (X may be over-allocated while building)
   // The residual's low-pass (parallel filtering): every column is evaluated on all n samples and
   // filtered by it before its fit rows are taken. Empty: no filter.
-  std::function<void(std::vector<double>&)> filter;  // in place
+  ColumnFilter filter;
   size_t n = 0;                // samples of the record
   int threads = 1;             // threads evaluating a column on the n samples (the same bits on any count)
 };
@@ -45,7 +49,7 @@ struct ColumnBank {
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin, const std::vector<double> tau_S[2],
                         std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows,
-                        std::function<void(std::vector<double>&)> filter = {}, int threads = 0);
+                        ColumnFilter filter = {}, int threads = 0);
 
 // Stores column c of the bank from per-sample values v[0] (hip rows), v[1] (knee rows), n each,
 // filtered by bank.filter when set and weighted by w.

@@ -16,9 +16,13 @@ namespace {
 
 
 
-// Amplitude spectrum (N m) of x[a, b) by a direct DFT of a strided copy, f in (0, fmax].
+// Amplitude spectrum (N m) of x[a, b) by a direct DFT of a strided copy (at most ~4000 samples), f
+// on a uniform grid in (0, fmax]. Each sample's phasor exp(i 2 pi f t_i) is stepped from one grid
+// frequency to the next by the constant factor exp(i 2 pi df t_i) and taken afresh by sin/cos every
+// kAnchor frequencies, so the rounding of the products stays near kAnchor ulps.
 SvgSeries Spectrum(const std::vector<double>& t, const std::vector<double>& x, size_t a, size_t b,
-                const std::string& color, const std::string& label) {
+                   const std::string& color, const std::string& label) {
+  constexpr int kAnchor = 32;
   SvgSeries s;
   s.color = color, s.label = label;
   const size_t stride = std::max<size_t>(1, (b - a) / 4000);
@@ -26,16 +30,29 @@ SvgSeries Spectrum(const std::vector<double>& t, const std::vector<double>& x, s
   double mean = 0;
   for (size_t i = a; i < b; i += stride) tt.push_back(t[i]), xx.push_back(x[i]), mean += x[i];
   mean /= static_cast<double>(xx.size());
+  for (double& v : xx) v -= mean;
   const double T = std::max(tt.back() - tt.front(), 1e-6);
   const double fmax = std::min(20.0, 0.5 * static_cast<double>(xx.size()) / T);
-  for (double f = 1.0 / T; f <= fmax; f += std::max(1.0 / T, fmax / 400)) {
-    double re = 0, im = 0;
-    for (size_t i = 0; i < xx.size(); ++i) {
-      const double ph = 2 * M_PI * f * tt[i];
-      re += (xx[i] - mean) * std::cos(ph), im += (xx[i] - mean) * std::sin(ph);
+  const double f0 = 1.0 / T, df = std::max(1.0 / T, fmax / 400);
+  const size_t N = xx.size();
+  std::vector<double> re(N), im(N), step_re(N), step_im(N);  // phasor at f, and its step per df
+  for (size_t i = 0; i < N; ++i) step_re[i] = std::cos(2 * M_PI * df * tt[i]), step_im[i] = std::sin(2 * M_PI * df * tt[i]);
+  for (int k = 0;; ++k) {
+    const double f = f0 + k * df;
+    if (f > fmax) break;
+    double sum_re = 0, sum_im = 0;
+    if (k % kAnchor == 0) {
+      for (size_t i = 0; i < N; ++i) re[i] = std::cos(2 * M_PI * f * tt[i]), im[i] = std::sin(2 * M_PI * f * tt[i]);
+    } else {
+      for (size_t i = 0; i < N; ++i) {
+        const double r = re[i] * step_re[i] - im[i] * step_im[i];
+        im[i] = re[i] * step_im[i] + im[i] * step_re[i];
+        re[i] = r;
+      }
     }
+    for (size_t i = 0; i < N; ++i) sum_re += xx[i] * re[i], sum_im += xx[i] * im[i];
     s.x.push_back(f);
-    s.y.push_back(2 * std::hypot(re, im) / static_cast<double>(xx.size()));
+    s.y.push_back(2 * std::hypot(sum_re, sum_im) / static_cast<double>(N));
   }
   return s;
 }
