@@ -365,16 +365,20 @@ std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const 
     // stays at 0), diagonal regularized by 1e-6 of itself: collinear candidates (the kitchen sink of
     // one record) pass SolveSigned's conditioning test (1e-8 of the largest
     // eigenvalue of the unit-diagonal Gram) at a cost of the order of 1e-6 of the fit.
+    // All columns' Gram at once (blocked, one pass over X), then the live columns' part.
+    Eigen::MatrixXd G_all = Eigen::MatrixXd::Zero(b.X.cols(), b.X.cols());
+    G_all.selfadjointView<Eigen::Lower>().rankUpdate(b.X.transpose());
+    const Eigen::VectorXd h_all = b.X.transpose() * b.r;
     std::vector<int> live;
     for (Eigen::Index k = 0; k < b.X.cols(); ++k)
-      if (b.X.col(k).squaredNorm() > 0) live.push_back(static_cast<int>(k));
+      if (G_all(k, k) > 0) live.push_back(static_cast<int>(k));
     Eigen::MatrixXd G(live.size(), live.size());
     Eigen::VectorXd h(live.size());
     std::vector<int> live_sign(live.size());
     for (size_t a = 0; a < live.size(); ++a) {
-      h[a] = b.X.col(live[a]).dot(b.r);
+      h[a] = h_all[live[a]];
       live_sign[a] = sign[static_cast<size_t>(live[a])];
-      for (size_t c = a; c < live.size(); ++c) G(a, c) = G(c, a) = b.X.col(live[a]).dot(b.X.col(live[c]));
+      for (size_t c = a; c < live.size(); ++c) G(a, c) = G(c, a) = G_all(std::max(live[a], live[c]), std::min(live[a], live[c]));
     }
     G.diagonal() += 1e-6 * G.diagonal();
     Eigen::VectorXd x_live, x = Eigen::VectorXd::Zero(b.X.cols());
@@ -387,21 +391,27 @@ std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const 
     for (size_t a = 0; a < live.size(); ++a) x[live[a]] = x_live[static_cast<Eigen::Index>(a)];
     const Eigen::VectorXd e = b.r - b.X * x;
     const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
-    // The null level: the same normal equations against the shifted residual.
-    double null_sse[2] = {0, 0};
-    for (double shift : kNullShifts) {
-      const Eigen::Index k = static_cast<Eigen::Index>(shift * static_cast<double>(m));
-      Eigen::VectorXd rs(b.r.size());
+    // The null level: the same normal equations against the shifted residuals (all shifts in one
+    // pass over X).
+    constexpr Eigen::Index S = static_cast<Eigen::Index>(std::size(kNullShifts));
+    Eigen::MatrixXd RS(b.r.size(), S), XS = Eigen::MatrixXd::Zero(b.X.cols(), S);
+    for (Eigen::Index s = 0; s < S; ++s) {
+      const Eigen::Index k = static_cast<Eigen::Index>(kNullShifts[s] * static_cast<double>(m));
       for (Eigen::Index j = 0; j < 2; ++j)
-        for (Eigen::Index i = 0; i < m; ++i) rs[j * m + i] = b.r[j * m + (i + k) % m];
-      Eigen::VectorXd hs(live.size()), xs_live, xs = Eigen::VectorXd::Zero(b.X.cols());
-      for (size_t a = 0; a < live.size(); ++a) hs[a] = b.X.col(live[a]).dot(rs);
+        for (Eigen::Index i = 0; i < m; ++i) RS(j * m + i, s) = b.r[j * m + (i + k) % m];
+    }
+    const Eigen::MatrixXd HS = b.X.transpose() * RS;
+    for (Eigen::Index s = 0; s < S; ++s) {
+      Eigen::VectorXd hs(live.size()), xs_live;
+      for (size_t a = 0; a < live.size(); ++a) hs[a] = HS(live[a], s);
       if (!live.empty() && !SolveSigned(G, hs, live_sign, &xs_live))
         throw std::logic_error("diagnose: the null ceiling of record " + std::to_string(r) + " is too ill-conditioned to solve");
-      for (size_t a = 0; a < live.size(); ++a) xs[live[a]] = xs_live[static_cast<Eigen::Index>(a)];
-      const Eigen::VectorXd es = rs - b.X * xs;
-      for (int j = 0; j < 2; ++j) null_sse[j] += es.segment(j * m, m).squaredNorm() / std::size(kNullShifts);
+      for (size_t a = 0; a < live.size(); ++a) XS(live[a], s) = xs_live[static_cast<Eigen::Index>(a)];
     }
+    RS.noalias() -= b.X * XS;  // the shifted residuals' errors
+    double null_sse[2] = {0, 0};
+    for (Eigen::Index s = 0; s < S; ++s)
+      for (int j = 0; j < 2; ++j) null_sse[j] += RS.col(s).segment(j * m, m).squaredNorm() / static_cast<double>(S);
     for (int j = 0; j < 2; ++j) {
       if (!(w[j] > 0) || m == 0) continue;
       const double before = b.r.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
@@ -993,6 +1003,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   UseSecantDelayColumns(recs, w, &banks);
   if (params.one_joint) KeepJointCandidates(1, &banks);
   const std::vector<CeilingScores> ceilings = Ceilings(banks, w);
+  Lap("ceilings");
   const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
   for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
