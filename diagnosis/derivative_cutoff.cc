@@ -118,6 +118,9 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
                   std::all_of(tau.begin(), tau.end(), [](double v) { return v == 0; });
     }
   }
+  // Threads of the per-sample loops and the candidates' work below (at most 2).
+  const int threads_of_records =
+      std::min(2, threads_asked > 0 ? threads_asked : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
   std::vector<RecordBase> base(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
     const MeasuredData& d = *records[r];
@@ -132,18 +135,18 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     for (int j = 0; j < 2; ++j)
       for (int k = 0; k < 2; ++k) B.recorded[j][k] = d.Column(std::string(k == 0 ? "qd_" : "qdd_") + names[j]);
     if (parallel) {
-      B.trig.reserve(n);
-      for (size_t i = 0; i < n; ++i) B.trig.push_back(TrigOf({d.q_hip()[i], d.q_knee()[i]}));
+      B.trig.resize(n);  // here: the threads below allocate nothing
+      ParallelForRanges(n, threads_of_records, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) B.trig[i] = TrigOf({d.q_hip()[i], d.q_knee()[i]});
+      });
     }
   }
   std::vector<std::vector<double>> row_scores;  // per candidate: each held-out row's score
-  constexpr size_t kBatch = 6;                  // columns low-passed together (memory: kBatch records)
+  constexpr size_t kBatch = 8;                  // columns low-passed together (memory: kBatch records)
   std::vector<double> batch[kBatch];
   // The work of a candidate on two threads where it splits without more memory: the two angles'
-  // rates (each into its own reused vectors), the regressor's samples by halves, a batch's low-pass by
-  // halves (each signal filtered as alone). The same bits on any thread count.
-  const int threads_of_records =
-      std::min(2, threads_asked > 0 ? threads_asked : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  // rates (each into its own reused vectors), a batch's columns by halves, each half generated block by
+  // block and low-passed as it comes (each signal filtered as alone). The same bits on any thread count.
   AngleRates derived_buffer[2];  // the rates of the record at hand, its vectors reused
   for (double fc : c.candidates_hz) {
     // Per record, on the rows: the regressor (parallel: from the angles differentiated at
@@ -204,39 +207,46 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
             {kRate, 0, 8},      {kRate, 1, 11},     {kTorque, 0, 0},    {kTorque, 1, 0}};
         for (size_t c0 = 0; c0 < std::size(kFiltered); c0 += kBatch) {
           const size_t K = std::min(kBatch, std::size(kFiltered) - c0);
-          bool regressor = false;
-          for (size_t e = 0; e < K; ++e) {
-            batch[e].resize(n);  // here: the threads below allocate nothing
-            regressor = regressor || kFiltered[c0 + e].kind == kRegressor;
-          }
-          // Every column of the batch on every sample, the samples in ranges.
-          ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
-            for (size_t i = begin; i < end; ++i) {
-              Matrix26 Y = Matrix26::Zero();
-              if (regressor)
-                Y = FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
-              for (size_t e = 0; e < K; ++e) {
-                const Col& c = kFiltered[c0 + e];
-                double& v = batch[e][i];
-                switch (c.kind) {
-                  case kRegressor: v = Y(c.j, c.col); break;
-                  case kOnes: v = 1.0; break;
-                  case kRate: v = (*qd[c.j])[i]; break;
-                  case kTorque: v = (*tau[c.j])[i]; break;
-                  case kSign: {
-                    const double w = (*qd[c.j])[i];
-                    v = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
-                    break;
-                  }
-                }
-              }
-            }
-          });
-          std::vector<double>* ptr[kBatch];
-          for (size_t e = 0; e < K; ++e) ptr[e] = &batch[e];
+          for (size_t e = 0; e < K; ++e) batch[e].resize(n);  // here: the threads below allocate nothing
+          // Each half of the batch on its own thread: its columns generated block by block and
+          // low-passed as they come (TimeBaseLowPass::ApplyGenerated), the regressor evaluated where
+          // the half holds one of its columns.
           ParallelFor(2, threads, [&](size_t half) {
             const size_t e0 = half * K / 2, e1 = (half + 1) * K / 2;
-            if (e1 > e0) low.Apply(ptr + e0, e1 - e0);
+            if (e1 == e0) return;
+            std::vector<double>* ptr[kBatch];
+            double* reg_out[kBatch];  // the half's regressor columns and their entries of Y
+            int reg_j[kBatch], reg_col[kBatch], regressors = 0;
+            for (size_t e = e0; e < e1; ++e) {
+              ptr[e - e0] = &batch[e];
+              const Col& c = kFiltered[c0 + e];
+              if (c.kind == kRegressor)
+                reg_out[regressors] = batch[e].data(), reg_j[regressors] = c.j, reg_col[regressors++] = c.col;
+            }
+            low.ApplyGenerated(ptr, e1 - e0, [&](size_t begin, size_t end) {
+              if (regressors > 0)
+                for (size_t i = begin; i < end; ++i) {
+                  const Matrix26 Y =
+                      FullRegressorOfTrig(L1, g, B.trig[i], {(*qd[0])[i], (*qd[1])[i]}, {(*qdd[0])[i], (*qdd[1])[i]});
+                  for (int k = 0; k < regressors; ++k) reg_out[k][i] = Y(reg_j[k], reg_col[k]);
+                }
+              for (size_t e = e0; e < e1; ++e) {
+                const Col& c = kFiltered[c0 + e];
+                double* v = batch[e].data();
+                switch (c.kind) {
+                  case kRegressor: break;
+                  case kOnes: std::fill(v + begin, v + end, 1.0); break;
+                  case kRate: std::copy(qd[c.j]->begin() + begin, qd[c.j]->begin() + end, v + begin); break;
+                  case kTorque: std::copy(tau[c.j]->begin() + begin, tau[c.j]->begin() + end, v + begin); break;
+                  case kSign:
+                    for (size_t i = begin; i < end; ++i) {
+                      const double w = (*qd[c.j])[i];
+                      v[i] = w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0);
+                    }
+                    break;
+                }
+              }
+            });
           });
           for (size_t e = 0; e < K; ++e) {
             const Col& c = kFiltered[c0 + e];

@@ -262,6 +262,52 @@ void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const*
   }
 }
 
+void FiltFiltGenerated(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count,
+                       const std::function<void(size_t begin, size_t end)>& fill) {
+  // FiltFiltInPlace's operations in its order, its forward pass over x cut into blocks (the
+  // sections' states carried in z from block to block), the signals interleaved.
+  constexpr size_t kMaxSignals = 8, kFillSamples = 2048;
+  if (count == 0) return;
+  if (count > kMaxSignals) throw std::invalid_argument("FiltFiltGenerated: more than 8 signals");
+  const size_t n = xs[0]->size();
+  for (size_t k = 1; k < count; ++k)
+    if (xs[k]->size() != n) throw std::invalid_argument("FiltFiltGenerated: signals of different lengths");
+  if (n == 0) return;
+  const size_t K = count, sections = sos.size();
+  size_t pad = 3 * (2 * sections + 1);
+  if (pad >= n) pad = n - 1;
+  double *x[kMaxSignals], *h[kMaxSignals], *t[kMaxSignals], *xb[kMaxSignals];
+  std::vector<double> head[kMaxSignals], tail[kMaxSignals];
+  std::vector<std::array<double, 2>> z[kMaxSignals];
+  std::array<double, 2>* zk[kMaxSignals];
+  // The tail's odd reflection of the raw last pad + 1 samples, before the forward pass overwrites them.
+  fill(n - 1 - pad, n);
+  for (size_t k = 0; k < K; ++k) {
+    x[k] = xs[k]->data();
+    head[k].resize(pad), tail[k].resize(pad);
+    for (size_t i = 1; i <= pad; ++i) tail[k][i - 1] = 2.0 * x[k][n - 1] - x[k][n - 1 - i];
+    z[k].assign(sections, {0.0, 0.0});
+    h[k] = head[k].data(), t[k] = tail[k].data(), zk[k] = z[k].data();
+  }
+  for (size_t b = 0; b < n; b += kFillSamples) {
+    const size_t e = std::min(n, b + kFillSamples);
+    fill(b, e);
+    if (b == 0) {  // the head's odd reflection of the raw first pad + 1 samples (pad < n, pad < e)
+      for (size_t k = 0; k < K; ++k) {
+        for (size_t i = 0; i < pad; ++i) head[k][i] = 2.0 * x[k][0] - x[k][pad - i];
+        ResetCascade(sos, z[k].data(), pad > 0 ? head[k].front() : x[k][0]);
+      }
+      RunCascade(sos, zk, h, K, pad, false);
+    }
+    for (size_t k = 0; k < K; ++k) xb[k] = x[k] + b;
+    RunCascade(sos, zk, xb, K, e - b, false);
+  }
+  RunCascade(sos, zk, t, K, pad, false);
+  for (size_t k = 0; k < K; ++k) ResetCascade(sos, z[k].data(), pad > 0 ? tail[k].back() : x[k][n - 1]);
+  RunCascade(sos, zk, t, K, pad, true);
+  RunCascade(sos, zk, x, K, n, true);
+}
+
 void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x) {
   std::vector<double>* one = &x;
   FiltFiltInPlace(sos, &one, 1);

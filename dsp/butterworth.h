@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 namespace exotwin::dsp {
@@ -49,5 +50,12 @@ void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>& x);
 // filtered a few at a time (faster than one by one). Throws std::invalid_argument for signals of
 // different lengths.
 void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count);
+// The same for count (1 .. 8) signals that the caller generates block by block: fill(begin, end) writes the
+// raw samples [begin, end) of every signal into (*xs[k])[begin .. end) (each *xs[k] sized n
+// beforehand; fill may be asked for a few samples twice and must give the same values). Each block is
+// filtered forward while it is still in cache, so a signal crosses memory twice (written, then
+// filtered backward) instead of four times. On return *xs[k] is FiltFiltInPlace's result, bit for bit.
+void FiltFiltGenerated(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count,
+                       const std::function<void(size_t begin, size_t end)>& fill);
 
 }  // namespace exotwin::dsp

@@ -224,6 +224,16 @@ void TimeBaseLowPass::Apply(std::vector<double>* const* xs, size_t count) const 
   for (size_t k = 0; k < count; ++k) *xs[k] = Interpolate(grid_, on_grid[k], t_);
 }
 
+void TimeBaseLowPass::ApplyGenerated(std::vector<double>* const* xs, size_t count,
+                                     const std::function<void(size_t begin, size_t end)>& fill) const {
+  if (uniform_) {
+    dsp::FiltFiltGenerated(sos_, xs, count, fill);
+    return;
+  }
+  if (count > 0) fill(0, xs[0]->size());
+  Apply(xs, count);
+}
+
 void TimeBaseLowPass::Apply(std::vector<double>& x) const {
   std::vector<double>* one = &x;
   Apply(&one, 1);

@@ -2,6 +2,7 @@
 // derived from it.
 #pragma once
 #include <cmath>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -141,6 +142,10 @@ class TimeBaseLowPass {
   void Apply(std::vector<double>& x) const;  // x (one value per time of t) filtered in place
   // Apply to *xs[0] .. *xs[count - 1], faster than one by one (dsp::FiltFiltInPlace of several).
   void Apply(std::vector<double>* const* xs, size_t count) const;
+  // Apply to count (1 .. 8) signals that fill(begin, end) writes block by block into (*xs[k])[begin ..
+  // end) (dsp::FiltFiltGenerated; each *xs[k] sized as t): the same bits as fill(0, n) then Apply.
+  void ApplyGenerated(std::vector<double>* const* xs, size_t count,
+                      const std::function<void(size_t begin, size_t end)>& fill) const;
   std::vector<double> operator()(std::vector<double> x) const {
     Apply(x);
     return x;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -118,6 +119,46 @@ TEST(FiltFilt, InPlaceAndBatchedEqualThePaddedCopyBitForBit) {
   std::vector<double> a(10), b(11);
   std::vector<double>* ab[2] = {&a, &b};
   EXPECT_THROW(FiltFiltInPlace(designs[0], ab, 2), std::invalid_argument);
+}
+
+// Signals generated block by block and filtered forward as they come (FiltFiltGenerated) end as the
+// padded copy's zero-phase filter, bit for bit: one to eight signals, records shorter than the pad,
+// than one block (2048 samples) and a few blocks long; every sample generated, none outside [0, n).
+TEST(FiltFilt, GeneratedBlockByBlockEqualsThePaddedCopyBitForBit) {
+  const std::vector<Biquad> designs[] = {DesignButterworth(2, BandType::kLowPass, 1000.0, 7.0),
+                                         DesignButterworth(4, BandType::kLowPass, 500.0, 30.0)};
+  auto Value = [](size_t k, size_t i) { return std::sin(0.01 * (k + 1) * i) + 0.1 * std::cos(1.7 * i * i + k); };
+  for (const auto& sos : designs)
+    for (size_t n : {1, 2, 9, 2047, 2048, 2049, 5000})
+      for (size_t count : {1, 3, 8}) {
+        SCOPED_TRACE(std::to_string(sos.size()) + " sections, n " + std::to_string(n) + ", " + std::to_string(count) + " signals");
+        std::vector<std::vector<double>> out(count, std::vector<double>(n, std::nan("")));
+        std::vector<double>* ptr[8];
+        for (size_t k = 0; k < count; ++k) ptr[k] = &out[k];
+        std::vector<int> generated(n, 0);
+        bool outside = false;
+        FiltFiltGenerated(sos, ptr, count, [&](size_t begin, size_t end) {
+          outside = outside || begin >= end || end > n;
+          for (size_t i = begin; i < end && i < n; ++i) {
+            ++generated[i];
+            for (size_t k = 0; k < count; ++k) out[k][i] = Value(k, i);
+          }
+        });
+        EXPECT_FALSE(outside);
+        EXPECT_TRUE(std::all_of(generated.begin(), generated.end(), [](int g) { return g >= 1; }));
+        for (size_t k = 0; k < count; ++k) {
+          std::vector<double> x(n);
+          for (size_t i = 0; i < n; ++i) x[i] = Value(k, i);
+          EXPECT_EQ(out[k], PaddedFiltFilt(sos, x));
+        }
+      }
+  std::vector<std::vector<double>> nine(9, std::vector<double>(10));
+  std::vector<double>* ptr[9];
+  for (size_t k = 0; k < 9; ++k) ptr[k] = &nine[k];
+  EXPECT_THROW(FiltFiltGenerated(designs[0], ptr, 9, [](size_t, size_t) {}), std::invalid_argument);
+  std::vector<double> a(10), b(11);
+  std::vector<double>* ab[2] = {&a, &b};
+  EXPECT_THROW(FiltFiltGenerated(designs[0], ab, 2, [](size_t, size_t) {}), std::invalid_argument);
 }
 
 // The low-pass of zeros is +0 everywhere (a column that is zero needs no filtering).

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -129,7 +130,8 @@ TEST(DeriveKinematics, TakingTheColumnsEqualsCopyingThem) {
 
 // TimeBaseLowPass (the sampling examined once, the filter designed once, several signals at a
 // time) gives LowPassOnTimeBase's composition bit for bit: FiltFilt on a uniform record, through
-// the median-step grid and back on a non-uniform one; DeriveAngleRates gives DeriveKinematics' rates.
+// the median-step grid and back on a non-uniform one, the signals given whole or generated block by
+// block; DeriveAngleRates gives DeriveKinematics' rates.
 TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
   for (bool uniform : {true, false}) {
     SCOPED_TRACE(uniform ? "uniform" : "non-uniform");
@@ -152,6 +154,14 @@ TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
       EXPECT_EQ(LowPassOnTimeBase(d.t(), xs[k], 7.0, d.source), ref);
       EXPECT_EQ(batched[k], ref);
     }
+    // The same signals generated block by block (ApplyGenerated): the same bits.
+    std::vector<double> generated[5];
+    std::vector<double>* gptr[5];
+    for (int k = 0; k < 5; ++k) generated[k].assign(d.size(), 0.0), gptr[k] = &generated[k];
+    low.ApplyGenerated(gptr, 5, [&](size_t begin, size_t end) {
+      for (int k = 0; k < 5; ++k) std::copy(xs[k].begin() + begin, xs[k].begin() + end, generated[k].begin() + begin);
+    });
+    for (int k = 0; k < 5; ++k) EXPECT_EQ(generated[k], batched[k]);
     const Kinematics k = DeriveKinematics(d, 15.0);
     for (int j = 0; j < 2; ++j) {
       const AngleRates r = DeriveAngleRates(s, d.t(), j == 0 ? d.q_hip() : d.q_knee(), 15.0, d.source);
