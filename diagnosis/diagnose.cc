@@ -64,7 +64,7 @@ struct Rec {
   // The twin: the rigid actuator torque (after stage 2 only on [0, RefineRows)) and the reading
   // with the model's effects (released by stage 6).
   std::vector<double> tau_R[2], tau_S[2];
-  std::vector<double> resid[2];         // Residual(j); released once the candidate columns took their rows
+  std::vector<double> resid[2];         // Residuals(); released once the candidate columns took their rows
   size_t split = 0;
   std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
   size_t n() const { return kin.t.size(); }
@@ -76,12 +76,22 @@ struct Rec {
     const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
     return LowPassOnTimeBase(t, x, hz, source);
   }
-  // The filtered residual of joint j, measured - twin (raw - tau_S), on kin.t's samples: the same
-  // bits wherever it is computed.
-  std::vector<double> Residual(int j) const {
-    std::vector<double> e(n());
-    for (size_t i = 0; i < e.size(); ++i) e[i] = raw[j][i] - tau_S[j][i];
-    return Filter(std::move(e));
+  // Filter of x[0] and x[1] (one length) together, in place: interleaved, each the same bits as Filter.
+  void FilterBoth(std::vector<double> x[2], size_t from = 0) const {
+    if (!(hz > 0)) return;
+    std::vector<double>* p[2] = {&x[0], &x[1]};
+    if (from == 0 && x[0].size() == kin.t.size()) return low->Apply(p, 2);
+    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x[0].size());
+    TimeBaseLowPass(t, hz, source).Apply(p, 2);
+  }
+  // The filtered residuals of both joints, measured - twin (raw - tau_S), on kin.t's samples: the same
+  // bits wherever they are computed.
+  void Residuals(std::vector<double> e[2]) const {
+    for (int j = 0; j < 2; ++j) {
+      e[j].resize(n());
+      for (size_t i = 0; i < e[j].size(); ++i) e[j][i] = raw[j][i] - tau_S[j][i];
+    }
+    FilterBoth(e);
   }
   ColumnFilter FilterFn() const {
     if (!(hz > 0)) return {};
@@ -299,14 +309,16 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
     std::vector<double> rigid[2] = {rc.tau_R[0], rc.tau_R[1]};
     ApplyEffects(params, kin, rigid, rc.tau_S);  // rc.tau_R stays the rigid torque
   }
-  for (int j = 0; j < 2; ++j) rc.resid[j] = rc.Residual(j);
+  rc.Residuals(rc.resid);
 }
 
 // Stage 3c: the measured torque filtered as the residual, into rc.meas (after the candidate columns,
 // whose temporaries are gone by then: a long record's peak memory).
 void FilterMeasured(std::vector<Rec>* recs) {
-  for (Rec& rc : *recs)
-    for (int j = 0; j < 2; ++j) rc.meas[j] = rc.Filter(std::vector<double>(rc.raw[j], rc.raw[j] + rc.n()));
+  for (Rec& rc : *recs) {
+    for (int j = 0; j < 2; ++j) rc.meas[j].assign(rc.raw[j], rc.raw[j] + rc.n());
+    rc.FilterBoth(rc.meas);
+  }
 }
 
 // Stage 2b: white noise per joint (N m, >= 1e-6) from the first differences of the residuals,
@@ -712,7 +724,8 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
     Rec& rc = recs[r];
     const size_t n = rc.n();
     // The residual again (released by the candidate columns), then the twin's reading is done with.
-    const std::vector<double> resid[2] = {rc.Residual(0), rc.Residual(1)};
+    std::vector<double> resid[2];
+    rc.Residuals(resid);
     for (int j = 0; j < 2; ++j) std::vector<double>().swap(rc.tau_S[j]);
     RecordScore rs;
     rs.source = rc.source;
@@ -722,10 +735,14 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
     const size_t warm = static_cast<size_t>(
         std::lower_bound(rc.kin.t.begin(), rc.kin.t.end(), rc.kin.t[rc.split] - 1.0) - rc.kin.t.begin());
     const Prediction held = PredictTorque(ext, Slice(rc.kin, warm, n));
+    std::vector<double> held_error[2];
     for (int j = 0; j < 2; ++j) {
-      std::vector<double> ea(n - warm);
-      for (size_t i = warm; i < n; ++i) ea[i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
-      ea = rc.Filter(std::move(ea), warm);
+      held_error[j].resize(n - warm);
+      for (size_t i = warm; i < n; ++i) held_error[j][i - warm] = rc.raw[j][i] - held.tau_S[j][i - warm];
+    }
+    rc.FilterBoth(held_error, warm);
+    for (int j = 0; j < 2; ++j) {
+      const std::vector<double>& ea = held_error[j];
       double b = 0, a = 0;
       for (size_t i = rc.split; i < n; ++i) {
         b += std::pow(resid[j][i], 2);
@@ -757,10 +774,14 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
       Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
       loo_plant.SetParams(p);
       const Prediction whole = PredictTorque(loo_plant, rc.kin);
+      std::vector<double> whole_error[2];
       for (int j = 0; j < 2; ++j) {
-        std::vector<double> ea(n);
-        for (size_t i = 0; i < n; ++i) ea[i] = rc.raw[j][i] - whole.tau_S[j][i];
-        ea = rc.Filter(std::move(ea));
+        whole_error[j].resize(n);
+        for (size_t i = 0; i < n; ++i) whole_error[j][i] = rc.raw[j][i] - whole.tau_S[j][i];
+      }
+      rc.FilterBoth(whole_error);
+      for (int j = 0; j < 2; ++j) {
+        const std::vector<double>& ea = whole_error[j];
         double b = 0, a = 0;
         for (size_t i = 0; i < n; ++i) b += std::pow(resid[j][i], 2), a += std::pow(ea[i], 2);
         rs.left_out[j] = ScoreOf(b, a, static_cast<double>(n));
@@ -834,16 +855,23 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
     const bool whole_long = D.leave_one_out && t.back() - t.front() >= opt.replay_horizon_s;
     const long from = static_cast<long>(rc.split);
     // The rigid twin and the other (extended, or the left-out fit's) replayed side by side on
-    // DiagnoseThreads threads, the other's input re-formed for its sensor effects into its own vectors.
+    // DiagnoseThreads threads (ReplayTwoTwins: the one done first takes the other's last windows on a
+    // second plant alike), the other's input re-formed for its sensor effects into its own vectors.
     const int threads = DiagnoseThreads(opt);
     std::vector<double> tau_other[2];
+    auto Second = [&](const LegParams& model, std::unique_ptr<Plant>* p) {
+      return [&opt, &model, p]() -> Plant& {
+        if (!*p) *p = MakeReplayPlant(model, "the second thread's plant", opt.mjcf);
+        return **p;
+      };
+    };
     if (split_long) {
       ActuatorTorqueFromReading(ext_fx, t, tau_S, tau_other);
-      ReplayRecord b, a;
-      ParallelFor(2, threads, [&](size_t k) {
-        if (k == 0) b = Replay(*rigid, series, opt.replay_horizon_s, rc.split, n);
-        else a = Replay(*ext, series, opt.replay_horizon_s, rc.split, n, tau_other);
-      });
+      std::unique_ptr<Plant> rigid2, ext2;
+      const ReplayTwin twins[2] = {{rigid.get(), Second(params, &rigid2), nullptr},
+                                   {ext.get(), Second(D.extended, &ext2), tau_other}};
+      std::array<ReplayRecord, 2> ba = ReplayTwoTwins(twins, series, opt.replay_horizon_s, threads, rc.split, n);
+      ReplayRecord &b = ba[0], &a = ba[1];
       Score(b.score, a.score, rs.sim_split);
       rs.sim_split_windows = b.score.windows;
       sb.Add(b.score), sa.Add(a.score);
@@ -863,11 +891,11 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
       PlantEffects loo_fx;
       if (!Make(loo, rc.source + " left out", &loo_plant, &loo_fx)) return;
       ActuatorTorqueFromReading(loo_fx, t, tau_S, tau_other);
-      ReplayScore b, a;
-      ParallelFor(2, threads, [&](size_t k) {
-        if (k == 0) b = Replay(*rigid, series, opt.replay_horizon_s).score;
-        else a = Replay(*loo_plant, series, opt.replay_horizon_s, 0, static_cast<size_t>(-1), tau_other).score;
-      });
+      std::unique_ptr<Plant> rigid2, loo2;
+      const ReplayTwin twins[2] = {{rigid.get(), Second(params, &rigid2), nullptr},
+                                   {loo_plant.get(), Second(loo, &loo2), tau_other}};
+      const std::array<ReplayRecord, 2> ba = ReplayTwoTwins(twins, series, opt.replay_horizon_s, threads);
+      const ReplayScore &b = ba[0].score, &a = ba[1].score;
       Score(b, a, rs.sim_left_out);
       rs.sim_left_out_windows = b.windows;
       lb.Add(b), la.Add(a);

@@ -121,17 +121,19 @@ void AddColumnPair(PendingColumns& p, const double w[2], int c1, int c2, F f) {
 }
 
 // The actuator torque R[k] = ActuatorTorque(rigid, x_k, qd, qdd) and the compliant part's torque
-// C[k] = CompliantPartTorque(rigid, x_k, qd, qdd) at x_0 = q, x_1 = q + 1e-5 e_j, x_2 = q - 1e-5 e_j,
+// C[k] = CompliantPartTorque(rigid, x_k, qd, qdd) at x_0 = q, x_1 = q + h e_j, x_2 = q - h e_j (h = kNearStep),
 // equal to them up to rounding: each point's rigid torque in the regressor form Y(x_k, qd, qdd) theta
 // (HJ15 eq. 18-21, model/regressors.h), one Y for both parameter sets, the sines and cosines of the
 // shifted angles from those of q by the angle-addition formulas (3 sincos per sample instead of 24),
-// and each point's passive moment computed once (in both). `total`: rigid.Total().
+// and each point's passive moment computed once (in both), the three from one set of exponentials
+// (model/passive_torque.h PassiveNearPoints, made for j and kNearStep). `total`: rigid.Total().
 struct NearTorques {
   Eigen::Vector2d R[3], C[3];
 };
-NearTorques TorquesNear(const LegParams& rigid, const LumpedParams& total, int j, const Eigen::Vector2d& q,
-                        const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
-  constexpr double kH = 1e-5;
+constexpr double kNearStep = 1e-5;  // rad
+NearTorques TorquesNear(const LegParams& rigid, const LumpedParams& total, const PassiveNearPoints& near_passive, int j,
+                        const Eigen::Vector2d& q, const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
+  constexpr double kH = kNearStep;
   static const double ch = std::cos(kH), sh = std::sin(kH);
   RegressorTrig trig[3];
   trig[0] = TrigOf(q);
@@ -152,16 +154,14 @@ NearTorques TorquesNear(const LegParams& rigid, const LumpedParams& total, int j
   const Vector6 theta_R = ToVector(total);
   NearTorques t;
   Eigen::Vector2d passive[3];
+  if (rigid.human) near_passive.At(q, passive);
   for (int k = 0; k < 3; ++k) {
-    Eigen::Vector2d x = q;
-    x[j] += k == 0 ? 0.0 : (k == 1 ? kH : -kH);
     const Matrix26 Y = FullRegressorOfTrig(rigid.L1, rigid.g, trig[k], qd, qdd);
     t.R[k] = Y * theta_R;
     if (!rigid.human) {  // no human: the compliant part is the whole chain
       t.C[k] = t.R[k];
       continue;
     }
-    passive[k] = PassiveElasticTorque(rigid.passive, x);
     t.C[k] = Y * ToVector(*rigid.human) + passive[k];
     t.R[k] += passive[k];
   }
@@ -310,8 +310,9 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
     // (1/k) dtau_C/dq_j tau_C,j (first order in 1/k). Both columns in one pass over the samples.
     {
       const int cb = NewColumn(b), cs = NewColumn(b);
+      const PassiveNearPoints near_passive(rigid.passive, j, kNearStep);
       AddColumnPair(pc, w, cb, cs, [&](size_t i, Eigen::Vector2d* backlash, Eigen::Vector2d* strap) {
-        const NearTorques t = TorquesNear(rigid, total, j, Q(i), QD(i), QDD(i));
+        const NearTorques t = TorquesNear(rigid, total, near_passive, j, Q(i), QD(i), QDD(i));
         const Eigen::Vector2d d = (t.R[1] - t.R[2]) / 2e-5;
         *backlash = Eigen::Vector2d(0.5 * std::tanh(t.R[0][j] / kBacklashTorqueWidth) * d);
         const Eigen::Vector2d dc = (t.C[1] - t.C[2]) / 2e-5;
@@ -330,19 +331,29 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
     if (!kin.emg.empty()) {
       std::vector<int> cols;
       std::vector<std::string> chans;
-      for (const auto& ch : kin.emg) {
-        if (j == 0) {
-          if (pc.size() >= 2) pc.Flush();  // the envelope's own record-long temporaries come next
-          std::vector<double> x = EmgEnvelope(kin.t, ch.second);
-          for (double& v : x) v = -v;
-          cols.push_back(NewColumn(b));
-          SetJointColumn(pc, cols.back(), w, 0, std::move(x), &envelope_rows[chans.size()]);
-        } else {
+      if (j == 0) {
+        // The channels' envelopes two at a time (filtered together: EmgEnvelopes), the pending columns
+        // placed first (the envelopes' record-long temporaries come next).
+        std::vector<const std::vector<double>*> emg;
+        for (const auto& ch : kin.emg) emg.push_back(&ch.second), chans.push_back(ch.first);
+        for (size_t c0 = 0; c0 < emg.size(); c0 += 2) {
+          pc.Flush();
+          const size_t K = std::min<size_t>(2, emg.size() - c0);
+          std::vector<std::vector<double>> env = EmgEnvelopes(kin.t, {emg.begin() + static_cast<long>(c0),
+                                                                      emg.begin() + static_cast<long>(c0 + K)});
+          for (size_t k = 0; k < K; ++k) {
+            for (double& v : env[k]) v = -v;
+            cols.push_back(NewColumn(b));
+            SetJointColumn(pc, cols.back(), w, 0, std::move(env[k]), &envelope_rows[c0 + k]);
+          }
+        }
+      } else {
+        for (const auto& ch : kin.emg) {
           const int c = NewColumn(b);
           SetJointRows(b, c, w, j, envelope_rows[chans.size()]);
           cols.push_back(c);
+          chans.push_back(ch.first);
         }
-        chans.push_back(ch.first);
       }
       add("muscle_activity", cols)->channels = chans;
     }

@@ -30,8 +30,14 @@ Eigen::Vector2d At(const std::vector<double> v[2], size_t i) { return {v[0][i], 
 }  // namespace
 
 std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg) {
-  if (t.size() < 2 || emg.size() != t.size())
-    throw InputError("EMG envelope: expected an EMG column with one value per sample");
+  return std::move(EmgEnvelopes(t, {&emg})[0]);
+}
+
+std::vector<std::vector<double>> EmgEnvelopes(const std::vector<double>& t,
+                                              const std::vector<const std::vector<double>*>& emg) {
+  for (const std::vector<double>* x : emg)
+    if (t.size() < 2 || x->size() != t.size())
+      throw InputError("EMG envelope: expected an EMG column with one value per sample");
   const double fs = 1.0 / MedianStep(t);
   if (!(fs > 40.0))
     throw InputError("EMG envelope: sample rate " + std::to_string(fs) +
@@ -45,8 +51,8 @@ std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<
   }
   // Odd reflection of up to 1 s at both ends before filtering keeps the start-up transients of
   // the 2 Hz low-pass out of the record.
-  const size_t pad = std::min(emg.size() - 1, static_cast<size_t>(fs));
-  return dsp::ZeroPhaseEnvelope(hp, lp, emg, pad);
+  const size_t pad = std::min(t.size() - 1, static_cast<size_t>(fs));
+  return dsp::ZeroPhaseEnvelopes(hp, lp, emg, pad);
 }
 
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],

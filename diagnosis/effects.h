@@ -43,5 +43,8 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
 // envelope low-pass, padded by up to 1 s at both ends. t strictly increasing with a sample rate above
 // 40 Hz (median step). Throws InputError otherwise.
 std::vector<double> EmgEnvelope(const std::vector<double>& t, const std::vector<double>& emg);
+// The envelopes of several such columns at once (dsp::ZeroPhaseEnvelopes), each EmgEnvelope's bits.
+std::vector<std::vector<double>> EmgEnvelopes(const std::vector<double>& t,
+                                              const std::vector<const std::vector<double>*>& emg);
 
 }  // namespace exotwin

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <mutex>
 #include <utility>
 
 #include "core/error.h"
@@ -231,21 +232,44 @@ void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>
   }
 }
 
-ReplayRecord ReplayOn(Plant& plant, const std::function<Plant&()>* second, const ReplaySeries& s, double horizon_s,
-                      size_t begin, size_t end, const std::vector<double>* tau_R) {
+// The record of a replay of samples [begin, end) of s before its windows run: the checks, the NaN
+// series, the windows.
+ReplayRecord StartRecord(const ReplaySeries& s, double horizon_s, size_t begin, size_t* end,
+                         std::vector<ReplayWindowSpan>* spans) {
   const std::vector<double>& t = s.t;
-  const std::vector<double>* u = tau_R ? tau_R : s.tau_R;
-  end = std::min(end, t.size());
+  *end = std::min(*end, t.size());
   if (!(horizon_s > 0)) throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s, expected > 0");
-  if (begin >= end || t[end - 1] - t[begin] < horizon_s)
+  if (begin >= *end || t[*end - 1] - t[begin] < horizon_s)
     throw InputError(s.source + ": replay horizon " + std::to_string(horizon_s) + " s is longer than the part replayed (" +
-                     std::to_string(begin < end ? t[end - 1] - t[begin] : 0.0) + " s)");
+                     std::to_string(begin < *end ? t[*end - 1] - t[begin] : 0.0) + " s)");
   ReplayRecord out;
   out.source = s.source;
   out.first = begin;
-  for (auto& v : out.sim) v.assign(end - begin, std::nan(""));
-  out.window.assign(end - begin, -1);
-  const std::vector<ReplayWindowSpan> spans = ReplayWindows(s, horizon_s, begin, end);
+  for (auto& v : out.sim) v.assign(*end - begin, std::nan(""));
+  out.window.assign(*end - begin, -1);
+  *spans = ReplayWindows(s, horizon_s, begin, *end);
+  return out;
+}
+
+// The score of a record whose windows have run, in sample order: the same sums whichever plant
+// simulated which window.
+void ScoreRecord(const ReplaySeries& s, size_t windows, ReplayRecord* out) {
+  for (size_t k = 0; k < out->window.size(); ++k) {
+    if (out->window[k] < 0) continue;
+    for (int j = 0; j < 2; ++j) {
+      const double e = out->sim[j][k] - s.q[j][out->first + k];
+      out->score.sse[j] += e * e;
+    }
+    ++out->score.count;
+  }
+  out->score.windows = windows;
+}
+
+ReplayRecord ReplayOn(Plant& plant, const std::function<Plant&()>* second, const ReplaySeries& s, double horizon_s,
+                      size_t begin, size_t end, const std::vector<double>* tau_R) {
+  const std::vector<double>* u = tau_R ? tau_R : s.tau_R;
+  std::vector<ReplayWindowSpan> spans;
+  ReplayRecord out = StartRecord(s, horizon_s, begin, &end, &spans);
   const size_t W = spans.size();
   auto Windows = [&](Plant& p, size_t w0, size_t w1) {
     for (size_t w = w0; w < w1; ++w) ReplayWindow(p, s, u, horizon_s, spans[w].start, spans[w].stop, static_cast<int>(w), &out);
@@ -258,13 +282,7 @@ ReplayRecord ReplayOn(Plant& plant, const std::function<Plant&()>* second, const
   } else {
     Windows(plant, 0, W);
   }
-  // The score in sample order: the same sums whichever plant simulated which window.
-  for (size_t k = 0; k < out.window.size(); ++k) {
-    if (out.window[k] < 0) continue;
-    for (int j = 0; j < 2; ++j) out.score.sse[j] += (out.sim[j][k] - s.q[j][begin + k]) * (out.sim[j][k] - s.q[j][begin + k]);
-    ++out.score.count;
-  }
-  out.score.windows = W;
+  ScoreRecord(s, W, &out);
   return out;
 }
 
@@ -278,6 +296,46 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
 ReplayRecord ReplayOnTwoPlants(Plant& plant, const std::function<Plant&()>& second, const ReplaySeries& s,
                                double horizon_s, size_t begin, size_t end, const std::vector<double>* tau_R) {
   return ReplayOn(plant, &second, s, horizon_s, begin, end, tau_R);
+}
+
+std::array<ReplayRecord, 2> ReplayTwoTwins(const ReplayTwin twins[2], const ReplaySeries& s, double horizon_s,
+                                           int threads, size_t begin, size_t end) {
+  std::array<ReplayRecord, 2> out;
+  std::vector<ReplayWindowSpan> spans;
+  size_t end_of[2] = {end, end};
+  for (int k = 0; k < 2; ++k) out[k] = StartRecord(s, horizon_s, begin, &end_of[k], &spans);
+  const size_t W = spans.size();
+  const std::vector<double>* u[2];
+  for (int k = 0; k < 2; ++k) u[k] = twins[k].tau_R ? twins[k].tau_R : s.tau_R;
+  auto Run = [&](int k, Plant& p, size_t w) {
+    ReplayWindow(p, s, u[k], horizon_s, spans[w].start, spans[w].stop, static_cast<int>(w), &out[k]);
+  };
+  if (threads < 2) {
+    for (int k = 0; k < 2; ++k)
+      for (size_t w = 0; w < W; ++w) Run(k, *twins[k].plant, w);
+  } else {
+    // Twin k's windows not yet taken: [next[k], last[k]).
+    size_t next[2] = {0, 0}, last[2] = {W, W};
+    std::mutex m;
+    auto Take = [&](int k, bool front, size_t* w) {
+      std::lock_guard<std::mutex> lock(m);
+      if (next[k] >= last[k]) return false;
+      *w = front ? next[k]++ : --last[k];
+      return true;
+    };
+    ParallelFor(2, 2, [&](size_t kk) {
+      const int k = static_cast<int>(kk), o = 1 - k;
+      size_t w;
+      while (Take(k, true, &w)) Run(k, *twins[k].plant, w);
+      Plant* helper = nullptr;  // the other twin's second plant, once there is a window to take
+      while (Take(o, false, &w)) {
+        if (!helper) helper = &twins[o].second();
+        Run(o, *helper, w);
+      }
+    });
+  }
+  for (int k = 0; k < 2; ++k) ScoreRecord(s, W, &out[k]);
+  return out;
 }
 
 }  // namespace exotwin

@@ -46,6 +46,7 @@
 //    start + horizon. A series quiet throughout has the every-horizon windows.
 //  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
 #pragma once
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -163,5 +164,21 @@ ReplayRecord Replay(Plant& plant, const ReplaySeries& s, double horizon_s, size_
 ReplayRecord ReplayOnTwoPlants(Plant& plant, const std::function<Plant&()>& second, const ReplaySeries& s,
                                double horizon_s, size_t begin = 0, size_t end = static_cast<size_t>(-1),
                                const std::vector<double>* tau_R = nullptr);
+
+// One twin of ReplayTwoTwins: its plant, a second plant alike built when first asked for (on the thread
+// that asks), and its input (nullptr: the series' tau_R).
+struct ReplayTwin {
+  Plant* plant = nullptr;
+  std::function<Plant&()> second;
+  const std::vector<double>* tau_R = nullptr;
+};
+
+// Two twins replayed on samples [begin, end) of `s` on two threads (threads >= 2; else one after the
+// other): each thread runs its own twin's windows from the first on, then takes the other's windows
+// not yet taken from the last on, on that twin's second plant; so twins of different costs share
+// both cores to the end. Each record is Replay(*twins[k].plant, s, horizon_s, begin, end,
+// twins[k].tau_R)'s bit for bit.
+std::array<ReplayRecord, 2> ReplayTwoTwins(const ReplayTwin twins[2], const ReplaySeries& s, double horizon_s,
+                                           int threads, size_t begin = 0, size_t end = static_cast<size_t>(-1));
 
 }  // namespace exotwin

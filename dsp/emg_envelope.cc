@@ -7,22 +7,31 @@
 namespace exotwin::dsp {
 namespace {
 
-// FiltFilt of x extended by `pad` odd-reflected samples at both ends, cropped back to x's samples
-// (in place in the one padded copy: a long record's envelope costs one record of memory).
-std::vector<double> PaddedFiltFilt(const std::vector<Biquad>& sos, const std::vector<double>& x, size_t pad) {
-  const size_t n = x.size();
-  if (n == 0) return {};
+// Each *xs[k] (all of one length n) replaced by the FiltFilt of itself extended by `pad` odd-reflected
+// samples at both ends, cropped back to n (a padded copy made per signal while the others wait: a
+// long record costs one record of memory per signal and one more); the signals filtered together,
+// each bit for bit as alone (FiltFiltInPlace). pad 0: FiltFilt's own padding.
+void PaddedFiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count, size_t pad) {
+  if (count == 0 || xs[0]->empty()) return;
+  const size_t n = xs[0]->size();
   pad = std::min(pad, n - 1);
-  if (pad == 0) return FiltFilt(sos, x);
-  std::vector<double> y;
-  y.reserve(n + 2 * pad);
-  for (size_t k = pad; k >= 1; --k) y.push_back(2 * x[0] - x[k]);
-  y.insert(y.end(), x.begin(), x.end());
-  for (size_t k = 1; k <= pad; ++k) y.push_back(2 * x[n - 1] - x[n - 1 - k]);
-  FiltFiltInPlace(sos, y);
-  y.erase(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(pad));
-  y.resize(n);
-  return y;
+  if (pad > 0)
+    for (size_t k = 0; k < count; ++k) {
+      const std::vector<double>& x = *xs[k];
+      std::vector<double> y;
+      y.reserve(n + 2 * pad);
+      for (size_t i = pad; i >= 1; --i) y.push_back(2 * x[0] - x[i]);
+      y.insert(y.end(), x.begin(), x.end());
+      for (size_t i = 1; i <= pad; ++i) y.push_back(2 * x[n - 1] - x[n - 1 - i]);
+      *xs[k] = std::move(y);
+    }
+  FiltFiltInPlace(sos, xs, count);
+  if (pad > 0)
+    for (size_t k = 0; k < count; ++k) {
+      std::vector<double>& y = *xs[k];
+      y.erase(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(pad));
+      y.resize(n);
+    }
 }
 
 }  // namespace
@@ -53,9 +62,23 @@ std::vector<double> LinearEnvelopeCausal(const std::vector<double>& x, double fs
 
 std::vector<double> ZeroPhaseEnvelope(const std::vector<Biquad>& prefilter, const std::vector<Biquad>& lowpass,
                                       const std::vector<double>& x, size_t pad) {
-  std::vector<double> y = PaddedFiltFilt(prefilter, x, pad);
-  for (double& v : y) v = Rectify(v);
-  return PaddedFiltFilt(lowpass, y, pad);
+  return std::move(ZeroPhaseEnvelopes(prefilter, lowpass, {&x}, pad)[0]);
+}
+
+std::vector<std::vector<double>> ZeroPhaseEnvelopes(const std::vector<Biquad>& prefilter,
+                                                    const std::vector<Biquad>& lowpass,
+                                                    const std::vector<const std::vector<double>*>& xs, size_t pad) {
+  std::vector<std::vector<double>> y(xs.size());
+  std::vector<std::vector<double>*> p(xs.size());
+  for (size_t k = 0; k < xs.size(); ++k) {
+    if (xs[k]->size() != xs[0]->size()) throw std::invalid_argument("ZeroPhaseEnvelopes: signals of different lengths");
+    y[k] = *xs[k], p[k] = &y[k];
+  }
+  PaddedFiltFiltInPlace(prefilter, p.data(), p.size(), pad);
+  for (std::vector<double>& v : y)
+    for (double& e : v) e = Rectify(e);
+  PaddedFiltFiltInPlace(lowpass, p.data(), p.size(), pad);
+  return y;
 }
 
 std::vector<double> LinearEnvelopeZeroPhase(const std::vector<double>& x, double fs, double fc) {

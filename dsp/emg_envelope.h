@@ -57,6 +57,12 @@ std::vector<double> LinearEnvelopeCausal(const std::vector<double>& amplified, d
 // transients of a slow low-pass out of a short record. pad = 0: FiltFilt's own padding only.
 std::vector<double> ZeroPhaseEnvelope(const std::vector<Biquad>& prefilter, const std::vector<Biquad>& lowpass,
                                       const std::vector<double>& x, size_t pad = 0);
+// The same for several signals of one length, filtered together (interleaved), each bit for bit as
+// ZeroPhaseEnvelope of it alone; memory: one record per signal and one more. Throws
+// std::invalid_argument for signals of different lengths.
+std::vector<std::vector<double>> ZeroPhaseEnvelopes(const std::vector<Biquad>& prefilter,
+                                                    const std::vector<Biquad>& lowpass,
+                                                    const std::vector<const std::vector<double>*>& xs, size_t pad = 0);
 
 // The paper's off-line chain for one channel of amplified EMG (V): zero-phase band-pass 20-450 Hz
 // (EmgBandPassDesign), rectification, zero-phase low-pass at fc (EnvelopeLowPassDesign, 2 Hz in the

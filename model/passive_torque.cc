@@ -18,21 +18,66 @@ namespace exotwin {
 //   H = deg(th1),  K = -deg(th2),  A = 0,
 // and, since the moment M_H acts along +th1 and M_K along -th2 (knee flexion = negative th2),
 //   P1 = -M_H,  P2 = -(-M_K) = +M_K.
-double RienerHipMoment(double H, double K) {
-  return std::exp(1.4655 - 0.0034 * K - 0.0750 * H) - std::exp(1.3403 - 0.0226 * K + 0.0305 * H) +
-         8.072;
+namespace {
+
+// The laws above as sums of terms sign * exp(a + cA A + cK K + cH H) plus a constant, evaluated in the
+// order written (each coefficient's sign carried into it: x - c y and x + (-c) y are the same double).
+struct ExpTerm {
+  double sign, a, cA, cK, cH;
+};
+constexpr ExpTerm kHipTerms[] = {{1, 1.4655, 0, -0.0034, -0.0750}, {-1, 1.3403, 0, -0.0226, 0.0305}};
+constexpr double kHipConstant = 8.072;
+constexpr ExpTerm kKneeTerms[] = {
+    {1, 1.800, -0.0460, -0.0352, 0.0217}, {-1, -3.971, -0.0004, 0.0495, -0.0128}, {1, 2.220, 0, -0.150, 0}};
+constexpr double kKneeConstant = -4.820;
+
+double Exponent(const ExpTerm& e, double A, double K, double H) { return e.a + e.cA * A + e.cK * K + e.cH * H; }
+
+template <size_t N>
+double Moment(const ExpTerm (&terms)[N], double constant, double A, double K, double H) {
+  double m = terms[0].sign * std::exp(Exponent(terms[0], A, K, H));
+  for (size_t i = 1; i < N; ++i) m += terms[i].sign * std::exp(Exponent(terms[i], A, K, H));
+  return m + constant;
 }
 
-double RienerKneeMoment(double A, double K, double H) {
-  return std::exp(1.800 - 0.0460 * A - 0.0352 * K + 0.0217 * H) -
-         std::exp(-3.971 - 0.0004 * A + 0.0495 * K - 0.0128 * H) + std::exp(2.220 - 0.150 * K) - 4.820;
-}
+}  // namespace
+
+double RienerHipMoment(double H, double K) { return Moment(kHipTerms, kHipConstant, 0.0, K, H); }
+
+double RienerKneeMoment(double A, double K, double H) { return Moment(kKneeTerms, kKneeConstant, A, K, H); }
 
 Eigen::Vector2d PassiveElasticTorque(PassiveModel model, const Eigen::Vector2d& q) {
   if (model == PassiveModel::kNone) return Eigen::Vector2d::Zero();
   const double H = q[0] * kDegPerRad;
   const double K = -q[1] * kDegPerRad;
   return Eigen::Vector2d(-RienerHipMoment(H, K), RienerKneeMoment(0.0, K, H));
+}
+
+PassiveNearPoints::PassiveNearPoints(PassiveModel model, int j, double h) : model_(model) {
+  // q_j + h moves H by +h deg (hip) or K by -h deg (knee): term i's exponent by slope_i h.
+  auto slope = [&](const ExpTerm& e) { return j == 0 ? e.cH * kDegPerRad : -e.cK * kDegPerRad; };
+  for (size_t i = 0; i < 2; ++i) up_[i] = std::exp(slope(kHipTerms[i]) * h), down_[i] = std::exp(-slope(kHipTerms[i]) * h);
+  for (size_t i = 0; i < 3; ++i)
+    up_[2 + i] = std::exp(slope(kKneeTerms[i]) * h), down_[2 + i] = std::exp(-slope(kKneeTerms[i]) * h);
+}
+
+void PassiveNearPoints::At(const Eigen::Vector2d& q, Eigen::Vector2d out[3]) const {
+  if (model_ == PassiveModel::kNone) {
+    out[0] = out[1] = out[2] = Eigen::Vector2d::Zero();
+    return;
+  }
+  const double H = q[0] * kDegPerRad, K = -q[1] * kDegPerRad;
+  double e[5];
+  for (size_t i = 0; i < 2; ++i) e[i] = std::exp(Exponent(kHipTerms[i], 0.0, K, H));
+  for (size_t i = 0; i < 3; ++i) e[2 + i] = std::exp(Exponent(kKneeTerms[i], 0.0, K, H));
+  for (int k = 0; k < 3; ++k) {
+    const double* f = k == 1 ? up_ : down_;
+    double x[5];
+    for (int i = 0; i < 5; ++i) x[i] = k == 0 ? e[i] : e[i] * f[i];
+    const double hip = kHipTerms[0].sign * x[0] + kHipTerms[1].sign * x[1] + kHipConstant;
+    const double knee = kKneeTerms[0].sign * x[2] + kKneeTerms[1].sign * x[3] + kKneeTerms[2].sign * x[4] + kKneeConstant;
+    out[k] = Eigen::Vector2d(-hip, knee);
+  }
 }
 
 }  // namespace exotwin

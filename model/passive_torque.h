@@ -20,6 +20,20 @@ double RienerKneeMoment(double A_deg, double K_deg, double H_deg);
 // coordinate. Ankle held at 0 (the lower leg is one rigid segment). N m. kNone gives zero.
 Eigen::Vector2d PassiveElasticTorque(PassiveModel model, const Eigen::Vector2d& q);
 
+// P at q, q + h e_j and q - h e_j (a central difference's three points; j 0 hip, 1 knee; h rad) for
+// many q with one j and h: each exponential of the laws at a shifted angle is its value at q times a
+// constant factor exp(+-slope h), so 5 exponentials per q instead of 15. The point q is
+// PassiveElasticTorque's bit for bit, the shifted ones to a few ulps of each term.
+class PassiveNearPoints {
+ public:
+  PassiveNearPoints(PassiveModel model, int j, double h);
+  void At(const Eigen::Vector2d& q, Eigen::Vector2d out[3]) const;
+
+ private:
+  PassiveModel model_;
+  double up_[5], down_[5];  // the factors of the hip's two terms, then the knee's three
+};
+
 // A subject's passive moment as a multiple of Riener & Edrich's population curves lies in (0, this]:
 // a stated bound (they and later studies report a wide spread between healthy subjects, none beyond
 // a few times the mean curve); the emg loop's passive scale and the passive_moment effect share it.

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -381,6 +382,54 @@ TEST(Replay, TwoPlantsAlikeGiveTheOnePlantsRecordBitForBit) {
     EXPECT_LT(a.score.Rmse(1), 0.02);  // the truth twin follows its record: the comparison is of real replays
   }
   EXPECT_EQ(built, 1);
+}
+
+// ReplayTwoTwins (diagnose's rigid and extended twins side by side, the one done first taking the
+// other's last windows on a second plant alike) gives each twin's Replay record bit for bit: a rigid
+// twin and one with a dead band and a strap (a run-in), the second on its own input, on one thread
+// and on two, on a part of the series.
+TEST(Replay, TwoTwinsSharingTheirWindowsGiveEachOnesRecordBitForBit) {
+  LegParams rigid_params = RealRigModel();
+  LegParams p = rigid_params;
+  p.effects = LinkEffects();
+  p.effects.push_back(MakeEffect("backlash", "knee", 0.01));
+  p.effects.push_back(MakeEffect("series_compliance", "hip", 3000));
+  ReplaySeries s = ExactRecord(Simulate(p, 4.0));
+  SetRestartState(kReplayCutoffHz, &s);
+  std::vector<double> other_input[2] = {s.tau_R[0], s.tau_R[1]};
+  for (double& v : other_input[0]) v *= 1.05;  // an input of its own (another twin's sensor effects)
+  const std::unique_ptr<Plant> rigid = MakeReplayPlant(rigid_params, "test"), ext = MakeReplayPlant(p, "test");
+  const size_t begin = s.t.size() / 4;
+  const ReplayRecord ref[2] = {Replay(*rigid, s, 0.5, begin), Replay(*ext, s, 0.5, begin, static_cast<size_t>(-1), other_input)};
+  ASSERT_GE(ref[0].score.windows, 4u);
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    std::unique_ptr<Plant> second[2];
+    const LegParams* model[2] = {&rigid_params, &p};
+    auto Second = [&](int k) {
+      return [&, k]() -> Plant& {
+        if (!second[k]) second[k] = MakeReplayPlant(*model[k], "test");
+        return *second[k];
+      };
+    };
+    const ReplayTwin twins[2] = {{rigid.get(), Second(0), nullptr}, {ext.get(), Second(1), other_input}};
+    const std::array<ReplayRecord, 2> got = ReplayTwoTwins(twins, s, 0.5, threads, begin);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_EQ(got[k].score.windows, ref[k].score.windows);
+      EXPECT_EQ(got[k].score.count, ref[k].score.count);
+      EXPECT_EQ(got[k].score.sse[0], ref[k].score.sse[0]);
+      EXPECT_EQ(got[k].score.sse[1], ref[k].score.sse[1]);
+      EXPECT_EQ(got[k].window, ref[k].window);
+      for (int j = 0; j < 2; ++j) {
+        ASSERT_EQ(got[k].sim[j].size(), ref[k].sim[j].size());
+        for (size_t i = 0; i < ref[k].sim[j].size(); ++i) {
+          if (std::isnan(ref[k].sim[j][i]) && std::isnan(got[k].sim[j][i])) continue;
+          ASSERT_EQ(got[k].sim[j][i], ref[k].sim[j][i]) << k << " " << j << " " << i;
+        }
+      }
+    }
+    if (threads == 1) EXPECT_TRUE(!second[0] && !second[1]);  // one after the other: no second plant
+  }
 }
 
 // The quiet windows' schedule (replay.h "windows") on a series whose fast content is given: knocks

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -121,6 +122,43 @@ TEST(EmgEnvelope, ZeroPhaseEnvelopeIsTheComposedFilters) {
   EXPECT_EQ(ZeroPhaseEnvelope(bp, lp, x), ref);
   EXPECT_EQ(LinearEnvelopeZeroPhase(x, kFs), ref);
   EXPECT_TRUE(ZeroPhaseEnvelope(bp, lp, {}, 10).empty());
+}
+
+// With padding: each FiltFilt on the odd-reflected extension, cropped (written out here); several
+// signals at once (ZeroPhaseEnvelopes) give each one's envelope bit for bit, a pad beyond the record
+// clipped to n - 1.
+TEST(EmgEnvelope, PaddedEnvelopesOfSeveralSignalsAreEachOnesBitForBit) {
+  Gauss g;
+  const auto hp = DesignButterworth(2, BandType::kHighPass, kFs, 20.0), lp = EnvelopeLowPassDesign(kFs, 2.0);
+  auto padded_filtfilt = [](const std::vector<Biquad>& sos, const std::vector<double>& x, size_t pad) {
+    const size_t n = x.size();
+    std::vector<double> y;
+    for (size_t k = pad; k >= 1; --k) y.push_back(2 * x[0] - x[k]);
+    y.insert(y.end(), x.begin(), x.end());
+    for (size_t k = 1; k <= pad; ++k) y.push_back(2 * x[n - 1] - x[n - 1 - k]);
+    y = FiltFilt(sos, y);
+    return std::vector<double>(y.begin() + static_cast<long>(pad), y.begin() + static_cast<long>(pad + n));
+  };
+  for (size_t n : {5, 800, 3000})
+    for (size_t pad : {size_t{0}, size_t{4}, size_t{1000}}) {
+      SCOPED_TRACE("n " + std::to_string(n) + ", pad " + std::to_string(pad));
+      std::vector<std::vector<double>> xs(3, std::vector<double>(n));
+      for (auto& x : xs)
+        for (double& v : x) v = 0.1 * g();
+      std::vector<const std::vector<double>*> ptr = {&xs[0], &xs[1], &xs[2]};
+      const std::vector<std::vector<double>> together = ZeroPhaseEnvelopes(hp, lp, ptr, pad);
+      ASSERT_EQ(together.size(), 3u);
+      for (size_t k = 0; k < 3; ++k) {
+        const size_t p = std::min(pad, n - 1);
+        std::vector<double> ref = p > 0 ? padded_filtfilt(hp, xs[k], p) : FiltFilt(hp, xs[k]);
+        for (double& v : ref) v = std::abs(v);
+        ref = p > 0 ? padded_filtfilt(lp, ref, p) : FiltFilt(lp, ref);
+        EXPECT_EQ(ZeroPhaseEnvelope(hp, lp, xs[k], pad), ref);
+        EXPECT_EQ(together[k], ref);
+      }
+    }
+  const std::vector<double> a(10), b(11);
+  EXPECT_THROW(ZeroPhaseEnvelopes(hp, lp, {&a, &b}, 3), std::invalid_argument);
 }
 
 TEST(EmgEnvelope, RmsEnvelopeIsEq1) {

@@ -27,6 +27,47 @@ TEST(PassiveTorque, RienerHipMagnitudes) {
   EXPECT_NEAR(RienerHipMoment(60, 0), -15.7, 0.05);
 }
 
+// The laws as printed by Riener & Edrich 1999 (the comment of passive_torque.cc), written out here:
+// the term tables the library evaluates give them bit for bit.
+TEST(PassiveTorque, TermTablesGiveThePrintedLawsBitForBit) {
+  for (double H = -30; H <= 90; H += 7.3)
+    for (double K = -5; K <= 120; K += 6.1)
+      for (double A : {0.0, -12.5, 20.0}) {
+        EXPECT_EQ(RienerHipMoment(H, K),
+                  std::exp(1.4655 - 0.0034 * K - 0.0750 * H) - std::exp(1.3403 - 0.0226 * K + 0.0305 * H) + 8.072);
+        EXPECT_EQ(RienerKneeMoment(A, K, H), std::exp(1.800 - 0.0460 * A - 0.0352 * K + 0.0217 * H) -
+                                                 std::exp(-3.971 - 0.0004 * A + 0.0495 * K - 0.0128 * H) +
+                                                 std::exp(2.220 - 0.150 * K) - 4.820);
+      }
+}
+
+// PassiveNearPoints: P at q bit for bit, at q +- h e_j within a few ulps of the terms (1e-13 N m on
+// moments of ~10 N m), and their central difference within 1e-6 of the one of PassiveElasticTorque
+// (h = 1e-5 rad: the difference's rounding, ~1e-15 / 1e-5, bounds both).
+TEST(PassiveTorque, NearPointsEqualTheDirectEvaluation) {
+  constexpr double h = 1e-5;
+  for (int j = 0; j < 2; ++j) {
+    const PassiveNearPoints near(PassiveModel::kRiener1999, j, h);
+    for (double th1 = -0.4; th1 <= 1.2; th1 += 0.13)
+      for (double th2 = -1.6; th2 <= 0.1; th2 += 0.11) {
+        const Eigen::Vector2d q(th1, th2);
+        Eigen::Vector2d out[3];
+        near.At(q, out);
+        EXPECT_EQ(out[0], PassiveElasticTorque(PassiveModel::kRiener1999, q));
+        Eigen::Vector2d up = q, down = q;
+        up[j] += h, down[j] -= h;
+        const Eigen::Vector2d P_up = PassiveElasticTorque(PassiveModel::kRiener1999, up);
+        const Eigen::Vector2d P_down = PassiveElasticTorque(PassiveModel::kRiener1999, down);
+        EXPECT_LT((out[1] - P_up).cwiseAbs().maxCoeff(), 1e-13);
+        EXPECT_LT((out[2] - P_down).cwiseAbs().maxCoeff(), 1e-13);
+        EXPECT_LT(((out[1] - out[2]) - (P_up - P_down)).cwiseAbs().maxCoeff() / (2 * h), 1e-6);
+      }
+    Eigen::Vector2d none[3];
+    PassiveNearPoints(PassiveModel::kNone, j, h).At({0.3, -0.5}, none);
+    for (const Eigen::Vector2d& v : none) EXPECT_EQ(v, Eigen::Vector2d::Zero());
+  }
+}
+
 // Convention mapping: H = deg(th1), K = -deg(th2), P1 = -M_H, P2 = +M_K.
 TEST(PassiveTorque, ConventionMapping) {
   const Eigen::Vector2d q(20 * kRadPerDeg, -45 * kRadPerDeg);
