@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "formats/number_rows.h"
 #include "core/error.h"
 #include "core/file_text.h"
+#include "core/parallel_for.h"
 #include "core/output_path.h"
 #include "core/realtime.h"
 
@@ -49,6 +51,11 @@ CsvReader::CsvReader(const char* begin, const char* end, std::string source)
 void CsvReader::Continue(const char* begin, const char* end) {
   next_ = begin;
   end_ = end;
+}
+
+void CsvReader::ContinueAfterLine(const char* begin, const char* end, int line_before) {
+  Continue(begin, end);
+  line_ = line_before;
 }
 
 std::string CsvReader::Where() const { return source_ + ":" + std::to_string(line_) + ": "; }
@@ -231,6 +238,10 @@ bool CsvReader::NextNumbers(double* values) {
   return complete ? true : NumbersFromFields(values);
 }
 
+namespace {
+constexpr size_t kSplitBytes = size_t{1} << 20;  // a piece read in two halves at once from this size on
+}  // namespace
+
 CsvTable ReadCsv(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a CSV file");
@@ -245,7 +256,12 @@ CsvTable ReadCsv(const std::string& path) {
   std::optional<CsvReader> reader;
   CsvTable t;
   std::vector<double> row;
-  // Whole lines [b, e) into t (the header first).
+  // Whole lines [b, e) into t (the header first). Once the header is known, a long piece is read in
+  // two halves at once: the second, from the first line start after its middle, by a copy of the reader
+  // on another thread into its own rows, appended after the first's. An error in the first half is
+  // the one reported (the file's first), as when read in one go.
+  std::vector<std::vector<double>> later_columns;
+  std::vector<int> later_lines;
   auto parse = [&](const char* b, const char* e) {
     if (!reader) reader.emplace(b, e, path);
     else reader->Continue(b, e);
@@ -255,9 +271,46 @@ CsvTable ReadCsv(const std::string& path) {
       t.columns.assign(t.names.size(), {});
       row.resize(t.names.size());
     }
-    while (reader->NextNumbers(row.data())) {
-      for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
-      t.line_of_row.push_back(reader->line());
+    const char* mid = static_cast<size_t>(e - b) >= kSplitBytes
+                          ? static_cast<const char*>(std::memchr(b + (e - b) / 2, '\n', static_cast<size_t>(e - (b + (e - b) / 2))))
+                          : nullptr;
+    if (mid && mid + 1 < e && t.rows() > 0) {
+      const char* m = mid + 1;
+      CsvReader later = *reader;
+      later.ContinueAfterLine(m, e, reader->line() + static_cast<int>(std::count(b, m, '\n')));
+      reader->Continue(b, m);
+      later_columns.assign(t.names.size(), {});
+      later_lines.clear();
+      std::exception_ptr error[2];
+      ParallelFor(2, 2, [&](size_t half) {
+        try {
+          if (half == 0) {
+            while (reader->NextNumbers(row.data())) {
+              for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
+              t.line_of_row.push_back(reader->line());
+            }
+          } else {
+            std::vector<double> values(t.names.size());
+            while (later.NextNumbers(values.data())) {
+              for (size_t i = 0; i < values.size(); ++i) later_columns[i].push_back(values[i]);
+              later_lines.push_back(later.line());
+            }
+          }
+        } catch (...) {
+          error[half] = std::current_exception();
+        }
+      });
+      for (const std::exception_ptr& x : error)
+        if (x) std::rethrow_exception(x);
+      for (size_t i = 0; i < t.columns.size(); ++i)
+        t.columns[i].insert(t.columns[i].end(), later_columns[i].begin(), later_columns[i].end());
+      t.line_of_row.insert(t.line_of_row.end(), later_lines.begin(), later_lines.end());
+      *reader = std::move(later);
+    } else {
+      while (reader->NextNumbers(row.data())) {
+        for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
+        t.line_of_row.push_back(reader->line());
+      }
     }
     parsed += static_cast<size_t>(e - b);
     if (!reserved && in.size() > parsed && t.rows() > 0) {

@@ -36,6 +36,9 @@ class CsvReader {
   // Goes on with the next whole lines [begin, end) of the same file (header, line numbers and
   // dialect kept; the previous text may be gone). Precondition as for the constructor.
   void Continue(const char* begin, const char* end);
+  // Continue where [begin, end) starts after line `line_before` of the file: for a copy of the reader
+  // that reads a later part of the same text (on another thread) while this one reads the part before.
+  void ContinueAfterLine(const char* begin, const char* end, int line_before);
 
   // Reads the header row. False if the text holds no record (only comments or blank lines).
   bool ReadHeader();

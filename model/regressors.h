@@ -24,8 +24,32 @@ struct RegressorTrig {
 RegressorTrig TrigOf(const Eigen::Vector2d& q);
 // FullRegressor(L1, g, q, qd, qdd) with trig = TrigOf(q), the same numbers: for a caller that
 // evaluates the regressor of one angle at several velocities.
-Matrix26 FullRegressorOfTrig(double L1, double g, const RegressorTrig& trig, const Eigen::Vector2d& qd,
-                       const Eigen::Vector2d& qdd);
+// Defined here, inline: the per-sample loops that call it for every sample of a long record keep
+// its entries in registers.
+inline Matrix26 FullRegressorOfTrig(double L1, double g, const RegressorTrig& trig, const Eigen::Vector2d& qd,
+                                    const Eigen::Vector2d& qdd) {
+  const double c2 = trig.c2, s2 = trig.s2, s1 = trig.s1, c1 = trig.c1, s12 = trig.s12, c12 = trig.c12;
+  const double a = 2.0 * qdd[0] + qdd[1];               // coefficient of h in row 1
+  const double v = qd[1] * qd[1] + 2.0 * qd[0] * qd[1];  // Coriolis/centrifugal combination, row 1
+  Matrix26 Y;
+  // Row 1 (hip):  J1 q1'' + J2 q2'' + X2 [L1 c2 a - L1 s2 v + g s12] + Y2 [-L1 s2 a - L1 c2 v + g c12]
+  //               + X1 g s1 + Y1 g c1
+  Y(0, 0) = qdd[0];
+  Y(0, 1) = qdd[1];
+  Y(0, 2) = g * s1;
+  Y(0, 3) = L1 * c2 * a - L1 * s2 * v + g * s12;
+  Y(0, 4) = g * c1;
+  Y(0, 5) = -L1 * s2 * a - L1 * c2 * v + g * c12;
+  // Row 2 (knee): J2 (q1'' + q2'') + X2 [L1 c2 q1'' + L1 s2 q1'^2 + g s12]
+  //               + Y2 [-L1 s2 q1'' + L1 c2 q1'^2 + g c12]
+  Y(1, 0) = 0.0;
+  Y(1, 1) = qdd[0] + qdd[1];
+  Y(1, 2) = 0.0;
+  Y(1, 3) = L1 * c2 * qdd[0] + L1 * s2 * qd[0] * qd[0] + g * s12;
+  Y(1, 4) = 0.0;
+  Y(1, 5) = -L1 * s2 * qdd[0] + L1 * c2 * qd[0] * qd[0] + g * c12;
+  return Y;
+}
 
 // One row of a step regressor: u* = w^T phi (HJ15 eq. 18).
 struct StepRow {

@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -315,6 +317,39 @@ TEST(ReadCsv, ChunkedReadingEqualsTheWholeText) {
   EXPECT_EQ(r, t.rows());
   EXPECT_EQ(t.rows(), 150001u);
   EXPECT_EQ(t.dropped_cut_line, 0);
+}
+
+// A long chunk is read in two halves at once (ReadCsv): a bad field in the second half is named at its
+// own line, and with another one in the first half that one, the file's first, is named instead.
+TEST(ReadCsv, AnErrorInEitherHalfOfAChunkNamesTheFilesFirstBadLine) {
+  auto File = [](const std::vector<int>& bad_rows) {
+    std::string text = "t,x\n";
+    text.reserve(14 << 20);
+    for (int i = 0; i < 1200000; ++i) {
+      const bool bad = std::find(bad_rows.begin(), bad_rows.end(), i) != bad_rows.end();
+      text += std::to_string(i) + (bad ? ",x7\n" : ",0.5\n");
+    }
+    return text;
+  };
+  const std::string path = TempPath("halves.csv");
+  // Rows are 10-12 bytes: row 600000 lies in the first half of the second 4 MiB chunk, 700000 in its second.
+  for (const auto& [rows, line] : std::vector<std::pair<std::vector<int>, int>>{
+           {{700000}, 700002}, {{600000, 700000}, 600002}, {{700000, 1100000}, 700002}}) {
+    Spit(path, File(rows));
+    try {
+      ReadCsv(path);
+      FAIL() << "expected an InputError";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), path + ":" + std::to_string(line) + ": column 'x': 'x7' is not a number");
+    }
+  }
+  Spit(path, File({}));
+  const CsvTable t = ReadCsv(path);
+  ASSERT_EQ(t.rows(), 1200000u);
+  for (size_t r = 0; r < t.rows(); r += 997) {
+    ASSERT_EQ(t.columns[0][r], static_cast<double>(r));
+    ASSERT_EQ(t.line_of_row[r], static_cast<int>(r) + 2);
+  }
 }
 
 // A streamed log cut in a later chunk: every complete row kept, the cut line named.
