@@ -865,11 +865,23 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
         return **p;
       };
     };
+    // The other twin's input: the series' own where its sensor effects are the model's (the same
+    // numbers, without a record-long copy), else re-formed.
+    auto OtherInput = [&](const PlantEffects& fx) -> const std::vector<double>* {
+      bool same = true;
+      for (int j = 0; j < 2; ++j) {
+        same = same && fx.sensor[j].size() == rigid_fx.sensor[j].size();
+        for (size_t k = 0; same && k < fx.sensor[j].size(); ++k)
+          same = fx.sensor[j][k].name == rigid_fx.sensor[j][k].name && fx.sensor[j][k].value == rigid_fx.sensor[j][k].value;
+      }
+      if (same) return nullptr;
+      ActuatorTorqueFromReading(fx, t, tau_S, tau_other);
+      return tau_other;
+    };
     if (split_long) {
-      ActuatorTorqueFromReading(ext_fx, t, tau_S, tau_other);
       std::unique_ptr<Plant> rigid2, ext2;
       const ReplayTwin twins[2] = {{rigid.get(), Second(params, &rigid2), nullptr},
-                                   {ext.get(), Second(D.extended, &ext2), tau_other}};
+                                   {ext.get(), Second(D.extended, &ext2), OtherInput(ext_fx)}};
       std::array<ReplayRecord, 2> ba = ReplayTwoTwins(twins, series, opt.replay_horizon_s, threads, rc.split, n);
       ReplayRecord &b = ba[0], &a = ba[1];
       Score(b.score, a.score, rs.sim_split);
@@ -890,10 +902,9 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
       std::unique_ptr<Plant> loo_plant;
       PlantEffects loo_fx;
       if (!Make(loo, rc.source + " left out", &loo_plant, &loo_fx)) return;
-      ActuatorTorqueFromReading(loo_fx, t, tau_S, tau_other);
       std::unique_ptr<Plant> rigid2, loo2;
       const ReplayTwin twins[2] = {{rigid.get(), Second(params, &rigid2), nullptr},
-                                   {loo_plant.get(), Second(loo, &loo2), tau_other}};
+                                   {loo_plant.get(), Second(loo, &loo2), OtherInput(loo_fx)}};
       const std::array<ReplayRecord, 2> ba = ReplayTwoTwins(twins, series, opt.replay_horizon_s, threads);
       const ReplayScore &b = ba[0].score, &a = ba[1].score;
       Score(b, a, rs.sim_left_out);
@@ -982,22 +993,30 @@ std::string MethodText(const Diagnosis& D, const DiagnoseOptions& opt) {
 
 namespace {
 
-// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's time and the
-// process's peak memory at its end to stderr. Diagnose of `records`; with `owned` (the same records, which the caller gives up), each record's
+// The stages of diagnose.h's method, in order; EXOTWIN_DIAG_TIMING=1 prints each one's wall and CPU
+// time and the process's peak memory at its end to stderr. Diagnose of `records`; with `owned` (the same records, which the caller gives up), each record's
 // columns are moved into the analysis once the cutoff is chosen instead of copied.
 Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const MeasuredData*>& records,
                           std::vector<MeasuredData>* owned, const DiagnoseOptions& opt) {
   if (opt.fit == DiagnoseFit::kMotion) return DiagnoseByMotion(params, records, opt);
   const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
+  auto CpuSeconds = [] {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  };
   auto clock0 = std::chrono::steady_clock::now();
+  double cpu0 = CpuSeconds();
   auto Lap = [&](const char* what) {
     if (!timing) return;
     const auto now = std::chrono::steady_clock::now();
+    const double cpu = CpuSeconds();
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);
-    std::fprintf(stderr, "diagnose: %-28s %8.3f s, peak %6.1f MB\n", what,
-                 std::chrono::duration<double>(now - clock0).count(), ru.ru_maxrss / 1024.0);
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s (CPU %.3f s), peak %6.1f MB\n", what,
+                 std::chrono::duration<double>(now - clock0).count(), cpu - cpu0, ru.ru_maxrss / 1024.0);
     clock0 = now;
+    cpu0 = cpu;
   };
   CheckInputs(records, opt);
   Diagnosis D;
@@ -1005,6 +1024,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const size_t R = records.size();
   D.leave_one_out = R >= 2;
 
+  ReturnFreedMemory();  // what reading the records freed, before the cutoff choice lays out its columns
   D.cutoff = ResolveCutoff(params, records, opt);
   ReturnFreedMemory();
   Lap("cutoff choice");
@@ -1030,12 +1050,17 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   FilterMeasured(&recs);
   UseSecantDelayColumns(recs, w, &banks);
   if (params.one_joint) KeepJointCandidates(1, &banks);
-  const std::vector<CeilingScores> ceilings = Ceilings(banks, w);
-  Lap("ceilings");
-  const Grams g = PooledGrams(recs, banks, w, &D.tau_eff);
+  // The ceilings and the pooled Grams only read the banks: the two side by side.
+  std::vector<CeilingScores> ceilings;
+  Grams g;
+  ParallelFor(2, DiagnoseThreads(opt), [&](size_t k) {
+    if (k == 0) g = PooledGrams(recs, banks, w, &D.tau_eff);
+    else ceilings = Ceilings(banks, w);
+  });
+  Lap("ceilings + grams");
   for (ColumnBank& b : banks) b.X = Eigen::MatrixXd(), b.r = Eigen::VectorXd();  // the Grams hold what the fits use
+  ReturnFreedMemory();  // the banks' and the workers' blocks, before the twins lay out theirs
   const ColumnBank& bank = banks[0];  // candidates and column indices (identical in every bank)
-  Lap("grams + noise");
 
   const PhysicalScale scale = ScaleOf(params, recs);
   const Fit f0 = FitCols(g, {});
