@@ -21,6 +21,8 @@ std::string Candidate::Label() const {
 
 namespace {
 
+constexpr size_t PendingColumnsMax = 4;  // PendingColumns::kPending, and SetColumn's two
+
 double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
 // f(i) for i = 0 .. n - 1 on the machine's cores, each thread a contiguous range: for the loops that
@@ -40,27 +42,33 @@ int NewColumn(ColumnBank& b) {
   return c;
 }
 
-// The bank's low-pass of *xs[0 .. count) in place: the all-zero ones left as they are (the low-pass of
-// zeros is zero), the others interleaved at least two to a thread (dsp::FiltFiltInPlace of several:
-// each signal the same bits as filtered alone).
-void FilterColumns(const ColumnBank& b, std::vector<double>* const* xs, size_t count) {
-  if (!b.filter) return;
-  std::vector<std::vector<double>*> nonzero;
-  for (size_t k = 0; k < count; ++k)
-    if (std::any_of(xs[k]->begin(), xs[k]->end(), [](double v) { return v != 0.0; })) nonzero.push_back(xs[k]);
-  const size_t T = std::clamp<size_t>(nonzero.size() / 2, 1, static_cast<size_t>(std::max(1, b.threads)));
+// The bank's low-pass of *xs[0 .. count) in place, then place(k) for each: the signals cut into
+// contiguous groups of at least two, one group per thread, each group's non-zero signals interleaved
+// (dsp::FiltFiltInPlace of several: each signal the same bits as filtered alone; the low-pass of zeros
+// is zero) and placed on the group's thread. place(k) must write only what signal k owns.
+template <class Place>
+void FilterAndPlace(const ColumnBank& b, std::vector<double>* const* xs, size_t count, Place place) {
+  const size_t T = std::clamp<size_t>(count / 2, 1, static_cast<size_t>(std::max(1, b.threads)));
   ParallelFor(T, static_cast<int>(T), [&](size_t h) {
-    const size_t e0 = h * nonzero.size() / T, e1 = (h + 1) * nonzero.size() / T;
-    if (e1 > e0) b.filter(nonzero.data() + e0, e1 - e0);
+    const size_t e0 = h * count / T, e1 = (h + 1) * count / T;
+    if (b.filter) {
+      std::vector<double>* nonzero[PendingColumnsMax];
+      size_t K = 0;
+      for (size_t k = e0; k < e1; ++k)
+        if (std::any_of(xs[k]->begin(), xs[k]->end(), [](double v) { return v != 0.0; })) nonzero[K++] = xs[k];
+      if (K > 0) b.filter(nonzero, K);
+    }
+    for (size_t k = e0; k < e1; ++k) place(k);
   });
 }
 
 // Columns evaluated on every sample of a record, waiting for the bank's low-pass: filtered kPending at
-// a time (FilterColumns), then each placed in the bank by its callback, in the order added. The
-// record-long temporaries are at most kPending. Without a filter a column is placed at once.
+// a time and each placed in the bank by its callback (FilterAndPlace: on the thread that filtered it;
+// each callback writes only its own column's rows). The record-long temporaries are at most kPending.
+// Without a filter a column is placed at once.
 class PendingColumns {
  public:
-  static constexpr size_t kPending = 4;
+  static constexpr size_t kPending = PendingColumnsMax;
   explicit PendingColumns(ColumnBank& b) : b_(b) { xs_.reserve(kPending), place_.reserve(kPending); }
   ColumnBank& bank() { return b_; }
   size_t size() const { return xs_.size(); }
@@ -73,8 +81,7 @@ class PendingColumns {
   void Flush() {
     std::vector<std::vector<double>*> p;
     for (std::vector<double>& x : xs_) p.push_back(&x);
-    FilterColumns(b_, p.data(), p.size());
-    for (size_t k = 0; k < xs_.size(); ++k) place_[k](xs_[k]);
+    FilterAndPlace(b_, p.data(), p.size(), [&](size_t k) { place_[k](xs_[k]); });
     xs_.clear();
     place_.clear();
   }
@@ -184,10 +191,15 @@ void SetJointColumn(PendingColumns& p, int c, const double w[2], int j, std::vec
                     std::vector<double>* rows_out = nullptr) {
   ColumnBank& b = p.bank();
   p.Add(std::move(x), [&b, w, c, j, rows_out](const std::vector<double>& filtered) {
-    std::vector<double> rows(b.sample.size());
-    for (size_t k = 0; k < rows.size(); ++k) rows[k] = filtered[b.sample[k]];
-    SetJointRows(b, c, w, j, rows);
-    if (rows_out) *rows_out = std::move(rows);
+    const size_t m = b.sample.size();
+    for (size_t k = 0; k < m; ++k) {
+      b.X(j * m + k, c) = w[j] * filtered[b.sample[k]];
+      b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
+    }
+    if (rows_out) {
+      rows_out->resize(m);
+      for (size_t k = 0; k < m; ++k) (*rows_out)[k] = filtered[b.sample[k]];
+    }
   });
 }
 
@@ -238,8 +250,7 @@ int AddBothJointsColumn(PendingColumns& p, const double w[2], G g) {
 
 void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]) {
   std::vector<double>* xs[2] = {&v[0], &v[1]};
-  FilterColumns(b, xs, 2);
-  for (int j = 0; j < 2; ++j) PlaceJointRows(b, c, w, j, v[j]);
+  FilterAndPlace(b, xs, 2, [&](size_t j) { PlaceJointRows(b, c, w, static_cast<int>(j), v[j]); });
 }
 
 ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
