@@ -21,7 +21,7 @@ std::string Candidate::Label() const {
 
 namespace {
 
-constexpr size_t PendingColumnsMax = 4;  // PendingColumns::kPending, and SetColumn's two
+constexpr size_t kPendingColumns = 4;  // PendingColumns::kPending, and SetColumn's two
 
 double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
@@ -52,7 +52,7 @@ void FilterAndPlace(const ColumnBank& b, std::vector<double>* const* xs, size_t 
   ParallelFor(T, static_cast<int>(T), [&](size_t h) {
     const size_t e0 = h * count / T, e1 = (h + 1) * count / T;
     if (b.filter) {
-      std::vector<double>* nonzero[PendingColumnsMax];
+      std::vector<double>* nonzero[kPendingColumns];
       size_t K = 0;
       for (size_t k = e0; k < e1; ++k)
         if (std::any_of(xs[k]->begin(), xs[k]->end(), [](double v) { return v != 0.0; })) nonzero[K++] = xs[k];
@@ -68,7 +68,7 @@ void FilterAndPlace(const ColumnBank& b, std::vector<double>* const* xs, size_t 
 // Without a filter a column is placed at once.
 class PendingColumns {
  public:
-  static constexpr size_t kPending = PendingColumnsMax;
+  static constexpr size_t kPending = kPendingColumns;
   explicit PendingColumns(ColumnBank& b) : b_(b) { xs_.reserve(kPending), place_.reserve(kPending); }
   ColumnBank& bank() { return b_; }
   size_t size() const { return xs_.size(); }

@@ -262,6 +262,14 @@ CsvTable ReadCsv(const std::string& path) {
   // the one reported (the file's first), as when read in one go.
   std::vector<std::vector<double>> later_columns;
   std::vector<int> later_lines;
+  // Every row `r` reads, into columns and lines.
+  auto ReadRows = [](CsvReader& r, double* values, std::vector<std::vector<double>>& columns,
+                     std::vector<int>& lines) {
+    while (r.NextNumbers(values)) {
+      for (size_t i = 0; i < columns.size(); ++i) columns[i].push_back(values[i]);
+      lines.push_back(r.line());
+    }
+  };
   auto parse = [&](const char* b, const char* e) {
     if (!reader) reader.emplace(b, e, path);
     else reader->Continue(b, e);
@@ -271,33 +279,27 @@ CsvTable ReadCsv(const std::string& path) {
       t.columns.assign(t.names.size(), {});
       row.resize(t.names.size());
     }
-    const char* mid = static_cast<size_t>(e - b) >= kSplitBytes
-                          ? static_cast<const char*>(std::memchr(b + (e - b) / 2, '\n', static_cast<size_t>(e - (b + (e - b) / 2))))
-                          : nullptr;
-    if (mid && mid + 1 < e && t.rows() > 0) {
-      const char* m = mid + 1;
+    const char* half = b + (e - b) / 2;
+    const char* nl = static_cast<size_t>(e - b) >= kSplitBytes && t.rows() > 0
+                         ? static_cast<const char*>(std::memchr(half, '\n', static_cast<size_t>(e - half)))
+                         : nullptr;
+    if (!nl || nl + 1 >= e) {
+      ReadRows(*reader, row.data(), t.columns, t.line_of_row);
+    } else {
+      const char* m = nl + 1;  // the second half's first line
       CsvReader later = *reader;
       later.ContinueAfterLine(m, e, reader->line() + static_cast<int>(std::count(b, m, '\n')));
       reader->Continue(b, m);
       later_columns.assign(t.names.size(), {});
       later_lines.clear();
+      std::vector<double> later_row(t.names.size());
       std::exception_ptr error[2];
-      ParallelFor(2, 2, [&](size_t half) {
+      ParallelFor(2, 2, [&](size_t k) {
         try {
-          if (half == 0) {
-            while (reader->NextNumbers(row.data())) {
-              for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
-              t.line_of_row.push_back(reader->line());
-            }
-          } else {
-            std::vector<double> values(t.names.size());
-            while (later.NextNumbers(values.data())) {
-              for (size_t i = 0; i < values.size(); ++i) later_columns[i].push_back(values[i]);
-              later_lines.push_back(later.line());
-            }
-          }
+          if (k == 0) ReadRows(*reader, row.data(), t.columns, t.line_of_row);
+          else ReadRows(later, later_row.data(), later_columns, later_lines);
         } catch (...) {
-          error[half] = std::current_exception();
+          error[k] = std::current_exception();
         }
       });
       for (const std::exception_ptr& x : error)
@@ -306,11 +308,6 @@ CsvTable ReadCsv(const std::string& path) {
         t.columns[i].insert(t.columns[i].end(), later_columns[i].begin(), later_columns[i].end());
       t.line_of_row.insert(t.line_of_row.end(), later_lines.begin(), later_lines.end());
       *reader = std::move(later);
-    } else {
-      while (reader->NextNumbers(row.data())) {
-        for (size_t i = 0; i < row.size(); ++i) t.columns[i].push_back(row[i]);
-        t.line_of_row.push_back(reader->line());
-      }
     }
     parsed += static_cast<size_t>(e - b);
     if (!reserved && in.size() > parsed && t.rows() > 0) {
