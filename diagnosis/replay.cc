@@ -302,8 +302,8 @@ std::array<ReplayRecord, 2> ReplayTwoTwins(const ReplayTwin twins[2], const Repl
                                            int threads, size_t begin, size_t end) {
   std::array<ReplayRecord, 2> out;
   std::vector<ReplayWindowSpan> spans;
-  size_t end_of[2] = {end, end};
-  for (int k = 0; k < 2; ++k) out[k] = StartRecord(s, horizon_s, begin, &end_of[k], &spans);
+  out[0] = StartRecord(s, horizon_s, begin, &end, &spans);
+  out[1] = out[0];  // the same part and windows, nothing simulated yet
   const size_t W = spans.size();
   const std::vector<double>* u[2];
   for (int k = 0; k < 2; ++k) u[k] = twins[k].tau_R ? twins[k].tau_R : s.tau_R;

@@ -265,7 +265,9 @@ void FiltFiltInPlace(const std::vector<Biquad>& sos, std::vector<double>* const*
 void FiltFiltGenerated(const std::vector<Biquad>& sos, std::vector<double>* const* xs, size_t count,
                        const std::function<void(size_t begin, size_t end)>& fill) {
   // FiltFiltInPlace's operations in its order, its forward pass over x cut into blocks (the
-  // sections' states carried in z from block to block), the signals interleaved.
+  // sections' states carried in z from block to block), the signals interleaved. (FiltFiltInPlace
+  // keeps its own whole-signal passes: for signals already in memory the blocks cost more than they
+  // save.)
   constexpr size_t kMaxSignals = 8, kFillSamples = 2048;
   if (count == 0) return;
   if (count > kMaxSignals) throw std::invalid_argument("FiltFiltGenerated: more than 8 signals");

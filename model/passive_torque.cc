@@ -33,11 +33,19 @@ constexpr double kKneeConstant = -4.820;
 
 double Exponent(const ExpTerm& e, double A, double K, double H) { return e.a + e.cA * A + e.cK * K + e.cH * H; }
 
+// The moment from its terms' exponentials e[i], summed in the order written.
+template <size_t N>
+double Sum(const ExpTerm (&terms)[N], double constant, const double* e) {
+  double m = terms[0].sign * e[0];
+  for (size_t i = 1; i < N; ++i) m += terms[i].sign * e[i];
+  return m + constant;
+}
+
 template <size_t N>
 double Moment(const ExpTerm (&terms)[N], double constant, double A, double K, double H) {
-  double m = terms[0].sign * std::exp(Exponent(terms[0], A, K, H));
-  for (size_t i = 1; i < N; ++i) m += terms[i].sign * std::exp(Exponent(terms[i], A, K, H));
-  return m + constant;
+  double e[N];
+  for (size_t i = 0; i < N; ++i) e[i] = std::exp(Exponent(terms[i], A, K, H));
+  return Sum(terms, constant, e);
 }
 
 }  // namespace
@@ -74,9 +82,7 @@ void PassiveNearPoints::At(const Eigen::Vector2d& q, Eigen::Vector2d out[3]) con
     const double* f = k == 1 ? up_ : down_;
     double x[5];
     for (int i = 0; i < 5; ++i) x[i] = k == 0 ? e[i] : e[i] * f[i];
-    const double hip = kHipTerms[0].sign * x[0] + kHipTerms[1].sign * x[1] + kHipConstant;
-    const double knee = kKneeTerms[0].sign * x[2] + kKneeTerms[1].sign * x[3] + kKneeTerms[2].sign * x[4] + kKneeConstant;
-    out[k] = Eigen::Vector2d(-hip, knee);
+    out[k] = Eigen::Vector2d(-Sum(kHipTerms, kHipConstant, x), Sum(kKneeTerms, kKneeConstant, x + 2));
   }
 }
 
