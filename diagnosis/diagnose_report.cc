@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <thread>
 
 #include "formats/number_text.h"
 #include "formats/svg_chart.h"
+#include "core/parallel_for.h"
 #include "core/units.h"
 
 namespace exotwin {
@@ -16,19 +18,20 @@ namespace {
 
 
 
-// Amplitude spectrum (N m) of x[a, b) by a direct DFT of a strided copy (at most ~4000 samples), f
+// Amplitude spectrum (N m) of x(i), i in [a, b), by a direct DFT of a strided copy (at most ~4000 samples), f
 // on a uniform grid in (0, fmax]. Each sample's phasor exp(i 2 pi f t_i) is stepped from one grid
 // frequency to the next by the constant factor exp(i 2 pi df t_i) and taken afresh by sin/cos every
 // kAnchor frequencies, so the rounding of the products stays near kAnchor ulps.
-SvgSeries Spectrum(const std::vector<double>& t, const std::vector<double>& x, size_t a, size_t b,
-                   const std::string& color, const std::string& label) {
+template <class X>
+SvgSeries Spectrum(const std::vector<double>& t, X x, size_t a, size_t b, const std::string& color,
+                   const std::string& label) {
   constexpr int kAnchor = 32;
   SvgSeries s;
   s.color = color, s.label = label;
   const size_t stride = std::max<size_t>(1, (b - a) / 4000);
   std::vector<double> tt, xx;
   double mean = 0;
-  for (size_t i = a; i < b; i += stride) tt.push_back(t[i]), xx.push_back(x[i]), mean += x[i];
+  for (size_t i = a; i < b; i += stride) tt.push_back(t[i]), xx.push_back(x(i)), mean += xx.back();
   mean /= static_cast<double>(xx.size());
   for (double& v : xx) v -= mean;
   const double T = std::max(tt.back() - tt.front(), 1e-6);
@@ -279,7 +282,12 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const size_t a0 = d.split, win = std::min(n - d.split, static_cast<size_t>(std::max<size_t>(
                                                      1, static_cast<size_t>(10.0 * n / std::max(k.t.back() - k.t.front(), 1e-9)))));
   const size_t st_line = std::max<size_t>(1, win / 1500), st_dot = std::max<size_t>(1, n / 1500);
-  for (int j = j0; j < 2; ++j) {
+  // Each joint's section into its own text, the two side by side (the same bytes on any thread count).
+  std::string joint_html[2];
+  ParallelFor(static_cast<size_t>(2 - j0), std::min(2, static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
+              [&](size_t jj) {
+    const int j = j0 + static_cast<int>(jj);
+    std::ostringstream o;
     o << "<h2>" << jn[j] << "</h2>\n";
     SvgSeries m{{}, {}, "#000", "measured (filtered alike)"}, b{{}, {}, "#d62728", "twin before"}, a{{}, {}, "#1f77b4", "extended twin"};
     for (size_t i = a0; i < a0 + win; i += st_line) {
@@ -300,23 +308,26 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
       o << SvgChart("simulated vs measured angle (held-out, restarted every " + NumberText(S.horizon_s) + " s)", "t (s)",
                     "angle (deg)", {sm, sr, se});
     }
-    std::vector<double> rb(n), ra(n);
-    for (size_t i = 0; i < n; ++i) rb[i] = d.measured[j][i] - d.before[j][i], ra[i] = d.measured[j][i] - d.after[j][i];
-    const std::vector<double> qdeg = [&] { std::vector<double> v(n); for (size_t i = 0; i < n; ++i) v[i] = k.q[j][i] * kDegPerRad; return v; }();
-    struct Axis { const std::vector<double>* x; const char* label; } axes[4] = {
-        {&qdeg, "angle (deg)"}, {&k.qd[j], "velocity (rad/s)"}, {&k.qdd[j], "acceleration (rad/s^2)"}, {&k.t, "t (s)"}};
+    // The residuals at the samples the plots take (a long record's memory: no record-long copies).
+    auto rb = [&](size_t i) { return d.measured[j][i] - d.before[j][i]; };
+    auto ra = [&](size_t i) { return d.measured[j][i] - d.after[j][i]; };
+    struct Axis { const std::vector<double>* x; double scale; const char* label; } axes[4] = {
+        {&k.q[j], kDegPerRad, "angle (deg)"}, {&k.qd[j], 1, "velocity (rad/s)"}, {&k.qdd[j], 1, "acceleration (rad/s^2)"},
+        {&k.t, 1, "t (s)"}};
     for (const auto& ax : axes) {
       SvgSeries sb{{}, {}, "#d62728", "residual before", true}, sa{{}, {}, "#1f77b4", "residual after (held-out)", true};
       for (size_t i = 0; i < n; i += st_dot) {
-        sb.x.push_back((*ax.x)[i]), sb.y.push_back(rb[i]);
-        sa.x.push_back((*ax.x)[i]), sa.y.push_back(ra[i]);
+        const double x = (*ax.x)[i] * ax.scale;  // exact where scale is 1
+        sb.x.push_back(x), sb.y.push_back(rb(i));
+        sa.x.push_back(x), sa.y.push_back(ra(i));
       }
       o << SvgChart(std::string("residual vs ") + ax.label, ax.label, "N m", {sb, sa});
     }
     o << SvgChart("residual amplitude spectrum", "f (Hz)", "N m",
                {Spectrum(k.t, rb, 0, n, "#d62728", "before"), Spectrum(k.t, ra, d.split, n, "#1f77b4", "after (held-out)")}, true);
-  }
-  o << "</body></html>\n";
+    joint_html[j] = o.str();
+  });
+  o << joint_html[0] << joint_html[1] << "</body></html>\n";
   return o.str();
 }
 

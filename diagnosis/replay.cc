@@ -36,7 +36,7 @@ void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>
 void SetRestartState(double cutoff_hz, ReplaySeries* out) {
   const Sampling sampling = ExamineSampling(out->t, out->source);
   for (int j = 0; j < 2; ++j) {
-    out->q0[j] = out->q[j];  // the measured angle itself (replay.h)
+    out->q0[j] = std::vector<double>();  // the measured angle itself (replay.h)
     AngleRates rates = DeriveAngleRates(sampling, out->t, out->q[j], cutoff_hz, out->source);
     out->qd0[j] = std::move(rates.qd);
     out->qdd0[j] = std::move(rates.qdd);
@@ -62,9 +62,8 @@ void SetRestartState(double cutoff_hz, ReplaySeries* out) {
     while (t[top.front()] < t[i] - kReplayQuietSpan - 1e-12) top.pop_front();
     out->fast[i] = miss[top.front()];
   }
-  std::vector<double> sorted = out->fast;
-  std::sort(sorted.begin(), sorted.end());
-  out->quiet_level = n > 0 ? kReplayQuietFactor * Percentile(sorted, 0.1) : 0.0;
+  std::vector<double> fast = out->fast;
+  out->quiet_level = n > 0 ? kReplayQuietFactor * PercentileInPlace(fast, 0.1) : 0.0;
 }
 
 ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>& t, const std::vector<double> q[2],
@@ -191,6 +190,7 @@ void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>
   auto StepVelocity = [&](size_t i) -> Eigen::Vector2d {
     return Eigen::Vector2d(s.qd0[0][i], s.qd0[1][i]) - 0.5 * dt * Acceleration(i);
   };
+  const std::vector<double>* angle0[2] = {&s.RestartAngle(0), &s.RestartAngle(1)};
   const double t0 = t[start], t_end = t0 + horizon_s;
   // The run-in's first sample: run_in_s before t0, the series' first at the earliest.
   const size_t r = run_in_s > 0 ? static_cast<size_t>(std::lower_bound(t.begin(), t.begin() + static_cast<long>(start),
@@ -199,7 +199,7 @@ void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>
   // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
   // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
   const Eigen::Vector2d qdd0 = Acceleration(r);
-  plant.Reset({s.q0[0][r], s.q0[1][r]}, StepVelocity(r), t[r], &qdd0);
+  plant.Reset({(*angle0[0])[r], (*angle0[1])[r]}, StepVelocity(r), t[r], &qdd0);
   if (r < start) {
     // The measured joints follow the restart state's motion (linear between samples), each step
     // driven by the input; the internal hinges move by their own dynamics.
@@ -209,11 +209,12 @@ void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>
       const double time = plant.time();
       while (k + 1 < start && t[k + 1] <= time) ++k;
       const double a = std::clamp((time - t[k]) / (t[k + 1] - t[k]), 0.0, 1.0);
-      plant.Restate({s.q0[0][k] + a * (s.q0[0][k + 1] - s.q0[0][k]), s.q0[1][k] + a * (s.q0[1][k + 1] - s.q0[1][k])},
+      plant.Restate({(*angle0[0])[k] + a * ((*angle0[0])[k + 1] - (*angle0[0])[k]),
+                     (*angle0[1])[k] + a * ((*angle0[1])[k + 1] - (*angle0[1])[k])},
                     StepVelocity(k) + a * (StepVelocity(k + 1) - StepVelocity(k)), time);
       plant.Step(Input(time + 0.5 * dt));
     }
-    plant.Restate({s.q0[0][start], s.q0[1][start]}, StepVelocity(start), t0);
+    plant.Restate({(*angle0[0])[start], (*angle0[1])[start]}, StepVelocity(start), t0);
   }
   in = start;
   Eigen::Vector2d q_prev = plant.q();

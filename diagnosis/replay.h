@@ -64,9 +64,10 @@ struct ReplaySeries {
   std::string source;
   std::vector<double> t;
   std::vector<double> q[2];              // measured angle, rad (scored)
-  // restart state: angle (rad; the measured one), velocity (rad/s) and acceleration (rad/s^2; empty:
-  // 0) derived at the cutoff
+  // restart state: angle (rad; empty: the measured one, q), velocity (rad/s) and acceleration
+  // (rad/s^2; empty: 0) derived at the cutoff
   std::vector<double> q0[2], qd0[2], qdd0[2];
+  const std::vector<double>& RestartAngle(int j) const { return q0[j].empty() ? q[j] : q0[j]; }
   std::vector<double> tau_R[2];          // actuator torque input, N m
   // The input between samples: false, linear interpolation (a rig's continuously sampled torque);
   // true, each sample held until the next (a zero-order hold: the twin's joint modules log the torque
@@ -108,8 +109,8 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
 // The same on a series whose source, t and q the caller filled (e.g. moved in, not copied): the restart
 // state and the input.
 void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s);
-// The restart state of a series whose source, t and q are filled (q0, qd0, qdd0 at cutoff_hz; fast
-// and quiet_level), the rest kept. Throws InputError naming the source for a cutoff not below half the
+// The restart state of a series whose source, t and q are filled (q0 emptied: the restart angle is
+// the measured one; qd0, qdd0 at cutoff_hz; fast and quiet_level), the rest kept. Throws InputError naming the source for a cutoff not below half the
 // sample rate.
 void SetRestartState(double cutoff_hz, ReplaySeries* s);
 

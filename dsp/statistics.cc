@@ -45,4 +45,15 @@ double Percentile(const std::vector<double>& sorted, double p) {
   return sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
 }
 
+double PercentileInPlace(std::vector<double>& values, double p) {
+  if (values.empty()) return std::nan("");
+  const double pos = p * static_cast<double>(values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const auto at_lo = values.begin() + static_cast<long>(lo);
+  std::nth_element(values.begin(), at_lo, values.end());
+  // The sorted order's next value: the least of those the selection placed after lo.
+  const double v_lo = *at_lo, v_hi = lo + 1 < values.size() ? *std::min_element(at_lo + 1, values.end()) : v_lo;
+  return v_lo + (pos - static_cast<double>(lo)) * (v_hi - v_lo);
+}
+
 }  // namespace exotwin

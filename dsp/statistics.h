@@ -19,5 +19,7 @@ double AutocorrelationLength(const double* x, size_t n);
 
 // p in [0, 1] of sorted values (linear interpolation between closest ranks); NaN if empty.
 double Percentile(const std::vector<double>& sorted, double p);
+// Percentile(sorted copy of values, p), the same number, by selection (O(n)): values is reordered.
+double PercentileInPlace(std::vector<double>& values, double p);
 
 }  // namespace exotwin

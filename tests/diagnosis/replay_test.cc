@@ -327,7 +327,7 @@ TEST(Replay, TheRestartAngleIsTheMeasuredOne) {
   const LegParams p = RealRigModel();
   ReplaySeries s = ExactRecord(Simulate(p, 3.0));
   SetRestartState(kReplayCutoffHz, &s);
-  for (int j = 0; j < 2; ++j) EXPECT_EQ(s.q0[j], s.q[j]);
+  for (int j = 0; j < 2; ++j) EXPECT_EQ(s.RestartAngle(j), s.q[j]);
   const std::unique_ptr<Plant> free_twin = FreeTwin(p);
   Plant& twin = *free_twin;
   const ReplayRecord measured = Replay(twin, s, 0.5);
@@ -428,7 +428,9 @@ TEST(Replay, TwoTwinsSharingTheirWindowsGiveEachOnesRecordBitForBit) {
         }
       }
     }
-    if (threads == 1) EXPECT_TRUE(!second[0] && !second[1]);  // one after the other: no second plant
+    if (threads == 1) {
+      EXPECT_TRUE(!second[0] && !second[1]);  // one after the other: no second plant
+    }
   }
 }
 

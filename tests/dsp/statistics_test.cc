@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -54,6 +55,24 @@ TEST(Statistics, PearsonAgainstClosedForms) {
   EXPECT_NEAR(Pearson(s, c, 0, q), sxy / std::sqrt(sxx * syy), 1e-12);
   EXPECT_LT(Pearson(s, c, 0, q), -0.9);
   EXPECT_EQ(Pearson(x, up, 5, 5), 0.0);  // empty range
+}
+
+// PercentileInPlace (selection) gives Percentile of the sorted values, the same number, at ranks on and
+// between the values, with ties and with one value.
+TEST(Statistics, PercentileBySelectionIsThePercentileOfTheSortedValues) {
+  Rng rng(11);
+  for (size_t n : {1, 2, 7, 1000}) {
+    std::vector<double> v(n);
+    for (double& x : v) x = std::floor(rng.Uniform(0, 50));  // ties
+    std::vector<double> sorted = v;
+    std::sort(sorted.begin(), sorted.end());
+    for (double p : {0.0, 0.1, 0.25, 0.5, 0.9, 0.999, 1.0}) {
+      std::vector<double> w = v;
+      EXPECT_EQ(PercentileInPlace(w, p), Percentile(sorted, p)) << "n " << n << " p " << p;
+    }
+  }
+  std::vector<double> empty;
+  EXPECT_TRUE(std::isnan(PercentileInPlace(empty, 0.5)));
 }
 
 }  // namespace

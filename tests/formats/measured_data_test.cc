@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "dsp/butterworth.h"
 
 namespace exotwin {
@@ -174,6 +175,38 @@ TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
       EXPECT_EQ(into.qdd, k.qdd[j]);
     }
     EXPECT_THROW(TimeBaseLowPass(s, d.t(), 600.0, d.source), InputError);  // above half the sample rate
+  }
+}
+
+// MedianStep (its counting pass on a guess, else selection) is the middle step of the sorted steps,
+// the m/2-th smallest of m, on time bases a file gives (0.001 i printed and parsed back: a few
+// distinct steps), two rates whose share puts the median at the boundary, a jittered clock, steps all
+// distinct (where the guess misses and the selection answers) and short records.
+TEST(MedianStep, IsTheMiddleOfTheSortedSteps) {
+  auto Reference = [](const std::vector<double>& t) {
+    std::vector<double> d(t.size() - 1);
+    for (size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];
+    std::sort(d.begin(), d.end());
+    return d[d.size() / 2];
+  };
+  Rng rng(7);
+  std::vector<std::pair<std::string, std::vector<double>>> bases;
+  for (size_t n : {2, 3, 100, 4097, 4098, 60001}) {
+    std::vector<double> printed(n), two_rates(n), jittered(n), distinct(n);
+    double tj = 0, td = 0;
+    for (size_t i = 0; i < n; ++i) {
+      printed[i] = std::stod(std::to_string(0.001 * static_cast<double>(i)));
+      two_rates[i] = i <= n / 2 ? 0.001 * static_cast<double>(i) : 0.001 * static_cast<double>(n / 2) + 0.002 * static_cast<double>(i - n / 2);
+      jittered[i] = tj, tj += rng.Uniform() < 0.2 ? 0.0011 : 0.001;
+      distinct[i] = td, td += 0.001 * (1 + rng.Uniform());
+    }
+    for (auto& [name, t] : {std::make_pair("printed", printed), std::make_pair("two rates", two_rates),
+                            std::make_pair("jittered", jittered), std::make_pair("distinct", distinct)})
+      bases.emplace_back(std::string(name) + " n=" + std::to_string(n), t);
+  }
+  for (const auto& [name, t] : bases) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(MedianStep(t), Reference(t));
   }
 }
 
