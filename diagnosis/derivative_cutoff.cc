@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <memory>
 #include <thread>
 
 #include <Eigen/Eigenvalues>
@@ -44,7 +45,7 @@ struct RecordBase {
   std::vector<size_t> at;  // the rows: every stride-th sample, filter edges left out
   size_t split = 0;        // first held-out sample
   const std::vector<double>* recorded[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};  // qd_*, qdd_*
-  std::vector<RegressorTrig> trig;
+  std::unique_ptr<RegressorTrig[]> trig;  // per sample (not zeroed: the threads that fill it touch its pages)
 };
 
 }  // namespace
@@ -135,7 +136,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
     for (int j = 0; j < 2; ++j)
       for (int k = 0; k < 2; ++k) B.recorded[j][k] = d.Column(std::string(k == 0 ? "qd_" : "qdd_") + names[j]);
     if (parallel) {
-      B.trig.resize(n);  // here: the threads below allocate nothing
+      B.trig.reset(new RegressorTrig[n]);  // here: the threads below allocate nothing
       ParallelForRanges(n, threads_of_records, [&](size_t begin, size_t end) {
         for (size_t i = begin; i < end; ++i) B.trig[i] = TrigOf({d.q_hip()[i], d.q_knee()[i]});
       });
@@ -247,20 +248,21 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
                 }
               }
             });
-          });
-          for (size_t e = 0; e < K; ++e) {
-            const Col& c = kFiltered[c0 + e];
-            const std::vector<double>& v = batch[e];
-            for (size_t a = 0; a < at.size(); ++a) {
-              if (c.kind == kTorque) {
-                R.u_f[a][c.j] = -v[at[a]], R.u_raw[a][c.j] = -(*tau[c.j])[at[a]];
-              } else if (c.kind == kOnes) {
-                R.Y[a](0, 6) = v[at[a]], R.Y[a](1, 9) = v[at[a]];
-              } else {
-                R.Y[a](c.j, c.col) = v[at[a]];
+            // The half's columns taken at the rows (each column its own entries of the rows).
+            for (size_t e = e0; e < e1; ++e) {
+              const Col& c = kFiltered[c0 + e];
+              const std::vector<double>& v = batch[e];
+              for (size_t a = 0; a < at.size(); ++a) {
+                if (c.kind == kTorque) {
+                  R.u_f[a][c.j] = -v[at[a]], R.u_raw[a][c.j] = -(*tau[c.j])[at[a]];
+                } else if (c.kind == kOnes) {
+                  R.Y[a](0, 6) = v[at[a]], R.Y[a](1, 9) = v[at[a]];
+                } else {
+                  R.Y[a](c.j, c.col) = v[at[a]];
+                }
               }
             }
-          }
+          });
         }
       }
       for (int j = 0; j < 2; ++j)
