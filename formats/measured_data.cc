@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <stdexcept>
 #include <utility>
 
 #include "formats/number_text.h"
@@ -126,22 +129,53 @@ MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t
 }
 
 double MedianStep(const std::vector<double>& t) {
+  if (t.size() < 2) throw std::invalid_argument("MedianStep: fewer than 2 times");
   const size_t m = t.size() - 1, k = m / 2;  // the median: the k-th smallest of the m steps
-  if (m >= 4096) {
-    // A guess, the median of about a thousand evenly spread steps, is the k-th smallest exactly when
-    // fewer than k + 1 steps are below it and more than k are at most it (one counting pass; a time
-    // base's steps take few distinct values). Else the selection below.
-    std::vector<double> some;
-    for (size_t i = 0; i < m; i += m / 1000) some.push_back(t[i + 1] - t[i]);
-    std::nth_element(some.begin(), some.begin() + static_cast<long>(some.size() / 2), some.end());
-    const double guess = some[some.size() / 2];
-    size_t below = 0, at = 0;
-    for (size_t i = 0; i < m; ++i) {
-      const double d = t[i + 1] - t[i];
-      below += d < guess;
-      at += d == guess;
+  // Radix selection on the steps' bit patterns, which order as the values do where every step is
+  // positive: the patterns in [lo, hi] hold the k-th smallest (rank k among them); each pass counts
+  // them by the 12 bits below the prefix lo and hi share and keeps the bin where rank k falls, then
+  // narrows [lo, hi] to that bin's least and largest pattern, until one pattern is left. A few passes
+  // over t (a time base's steps take few distinct values), no copy. A step that is not positive
+  // (times out of order, NaN): the selection below.
+  auto Bits = [&](size_t i) {
+    const double d = t[i + 1] - t[i];
+    uint64_t b;
+    std::memcpy(&b, &d, sizeof b);
+    return b;
+  };
+  bool positive = true;
+  uint64_t lo = ~uint64_t{0}, hi = 0;
+  for (size_t i = 0; i < m; ++i) {
+    positive &= t[i + 1] - t[i] > 0;
+    const uint64_t b = Bits(i);
+    lo = std::min(lo, b), hi = std::max(hi, b);
+  }
+  if (positive) {
+    size_t rank = k;
+    while (lo != hi) {
+      constexpr int kBits = 12;
+      const int below_prefix = 64 - __builtin_clzll(lo ^ hi);
+      const int shift = std::max(0, below_prefix - kBits);
+      std::vector<size_t> count(size_t{1} << kBits, 0);
+      for (size_t i = 0; i < m; ++i) {
+        const uint64_t b = Bits(i);
+        if (b >= lo && b <= hi) ++count[(b >> shift) & ((uint64_t{1} << kBits) - 1)];
+      }
+      size_t bin = 0;
+      while (rank >= count[bin]) rank -= count[bin++];
+      // The bin's patterns: lo and hi's prefix, then bin; its least and largest taken in one more pass.
+      const uint64_t bin_lo = std::max(lo, ((lo >> (shift + kBits)) << (shift + kBits)) | (uint64_t{bin} << shift));
+      const uint64_t bin_hi = std::min(hi, bin_lo | ((uint64_t{1} << shift) - 1));
+      uint64_t new_lo = ~uint64_t{0}, new_hi = 0;
+      for (size_t i = 0; i < m; ++i) {
+        const uint64_t b = Bits(i);
+        if (b >= bin_lo && b <= bin_hi) new_lo = std::min(new_lo, b), new_hi = std::max(new_hi, b);
+      }
+      lo = new_lo, hi = new_hi;
     }
-    if (below <= k && k < below + at) return guess;
+    double d;
+    std::memcpy(&d, &lo, sizeof d);
+    return d;
   }
   std::vector<double> d(t.size() - 1);
   for (size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];

@@ -169,7 +169,7 @@ AngleRates DeriveAngleRates(const Sampling& s, const std::vector<double>& t, con
 void DeriveAngleRatesInto(const Sampling& s, const std::vector<double>& t, const std::vector<double>& q,
                           double cutoff_hz, const std::string& source, AngleRates* out);
 
-// Median sample period (s) of strictly increasing times (>= 2 samples).
+// Median sample period (s) of strictly increasing times (>= 2 samples: else std::invalid_argument).
 double MedianStep(const std::vector<double>& t);
 
 // Linear interpolation of (x, y) at xq (x strictly increasing; clamped at the ends).

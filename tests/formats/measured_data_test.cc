@@ -178,10 +178,10 @@ TEST(TimeBaseLowPass, EqualsFilteringOnTheTimeBaseBitForBit) {
   }
 }
 
-// MedianStep (its counting pass on a guess, else selection) is the middle step of the sorted steps,
+// MedianStep (radix selection on the steps' bit patterns, else selection) is the middle step of the sorted steps,
 // the m/2-th smallest of m, on time bases a file gives (0.001 i printed and parsed back: a few
 // distinct steps), two rates whose share puts the median at the boundary, a jittered clock, steps all
-// distinct (where the guess misses and the selection answers) and short records.
+// distinct (the most passes), a step out of order (the selection) and short records.
 TEST(MedianStep, IsTheMiddleOfTheSortedSteps) {
   auto Reference = [](const std::vector<double>& t) {
     std::vector<double> d(t.size() - 1);
@@ -204,10 +204,15 @@ TEST(MedianStep, IsTheMiddleOfTheSortedSteps) {
                             std::make_pair("jittered", jittered), std::make_pair("distinct", distinct)})
       bases.emplace_back(std::string(name) + " n=" + std::to_string(n), t);
   }
+  // Times out of order (a negative step): the selection, the same middle step.
+  std::vector<double> unordered = bases.back().second;
+  std::swap(unordered[10], unordered[11]);
+  bases.emplace_back("one step negative", unordered);
   for (const auto& [name, t] : bases) {
     SCOPED_TRACE(name);
     EXPECT_EQ(MedianStep(t), Reference(t));
   }
+  EXPECT_THROW(MedianStep({0.0}), std::invalid_argument);
 }
 
 }  // namespace
