@@ -380,54 +380,23 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
   double found[2];
   ParallelFor(2, banks[0].threads, [&](size_t jj) {
     const int j = static_cast<int>(jj);
-    auto sse = [&](double f) {
-      double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
-      for (size_t r = 0; r < banks.size(); ++r) {
-        const ColumnBank& b = banks[r];
-        const size_t m = b.sample.size();
-        // The search uses at most ~8000 fitting rows per record (every step-th).
-        const size_t step = std::max<size_t>(1, m / 8000);
-        for (size_t k = 0; k < m; k += step) {
-          if (!b.train[k]) continue;
-          const double x = 2 * M_PI * f * kins[r]->q[j][b.sample[k]];
-          const double s = std::sin(x), c = std::cos(x), y = targets[r][j * m + k];
-          ss += s * s, sc += s * c, cc += c * c, ys += y * s, yc += y * c, yy += y * y;
-        }
-      }
-      const double det = ss * cc - sc * sc;
-      if (det <= 1e-12 * (ss * cc + 1e-300)) return yy;
-      const double a = (ys * cc - yc * sc) / det, c2 = (yc * ss - ys * sc) / det;
-      return yy - a * ys - c2 * yc;
-    };
-    // The grid f = 1, 1.1, .. 10 Hz in one pass per frequency over the search's rows, each row's
-    // phasor exp(i 2 pi f q) stepped from one frequency to the next by exp(i 2 pi 0.1 q) and taken
-    // afresh by sin/cos every kAnchor frequencies (the rounding of the products stays near kAnchor
-    // ulps; sse as above, its sums in the same order).
-    std::vector<double> x_row, y_row;  // 2 pi q and the target, per row, in sse's order
+    // The search's rows: at most ~8000 fitting rows per record (every step-th), the angle and the target.
+    std::vector<double> q_row, y_row;
     for (size_t r = 0; r < banks.size(); ++r) {
       const ColumnBank& b = banks[r];
       const size_t m = b.sample.size();
       const size_t step = std::max<size_t>(1, m / 8000);
       for (size_t k = 0; k < m; k += step) {
         if (!b.train[k]) continue;
-        x_row.push_back(2 * M_PI * kins[r]->q[j][b.sample[k]]);
+        q_row.push_back(kins[r]->q[j][b.sample[k]]);
         y_row.push_back(targets[r][j * m + k]);
       }
     }
-    const size_t N = x_row.size();
-    std::vector<double> re(N), im(N), step_re(N), step_im(N);
-    for (size_t i = 0; i < N; ++i) step_re[i] = std::cos(0.1 * x_row[i]), step_im[i] = std::sin(0.1 * x_row[i]);
-    constexpr int kAnchor = 16;
-    auto grid_sse = [&](int g, double f) {
-      if (g % kAnchor == 0) {
-        for (size_t i = 0; i < N; ++i) re[i] = std::cos(f * x_row[i]), im[i] = std::sin(f * x_row[i]);
-      } else {
-        for (size_t i = 0; i < N; ++i) {
-          const double c = re[i] * step_re[i] - im[i] * step_im[i];
-          im[i] = re[i] * step_im[i] + im[i] * step_re[i];
-          re[i] = c;
-        }
-      }
+    const size_t N = q_row.size();
+    // Each row's phasor exp(i x), x = 2 pi f q, and the residual sum of squares of the target fitted
+    // by a sin x + b cos x.
+    std::vector<double> re(N), im(N);
+    auto sse_of_phasors = [&] {
       double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
       for (size_t i = 0; i < N; ++i) {
         const double sn = im[i], c = re[i], y = y_row[i];
@@ -438,11 +407,37 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       const double a = (ys * cc - yc * sc) / det, c2 = (yc * ss - ys * sc) / det;
       return yy - a * ys - c2 * yc;
     };
-    double best_f = 1.0, best = grid_sse(0, 1.0);
+    auto sse = [&](double f) {
+      for (size_t i = 0; i < N; ++i) {
+        const double x = 2 * M_PI * f * q_row[i];
+        im[i] = std::sin(x), re[i] = std::cos(x);
+      }
+      return sse_of_phasors();
+    };
+    // The grid f = 1, 1.1, .. 10 Hz: each row's phasor stepped from one frequency to the next by
+    // exp(i 2 pi 0.1 q) and taken afresh by sin/cos every kAnchor frequencies (the rounding of the
+    // products stays near kAnchor ulps).
+    constexpr int kAnchor = 16;
+    std::vector<double> step_re(N), step_im(N);
+    for (size_t i = 0; i < N; ++i) {
+      const double x = 2 * M_PI * 0.1 * q_row[i];
+      step_re[i] = std::cos(x), step_im[i] = std::sin(x);
+    }
+    double best_f = 1.0, best = 0;
     int g = 0;
     for (double f = 1.0; f <= 10.0 + 1e-9; f += 0.1, ++g) {
-      const double v = g == 0 ? best : grid_sse(g, f);
-      if (v < best) best = v, best_f = f;
+      double v;
+      if (g % kAnchor == 0) {
+        v = sse(f);
+      } else {
+        for (size_t i = 0; i < N; ++i) {
+          const double c = re[i] * step_re[i] - im[i] * step_im[i];
+          im[i] = re[i] * step_im[i] + im[i] * step_re[i];
+          re[i] = c;
+        }
+        v = sse_of_phasors();
+      }
+      if (g == 0 || v < best) best = v, best_f = f;
     }
     double lo = best_f - 0.1, hi = best_f + 0.1;
     const double gr = 0.5 * (std::sqrt(5.0) - 1);
