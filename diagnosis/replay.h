@@ -110,8 +110,8 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
 // state and the input.
 void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s);
 // The restart state of a series whose source, t and q are filled (q0 emptied: the restart angle is
-// the measured one; qd0, qdd0 at cutoff_hz; fast and quiet_level), the rest kept. Throws InputError naming the source for a cutoff not below half the
-// sample rate.
+// the measured one; qd0, qdd0 at cutoff_hz; fast and quiet_level), the rest kept. Throws InputError
+// naming the source for a cutoff not below half the sample rate.
 void SetRestartState(double cutoff_hz, ReplaySeries* s);
 
 // One window of a replay: samples (start, stop) scored, restarted at start.
