@@ -15,6 +15,10 @@ namespace parallel_for_detail {
 inline thread_local bool in_worker = false;  // inside ParallelFor's work: nested calls run serially
 }  // namespace parallel_for_detail
 
+// The machine's cores (std::thread::hardware_concurrency, at least 1): the offline analyses' default
+// thread count.
+inline int MachineCores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+
 // True inside a ParallelFor item (where a nested ParallelFor runs serially).
 inline bool InsideParallelFor() { return parallel_for_detail::in_worker; }
 

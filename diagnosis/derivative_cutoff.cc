@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <iterator>
 #include <memory>
-#include <thread>
 
 #include <Eigen/Eigenvalues>
 
@@ -121,7 +120,7 @@ CutoffChoice ChooseCutoff(const std::vector<const MeasuredData*>& records, doubl
   }
   // Threads of the per-sample loops and the candidates' work below (at most 2).
   const int threads_of_records =
-      std::min(2, threads_asked > 0 ? threads_asked : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+      std::min(2, threads_asked > 0 ? threads_asked : MachineCores());
   std::vector<RecordBase> base(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
     const MeasuredData& d = *records[r];

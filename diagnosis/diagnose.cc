@@ -14,7 +14,6 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include <Eigen/Cholesky>
 
@@ -37,7 +36,7 @@ namespace exotwin {
 
 int DiagnoseThreads(const DiagnoseOptions& opt) {
   if (opt.threads > 0) return opt.threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return MachineCores();
 }
 
 const char* DiagnoseFitName(DiagnoseFit fit) { return fit == DiagnoseFit::kMotion ? "motion" : "torque"; }
@@ -868,13 +867,7 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
     // The other twin's input: the series' own where its sensor effects are the model's (the same
     // numbers, without a record-long copy), else re-formed.
     auto OtherInput = [&](const PlantEffects& fx) -> const std::vector<double>* {
-      bool same = true;
-      for (int j = 0; j < 2; ++j) {
-        same = same && fx.sensor[j].size() == rigid_fx.sensor[j].size();
-        for (size_t k = 0; same && k < fx.sensor[j].size(); ++k)
-          same = fx.sensor[j][k].name == rigid_fx.sensor[j][k].name && fx.sensor[j][k].value == rigid_fx.sensor[j][k].value;
-      }
-      if (same) return nullptr;
+      if (fx.sensor[0] == rigid_fx.sensor[0] && fx.sensor[1] == rigid_fx.sensor[1]) return nullptr;
       ActuatorTorqueFromReading(fx, t, tau_S, tau_other);
       return tau_other;
     };
@@ -1000,19 +993,19 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
                           std::vector<MeasuredData>* owned, const DiagnoseOptions& opt) {
   if (opt.fit == DiagnoseFit::kMotion) return DiagnoseByMotion(params, records, opt);
   const bool timing = std::getenv("EXOTWIN_DIAG_TIMING") != nullptr;
-  auto CpuSeconds = [] {
-    rusage ru{};
-    getrusage(RUSAGE_SELF, &ru);
+  auto CpuSeconds = [](const rusage& ru) {
     return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   };
   auto clock0 = std::chrono::steady_clock::now();
-  double cpu0 = CpuSeconds();
+  rusage ru0{};
+  getrusage(RUSAGE_SELF, &ru0);
+  double cpu0 = CpuSeconds(ru0);
   auto Lap = [&](const char* what) {
     if (!timing) return;
     const auto now = std::chrono::steady_clock::now();
-    const double cpu = CpuSeconds();
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);
+    const double cpu = CpuSeconds(ru);
     std::fprintf(stderr, "diagnose: %-28s %8.3f s (CPU %.3f s), peak %6.1f MB\n", what,
                  std::chrono::duration<double>(now - clock0).count(), cpu - cpu0, ru.ru_maxrss / 1024.0);
     clock0 = now;

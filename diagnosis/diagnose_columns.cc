@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 
 #include <Eigen/Cholesky>
 
 #include "core/parallel_for.h"
+#include "dsp/grid_phasors.h"
 #include "diagnosis/effects.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
@@ -175,12 +175,13 @@ NearTorques TorquesNear(const LegParams& rigid, const LumpedParams& total, const
   return t;
 }
 
-// Column c from the values x_j of its joint-j rows on the fit rows (the other joint's rows zero),
-// weighted by w as SetColumn stores them.
-void SetJointRows(ColumnBank& b, int c, const double w[2], int j, const std::vector<double>& x_j) {
+// Column c from the values x_j(k) of its joint-j rows on the fit rows k (the other joint's rows
+// zero), weighted by w as SetColumn stores them.
+template <class X>
+void SetJointRows(ColumnBank& b, int c, const double w[2], int j, X x_j) {
   const size_t m = b.sample.size();
   for (size_t k = 0; k < m; ++k) {
-    b.X(j * m + k, c) = w[j] * x_j[k];
+    b.X(j * m + k, c) = w[j] * x_j(k);
     b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
   }
 }
@@ -192,10 +193,7 @@ void SetJointColumn(PendingColumns& p, int c, const double w[2], int j, std::vec
   ColumnBank& b = p.bank();
   p.Add(std::move(x), [&b, w, c, j, rows_out](const std::vector<double>& filtered) {
     const size_t m = b.sample.size();
-    for (size_t k = 0; k < m; ++k) {
-      b.X(j * m + k, c) = w[j] * filtered[b.sample[k]];
-      b.X((1 - j) * m + k, c) = w[1 - j] * 0.0;
-    }
+    SetJointRows(b, c, w, j, [&](size_t k) { return filtered[b.sample[k]]; });
     if (rows_out) {
       rows_out->resize(m);
       for (size_t k = 0; k < m; ++k) (*rows_out)[k] = filtered[b.sample[k]];
@@ -258,7 +256,7 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
                         std::vector<double> resid[2], const double w[2], size_t split,
                         size_t max_rows, ColumnFilter filter, int threads) {
   ColumnBank b;
-  b.threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  b.threads = threads > 0 ? threads : MachineCores();
   const size_t n = kin.t.size();
   b.filter = std::move(filter);
   b.n = n;
@@ -361,7 +359,8 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       } else {
         for (const auto& ch : kin.emg) {
           const int c = NewColumn(b);
-          SetJointRows(b, c, w, j, envelope_rows[chans.size()]);
+          const std::vector<double>& rows = envelope_rows[chans.size()];
+          SetJointRows(b, c, w, j, [&](size_t k) { return rows[k]; });
           cols.push_back(c);
           chans.push_back(ch.first);
         }
@@ -393,9 +392,13 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       }
     }
     const size_t N = q_row.size();
-    // Each row's phasor exp(i x), x = 2 pi f q, and the residual sum of squares of the target fitted
-    // by a sin x + b cos x.
-    std::vector<double> re(N), im(N);
+    // The rows' phasors exp(i x), x = 2 pi f q, on the grid f = 1, 1.1, .. 10 Hz (dsp::GridPhasors)
+    // and at the refinement's frequencies; the residual sum of squares of the target fitted by
+    // a sin x + b cos x.
+    constexpr int kAnchor = 16;
+    dsp::GridPhasors phasors(std::move(q_row), 0.1, kAnchor);
+    const std::vector<double>& re = phasors.re();
+    const std::vector<double>& im = phasors.im();
     auto sse_of_phasors = [&] {
       double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0, yy = 0;
       for (size_t i = 0; i < N; ++i) {
@@ -408,35 +411,14 @@ void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const
       return yy - a * ys - c2 * yc;
     };
     auto sse = [&](double f) {
-      for (size_t i = 0; i < N; ++i) {
-        const double x = 2 * M_PI * f * q_row[i];
-        im[i] = std::sin(x), re[i] = std::cos(x);
-      }
+      phasors.At(f);
       return sse_of_phasors();
     };
-    // The grid f = 1, 1.1, .. 10 Hz: each row's phasor stepped from one frequency to the next by
-    // exp(i 2 pi 0.1 q) and taken afresh by sin/cos every kAnchor frequencies (the rounding of the
-    // products stays near kAnchor ulps).
-    constexpr int kAnchor = 16;
-    std::vector<double> step_re(N), step_im(N);
-    for (size_t i = 0; i < N; ++i) {
-      const double x = 2 * M_PI * 0.1 * q_row[i];
-      step_re[i] = std::cos(x), step_im[i] = std::sin(x);
-    }
     double best_f = 1.0, best = 0;
     int g = 0;
     for (double f = 1.0; f <= 10.0 + 1e-9; f += 0.1, ++g) {
-      double v;
-      if (g % kAnchor == 0) {
-        v = sse(f);
-      } else {
-        for (size_t i = 0; i < N; ++i) {
-          const double c = re[i] * step_re[i] - im[i] * step_im[i];
-          im[i] = re[i] * step_im[i] + im[i] * step_re[i];
-          re[i] = c;
-        }
-        v = sse_of_phasors();
-      }
+      phasors.AtGrid(g, f);
+      const double v = sse_of_phasors();
       if (g == 0 || v < best) best = v, best_f = f;
     }
     double lo = best_f - 0.1, hi = best_f + 0.1;

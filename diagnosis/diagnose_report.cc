@@ -4,8 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
-#include <thread>
+#include <utility>
 
+#include "dsp/grid_phasors.h"
 #include "formats/number_text.h"
 #include "formats/svg_chart.h"
 #include "core/parallel_for.h"
@@ -14,14 +15,8 @@
 namespace exotwin {
 namespace {
 
-
-
-
-
-// Amplitude spectrum (N m) of x(i), i in [a, b), by a direct DFT of a strided copy (at most ~4000 samples), f
-// on a uniform grid in (0, fmax]. Each sample's phasor exp(i 2 pi f t_i) is stepped from one grid
-// frequency to the next by the constant factor exp(i 2 pi df t_i) and taken afresh by sin/cos every
-// kAnchor frequencies, so the rounding of the products stays near kAnchor ulps.
+// Amplitude spectrum (N m) of x(i), i in [a, b), by a direct DFT of a strided copy (at most ~4000
+// samples), f on a uniform grid in (0, fmax], the phasors stepped along the grid (dsp::GridPhasors).
 template <class X>
 SvgSeries Spectrum(const std::vector<double>& t, X x, size_t a, size_t b, const std::string& color,
                    const std::string& label) {
@@ -38,21 +33,14 @@ SvgSeries Spectrum(const std::vector<double>& t, X x, size_t a, size_t b, const 
   const double fmax = std::min(20.0, 0.5 * static_cast<double>(xx.size()) / T);
   const double f0 = 1.0 / T, df = std::max(1.0 / T, fmax / 400);
   const size_t N = xx.size();
-  std::vector<double> re(N), im(N), step_re(N), step_im(N);  // phasor at f, and its step per df
-  for (size_t i = 0; i < N; ++i) step_re[i] = std::cos(2 * M_PI * df * tt[i]), step_im[i] = std::sin(2 * M_PI * df * tt[i]);
+  dsp::GridPhasors phasors(std::move(tt), df, kAnchor);
+  const std::vector<double>& re = phasors.re();
+  const std::vector<double>& im = phasors.im();
   for (int k = 0;; ++k) {
     const double f = f0 + k * df;
     if (f > fmax) break;
+    phasors.AtGrid(k, f);
     double sum_re = 0, sum_im = 0;
-    if (k % kAnchor == 0) {
-      for (size_t i = 0; i < N; ++i) re[i] = std::cos(2 * M_PI * f * tt[i]), im[i] = std::sin(2 * M_PI * f * tt[i]);
-    } else {
-      for (size_t i = 0; i < N; ++i) {
-        const double r = re[i] * step_re[i] - im[i] * step_im[i];
-        im[i] = re[i] * step_im[i] + im[i] * step_re[i];
-        re[i] = r;
-      }
-    }
     for (size_t i = 0; i < N; ++i) sum_re += xx[i] * re[i], sum_im += xx[i] * im[i];
     s.x.push_back(f);
     s.y.push_back(2 * std::hypot(sum_re, sum_im) / static_cast<double>(N));
@@ -284,8 +272,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   const size_t st_line = std::max<size_t>(1, win / 1500), st_dot = std::max<size_t>(1, n / 1500);
   // Each joint's section into its own text, the two side by side (the same bytes on any thread count).
   std::string joint_html[2];
-  ParallelFor(static_cast<size_t>(2 - j0), std::min(2, static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
-              [&](size_t jj) {
+  ParallelFor(static_cast<size_t>(2 - j0), std::min(2, MachineCores()), [&](size_t jj) {
     const int j = j0 + static_cast<int>(jj);
     std::ostringstream o;
     o << "<h2>" << jn[j] << "</h2>\n";

@@ -63,6 +63,7 @@ double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q);
 struct SensorEffect {
   std::string name;  // sensor_offset | sensor_gain | sensor_delay
   double value = 0;
+  bool operator==(const SensorEffect& o) const { return name == o.name && value == o.value; }
 };
 
 // Transition width of the backlash flank selection s(tau) = tanh(tau / width), N m (the inverse form:
