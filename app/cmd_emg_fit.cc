@@ -101,6 +101,18 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
                     jn[j], d.calibration.msk_form[j] ? "musculoskeletal" : "linear", d.calibration.figures[j].r2_cv,
                     msk.r2_cv[j], 100 * msk.reachable_share[j], 100 * msk.reachable_share_recorded[j],
                     kStrengthHi);  // the map may narrow it per channel
+      std::string terms;
+      for (const EmgMskMuscle& m : msk.muscles)
+        if (m.synthesized) terms += (terms.empty() ? "" : ", ") + m.channel + " " + NumberText(m.strength, 3);
+      if (!terms.empty()) {
+        std::printf("%s synthesized from the recorded excitations (strength x synergy weight: %s); its activation x "
+                    "strength peaks at %.3f (a muscle's at most %.1f)\n",
+                    (d.missing.empty() ? std::string("the missing muscle") : "the missing " + d.missing.front()).c_str(), terms.c_str(),
+                    msk.synthesized_peak, kStrengthHi);
+        if (msk.synthesized_peak > kStrengthHi)
+          std::fprintf(stderr, "emg-fit: warning: the synthesized muscle's activation x strength peaks at %.3f, above a "
+                       "muscle's %.1f: the recorded excitations do not carry it\n", msk.synthesized_peak, kStrengthHi);
+      }
     }
     for (int j = 0; j < 2; ++j)
       std::printf("%s: the estimate holds all but %g %% of its variance below %.1f Hz; the measured moment has %.1f %% of "

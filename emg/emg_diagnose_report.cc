@@ -218,13 +218,13 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
       << NumberText(100 * m.reachable_share_recorded[0], 3) << " % / " << NumberText(100 * m.reachable_share_recorded[1], 3)
       << " % at their recorded activation. Tendon " << (m.elastic_tendon ? "elastic" : "rigid") << ". Delay " << NumberText(1e3 * m.delay, 3)
       << " ms, twitch " << NumberText(1e3 * m.twitch, 3) << " ms, A " << NumberText(m.a_shape, 3) << ".</p>";
-    o << "<table><tr><th>channel</th><th>path</th><th>F_max (N)</th><th>strength (0.5-1.5)</th><th>l_ts (m) [bounds]</th>"
+    o << "<table><tr><th>channel</th><th>path</th><th>F_max (N)</th><th>strength (x F_max; bounds 0.5-1.5, a synthesized term 0-1.5)</th><th>l_ts (m) [bounds]</th>"
          "<th>l_opt (m) [bounds]</th><th>force over the trial (N) min / mean / max</th><th>fibre length (l_opt) min / max</th></tr>";
     const EmgRecording& rec0 = d.first_recording;
     const EmgMskSeries ser = rec0.size() ? MskSeries(m, rec0) : EmgMskSeries{};
     for (size_t c = 0; c < m.muscles.size(); ++c) {
       const EmgMskMuscle& x = m.muscles[c];
-      o << "<tr><td>" << HtmlEscape(x.channel) << "</td><td>" << HtmlEscape(MusculotendonPathSource(x.muscle)) << "</td><td>"
+      o << "<tr><td>" << HtmlEscape(x.Label()) << "</td><td>" << HtmlEscape(MusculotendonPathSource(x.muscle)) << "</td><td>"
         << NumberText(x.nominal.f_max, 4) << "</td><td>" << NumberText(x.strength, 3) << "</td><td>" << NumberText(x.l_ts, 4)
         << " [" << NumberText((1 - kTendonSlackChange) * x.nominal.l_ts, 4) << ", "
         << NumberText((1 + kTendonSlackChange) * x.nominal.l_ts, 4) << "]</td><td>" << NumberText(x.l_opt, 4) << " ["
@@ -248,8 +248,8 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
       std::vector<SvgSeries> fs, ls;
       for (size_t c = 0; c < ser.force.size(); ++c) {
         const char* col = kColour[c % 10];
-        fs.push_back({t, std::vector<double>(ser.force[c].begin(), ser.force[c].begin() + static_cast<long>(b)), col, m.muscles[c].channel});
-        ls.push_back({t, std::vector<double>(ser.fibre[c].begin(), ser.fibre[c].begin() + static_cast<long>(b)), col, m.muscles[c].channel});
+        fs.push_back({t, std::vector<double>(ser.force[c].begin(), ser.force[c].begin() + static_cast<long>(b)), col, m.muscles[c].Label()});
+        ls.push_back({t, std::vector<double>(ser.fibre[c].begin(), ser.fibre[c].begin() + static_cast<long>(b)), col, m.muscles[c].Label()});
       }
       o << "<h2>Muscle forces (first 10 s)</h2>" << SvgChart("muscle force", "t (s)", "N", fs)
         << "<h2>Fibre lengths (first 10 s)</h2>" << SvgChart("fibre length", "t (s)", "l / l_opt", ls);

@@ -19,6 +19,8 @@ MusculotendonParams EmgMskMuscle::Params() const {
   return p;
 }
 
+std::string EmgMskMuscle::Label() const { return synthesized ? MuscleName(muscle) + std::string(" from ") + channel : channel; }
+
 namespace {
 
 constexpr int kExtras = 4;  // beta, gamma, offset, passive_scale per joint
@@ -60,11 +62,12 @@ Geometry GeometryOf(const EmgRecording& rec, const std::vector<EmgMskMuscle>& mu
 }
 
 // The unit's states on a recording at activations a: force per F_max, normalized fibre length and
-// velocity per sample (the elastic tendon's series, or the rigid tendon's state sample by sample).
-TendonSeries UnitStates(const MusculotendonParams& p, bool elastic, const std::vector<double>& t, const Geometry& g,
-                        size_t c, const std::vector<double>& a) {
+// velocity per sample (the elastic tendon's series, or the rigid tendon's state sample by sample; a
+// synthesized term's: rigid, active force only, EmgMskMuscle).
+TendonSeries UnitStates(const EmgMskMuscle& m, const MusculotendonParams& p, bool elastic, const std::vector<double>& t,
+                        const Geometry& g, size_t c, const std::vector<double>& a) {
   TendonSeries s;
-  if (elastic) {
+  if (elastic && !m.synthesized) {
     ElasticTendonSeries(p, t, g.L[c], a, &s);
     return s;
   }
@@ -72,7 +75,7 @@ TendonSeries UnitStates(const MusculotendonParams& p, bool elastic, const std::v
   s.fibre_length.resize(n), s.fibre_velocity.resize(n), s.force.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const HillState h = RigidTendonState(p, g.L[c][i], g.Ld[c][i]);
-    s.force[i] = a[i] * h.active + h.passive;
+    s.force[i] = a[i] * h.active + (m.synthesized ? 0.0 : h.passive);
     s.fibre_length[i] = h.fibre_length, s.fibre_velocity[i] = h.fibre_velocity;
   }
   return s;
@@ -81,7 +84,7 @@ TendonSeries UnitStates(const MusculotendonParams& p, bool elastic, const std::v
 // Unit-strength moment columns of channel c at both joints: F_max f r_j, f the force per F_max.
 void MuscleColumns(const EmgMskMuscle& m, const MusculotendonParams& p, bool elastic, const std::vector<double>& t,
                    const std::vector<double>& a, const Geometry& g, size_t c, std::vector<double> col[2]) {
-  const TendonSeries s = UnitStates(p, elastic, t, g, c, a);
+  const TendonSeries s = UnitStates(m, p, elastic, t, g, c, a);
   const size_t n = a.size();
   col[0].resize(n), col[1].resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -237,11 +240,11 @@ class Calibration {
         if (s < best) best = s, *delay = 0.01 * di, *A = a;
       }
     // Parameters in their bands: [0] delay 10-100 ms, [1] A in (-3, 0), then l_ts, l_opt per channel.
-    const size_t P = 2 + 2 * mus_.size();
+    const size_t P = 2 + 2 * Searched();
     std::vector<double> lo(P), hi(P), x(P);
     lo[0] = 0.01, hi[0] = 0.1, x[0] = *delay;
     lo[1] = -2.999, hi[1] = -0.001, x[1] = std::clamp(*A, lo[1], hi[1]);
-    for (size_t c = 0; c < mus_.size(); ++c) {
+    for (size_t c = 0; c < Searched(); ++c) {
       const MusculotendonParams& n = mus_[c].nominal;
       lo[2 + 2 * c] = (1 - kTendonSlackChange) * n.l_ts, hi[2 + 2 * c] = (1 + kTendonSlackChange) * n.l_ts;
       lo[3 + 2 * c] = (1 - kOptimalFibreChange) * n.l_opt, hi[3 + 2 * c] = (1 + kOptimalFibreChange) * n.l_opt;
@@ -294,7 +297,7 @@ class Calibration {
     const size_t M = mus_.size(), P = x.size(), L = M + 2 * kExtras, N = P + L;
     auto set = [&](const std::vector<double>& v) {
       SetActivation(v[0], twitch, v[1]);
-      for (size_t c = 0; c < M; ++c) mus_[c].l_ts = v[2 + 2 * c], mus_[c].l_opt = v[3 + 2 * c];
+      for (size_t c = 0; c < Searched(); ++c) mus_[c].l_ts = v[2 + 2 * c], mus_[c].l_opt = v[3 + 2 * c];
       SetAllColumns();
     };
     // Columns of every recording at the current parameters (copy).
@@ -406,6 +409,14 @@ class Calibration {
     }
   }
 
+  // The units whose lengths are searched: the recorded ones (the synthesized terms come last and keep
+  // their path's nominal lengths: each is a share of one muscle, EmgMskMuscle).
+  size_t Searched() const {
+    size_t n = 0;
+    while (n < mus_.size() && !mus_[n].synthesized) ++n;
+    return n;
+  }
+
   bool Fitted(size_t k, int j, size_t i) const {
     return recs_[k].spike_ok[j][i] && !(static_cast<int>(k) == out_rec_ && i >= out_a_ && i < out_b_);
   }
@@ -451,7 +462,7 @@ EmgMskSeries MskSeries(const EmgMskModel& m, const EmgRecording& rec) {
     const EmgMskMuscle& mu = m.muscles[c];
     const MusculotendonParams p = mu.Params();
     const std::vector<double> a = Activation(rec, mu.channel, m.delay, m.twitch, m.a_shape);
-    TendonSeries st = UnitStates(p, m.elastic_tendon, rec.t, g, c, a);
+    TendonSeries st = UnitStates(mu, p, m.elastic_tendon, rec.t, g, c, a);
     std::vector<double> F(n), &l = st.fibre_length, &v = st.fibre_velocity;
     for (size_t i = 0; i < n; ++i) {
       F[i] = mu.strength * p.f_max * st.force[i];
@@ -483,6 +494,22 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     const auto sb = opt.strength_bounds.find(m.channel);
     if (sb != opt.strength_bounds.end()) m.strength_lo = sb->second[0], m.strength_hi = sb->second[1];
     model.muscles.push_back(m);
+  }
+  // The recordings' missing muscles, each synthesized from every recorded channel (EmgMskMuscle).
+  if (opt.synthesize_missing) {
+    const size_t recorded = model.muscles.size();
+    for (const std::string& name : r0.missing) {
+      Muscle mu;
+      if (!MuscleByName(name, &mu)) continue;
+      for (size_t c = 0; c < recorded; ++c) {
+        EmgMskMuscle m;
+        m.channel = model.muscles[c].channel, m.muscle = mu, m.synthesized = true;
+        m.nominal = ScaledMusculotendon(mu, GenericMusculotendon(mu));
+        m.l_opt = m.nominal.l_opt, m.l_ts = m.nominal.l_ts;
+        m.strength_lo = kSynthesizedStrengthLo, m.strength_hi = kStrengthHi;
+        model.muscles.push_back(m);
+      }
+    }
   }
   std::vector<Rec> rs;
   double w[2];
@@ -568,10 +595,21 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     const std::vector<double> ones(recs[k]->size(), 1.0);
     for (size_t c = 0; c < model.muscles.size(); ++c) {
       const EmgMskMuscle& m = model.muscles[c];
-      full.push_back(UnitStates(m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c, ones));
-      recorded.push_back(UnitStates(m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c,
+      full.push_back(UnitStates(m, m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c, ones));
+      recorded.push_back(UnitStates(m, m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c,
                                     Activation(*recs[k], m.channel, model.delay, model.twitch, model.a_shape)));
     }
+    std::map<Muscle, std::vector<double>> synthesized;  // sum_k s_k a_k per synthesized muscle
+    for (size_t c = 0; c < model.muscles.size(); ++c) {
+      const EmgMskMuscle& m = model.muscles[c];
+      if (!m.synthesized) continue;
+      std::vector<double>& sum = synthesized[m.muscle];
+      sum.resize(recs[k]->size(), 0.0);
+      const std::vector<double> a = Activation(*recs[k], m.channel, model.delay, model.twitch, model.a_shape);
+      for (size_t i = 0; i < a.size(); ++i) sum[i] += m.strength * a[i];
+    }
+    for (const auto& [mu, sum] : synthesized)
+      for (double v : sum) model.synthesized_peak = std::max(model.synthesized_peak, v);
     for (size_t c = 0; c < model.muscles.size(); ++c) {
       EmgMskMuscle& m = model.muscles[c];
       const auto l = std::minmax_element(ser.fibre[c].begin(), ser.fibre[c].end());
@@ -589,6 +627,7 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
         double M_dir = 0, M_rec = 0;
         for (size_t c = 0; c < model.muscles.size(); ++c) {
           const EmgMskMuscle& m = model.muscles[c];
+          if (m.synthesized) continue;  // what the recorded muscles reach
           const double arm = m.strength_hi * m.nominal.f_max * rs[k].geo.r[j][c][i];
           if (arm * full[c].force[i] * tau > 0) M_dir += std::abs(arm * full[c].force[i]);
           if (arm * recorded[c].force[i] * tau > 0) M_rec += std::abs(arm * recorded[c].force[i]);

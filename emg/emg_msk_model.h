@@ -40,9 +40,23 @@ namespace exotwin {
 constexpr double kTendonSlackChange = 0.05;                 // +- fraction of the nominal l_ts
 constexpr double kOptimalFibreChange = 0.025;               // +- fraction of the nominal l_opt
 
+// A muscle of the twin's set that the recording lacks (EmgRecording::missing, the gluteus maximus of
+// the development trial) is synthesized from the recorded excitations, as the synergy extrapolation of
+// Ao, Shourijeh, Patten & Fregly 2020 (Front Comput Neurosci; the NMSM Pipeline's SynX) estimates an
+// unmeasured excitation as a combination of the measured ones: its activation is sum_k w_k a_k of the
+// recorded channels' activations, w_k >= 0 (an excitation does not go below zero), on its own gait2392
+// path. Each term is one unit here (`synthesized`, `channel` the source, strength = w_k x its F_max,
+// within [0, kStrengthHi]); with a rigid tendon and the active force only the units add up to exactly
+// one muscle's active force, F_max cos(phi) f_L(l) f_V(v) sum_k w_k a_k, l and v of its path. Rigid:
+// glut_max2's tendon is short (l_ts / l_opt 0.86; a tendon's compliance matters from about 1 on,
+// Zajac 1989, Crit Rev Biomed Eng 17:359-411). Active only: the passive stretch of unrecorded tissues is
+// the remainder's passive moment (Riener & Edrich 1999, a whole joint's).
+constexpr double kSynthesizedStrengthLo = 0.0;
+
 struct EmgMskMuscle {
   std::string channel;
   Muscle muscle = Muscle::kVM;          // the path (sim/musculotendon.h)
+  bool synthesized = false;             // an unrecorded muscle's term driven by `channel` (above)
   MusculotendonParams nominal;          // F_max of the channel's actuator, lengths of its path, scaled
   double strength = 1;                  // x F_max
   double strength_lo = kStrengthLo, strength_hi = kStrengthHi;  // its bounds (a map file may narrow them)
@@ -51,6 +65,7 @@ struct EmgMskMuscle {
   // velocity over the calibration samples.
   double fibre_lo = 0, fibre_hi = 0, velocity_lo = 0, velocity_hi = 0;
   MusculotendonParams Params() const;   // nominal with the calibrated lengths
+  std::string Label() const;            // the channel, or "GMAX from <channel>" for a synthesized term
 };
 
 struct EmgMskModel {
@@ -77,6 +92,9 @@ struct EmgMskModel {
   // The same at the recorded activations (the calibration's delay, twitch and shape): what the
   // recorded muscles can reach as they were activated, every strength at its upper bound.
   double reachable_share_recorded[2] = {0, 0};
+  // The largest activation x strength of a synthesized muscle, sum_k s_k a_k over its terms, on the
+  // calibration samples (x F_max; one muscle's is at most kStrengthHi: checked, warned about by emg-fit).
+  double synthesized_peak = 0;
   double seconds = 0;  // run time of the calibration (cross-validation included)
 };
 
@@ -95,6 +113,7 @@ struct EmgMskFitOptions {
   int blocks = 5;          // one recording: contiguous cross-validation blocks
   bool cross_validate = true;
   bool elastic_tendon = true;  // EmgMskModel::elastic_tendon
+  bool synthesize_missing = true;  // the recordings' missing muscles from the recorded excitations (above)
   std::map<std::string, std::array<double, 2>> strength_bounds;  // per channel (MuscleMap::strength_bounds)
 };
 

@@ -16,12 +16,6 @@ namespace {
 constexpr double kMaxUndershoot = 0.1;  // an envelope may dip below 0 by this share of its peak
 constexpr size_t kMinSamples = 20;
 
-bool MuscleByName(const std::string& s, Muscle* m) {
-  for (int i = 0; i < kNumMuscles; ++i)
-    if (s == MuscleName(MuscleAt(i))) return *m = MuscleAt(i), true;
-  return false;
-}
-
 bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }

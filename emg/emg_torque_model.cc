@@ -28,12 +28,6 @@ int ChannelIndex(const EmgRecording& rec, const std::string& ch) {
   return -1;
 }
 
-bool MuscleByName(const std::string& s, Muscle* m) {
-  for (int i = 0; i < kNumMuscles; ++i)
-    if (s == MuscleName(MuscleAt(i))) return *m = MuscleAt(i), true;
-  return false;
-}
-
 }  // namespace
 
 double EmgModelSpec::Delay(Muscle m) const {
@@ -630,12 +624,18 @@ std::string EmgMskYaml(const EmgTorqueModel& em) {
   o << "  muscles:\n";
   for (const EmgMskMuscle& x : m.muscles) {
     const MusculotendonParams& n = x.nominal;
-    o << "    - channel: " << x.channel << "\n      muscle: " << MuscleName(x.muscle) << "\n      path: \""
-      << MusculotendonPathSource(x.muscle) << "\"\n      actuator: " << n.name << "\n";
+    o << "    - channel: " << x.channel << "\n      muscle: " << MuscleName(x.muscle) << "\n";
+    if (x.synthesized)
+      o << "      synthesized: true   # an unrecorded muscle's term: activation w a(channel), w = strength "
+           "(synergy extrapolation, Ao et al. 2020); rigid tendon, active force only\n";
+    o << "      path: \"" << MusculotendonPathSource(x.muscle) << "\"\n      actuator: " << n.name << "\n";
     o << "      max_isometric_force: {value: " << num(n.f_max) << ", unit: N, source: \"gait2392 " << n.name << "\"}\n";
     o << "      pennation: {value: " << num(n.pennation) << ", unit: rad, source: \"gait2392, of the path\"}\n";
     o << "      strength: {value: " << num(x.strength) << ", bounds: [" << num(x.strength_lo) << ", " << num(x.strength_hi)
-      << "], unit: \"x F_max\", source: \"CEINMS-RT calibration bounds\"}\n";
+      << "], unit: \"x F_max\", source: \""
+      << (x.synthesized ? "synergy weight x strength, >= 0 (Ao et al. 2020), at most CEINMS-RT's upper bound"
+                        : "CEINMS-RT calibration bounds")
+      << "\"}\n";
     o << "      tendon_slack_length: {value: " << num(x.l_ts) << ", nominal: " << num(n.l_ts) << ", bounds: ["
       << num((1 - kTendonSlackChange) * n.l_ts) << ", " << num((1 + kTendonSlackChange) * n.l_ts)
       << "], unit: m, source: \"gait2392 scaled to the path (Delp et al. 2007); +-5 % CEINMS-RT\"}\n";
@@ -700,6 +700,11 @@ void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em
     x.channel = e["channel"].as<std::string>();
     if (!e["muscle"] || !MuscleByName(e["muscle"].as<std::string>(), &x.muscle))
       c.Fail(key + ".muscle", "expected GMAX, VM, RF, ST or GAS (a path of sim/musculotendon.h)" + YamlLine(e["muscle"]));
+    if (const YAML::Node sy = e["synthesized"]) {
+      if (!sy.IsScalar() || (sy.as<std::string>() != "true" && sy.as<std::string>() != "false"))
+        c.Fail(key + ".synthesized", "expected true or false" + YamlLine(sy));
+      x.synthesized = sy.as<std::string>() == "true";
+    }
     x.nominal = ScaledMusculotendon(x.muscle, GenericMusculotendon(x.muscle));
     x.nominal.name = e["actuator"] ? e["actuator"].as<std::string>() : x.nominal.name;
     // Physiology: a force of one human muscle (Delp 1990's largest: soleus 3549 N, x 1.5), pennation
@@ -708,7 +713,8 @@ void ReadEmgMsk(const YamlContext& c, const YAML::Node& root, EmgTorqueModel* em
     x.nominal.pennation = YamlNumber(c, e["pennation"]["value"], key + ".pennation.value", 0, 0.7854, "rad");
     const YAML::Node sb = e["strength"]["bounds"];
     if (!sb || !sb.IsSequence() || sb.size() != 2) c.Fail(key + ".strength.bounds", "expected [low, high]" + YamlLine(sb));
-    x.strength_lo = YamlNumber(c, sb[0], key + ".strength.bounds[0]", kStrengthLo, kStrengthHi, "x F_max");
+    x.strength_lo = YamlNumber(c, sb[0], key + ".strength.bounds[0]", x.synthesized ? kSynthesizedStrengthLo : kStrengthLo,
+                               kStrengthHi, "x F_max");
     x.strength_hi = YamlNumber(c, sb[1], key + ".strength.bounds[1]", x.strength_lo, kStrengthHi, "x F_max");
     x.strength = YamlNumber(c, e["strength"]["value"], key + ".strength.value", x.strength_lo, x.strength_hi, "x F_max");
     x.nominal.l_ts = YamlNumber(c, e["tendon_slack_length"]["nominal"], key + ".tendon_slack_length.nominal", 0.005, 0.6, "m");

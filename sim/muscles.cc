@@ -45,6 +45,12 @@ const char* MuscleName(Muscle m) {
   return "?";
 }
 
+bool MuscleByName(const std::string& name, Muscle* m) {
+  for (int i = 0; i < kNumMuscles; ++i)
+    if (name == MuscleName(MuscleAt(i))) return *m = MuscleAt(i), true;
+  return false;
+}
+
 std::vector<std::string> EmgChannelNames() {
   std::vector<std::string> names;
   for (int c = 0; c < kNumMuscles; ++c) names.push_back(MuscleName(MuscleAt(c)));

@@ -39,6 +39,8 @@ using MuscleVec = Eigen::Matrix<double, kNumMuscles, 1>;  // one value per muscl
 const char* MuscleName(Muscle m);
 // Index -> Muscle (0..4). Precondition: 0 <= i < kNumMuscles.
 inline Muscle MuscleAt(int i) { return static_cast<Muscle>(i); }
+// The muscle named `name` (MuscleName's spelling) into *m; false when no muscle has that name.
+bool MuscleByName(const std::string& name, Muscle* m);
 
 // The EMG amplifier's channel names, channel c recording muscle MuscleAt(c) ("GMAX", "VM", ...).
 std::vector<std::string> EmgChannelNames();

@@ -25,8 +25,12 @@ TEST(CorpusReplay, ScenarioYamlParsesOrThrowsInputError) {
     try {
       const bool ok = fuzz::ScenarioText(fuzz::FileBytes(f), tmp.path());
       parsed += ok;
-      if (name.rfind("valid_", 0) == 0) EXPECT_TRUE(ok) << name;
-      if (name.rfind("invalid_", 0) == 0 || name.rfind("crash_", 0) == 0) EXPECT_FALSE(ok) << name;
+      if (name.rfind("valid_", 0) == 0) {
+        EXPECT_TRUE(ok) << name;
+      }
+      if (name.rfind("invalid_", 0) == 0 || name.rfind("crash_", 0) == 0) {
+        EXPECT_FALSE(ok) << name;
+      }
     } catch (const std::exception& e) {
       ADD_FAILURE() << f << ": " << e.what();
     }

@@ -60,8 +60,11 @@ TEST(ExowheelSession, AdvancedInPartsIsTheRunBitForBit) {
   EXPECT_EQ(whole_logs[2].file, "measured_trial2.csv");
   EXPECT_EQ(whole_logs[0].rows(), 600u);
   ExpectSameLogs(whole_logs, part_logs);
-  for (const auto& [name, value] : whole.metrics)
-    if (name != "wall_time_s") EXPECT_EQ(parts.metrics.at(name), value) << name;
+  for (const auto& [name, value] : whole.metrics) {
+    if (name != "wall_time_s") {
+      EXPECT_EQ(parts.metrics.at(name), value) << name;
+    }
+  }
   EXPECT_EQ(parts.files, whole.files);
   EXPECT_EQ(parts.events, whole.events);
 }
