@@ -63,15 +63,17 @@ void ReportMuscleStates(const EmgTorqueModel& model, const EmgRecording& rec, co
               model.msk_form[1] ? "musculoskeletal" : "linear");
   const double n = static_cast<double>(std::max<size_t>(1, rec.size()));
   std::printf("muscle states: share of samples outside the calibrated fibre length or velocity\n");
+  std::set<Muscle> synthesized;  // a synthesized muscle's terms share one path and state: one line
   for (size_t c = 0; c < model.msk.muscles.size() && c < pr.msk.fibre.size(); ++c) {
     const EmgMskMuscle& m = model.msk.muscles[c];
+    if (m.synthesized && !synthesized.insert(m.muscle).second) continue;
     double out = 0;
     for (size_t i = 0; i < rec.size(); ++i) {
       const double l = pr.msk.fibre[c][i], v = pr.msk.velocity[c][i];
       out += (l < m.fibre_lo || l > m.fibre_hi || v < m.velocity_lo || v > m.velocity_hi) ? 1 : 0;
     }
     std::printf("  %-28s %6.1f %%   calibrated fibre %.3g .. %.3g l_opt, velocity %.3g .. %.3g v_max\n",
-                ("muscle " + m.Label()).c_str(), 100 * out / n, m.fibre_lo, m.fibre_hi, m.velocity_lo, m.velocity_hi);
+                ("muscle " + (m.synthesized ? MuscleName(m.muscle) + std::string(" (synthesized)") : m.channel)).c_str(), 100 * out / n, m.fibre_lo, m.fibre_hi, m.velocity_lo, m.velocity_hi);
   }
   for (int j = 0; j < 2; ++j) {
     if (!model.msk_form[j] || pr.papers[j]) continue;  // another gait: ReportOtherGait

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <sstream>
 
 #include "formats/csv_table.h"
@@ -246,10 +247,21 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
       const size_t b = std::min(rec0.size(), static_cast<size_t>(10.0 / std::max(1e-6, rec0.t[1] - rec0.t[0])));
       const std::vector<double> t(rec0.t.begin(), rec0.t.begin() + static_cast<long>(b));
       std::vector<SvgSeries> fs, ls;
+      std::map<Muscle, size_t> synthesized;  // a synthesized muscle: one series, its terms' forces summed
       for (size_t c = 0; c < ser.force.size(); ++c) {
-        const char* col = kColour[c % 10];
-        fs.push_back({t, std::vector<double>(ser.force[c].begin(), ser.force[c].begin() + static_cast<long>(b)), col, m.muscles[c].Label()});
-        ls.push_back({t, std::vector<double>(ser.fibre[c].begin(), ser.fibre[c].begin() + static_cast<long>(b)), col, m.muscles[c].Label()});
+        const EmgMskMuscle& x = m.muscles[c];
+        const std::vector<double> f(ser.force[c].begin(), ser.force[c].begin() + static_cast<long>(b));
+        if (x.synthesized) {
+          const auto [it, first] = synthesized.emplace(x.muscle, fs.size());
+          if (!first) {
+            for (size_t i = 0; i < b; ++i) fs[it->second].y[i] += f[i];
+            continue;
+          }
+        }
+        const char* col = kColour[fs.size() % 10];
+        const std::string name = x.synthesized ? MuscleName(x.muscle) + std::string(" (synthesized)") : x.channel;
+        fs.push_back({t, f, col, name});
+        ls.push_back({t, std::vector<double>(ser.fibre[c].begin(), ser.fibre[c].begin() + static_cast<long>(b)), col, name});
       }
       o << "<h2>Muscle forces (first 10 s)</h2>" << SvgChart("muscle force", "t (s)", "N", fs)
         << "<h2>Fibre lengths (first 10 s)</h2>" << SvgChart("fibre length", "t (s)", "l / l_opt", ls);

@@ -157,7 +157,9 @@ EmgRecording ReadEmgRecording(const std::string& emg_path, const std::string& ki
   if (!r.missing.empty()) {
     std::string s;
     for (const auto& m : r.missing) s += (s.empty() ? "" : ", ") + m;
-    r.notes.push_back("no EMG channel for " + s + " (the model goes without it)");
+    r.notes.push_back("no EMG channel for " + s +
+                      " (the linear form goes without it; the musculoskeletal form synthesizes it from the recorded "
+                      "excitations)");
   }
 
   // Kinematics on their own time base, derivatives there.

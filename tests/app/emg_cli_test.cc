@@ -123,6 +123,10 @@ TEST_F(EmgCli, FitWritesEveryParameterWithUnitAndUncertainty) {
   EXPECT_EQ(y.find("soleus_r"), std::string::npos);  // the soleus spans neither hip nor knee
   EXPECT_NE(r.output.find("soleus_r"), std::string::npos) << "unused channels are reported: " << r.output;
   EXPECT_NE(r.output.find("GMAX"), std::string::npos) << "the missing gluteus is reported: " << r.output;
+  // ... and synthesized from the recorded excitations in the musculoskeletal form, said and written.
+  EXPECT_NE(r.output.find("the missing GMAX synthesized from the recorded excitations"), std::string::npos) << r.output;
+  EXPECT_NE(y.find("synthesized: true"), std::string::npos);
+  EXPECT_NE(ReadText(dir_ + "/rep/report.html").find("GMAX from rect_fem_r"), std::string::npos);
   const std::string j = ReadText(dir_ + "/rep/diagnosis.json");
   for (const char* s : {"\"effects\"", "\"joints\"", "\"rmse_before\"", "\"gain_pct\"", "\"selection\"", "\"steps\""})
     EXPECT_NE(j.find(s), std::string::npos) << s;

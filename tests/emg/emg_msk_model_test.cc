@@ -205,17 +205,28 @@ TEST(EmgMskModel, ModelFileCarriesTheFormsAndTheMuscles) {
     const std::vector<double> x = PredictMoment(m, a, j), y = PredictMoment(back, a, j);
     for (size_t i = 0; i < x.size(); i += 37) EXPECT_NEAR(x[i], y[i], 1e-6 * (1 + std::abs(x[i]))) << j;
   }
-  // A parameter outside its physiological bounds: exit 2 naming the file and the key.
-  std::string bad = text;
-  const size_t at = bad.find("strength: {value: ");
-  bad.replace(at, bad.find(',', at) - at, "strength: {value: 2.5");
-  WriteText(path, bad);
-  try {
-    ReadEmgModel(path);
-    ADD_FAILURE() << "accepted a strength of 2.5 F_max";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("musculoskeletal.muscles[0].strength.value"), std::string::npos) << e.what();
+  // A parameter outside its physiological bounds, a recorded muscle with a synthesized term's lower
+  // bound (0), a synthesized flag that is not a boolean: exit 2 naming the file and the key.
+  auto replaced = [&](const std::string& from, const std::string& upto, const std::string& to) {
+    std::string bad = text;
+    const size_t at = bad.find(from);
+    bad.replace(at, bad.find(upto, at) - at, to);
+    return bad;
+  };
+  const std::pair<std::string, std::string> bad[] = {
+      {replaced("strength: {value: ", ",", "strength: {value: 2.5"), "musculoskeletal.muscles[0].strength.value"},
+      {replaced("bounds: [0.5, 1.5]", "]", "bounds: [0, 1.5"), "musculoskeletal.muscles[0].strength.bounds[0]"},
+      {replaced("synthesized: true", "\n", "synthesized: maybe"), ".synthesized"},
+  };
+  for (const auto& [file, key] : bad) {
+    WriteText(path, file);
+    try {
+      ReadEmgModel(path);
+      ADD_FAILURE() << "accepted " << key;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
   }
 }
 
