@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <string>
 
 #include "core/rng.h"
 #include "emg/emg_torque_model.h"
@@ -73,12 +74,25 @@ EmgMskModel ApplyLaw(const Law& law, EmgRecording* r, uint64_t seed) {
   return m;
 }
 
+// Two trials of one law (seeds `seed` and seed + 1): a to calibrate on, b to predict.
+struct TwoTrials {
+  EmgRecording a, b;
+  EmgMskModel truth;  // of a
+};
+TwoTrials TrialsOf(const Law& law, uint64_t seed) {
+  NormalRng<NormalPolar> ra(seed), rb(seed + 1);
+  TwoTrials t{GaitEnvelopesAndAngles(ra, "gait trial " + std::to_string(seed)),
+              GaitEnvelopesAndAngles(rb, "gait trial " + std::to_string(seed + 1)), {}};
+  t.truth = ApplyLaw(law, &t.a, seed);
+  ApplyLaw(law, &t.b, seed + 1);
+  return t;
+}
+
 TEST(EmgMskModel, SyntheticHillLawIsRecoveredWithin10Percent) {
   const Law law;
-  NormalRng<NormalPolar> ra(31), rb(32);
-  EmgRecording a = GaitEnvelopesAndAngles(ra, "gait trial 31"), b = GaitEnvelopesAndAngles(rb, "gait trial 32");
-  const EmgMskModel truth = ApplyLaw(law, &a, 31);
-  ApplyLaw(law, &b, 32);
+  TwoTrials trials = TrialsOf(law, 31);
+  const EmgRecording &a = trials.a, &b = trials.b;
+  const EmgMskModel& truth = trials.truth;
   EmgMskFitOptions opt;
   opt.cross_validate = false;
   opt.synthesize_missing = false;  // this law has no unrecorded muscle (the next test has one)
@@ -127,10 +141,9 @@ TEST(EmgMskModel, UnrecordedGluteusIsSynthesizedFromTheRecordedExcitations) {
   Law law;
   law.gmax[0] = 0.9;  // vas_lat_r: the weight-acceptance burst (Neptune et al. 2009's first module)
   law.gmax[2] = 1.2;  // semimem_r: the late-swing burst
-  NormalRng<NormalPolar> ra(71), rb(72);
-  EmgRecording a = GaitEnvelopesAndAngles(ra, "gait trial 71"), b = GaitEnvelopesAndAngles(rb, "gait trial 72");
-  const EmgMskModel truth = ApplyLaw(law, &a, 71);
-  ApplyLaw(law, &b, 72);
+  TwoTrials trials = TrialsOf(law, 71);
+  const EmgRecording &a = trials.a, &b = trials.b;
+  const EmgMskModel& truth = trials.truth;
   EmgMskFitOptions opt;
   opt.cross_validate = false;
   const EmgMskModel fit = FitEmgMsk({&a}, law.twitch, opt);
