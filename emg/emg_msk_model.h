@@ -48,8 +48,8 @@ constexpr double kOptimalFibreChange = 0.025;               // +- fraction of th
 // path. Each term is one unit here (`synthesized`, `channel` the source, strength = w_k x its F_max,
 // within [0, kStrengthHi]); with a rigid tendon and the active force only the units add up to exactly
 // one muscle's active force, F_max cos(phi) f_L(l) f_V(v) sum_k w_k a_k, l and v of its path. Rigid:
-// glut_max2's tendon is short (l_ts / l_opt 0.86; a tendon's compliance matters from about 1 on,
-// Zajac 1989, Crit Rev Biomed Eng 17:359-411). Active only: the passive stretch of unrecorded tissues is
+// glut_max2's tendon is shorter than its fibre (l_ts / l_opt 0.86), where a rigid tendon is adequate
+// (Millard, Uchida, Seth & Delp 2013, J Biomech Eng 135:021005). Active only: the passive stretch of unrecorded tissues is
 // the remainder's passive moment (Riener & Edrich 1999, a whole joint's).
 constexpr double kSynthesizedStrengthLo = 0.0;
 
