@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 
 #include "formats/csv_table.h"
@@ -101,13 +102,17 @@ CommandRunner RegisterEmgFit(CLI::App& app) {
                     jn[j], d.calibration.msk_form[j] ? "musculoskeletal" : "linear", d.calibration.figures[j].r2_cv,
                     msk.r2_cv[j], 100 * msk.reachable_share[j], 100 * msk.reachable_share_recorded[j],
                     kStrengthHi);  // the map may narrow it per channel
-      std::string terms;
+      std::map<std::string, std::string> terms;  // per synthesized muscle: its sources and weights
       for (const EmgMskMuscle& m : msk.muscles)
-        if (m.synthesized) terms += (terms.empty() ? "" : ", ") + m.channel + " " + NumberText(m.strength, 3);
+        if (m.synthesized) {
+          std::string& t = terms[MuscleName(m.muscle)];
+          t += (t.empty() ? "" : ", ") + m.channel + " " + NumberText(m.strength, 3);
+        }
+      for (const auto& [muscle, list] : terms)
+        std::printf("the missing %s synthesized from the recorded excitations (strength x synergy weight: %s)\n",
+                    muscle.c_str(), list.c_str());
       if (!terms.empty()) {
-        std::printf("%s synthesized from the recorded excitations (strength x synergy weight: %s); its activation x "
-                    "strength peaks at %.3f (a muscle's at most %.1f)\n",
-                    (d.missing.empty() ? std::string("the missing muscle") : "the missing " + d.missing.front()).c_str(), terms.c_str(),
+        std::printf("the synthesized activation x strength peaks at %.3f (a muscle's at most %.1f)\n",
                     msk.synthesized_peak, kStrengthHi);
         if (msk.synthesized_peak > kStrengthHi)
           std::fprintf(stderr, "emg-fit: warning: the synthesized muscle's activation x strength peaks at %.3f, above a "
