@@ -73,7 +73,7 @@ void ReportMuscleStates(const EmgTorqueModel& model, const EmgRecording& rec, co
       out += (l < m.fibre_lo || l > m.fibre_hi || v < m.velocity_lo || v > m.velocity_hi) ? 1 : 0;
     }
     std::printf("  %-28s %6.1f %%   calibrated fibre %.3g .. %.3g l_opt, velocity %.3g .. %.3g v_max\n",
-                ("muscle " + (m.synthesized ? MuscleName(m.muscle) + std::string(" (synthesized)") : m.channel)).c_str(), 100 * out / n, m.fibre_lo, m.fibre_hi, m.velocity_lo, m.velocity_hi);
+                ("muscle " + m.MuscleLabel()).c_str(), 100 * out / n, m.fibre_lo, m.fibre_hi, m.velocity_lo, m.velocity_hi);
   }
   for (int j = 0; j < 2; ++j) {
     if (!model.msk_form[j] || pr.papers[j]) continue;  // another gait: ReportOtherGait

@@ -259,7 +259,7 @@ std::string EmgDiagnosisHtml(const EmgDiagnosis& d) {
           }
         }
         const char* col = kColour[fs.size() % 10];
-        const std::string name = x.synthesized ? MuscleName(x.muscle) + std::string(" (synthesized)") : x.channel;
+        const std::string name = x.MuscleLabel();
         fs.push_back({t, f, col, name});
         ls.push_back({t, std::vector<double>(ser.fibre[c].begin(), ser.fibre[c].begin() + static_cast<long>(b)), col, name});
       }

@@ -20,6 +20,7 @@ MusculotendonParams EmgMskMuscle::Params() const {
 }
 
 std::string EmgMskMuscle::Label() const { return synthesized ? MuscleName(muscle) + std::string(" from ") + channel : channel; }
+std::string EmgMskMuscle::MuscleLabel() const { return synthesized ? MuscleName(muscle) + std::string(" (synthesized)") : channel; }
 
 namespace {
 
@@ -180,7 +181,11 @@ class Calibration {
   void SetActivation(double delay, double twitch, double A) {
     for (Rec& r : recs_) {
       r.act.resize(mus_.size());
-      for (size_t c = 0; c < mus_.size(); ++c) r.act[c] = Activation(*r.rec, mus_[c].channel, delay, twitch, A);
+      for (size_t c = 0; c < mus_.size(); ++c) {
+        // A synthesized term's source is a recorded unit's channel: its activation, already computed.
+        const size_t first = FirstOfChannel(c);
+        r.act[c] = first < c ? r.act[first] : Activation(*r.rec, mus_[c].channel, delay, twitch, A);
+      }
     }
   }
   void SetColumns(size_t c) {
@@ -409,6 +414,13 @@ class Calibration {
     }
   }
 
+  // The first unit driven by unit c's channel.
+  size_t FirstOfChannel(size_t c) const {
+    size_t f = 0;
+    while (mus_[f].channel != mus_[c].channel) ++f;
+    return f;
+  }
+
   // The units whose lengths are searched: the recorded ones (the synthesized terms come last and keep
   // their path's nominal lengths: each is a share of one muscle, EmgMskMuscle).
   size_t Searched() const {
@@ -593,19 +605,15 @@ EmgMskModel FitEmgMsk(const std::vector<const EmgRecording*>& recs, double twitc
     // Every unit at full activation, and at its recorded activation (the calibration's).
     std::vector<TendonSeries> full, recorded;
     const std::vector<double> ones(recs[k]->size(), 1.0);
-    for (size_t c = 0; c < model.muscles.size(); ++c) {
-      const EmgMskMuscle& m = model.muscles[c];
-      full.push_back(UnitStates(m, m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c, ones));
-      recorded.push_back(UnitStates(m, m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c,
-                                    Activation(*recs[k], m.channel, model.delay, model.twitch, model.a_shape)));
-    }
     std::map<Muscle, std::vector<double>> synthesized;  // sum_k s_k a_k per synthesized muscle
     for (size_t c = 0; c < model.muscles.size(); ++c) {
       const EmgMskMuscle& m = model.muscles[c];
+      const std::vector<double> a = Activation(*recs[k], m.channel, model.delay, model.twitch, model.a_shape);
+      full.push_back(UnitStates(m, m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c, ones));
+      recorded.push_back(UnitStates(m, m.Params(), model.elastic_tendon, recs[k]->t, rs[k].geo, c, a));
       if (!m.synthesized) continue;
       std::vector<double>& sum = synthesized[m.muscle];
-      sum.resize(recs[k]->size(), 0.0);
-      const std::vector<double> a = Activation(*recs[k], m.channel, model.delay, model.twitch, model.a_shape);
+      sum.resize(a.size(), 0.0);
       for (size_t i = 0; i < a.size(); ++i) sum[i] += m.strength * a[i];
     }
     for (const auto& [mu, sum] : synthesized)

@@ -66,6 +66,7 @@ struct EmgMskMuscle {
   double fibre_lo = 0, fibre_hi = 0, velocity_lo = 0, velocity_hi = 0;
   MusculotendonParams Params() const;   // nominal with the calibrated lengths
   std::string Label() const;            // the channel, or "GMAX from <channel>" for a synthesized term
+  std::string MuscleLabel() const;      // the channel, or "GMAX (synthesized)": the muscle a term belongs to
 };
 
 struct EmgMskModel {
