@@ -36,6 +36,12 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
+# The independent MCAP / ROS 2 client of the bag tests (tests/mcap_client: Foxglove's @mcap/core and
+# ROS 2 serialization, pinned by its package-lock.json), from the npm registry.
+if command -v npm >/dev/null && [ ! -d tests/mcap_client/node_modules/@mcap/core ]; then
+  (cd tests/mcap_client && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+fi
+
 if [ "${1:-}" != "--no-build" ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build build -j"$(nproc)"
