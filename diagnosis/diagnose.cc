@@ -18,7 +18,9 @@
 #include <Eigen/Cholesky>
 
 #include "diagnosis/diagnose_columns.h"
+#include "diagnosis/diagnose_internal.h"
 #include "diagnosis/diagnose_select.h"
+#include "diagnosis/diagnose_unexplained.h"
 #include "diagnosis/effects.h"
 #include "diagnosis/generate.h"
 #include "diagnosis/motion_fit.h"
@@ -47,8 +49,6 @@ DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where) 
   throw InputError(where + ": '" + text + "', expected torque or motion");
 }
 namespace {
-
-const char* kJoint[2] = {"hip", "knee"};
 
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
@@ -118,11 +118,15 @@ double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
   return std::max(AutocorrelationLength(e.data(), m), AutocorrelationLength(e.data() + m, m));
 }
 
+}  // namespace
+
 // Held-out scores from the sums of squares before / after over `count` samples.
 JointScore ScoreOf(double sse_before, double sse_after, double count) {
   return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
           sse_before > 0 ? 100 * (1 - std::sqrt(sse_after / sse_before)) : 0};
 }
+
+namespace {
 
 // Records of one device: the same columns the analysis reads, and sample rates within a factor 5.
 void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
@@ -204,26 +208,6 @@ void TrimTo(Kinematics* kin, size_t a, size_t b) {
   kin->resampled = false;  // as Slice
 }
 
-// Dominant frequency (Hz) of x[a, b) by a direct DFT of a strided copy, 0.05 .. 25 Hz.
-double DominantHz(const std::vector<double>& t, const std::vector<double>& x, size_t a, size_t b) {
-  const size_t stride = std::max<size_t>(1, (b - a) / 8000);
-  std::vector<double> tt, xx;
-  double mean = 0;
-  for (size_t i = a; i < b; i += stride) tt.push_back(t[i]), xx.push_back(x[i]), mean += x[i];
-  mean /= static_cast<double>(xx.size());
-  const double T = tt.back() - tt.front();
-  const double fmax = std::min(25.0, 0.5 * static_cast<double>(xx.size()) / std::max(T, 1e-9));
-  double best = 0, best_f = 0;
-  for (double f = std::max(0.05, 1.0 / std::max(T, 1e-9)); f <= fmax; f += 0.5 / std::max(T, 1.0)) {
-    double re = 0, im = 0;
-    for (size_t i = 0; i < xx.size(); ++i) {
-      const double ph = 2 * M_PI * f * tt[i];
-      re += (xx[i] - mean) * std::cos(ph), im += (xx[i] - mean) * std::sin(ph);
-    }
-    if (re * re + im * im > best) best = re * re + im * im, best_f = f;
-  }
-  return best_f;
-}
 
 // Stage 0: the records and options are fit for a diagnosis (>= 200 samples each, holdout 0.1..0.5,
 // 0..6 effects, one device); throws InputError otherwise.
@@ -350,89 +334,6 @@ std::vector<Eigen::VectorXd> KitchenSinkResiduals(const std::vector<ColumnBank>&
   return out;
 }
 
-// Stage 3d: every record's ceiling (RecordScore::ceiling): all candidate columns at once fitted on
-// that record's bank alone, each effect's value of the sign its range allows (coulomb, viscous,
-// backlash, series_compliance's 1/k, sensor_delay, joint_stiffness >= 0; the others free: a
-// relaxation of DESIGN.md's ranges, so the ceiling bounds any in-range combination), scored on its
-// fit rows against the residual of the model given (weights undone; a joint of weight 0, a
-// one-joint device's held hip, scores 0). Also its null level (RecordScore::ceiling_null): the same
-// fit against the residual shifted circularly in time by kNullShifts of the record's rows (every
-// joint alike), the after-error's sum of squares averaged over the shifts: a circular-shift
-// permutation test of "the residual is no function of the motion", its spectrum kept.
-struct CeilingScores {
-  JointScore ceiling[2], null[2];
-};
-constexpr double kNullShifts[] = {0.2, 0.35, 0.5, 0.65, 0.8};
-std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]) {
-  static const std::set<std::string> kNonNegative = {"coulomb_friction", "viscous_friction", "backlash",
-                                                     "series_compliance", "sensor_delay", "joint_stiffness"};
-  std::vector<CeilingScores> out(banks.size());
-  for (size_t r = 0; r < banks.size(); ++r) {
-    const ColumnBank& b = banks[r];
-    std::vector<int> sign(static_cast<size_t>(b.X.cols()), 0);
-    for (const Candidate& c : b.candidates)
-      if (kNonNegative.count(c.name)) sign[static_cast<size_t>(c.cols[0])] = 1;
-    // The normal equations of the columns this record moves (a column of zeros, e.g. a held hip's,
-    // stays at 0), diagonal regularized by 1e-6 of itself: collinear candidates (the kitchen sink of
-    // one record) pass SolveSigned's conditioning test (1e-8 of the largest
-    // eigenvalue of the unit-diagonal Gram) at a cost of the order of 1e-6 of the fit.
-    // All columns' Gram at once (blocked, one pass over X), then the live columns' part.
-    Eigen::MatrixXd G_all = Eigen::MatrixXd::Zero(b.X.cols(), b.X.cols());
-    G_all.selfadjointView<Eigen::Lower>().rankUpdate(b.X.transpose());
-    const Eigen::VectorXd h_all = b.X.transpose() * b.r;
-    std::vector<int> live;
-    for (Eigen::Index k = 0; k < b.X.cols(); ++k)
-      if (G_all(k, k) > 0) live.push_back(static_cast<int>(k));
-    Eigen::MatrixXd G(live.size(), live.size());
-    Eigen::VectorXd h(live.size());
-    std::vector<int> live_sign(live.size());
-    for (size_t a = 0; a < live.size(); ++a) {
-      h[a] = h_all[live[a]];
-      live_sign[a] = sign[static_cast<size_t>(live[a])];
-      for (size_t c = a; c < live.size(); ++c) G(a, c) = G(c, a) = G_all(std::max(live[a], live[c]), std::min(live[a], live[c]));
-    }
-    G.diagonal() += 1e-6 * G.diagonal();
-    Eigen::VectorXd x_live, x = Eigen::VectorXd::Zero(b.X.cols());
-    // With the ridge the unit-diagonal Gram's smallest eigenvalue is >= 1e-6 and its largest <= its
-    // column count, so SolveSigned's test passes for up to 100 columns; beyond that a ceiling of 0 %
-    // would be a false bound, so it is an error, not a score.
-    if (!live.empty() && !SolveSigned(G, h, live_sign, &x_live))
-      throw std::logic_error("diagnose: the ceiling of record " + std::to_string(r) + " (" +
-                             std::to_string(live.size()) + " candidate columns) is too ill-conditioned to solve");
-    for (size_t a = 0; a < live.size(); ++a) x[live[a]] = x_live[static_cast<Eigen::Index>(a)];
-    const Eigen::VectorXd e = b.r - b.X * x;
-    const Eigen::Index m = static_cast<Eigen::Index>(b.sample.size());
-    // The null level: the same normal equations against the shifted residuals (all shifts in one
-    // pass over X).
-    constexpr Eigen::Index S = static_cast<Eigen::Index>(std::size(kNullShifts));
-    Eigen::MatrixXd RS(b.r.size(), S), XS = Eigen::MatrixXd::Zero(b.X.cols(), S);
-    for (Eigen::Index s = 0; s < S; ++s) {
-      const Eigen::Index k = static_cast<Eigen::Index>(kNullShifts[s] * static_cast<double>(m));
-      for (Eigen::Index j = 0; j < 2; ++j)
-        for (Eigen::Index i = 0; i < m; ++i) RS(j * m + i, s) = b.r[j * m + (i + k) % m];
-    }
-    const Eigen::MatrixXd HS = b.X.transpose() * RS;
-    for (Eigen::Index s = 0; s < S; ++s) {
-      Eigen::VectorXd hs(live.size()), xs_live;
-      for (size_t a = 0; a < live.size(); ++a) hs[a] = HS(live[a], s);
-      if (!live.empty() && !SolveSigned(G, hs, live_sign, &xs_live))
-        throw std::logic_error("diagnose: the null ceiling of record " + std::to_string(r) + " is too ill-conditioned to solve");
-      for (size_t a = 0; a < live.size(); ++a) XS(live[a], s) = xs_live[static_cast<Eigen::Index>(a)];
-    }
-    RS.noalias() -= b.X * XS;  // the shifted residuals' errors
-    double null_sse[2] = {0, 0};
-    for (Eigen::Index s = 0; s < S; ++s)
-      for (int j = 0; j < 2; ++j) null_sse[j] += RS.col(s).segment(j * m, m).squaredNorm() / static_cast<double>(S);
-    for (int j = 0; j < 2; ++j) {
-      if (!(w[j] > 0) || m == 0) continue;
-      const double before = b.r.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
-      const double after = e.segment(j * m, m).squaredNorm() / (w[j] * w[j]);
-      out[r].ceiling[j] = ScoreOf(before, after, static_cast<double>(m));
-      out[r].null[j] = ScoreOf(before, null_sse[j] / (w[j] * w[j]), static_cast<double>(m));
-    }
-  }
-  return out;
-}
 
 // Stage 3: the candidate columns of every record (the same columns in each bank, rows weighted by
 // w), with the ripple candidates' frequency searched.
@@ -919,9 +820,9 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
   S.note = S.done ? os.str() : "not simulated: every part is shorter than the horizon of " + NumberText(opt.replay_horizon_s) + " s";
 }
 
-// Stage 7: structure the extended twin leaves in the first record's held-out residual (5 Hz
-// low-passed rms above 4x the low-passed noise, 0.05 N m and 15 % of rmse_before) into
-// D->unexplained, with its dominant frequency and correlations. Needs D->kin, split, measured, after.
+// Stage 7: structure the extended twin leaves in the first record's held-out residual torque
+// (StructureLeft, diagnose_unexplained.h: the floor kUnexplainedFloorTorque) into D->unexplained.
+// Needs D->kin, split, measured, after.
 void FindUnexplained(Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   const Kinematics& kin = D.kin;
@@ -929,34 +830,11 @@ void FindUnexplained(Diagnosis* D_out) {
   const double dt = (kin.t.back() - kin.t.front()) / static_cast<double>(n - 1);
   const double fs = 1.0 / dt;
   for (int j = D.extended.one_joint ? 1 : 0; j < 2; ++j) {
-    std::vector<double> e(n - D.split);
-    for (size_t i = D.split; i < n; ++i) e[i - D.split] = D.measured[j][i] - D.after[j][i];
-    std::vector<double> elp = e;
-    if (fs > 12) elp = dsp::FiltFilt(dsp::DesignButterworth(2, dsp::BandType::kLowPass, fs, 5.0), e);
-    double mean = 0, rms = 0;
-    for (double v : elp) mean += v;
-    mean /= static_cast<double>(elp.size());
-    for (double v : elp) rms += (v - mean) * (v - mean);
-    rms = std::sqrt(rms / static_cast<double>(elp.size()));
-    const double white_lp = D.noise[j] * std::sqrt(std::min(1.0, 10.0 / fs));
-    if (rms > std::max(4.0 * white_lp, 0.05) && rms > 0.15 * D.joints[j].rmse_before) {
-      UnexplainedStructure u;
-      u.joint = kJoint[j];
-      u.rms = rms;
-      std::vector<double> full(n, 0.0);
-      for (size_t i = D.split; i < n; ++i) full[i] = D.measured[j][i] - D.after[j][i];
-      u.dominant_hz = DominantHz(kin.t, full, D.split, n);
-      u.corr_q = Pearson(full, kin.q[j], D.split, n);
-      u.corr_qd = Pearson(full, kin.qd[j], D.split, n);
-      u.corr_qdd = Pearson(full, kin.qdd[j], D.split, n);
-      u.corr_t = Pearson(full, kin.t, D.split, n);
-      const double cs[4] = {std::abs(u.corr_q), std::abs(u.corr_qd), std::abs(u.corr_qdd), std::abs(u.corr_t)};
-      const char* what[4] = {"angle", "velocity", "acceleration", "time (drift)"};
-      const int k = static_cast<int>(std::max_element(cs, cs + 4) - cs);
-      u.hint = cs[k] > 0.3 ? std::string("follows the ") + what[k]
-                           : "not a function of angle, velocity, acceleration or time alone";
-      D.unexplained.push_back(u);
-    }
+    std::vector<double> full(n, 0.0);
+    for (size_t i = D.split; i < n; ++i) full[i] = D.measured[j][i] - D.after[j][i];
+    const HeldOutResidual r{kin.t, full, kin.q[j], kin.qd[j], kin.qdd[j], D.split, n, fs};
+    if (auto u = StructureLeft(r, j, D.noise[j], kUnexplainedFloorTorque, D.joints[j].rmse_before))
+      D.unexplained.push_back(*u);
   }
 }
 

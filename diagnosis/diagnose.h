@@ -66,6 +66,7 @@ constexpr size_t kMaxAliases = 6;
 struct UnexplainedStructure {
   std::string joint;
   double rms = 0;                // N m, low-passed (5 Hz) held-out residual after the extension
+                                 // (the motion fit: rad, the simulated angle's)
   double dominant_hz = 0;        // peak of the residual spectrum
   double corr_q = 0, corr_qd = 0, corr_qdd = 0, corr_t = 0;  // Pearson correlation with r
   std::string hint;              // words: what it looks like

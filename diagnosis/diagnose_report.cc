@@ -249,7 +249,8 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<h2>Unexplained structure</h2>";
   if (d.unexplained.empty()) o << "<p>None above the noise.</p>";
   for (const auto& u : d.unexplained)
-    o << "<p><b>" << u.joint << "</b>: rms " << NumberText(u.rms, 3) << " N m (below 5 Hz), dominant "
+    o << "<p><b>" << u.joint << "</b>: rms " << NumberText(u.rms, 3)
+      << (d.fit == DiagnoseFit::kMotion ? " rad" : " N m") << " (below 5 Hz), dominant "
       << NumberText(u.dominant_hz, 3) << " Hz; correlation with angle " << NumberText(u.corr_q, 2) << ", velocity "
       << NumberText(u.corr_qd, 2) << ", acceleration " << NumberText(u.corr_qdd, 2) << ", time " << NumberText(u.corr_t, 2)
       << " &mdash; " << HtmlEscape(u.hint) << ".</p>";

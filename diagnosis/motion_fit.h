@@ -214,6 +214,9 @@ class MotionProblem {
  private:
   struct Record;
   Rollout Run(const Eigen::VectorXd& theta, Part part, int only) const;  // only >= 0: that record alone
+  // The candidates (candidates_) and their parameters (kind_, joint_, lo_, hi_, step_, ripple_f_) of
+  // the records' kinematics `kins` (motion_fit.h "Candidates"; sets qd_rms_), motion_candidates.cc.
+  void AddCandidates(const std::vector<Kinematics>& kins, const std::vector<DiagnosedEffect>& torque_named);
   // rw_ and w_ = 1 / the RMS of per-record fit-part SSEs `sse` and of the pooled `pooled` (rad^2);
   // a one-joint device's hip: 0.
   void SetWeights(const std::vector<std::array<double, 2>>& sse, const double pooled[2]);

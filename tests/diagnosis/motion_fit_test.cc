@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "diagnosis/diagnose.h"
+#include "diagnosis/generate.h"
 #include "diagnosis/motion_fit.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
@@ -477,6 +478,46 @@ TEST(MotionFit, HumanSideStrapDampingAndPassiveMomentsAreNamed) {
     ASSERT_TRUE(named.count(t.first)) << t.first << " not named";
     EXPECT_NEAR(named[t.first], t.second, 0.25 * std::abs(t.second)) << t.first;
   }
+}
+
+// Diagnosis::unexplained of the motion fit (StructureLeft, diagnose_unexplained.h, on the first
+// record's held-out simulated angle): a subject's muscles at the knee (a generated record whose torque
+// holds muscle activity, which the forward plant cannot carry: no candidate explains the motion the
+// reading drives) leave structure there; a clean record of the same generator leaves none.
+Diagnosis MotionFitOfGenerated(const std::vector<std::string>& effects, uint64_t seed) {
+  GenerateOptions g;
+  g.seed = seed;
+  g.effects = static_cast<int>(effects.size());
+  g.allowed = effects;
+  g.joint = "knee";
+  g.duration = 20;
+  g.rate = 500;
+  const LegParams base = ReadModelFile(kSrc + "/examples/S1.yaml");
+  DiagnoseOptions opt;
+  opt.fit = DiagnoseFit::kMotion;
+  opt.threads = 2;
+  const Diagnosis d = Diagnose(base, GenerateMeasured(base, g).data, opt);
+  Print(effects.empty() ? "clean record" : effects[0], d);
+  for (const auto& u : d.unexplained)
+    std::printf("  unexplained at the %s: rms %.4g rad, %.3g Hz, %s\n", u.joint.c_str(), u.rms, u.dominant_hz,
+                u.hint.c_str());
+  return d;
+}
+
+TEST(MotionFit, MuscleActivityIsUnexplainedStructure) {
+  const Diagnosis d = MotionFitOfGenerated({"muscle_activity"}, 7);
+  bool knee = false;
+  for (const auto& u : d.unexplained) knee = knee || u.joint == "knee";
+  EXPECT_TRUE(knee);
+  bool listed = false;  // and the torque fit's muscle activity is listed as not carried
+  for (const auto& o : d.torque_only) listed = listed || (o.effect.name == "muscle_activity" && !o.simulated);
+  EXPECT_TRUE(listed);
+}
+
+TEST(MotionFit, NothingIsUnexplainedOnACleanRecord) {
+  const Diagnosis d = MotionFitOfGenerated({}, 21);
+  EXPECT_TRUE(d.effects.empty());
+  EXPECT_TRUE(d.unexplained.empty());
 }
 
 TEST(MotionFit, NothingIsNamedOnTheRigidPlant) {

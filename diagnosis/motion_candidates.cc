@@ -1,0 +1,208 @@
+// The motion fit's effect candidates (motion_fit.h "Candidates"): which effects are candidates, their
+// parameters, boxes and secant steps, the effects a parameter vector stands for, and the torque fit's
+// effects as parameter values. The code of the motion fit that branches on effect names lives here.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "diagnosis/motion_fit.h"
+#include "diagnosis/motion_fit_internal.h"
+#include "model/passive_torque.h"
+
+namespace exotwin {
+
+namespace {
+
+constexpr double kNoBacklash = 1e-5;    // rad: a narrower dead band is none (the hinge is not built)
+constexpr double kNoCompliance = 1e-7;  // rad/(N m): a stiffer strap is none
+
+// The effect of the model given that takes the place of candidate `name` at `joint` (the same effect;
+// a dead band or a strap for either: one internal hinge per joint), nullptr if none.
+const Effect* CarriedByModel(const LegParams& params, const std::string& name, const std::string& joint) {
+  auto hinge = [](const std::string& n) { return n == "backlash" || n == "series_compliance"; };
+  for (const Effect& e : params.effects)
+    if (e.joint == joint && (e.name == name || (hinge(name) && hinge(e.name)))) return &e;
+  return nullptr;
+}
+
+}  // namespace
+
+namespace motion {
+
+bool TorqueValues(const MotionProblem& P, const Effect& e, Eigen::VectorXd* theta) {
+  const int c = P.CandidateIndex(e.name, e.joint, e.axis);
+  if (c < 0) return false;
+  const Candidate& cand = P.candidates()[static_cast<size_t>(c)];
+  const double v = e.value;
+  if (e.name == "series_compliance") {
+    (*theta)[cand.cols[0]] = v > 0 ? 1 / v : 0;
+  } else if (e.name == "joint_stiffness") {
+    (*theta)[cand.cols[0]] = v;
+    (*theta)[cand.cols[1]] = v * (e.fields.count("q0") ? e.fields.at("q0") : 0.0);
+  } else if (e.name == "torque_ripple") {
+    const double ph = e.fields.count("phase") ? e.fields.at("phase") : 0.0;
+    (*theta)[cand.cols[0]] = v * std::cos(ph);
+    (*theta)[cand.cols[1]] = v * std::sin(ph);
+  } else {
+    (*theta)[cand.cols[0]] = v;
+  }
+  return true;
+}
+
+bool TorqueValuesOfSet(const MotionProblem& P, const std::vector<DiagnosedEffect>& torque, const std::vector<int>& chosen,
+                       Eigen::VectorXd* start_torque) {
+  const std::vector<Candidate>& cands = P.candidates();
+  bool has_torque = false;
+  for (int c : chosen)
+    for (const DiagnosedEffect& e : torque) {
+      const Candidate& cand = cands[static_cast<size_t>(c)];
+      if (e.effect.name == cand.name && e.effect.joint == kJoint[cand.joint] &&
+          (cand.name != "gravity_error" || e.effect.axis == cand.axis))
+        has_torque = TorqueValues(P, e.effect, start_torque) || has_torque;
+    }
+  return has_torque;
+}
+
+}  // namespace motion
+
+using motion::RmsAboutMean;
+using motion::kJoint;
+
+void MotionProblem::AddCandidates(const std::vector<Kinematics>& kins, const std::vector<DiagnosedEffect>& torque_named) {
+  const LegParams& params = params_;
+  const int j0 = params.one_joint ? 1 : 0;
+  // Parameters, their boxes (DESIGN.md's ranges) and secant steps.
+  auto Add = [&](const std::string& kind, int j, double lo, double hi, double step, double f = 0) {
+    kind_.push_back(kind), joint_.push_back(j), lo_.push_back(lo), hi_.push_back(hi), step_.push_back(step);
+    ripple_f_.push_back(f);
+    return static_cast<int>(lo_.size()) - 1;
+  };
+  auto Has = [&](const std::string& name, int j) { return CarriedByModel(params, name, kJoint[j]) != nullptr; };
+  for (int j = j0; j < 2; ++j) {
+    double qd2 = 0, qdev = 0, cnt = 0;
+    std::vector<double> all_q;
+    for (const Kinematics& k : kins) {
+      for (double v : k.qd[j]) qd2 += v * v, cnt += 1;
+      all_q.insert(all_q.end(), k.q[j].begin(), k.q[j].end());
+    }
+    qdev = std::max(RmsAboutMean(all_q), 1e-3);
+    const double qd_rms = std::max(std::sqrt(qd2 / std::max(cnt, 1.0)), 1e-3);
+    qd_rms_[j] = qd_rms;
+    const double tau = std::max(scale_.tau_max[j], 1e-3);
+    const double M = std::max(scale_.M_jj[j], 1e-6);
+    const double grav = 0.5 * scale_.distal_moment[j] + 0.05;
+    const double range = scale_.q_max[j] - scale_.q_min[j];
+    auto Cand = [&](const std::string& name, std::vector<int> cols, const std::string& axis = "") {
+      Candidate c;
+      c.name = name, c.joint = j, c.axis = axis, c.cols = std::move(cols);
+      c.ripple_f = ripple_f_[static_cast<size_t>(c.cols[0])];
+      candidates_.push_back(c);
+    };
+    const int off = Add("offset", j, -0.5 * tau, 0.5 * tau, 0.02 * tau);
+    // Friction and inertia are summed by the plant (sim/plant_effects.h): candidates on top of the
+    // model's own (a one-joint device's R and C are its knee's frictions, model/one_joint.h).
+    Cand("coulomb_friction", {Add("coulomb_friction", j, 0, 0.5 * tau, 0.02 * tau)});
+    Cand("viscous_friction", {Add("viscous_friction", j, 0, 100 * tau / qd_rms, 0.02 * tau / qd_rms)});
+    Cand("inertia_error", {Add("inertia_error", j, -0.45 * M, M, 0.02 * M)});
+    if (!Has("gravity_error", j)) {
+      Cand("gravity_error", {Add("gravity_error.X", j, -grav, grav, 0.02 * grav)}, "X");
+      Cand("gravity_error", {Add("gravity_error.Y", j, -grav, grav, 0.02 * grav)}, "Y");
+    }
+    if (!Has("joint_stiffness", j))
+      Cand("joint_stiffness", {Add("joint_stiffness", j, 0, 100 * tau / qdev, 0.02 * tau / qdev), off});
+    if (params.human && !params.one_joint && !Has("passive_moment", j))
+      Cand("passive_moment", {Add("passive_moment", j, -0.95, kMaxPassiveScale - 1, 0.05)});
+    if (!Has("backlash", j)) Cand("backlash", {Add("backlash", j, 0, 0.1, 0.005)});
+    if (!Has("series_compliance", j) && !(j == 0 && params.human)) {
+      const double tc = std::max(scale_.tau_C_max[j], 1e-3);
+      Cand("series_compliance", {Add("series_compliance", j, 0, 0.5 * range / tc, 0.005 / tc)});
+    }
+    for (const DiagnosedEffect& d : torque_named)
+      if (d.effect.name == "torque_ripple" && d.effect.joint == kJoint[j] && !Has("torque_ripple", j)) {
+        const double f = d.effect.fields.at("cycles_per_rad");
+        const int a = Add("torque_ripple.sin", j, -0.5 * tau, 0.5 * tau, 0.02 * tau, f);
+        Cand("torque_ripple", {a, Add("torque_ripple.cos", j, -0.5 * tau, 0.5 * tau, 0.02 * tau, f)});
+      }
+    if (reading_input_) {
+      if (!Has("sensor_offset", j)) Cand("sensor_offset", {off});
+      if (!Has("sensor_gain", j)) Cand("sensor_gain", {Add("sensor_gain", j, -0.25, 0.25, 0.02)});
+      if (!Has("sensor_delay", j)) Cand("sensor_delay", {Add("sensor_delay", j, 0, 0.05, 0.002)});
+    }
+  }
+
+}
+
+int MotionProblem::CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis) const {
+  for (size_t c = 0; c < candidates_.size(); ++c)
+    if (candidates_[c].name == name && kJoint[candidates_[c].joint] == joint &&
+        (name != "gravity_error" || candidates_[c].axis == axis))
+      return static_cast<int>(c);
+  return -1;
+}
+
+std::string MotionProblem::WhyNoCandidate(const Effect& e) const {
+  if (CandidateIndex(e.name, e.joint, e.axis) >= 0) return "";
+  if (e.name == "muscle_activity") return "not carried by the forward plant";
+  if (e.name.rfind("sensor_", 0) == 0 && !reading_input_) return "the commands drive the plant: no torque reading to correct";
+  if (const Effect* g = CarriedByModel(params_, e.name, e.joint))
+    return "the model given already carries a " + g->name + " at the " + g->joint + ": no candidate";
+  if (e.name == "series_compliance" && e.joint == "hip" && params_.human)
+    return "the plant carries a strap with a human at the knee only";
+  if (e.name == "passive_moment") return "no passive moment in this model (a two-joint model with a human carries it)";
+  if (params_.one_joint && e.joint == "hip") return "a one-joint model has no hip";
+  return "no candidate of the motion fit";
+}
+
+std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const {
+  std::vector<Effect> link, sensor;
+  auto Make = [](const std::string& name, int j, double v, const std::string& unit) {
+    Effect e;
+    e.name = name, e.joint = kJoint[j], e.value = v, e.unit = unit;
+    return e;
+  };
+  for (int k = 0; k < parameters(); ++k) {
+    const double v = theta[k];
+    const int j = joint_[k];
+    const std::string& kind = kind_[k];
+    if (v == 0) continue;
+    if (kind == "coulomb_friction" && v > 0) link.push_back(Make(kind, j, v, "N m"));
+    if (kind == "viscous_friction" && v > 0) link.push_back(Make(kind, j, v, "N m s/rad"));
+    if (kind == "inertia_error") link.push_back(Make(kind, j, v, "kg m^2"));
+    if (kind == "passive_moment") link.push_back(Make(kind, j, v, "relative"));
+    if (kind.rfind("gravity_error", 0) == 0) {
+      Effect e = Make("gravity_error", j, v, "kg m");
+      e.axis = kind.substr(14);
+      link.push_back(e);
+    }
+    if (kind == "joint_stiffness" && v > 0) {  // its constant part k q0 is the offset parameter
+      Effect e = Make(kind, j, v, "N m/rad");
+      e.fields["q0"] = 0;
+      link.push_back(e);
+    }
+    if (kind == "backlash" && v > kNoBacklash) link.push_back(Make(kind, j, v, "rad"));
+    if (kind == "series_compliance" && v > kNoCompliance) link.push_back(Make(kind, j, 1 / v, "N m/rad"));
+    if (kind == "torque_ripple.sin") {
+      const double b = theta[k + 1];
+      Effect e = Make("torque_ripple", j, std::hypot(v, b), "N m");
+      e.fields["cycles_per_rad"] = ripple_f_[k];
+      e.fields["phase"] = std::atan2(b, v);
+      link.push_back(e);
+    }
+    // The input's constant torque: a sensor offset where the reading drives (tau_R = -(reading - offset)).
+    if (kind == "offset" && reading_input_) sensor.push_back(Make("sensor_offset", j, v, "N m"));
+    if (kind == "sensor_gain") sensor.push_back(Make(kind, j, v, "relative"));
+    if (kind == "sensor_delay" && v > 0) sensor.push_back(Make(kind, j, v, "s"));
+  }
+  for (int k = 0; k < parameters(); ++k)  // a ripple whose sine part is 0
+    if (kind_[k] == "torque_ripple.cos" && theta[k] != 0 && theta[k - 1] == 0) {
+      Effect e = Make("torque_ripple", joint_[k], std::abs(theta[k]), "N m");
+      e.fields["cycles_per_rad"] = ripple_f_[k];
+      e.fields["phase"] = std::atan2(theta[k], 0.0);
+      link.push_back(e);
+    }
+  link.insert(link.end(), sensor.begin(), sensor.end());
+  return link;
+}
+
+}  // namespace exotwin
