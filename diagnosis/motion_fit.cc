@@ -474,7 +474,7 @@ void MotionFit::FindUnexplained() {
     }
     const double noise = std::sqrt(diff2 / (2.0 * std::max(diffs, 1.0)));
     const HeldOutResidual r{t, e, q, qd, qdd, 0, e.size(), fs};
-    if (auto u = StructureLeft(r, j, noise, kUnexplainedFloorAngle, D.joints[j].rmse_before))
+    if (auto u = StructureLeft(r, j, noise, kUnexplainedFloorAngle, D.records[0].split[j].rmse_before))
       D.unexplained.push_back(*u);
   }
 }

@@ -108,7 +108,8 @@
 // Diagnosis fields of a motion fit: effects (value, ci95), extended, selection, records (split: the
 // simulated angle, rad), joints (the same pooled, rad), simulation (rigid vs extended, held-out and
 // whole records left out, and the torque fit's twin on the same rows), noise (the records pooled:
-// 1 / w_j, rad), tau_eff (rows), torque_named, torque_only; cutoff and kin are the torque fit's (the
+// 1 / w_j, rad), tau_eff (rows), torque_named, torque_only, unexplained (the first record's held-out
+// simulated angle, rad; MotionFit::FindUnexplained); cutoff and kin are the torque fit's (the
 // report's header).
 #pragma once
 #include <array>

@@ -134,7 +134,9 @@ class MotionFit {
   // SimulationScores::torque_fit_*: the torque fit's twin on the same rows.
   void ScoreTorqueFitTwin();
   // D.unexplained: the structure the extended twin leaves in the first record's held-out simulated
-  // angle (StructureLeft, diagnose_unexplained.h).
+  // angle (StructureLeft, diagnose_unexplained.h): its scored held-out rows in time order (the windows
+  // joined), the white noise from the first differences of consecutive samples, the floor
+  // kUnexplainedFloorAngle, 15 % of that record's own held-out error of the model given.
   void FindUnexplained();
   // The simulation's cost in the selection log, the method in words; the diagnosis.
   Diagnosis Finish();
