@@ -8,6 +8,7 @@
 
 #include "diagnosis/motion_fit.h"
 #include "diagnosis/motion_fit_internal.h"
+#include "formats/number_text.h"
 #include "model/passive_torque.h"
 
 namespace exotwin {
@@ -48,6 +49,28 @@ bool TorqueValues(const MotionProblem& P, const Effect& e, Eigen::VectorXd* thet
     (*theta)[cand.cols[0]] = v;
   }
   return true;
+}
+
+int CandidateOf(const MotionProblem& P, const Effect& fx) {
+  return P.CandidateIndex(fx.name, fx.joint, fx.name == "gravity_error" ? fx.axis : "");
+}
+
+void ExtendedTwin(const LegParams& params, Diagnosis* D_out) {
+  Diagnosis& D = *D_out;
+  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
+    const bool sa = a.effect.name.rfind("sensor_", 0) == 0, sb = b.effect.name.rfind("sensor_", 0) == 0;
+    return sa != sb ? !sa : a.explained_pct > b.explained_pct;
+  });
+  D.extended = params;
+  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
+  // The sensor effects in the order the rollouts applied them (offset, gain, delay).
+  std::stable_sort(D.extended.effects.begin() + static_cast<long>(params.effects.size()), D.extended.effects.end(),
+                   [](const Effect& a, const Effect& b) {
+                     auto rank = [](const Effect& e) {
+                       return e.name == "sensor_offset" ? 1 : e.name == "sensor_gain" ? 2 : e.name == "sensor_delay" ? 3 : 0;
+                     };
+                     return rank(a) < rank(b);
+                   });
 }
 
 bool TorqueValuesOfSet(const MotionProblem& P, const std::vector<DiagnosedEffect>& torque, const std::vector<int>& chosen,
@@ -205,4 +228,46 @@ std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const
   return link;
 }
 
+namespace motion {
+
+// The friction's form on the exact plant: each named viscous friction exchanged for a Coulomb
+// friction at its joint and the other way round (the linear model's ranking cannot tell the two
+// apart where the joint's speed is nearly constant in magnitude; the torque fit's confusion),
+// from the value dissipating the same power at the joint's RMS speed (c = b qd_rms) and from the
+// torque fit's, taken where the exact fit-part BIC is lower.
+void MotionFit::ExchangeFrictionForm(int round) {
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    const Candidate& from = cands[static_cast<size_t>(chosen[i])];
+    if (from.name != "viscous_friction" && from.name != "coulomb_friction") continue;
+    const bool to_coulomb = from.name == "viscous_friction";
+    const int to = P.CandidateIndex(to_coulomb ? "coulomb_friction" : "viscous_friction", kJoint[from.joint]);
+    if (to < 0 || std::find(chosen.begin(), chosen.end(), to) != chosen.end()) continue;
+    std::vector<int> set = chosen;
+    set[i] = to;
+    const int kf = from.cols[0], kt = cands[static_cast<size_t>(to)].cols[0];
+    const double v = theta[kf], speed = P.qd_rms(from.joint);
+    std::vector<Eigen::VectorXd> starts(1, theta);
+    starts[0][kf] = 0;
+    starts[0][kt] = std::clamp(to_coulomb ? v * speed : v / speed, P.lower(kt), P.upper(kt));
+    for (const DiagnosedEffect& d : T.effects)
+      if (d.effect.name == cands[static_cast<size_t>(to)].name && d.effect.joint == kJoint[from.joint]) {
+        starts.push_back(starts[0]);
+        starts.back()[kt] = std::clamp(d.effect.value, P.lower(kt), P.upper(kt));
+      }
+    const Refined rf = Refine(P, ColumnsOf(cand_bank, set), starts, kMotionLmIterations, false);
+    if (!std::isfinite(rf.cost)) continue;
+    const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    const double bic_x = ExactBic(rf.cost, ParameterCount(set));
+    const bool better = bic_x < bic_now;
+    D.selection.push_back("round " + std::to_string(round + 1) + ": friction form " + Labels(P, chosen) + " -> " +
+                          Labels(P, set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " + NumberText(bic_x, 4) +
+                          (better ? ", taken" : ", not taken"));
+    if (!better) continue;
+    MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);
+    if (!rx.ok) continue;
+    chosen = set, theta = rf.theta, at = std::move(rx);
+  }
+}
+
+}  // namespace motion
 }  // namespace exotwin

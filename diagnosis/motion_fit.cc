@@ -256,20 +256,7 @@ void MotionFit::Intervals() {
       D.effects.push_back(de);
     }
   }
-  std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
-    const bool sa = a.effect.name.rfind("sensor_", 0) == 0, sb = b.effect.name.rfind("sensor_", 0) == 0;
-    return sa != sb ? !sa : a.explained_pct > b.explained_pct;
-  });
-  D.extended = params;
-  for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  // The sensor effects in the order the rollouts applied them (offset, gain, delay).
-  std::stable_sort(D.extended.effects.begin() + static_cast<long>(params.effects.size()), D.extended.effects.end(),
-                   [](const Effect& a, const Effect& b) {
-                     auto rank = [](const Effect& e) {
-                       return e.name == "sensor_offset" ? 1 : e.name == "sensor_gain" ? 2 : e.name == "sensor_delay" ? 3 : 0;
-                     };
-                     return rank(a) < rank(b);
-                   });
+  ExtendedTwin(params, &D);
 }
 
 void MotionFit::ScoreTwins() {

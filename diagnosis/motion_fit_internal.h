@@ -1,6 +1,7 @@
 // The motion fit's parts (motion_fit.h), shared by its files and by nothing else:
 //   motion_problem.cc     MotionProblem: the records, rollouts, Jacobians, weighted errors;
-//   motion_candidates.cc  the candidates, EffectsOf, TorqueValues (the code that branches on names);
+//   motion_candidates.cc  the candidates, EffectsOf, TorqueValues, the friction's form, the effects'
+//                         order (the code that branches on effect names);
 //   motion_refine.cc      the numerics of steps 2-4: weighted residual and Jacobian, Refine, RefineOne,
 //                         LeftOutThetas;
 //   motion_rounds.cc      the phases of steps 2-5 (MotionFit::Rounds, ConfirmTorqueNamed);
@@ -41,6 +42,11 @@ size_t CheckMotionRecord(const LegParams& params, const MeasuredData& data, cons
 
 // The values of a torque-named effect as the candidate's parameters (into *theta); false if none.
 bool TorqueValues(const MotionProblem& P, const Effect& e, Eigen::VectorXd* theta);
+// The candidate of the torque fit's effect fx (CandidateIndex), -1 if none.
+int CandidateOf(const MotionProblem& P, const Effect& fx);
+// D->effects in order (the link effects first, each group by explained_pct) and D->extended: `params`
+// with them, the sensor effects in the order the rollouts apply them (offset, gain, delay).
+void ExtendedTwin(const LegParams& params, Diagnosis* D);
 // TorqueValues of every effect of `torque` that is a candidate of `chosen` (the same name, joint and,
 // for gravity_error, axis), into *theta; false if none is.
 bool TorqueValuesOfSet(const MotionProblem& P, const std::vector<DiagnosedEffect>& torque, const std::vector<int>& chosen,

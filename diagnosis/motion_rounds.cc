@@ -260,45 +260,6 @@ void MotionFit::ExchangeEffects(const ColumnBank& bank, const Grams& g, int roun
   }
 }
 
-// The friction's form on the exact plant: each named viscous friction exchanged for a Coulomb
-// friction at its joint and the other way round (the linear model's ranking cannot tell the two
-// apart where the joint's speed is nearly constant in magnitude; the torque fit's confusion),
-// from the value dissipating the same power at the joint's RMS speed (c = b qd_rms) and from the
-// torque fit's, taken where the exact fit-part BIC is lower.
-void MotionFit::ExchangeFrictionForm(int round) {
-  for (size_t i = 0; i < chosen.size(); ++i) {
-    const Candidate& from = cands[static_cast<size_t>(chosen[i])];
-    if (from.name != "viscous_friction" && from.name != "coulomb_friction") continue;
-    const bool to_coulomb = from.name == "viscous_friction";
-    const int to = P.CandidateIndex(to_coulomb ? "coulomb_friction" : "viscous_friction", kJoint[from.joint]);
-    if (to < 0 || std::find(chosen.begin(), chosen.end(), to) != chosen.end()) continue;
-    std::vector<int> set = chosen;
-    set[i] = to;
-    const int kf = from.cols[0], kt = cands[static_cast<size_t>(to)].cols[0];
-    const double v = theta[kf], speed = P.qd_rms(from.joint);
-    std::vector<Eigen::VectorXd> starts(1, theta);
-    starts[0][kf] = 0;
-    starts[0][kt] = std::clamp(to_coulomb ? v * speed : v / speed, P.lower(kt), P.upper(kt));
-    for (const DiagnosedEffect& d : T.effects)
-      if (d.effect.name == cands[static_cast<size_t>(to)].name && d.effect.joint == kJoint[from.joint]) {
-        starts.push_back(starts[0]);
-        starts.back()[kt] = std::clamp(d.effect.value, P.lower(kt), P.upper(kt));
-      }
-    const Refined rf = Refine(P, ColumnsOf(cand_bank, set), starts, kMotionLmIterations, false);
-    if (!std::isfinite(rf.cost)) continue;
-    const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
-    const double bic_x = ExactBic(rf.cost, ParameterCount(set));
-    const bool better = bic_x < bic_now;
-    D.selection.push_back("round " + std::to_string(round + 1) + ": friction form " + Labels(P, chosen) + " -> " +
-                          Labels(P, set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " + NumberText(bic_x, 4) +
-                          (better ? ", taken" : ", not taken"));
-    if (!better) continue;
-    MotionProblem::Rollout rx = P.Simulate(rf.theta, Part::kBoth);
-    if (!rx.ok) continue;
-    chosen = set, theta = rf.theta, at = std::move(rx);
-  }
-}
-
 // The torque fit's effects put to the plant (motion_fit.h step 5): each effect the torque fit names
 // that is a candidate and not chosen, added to the set at the torque fit's value (fitted on the
 // same fit parts), is tried further where it lowers the held-out simulated error at its joint by
@@ -323,7 +284,7 @@ void MotionFit::ConfirmTorqueNamed() {
   std::vector<char> simulated(T.effects.size(), 0);
   for (size_t e = 0; e < T.effects.size(); ++e) {
     const Effect& fx = T.effects[e].effect;
-    cand_of[e] = P.CandidateIndex(fx.name, fx.joint, fx.name == "gravity_error" ? fx.axis : "");
+    cand_of[e] = CandidateOf(P, fx);
   }
   for (size_t e = 0; e < T.effects.size(); ++e) {
     const int c = cand_of[e];
