@@ -50,68 +50,11 @@ DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where) 
 }
 namespace {
 
-// One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
-// the twin's prediction and the residual.
-struct Rec {
-  std::string source;  // the record's name, for messages
-  size_t samples = 0;  // the record's samples (before the trim)
-  Kinematics kin;
-  std::vector<double> taken[2];         // the record's tau_hip, tau_knee when Diagnose took it over
-  const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
-  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots; released by stage 6)
-  double hz = 0;                        // the parallel low-pass (0: none)
-  // The twin: the rigid actuator torque (after stage 2 only on [0, RefineRows)) and the reading
-  // with the model's effects (released by stage 6).
-  std::vector<double> tau_R[2], tau_S[2];
-  std::vector<double> resid[2];         // Residuals(); released once the candidate columns took their rows
-  size_t split = 0;
-  std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
-  size_t n() const { return kin.t.size(); }
-  // The residual's low-pass (parallel filtering: measured and predicted torque filtered alike) of x,
-  // whose samples are those of kin.t from `from` on.
-  std::vector<double> Filter(std::vector<double> x, size_t from = 0) const {
-    if (!(hz > 0)) return x;
-    if (from == 0 && x.size() == kin.t.size()) return (*low)(std::move(x));
-    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
-    return LowPassOnTimeBase(t, x, hz, source);
-  }
-  // Filter of x[0] and x[1] (one length) together, in place: interleaved, each the same bits as Filter.
-  void FilterBoth(std::vector<double> x[2], size_t from = 0) const {
-    if (!(hz > 0)) return;
-    std::vector<double>* p[2] = {&x[0], &x[1]};
-    if (from == 0 && x[0].size() == kin.t.size()) return low->Apply(p, 2);
-    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x[0].size());
-    TimeBaseLowPass(t, hz, source).Apply(p, 2);
-  }
-  // The filtered residuals of both joints, measured - twin (raw - tau_S), on kin.t's samples: the same
-  // bits wherever they are computed.
-  void Residuals(std::vector<double> e[2]) const {
-    for (int j = 0; j < 2; ++j) {
-      e[j].resize(n());
-      for (size_t i = 0; i < e[j].size(); ++i) e[j][i] = raw[j][i] - tau_S[j][i];
-    }
-    FilterBoth(e);
-  }
-  ColumnFilter FilterFn() const {
-    if (!(hz > 0)) return {};
-    return [this](std::vector<double>* const* xs, size_t count) { low->Apply(xs, count); };
-  }
-  // The measured tau_S of joint j on kin.t's samples (raw[j]'s n values), for the last user of raw:
-  // the column taken over, cut in place, else a copy. raw[j] is left null.
-  std::vector<double> TakeRaw(int j) {
-    std::vector<double> v;
-    if (taken[j].empty()) {
-      v.assign(raw[j], raw[j] + n());
-    } else {
-      const size_t off = static_cast<size_t>(raw[j] - taken[j].data());
-      v = std::move(taken[j]);
-      v.erase(v.begin() + static_cast<long>(off + n()), v.end());
-      v.erase(v.begin(), v.begin() + static_cast<long>(off));
-    }
-    raw[j] = nullptr;
-    return v;
-  }
-};
+using torque_fit::Rec;
+using torque_fit::ExtendAndRefine;
+using torque_fit::RangeEdge;
+using torque_fit::RefineRows;
+using torque_fit::UseSecantDelayColumns;
 
 // Autocorrelation length (in rows) of a residual of 2m rows (hip block, knee block): the longer.
 double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
@@ -155,32 +98,6 @@ void CheckSameDevice(const std::vector<const MeasuredData*>& records) {
                        NumberText(dta) + " s in " + a.source +
                        ", expected records of one device in the same time unit (s)");
   }
-}
-
-// Weighted SSE of the filtered (measured - (base tau_R through ApplyEffects(p))) on samples [a, b).
-double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, size_t b) {
-  if (b <= a + 2) return 0;
-  const Kinematics& kin = rc.kin;
-  Kinematics k;
-  k.t.assign(kin.t.begin() + a, kin.t.begin() + b);
-  std::vector<double> tr[2], ts[2];
-  for (int j = 0; j < 2; ++j) {
-    k.q[j].assign(kin.q[j].begin() + a, kin.q[j].begin() + b);
-    k.qd[j].assign(kin.qd[j].begin() + a, kin.qd[j].begin() + b);
-    k.qdd[j].assign(kin.qdd[j].begin() + a, kin.qdd[j].begin() + b);
-    tr[j].assign(rc.tau_R[j].begin() + a, rc.tau_R[j].begin() + b);
-  }
-  for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
-  ApplyEffects(p, k, tr, ts);
-  double s = 0;
-  const size_t lo = std::min<size_t>(200, (b - a) / 10);  // skip the edges (delay, filters)
-  for (int j = 0; j < 2; ++j) {
-    std::vector<double> e(b - a);
-    for (size_t i = 0; i < b - a; ++i) e[i] = rc.raw[j][a + i] - ts[j][i];
-    e = rc.Filter(std::move(e), a);
-    for (size_t i = lo; i + lo < b - a; ++i) s += std::pow(w[j] * e[i], 2);
-  }
-  return s;
 }
 
 Kinematics Slice(const Kinematics& kin, size_t a, size_t b) {
@@ -357,40 +274,6 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Re
   return banks;
 }
 
-// Stage 3b: every sensor_delay column replaced by the secant (tau_S(t - d) - tau_S(t)) / d at the
-// single fit's delay d (s, pooled over records; kept when 1e-4 < d < 0.5), twice, so the
-// second-order term is not left for sensor_gain.
-void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io) {
-  std::vector<ColumnBank>& banks = *banks_io;
-  for (int pass = 0; pass < 2; ++pass) {
-    for (const auto& c : banks[0].candidates) {
-      if (c.name != "sensor_delay") continue;
-      const int j = c.joint;
-      double xr = 0, xx = 0;
-      for (const ColumnBank& b : banks) {
-        const size_t m = b.sample.size();
-        for (size_t k = 0; k < m; ++k) {
-          if (!b.train[k]) continue;
-          const double x = b.X(j * m + k, c.cols[0]);
-          xr += x * b.r[j * m + k], xx += x * x;
-        }
-      }
-      const double d = xx > 0 ? xr / xx : 0;
-      if (!(d > 1e-4 && d < 0.5)) continue;
-      for (size_t r = 0; r < recs.size(); ++r) {
-        const Rec& rc = recs[r];
-        ColumnBank& b = banks[r];
-        std::vector<double> tq(rc.n());
-        for (size_t i = 0; i < rc.n(); ++i) tq[i] = rc.kin.t[i] - d;
-        const std::vector<double> shifted = Interpolate(rc.kin.t, rc.tau_S[j], tq);
-        std::vector<double> v[2] = {std::vector<double>(rc.n(), 0.0), std::vector<double>(rc.n(), 0.0)};
-        for (size_t i = 0; i < rc.n(); ++i) v[j][i] = (shifted[i] - rc.tau_S[j][i]) / d;
-        SetColumn(b, c.cols[0], w, v);
-      }
-    }
-  }
-}
-
 // Stage 3b (one-joint device): only the candidates of joint j stay (the others' columns are left unused).
 void KeepJointCandidates(int j, std::vector<ColumnBank>* banks) {
   for (ColumnBank& b : *banks)
@@ -424,17 +307,6 @@ PhysicalScale ScaleOf(const LegParams& params, const std::vector<Rec>& recs) {
   std::vector<ScaleRecord> in;
   for (const Rec& rc : recs) in.push_back({&rc.kin, {&rc.meas[0], &rc.meas[1]}});
   return exotwin::ScaleOf(params, in);
-}
-
-// The largest magnitude DESIGN.md's physical range allows a one-parameter candidate (0: unbounded or
-// several parameters).
-double RangeEdge(const Candidate& c, const PhysicalScale& s) {
-  const int j = c.joint;
-  if (c.name == "inertia_error") return s.M_jj[j];
-  if (c.name == "gravity_error") return 0.5 * s.distal_moment[j] + 0.05;
-  if (c.name == "coulomb_friction" || c.name == "sensor_offset") return 0.5 * s.tau_max[j];
-  if (c.name == "sensor_gain") return 0.25;
-  return 0;
 }
 
 // Stage 4b: the report's candidate table into D->scores (the 12 best single candidates by BIC, then
@@ -486,55 +358,6 @@ void ScoreCandidates(const ColumnBank& bank, const Grams& g, const PhysicalScale
         D->collinear.push_back(bank.candidates[a].Label() + " ~ " + bank.candidates[b].Label() +
                                " (|cos| = " + std::to_string(std::abs(r)).substr(0, 5) + ")");
     }
-}
-
-// The samples [0, RefineRows) of a record on which stage 5 refines (of R records).
-size_t RefineRows(const Rec& rc, size_t R) { return std::min<size_t>(rc.split, 6000 / R + 1); }
-
-// Stage 5: the extension D->extended = params + the chosen effects (D->effects); delay, backlash
-// and strap stiffness refined by golden search on the exact model (fit rows); each effect's share of
-// the held-out residual (leave-one-effect-out). Returns each effect's refined / linear value ratio.
-std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
-                                    const ColumnBank& bank, const Grams& g, const Fit& f0,
-                                    const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D) {
-  const size_t R = recs.size();
-  D->extended = params;
-  std::vector<double> refine_ratio(chosen.size(), 1.0);
-  for (int c : chosen) D->effects.push_back(ToEffect(bank.candidates[c], chosen_fit));
-  for (auto& de : D->effects) D->extended.effects.push_back(de.effect);
-  for (size_t k = 0; k < D->effects.size(); ++k) {
-    const std::string& nm = D->effects[k].effect.name;
-    if (nm != "sensor_delay" && nm != "backlash" && nm != "series_compliance") continue;
-    const size_t idx = params.effects.size() + k;
-    const double v0 = D->extended.effects[idx].value;
-    auto obj = [&](double v) {
-      LegParams p = D->extended;
-      p.effects[idx].value = v;
-      double s = 0;
-      for (const Rec& rc : recs) s += ExactSse(p, rc, w, 0, RefineRows(rc, R));
-      return s;
-    };
-    double lo = 0.6 * v0, hi = 1.6 * v0;
-    const double gr = 0.5 * (std::sqrt(5.0) - 1);
-    double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo), f1 = obj(x1), f2 = obj(x2);
-    for (int it = 0; it < 16; ++it) {
-      if (f1 < f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - gr * (hi - lo), f1 = obj(x1);
-      else lo = x1, x1 = x2, f1 = f2, x2 = lo + gr * (hi - lo), f2 = obj(x2);
-    }
-    const double v = 0.5 * (lo + hi);
-    refine_ratio[k] = v / v0;
-    D->extended.effects[idx].value = v;
-    D->effects[k].effect.value = v;
-    D->effects[k].ci_lo *= v / v0, D->effects[k].ci_hi *= v / v0;
-  }
-  // Share of the held-out residual each effect removes (joint linear model, leave-one-effect-out).
-  for (size_t k = 0; k < chosen.size(); ++k) {
-    std::vector<int> rest = chosen;
-    rest.erase(rest.begin() + static_cast<long>(k));
-    const Fit fr = FitCols(g, ColumnsOf(bank, rest));
-    D->effects[k].explained_pct = f0.sse_te > 0 ? 100 * (fr.sse_te - chosen_fit.sse_te) / f0.sse_te : 0;
-  }
-  return refine_ratio;
 }
 
 // Stage 5b: each named effect's aliases (DiagnosedEffect::aliases). With the other named effects

@@ -1,9 +1,14 @@
-// The torque fit's internal parts shared by its files (diagnose.cc, diagnose_ceiling.cc).
+// The torque fit's internal parts shared by its files (diagnose.cc, diagnose_ceiling.cc,
+// diagnose_torque_effects.cc).
 #pragma once
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "diagnosis/diagnose.h"
 #include "diagnosis/diagnose_columns.h"
+#include "diagnosis/diagnose_select.h"
+#include "formats/measured_data.h"
 
 namespace exotwin {
 
@@ -24,4 +29,89 @@ struct CeilingScores {
 };
 std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]);
 
+namespace torque_fit {
+
+// One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
+// the twin's prediction and the residual.
+struct Rec {
+  std::string source;  // the record's name, for messages
+  size_t samples = 0;  // the record's samples (before the trim)
+  Kinematics kin;
+  std::vector<double> taken[2];         // the record's tau_hip, tau_knee when Diagnose took it over
+  const double* raw[2] = {nullptr, nullptr};  // measured tau_S: the record's, from kin.t's first sample
+  std::vector<double> meas[2];          // measured tau_S, filtered as the angles (for plots; released by stage 6)
+  double hz = 0;                        // the parallel low-pass (0: none)
+  // The twin: the rigid actuator torque (after stage 2 only on [0, RefineRows)) and the reading
+  // with the model's effects (released by stage 6).
+  std::vector<double> tau_R[2], tau_S[2];
+  std::vector<double> resid[2];         // Residuals(); released once the candidate columns took their rows
+  size_t split = 0;
+  std::optional<TimeBaseLowPass> low;   // the low-pass at hz on kin.t (hz > 0)
+  size_t n() const { return kin.t.size(); }
+  // The residual's low-pass (parallel filtering: measured and predicted torque filtered alike) of x,
+  // whose samples are those of kin.t from `from` on.
+  std::vector<double> Filter(std::vector<double> x, size_t from = 0) const {
+    if (!(hz > 0)) return x;
+    if (from == 0 && x.size() == kin.t.size()) return (*low)(std::move(x));
+    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x.size());
+    return LowPassOnTimeBase(t, x, hz, source);
+  }
+  // Filter of x[0] and x[1] (one length) together, in place: interleaved, each the same bits as Filter.
+  void FilterBoth(std::vector<double> x[2], size_t from = 0) const {
+    if (!(hz > 0)) return;
+    std::vector<double>* p[2] = {&x[0], &x[1]};
+    if (from == 0 && x[0].size() == kin.t.size()) return low->Apply(p, 2);
+    const std::vector<double> t(kin.t.begin() + from, kin.t.begin() + from + x[0].size());
+    TimeBaseLowPass(t, hz, source).Apply(p, 2);
+  }
+  // The filtered residuals of both joints, measured - twin (raw - tau_S), on kin.t's samples: the same
+  // bits wherever they are computed.
+  void Residuals(std::vector<double> e[2]) const {
+    for (int j = 0; j < 2; ++j) {
+      e[j].resize(n());
+      for (size_t i = 0; i < e[j].size(); ++i) e[j][i] = raw[j][i] - tau_S[j][i];
+    }
+    FilterBoth(e);
+  }
+  ColumnFilter FilterFn() const {
+    if (!(hz > 0)) return {};
+    return [this](std::vector<double>* const* xs, size_t count) { low->Apply(xs, count); };
+  }
+  // The measured tau_S of joint j on kin.t's samples (raw[j]'s n values), for the last user of raw:
+  // the column taken over, cut in place, else a copy. raw[j] is left null.
+  std::vector<double> TakeRaw(int j) {
+    std::vector<double> v;
+    if (taken[j].empty()) {
+      v.assign(raw[j], raw[j] + n());
+    } else {
+      const size_t off = static_cast<size_t>(raw[j] - taken[j].data());
+      v = std::move(taken[j]);
+      v.erase(v.begin() + static_cast<long>(off + n()), v.end());
+      v.erase(v.begin(), v.begin() + static_cast<long>(off));
+    }
+    raw[j] = nullptr;
+    return v;
+  }
+};
+
+// Stage 3b: every sensor_delay column replaced by the secant (tau_S(t - d) - tau_S(t)) / d at the
+// single fit's delay d (s, pooled over records; kept when 1e-4 < d < 0.5), twice, so the
+// second-order term is not left for sensor_gain.
+void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io);
+
+// The largest magnitude DESIGN.md's physical range allows a one-parameter candidate (0: unbounded or
+// several parameters).
+double RangeEdge(const Candidate& c, const PhysicalScale& s);
+
+// The samples [0, RefineRows) of a record on which stage 5 refines (of R records).
+size_t RefineRows(const Rec& rc, size_t R);
+
+// Stage 5: the extension D->extended = params + the chosen effects (D->effects); delay, backlash
+// and strap stiffness refined by golden search on the exact model (fit rows); each effect's share of
+// the held-out residual (leave-one-effect-out). Returns each effect's refined / linear value ratio.
+std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
+                                    const ColumnBank& bank, const Grams& g, const Fit& f0,
+                                    const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D);
+
+}  // namespace torque_fit
 }  // namespace exotwin
