@@ -16,8 +16,9 @@ void CdrWriter::Align(size_t n) {
 
 void CdrWriter::Primitive(const void* v, size_t n) {
   Align(n);
-  const auto* p = static_cast<const uint8_t*>(v);
-  buf_.insert(buf_.end(), p, p + n);
+  const size_t at = buf_.size();
+  buf_.resize(at + n);
+  std::memcpy(buf_.data() + at, v, n);
 }
 
 void CdrWriter::String(const std::string& v) {
@@ -26,12 +27,14 @@ void CdrWriter::String(const std::string& v) {
   buf_.push_back(0);
 }
 
-void CdrWriter::Float64Sequence(const double* v, size_t n) {
+size_t CdrWriter::Float64Sequence(const double* v, size_t n) {
   Uint32(static_cast<uint32_t>(n));
-  if (n == 0) return;
+  if (n == 0) return 0;
   Align(8);
-  const auto* p = reinterpret_cast<const uint8_t*>(v);
-  buf_.insert(buf_.end(), p, p + 8 * n);
+  const size_t at = buf_.size();
+  buf_.resize(at + 8 * n);
+  std::memcpy(buf_.data() + at, v, 8 * n);
+  return at;
 }
 
 void CdrWriter::StringSequence(const std::vector<std::string>& v) {
@@ -39,30 +42,56 @@ void CdrWriter::StringSequence(const std::vector<std::string>& v) {
   for (const std::string& s : v) String(s);
 }
 
-void Time(CdrWriter& w, int64_t ns) {
-  int64_t sec = ns / 1000000000, rest = ns % 1000000000;
-  if (rest < 0) rest += 1000000000, --sec;
-  w.Int32(static_cast<int32_t>(sec));
-  w.Uint32(static_cast<uint32_t>(rest));
+namespace {
+
+void SecondsAndNanoseconds(int64_t ns, int32_t* sec, uint32_t* nanosec) {
+  int64_t s = ns / 1000000000, rest = ns % 1000000000;
+  if (rest < 0) rest += 1000000000, --s;
+  *sec = static_cast<int32_t>(s);
+  *nanosec = static_cast<uint32_t>(rest);
 }
 
-void JointState(CdrWriter& w, int64_t stamp_ns, const std::string& frame_id, const std::vector<std::string>& names,
-                const double* position, const double* velocity, const double* effort, size_t n) {
+}  // namespace
+
+void Time(CdrWriter& w, int64_t ns) {
+  int32_t sec;
+  uint32_t nanosec;
+  SecondsAndNanoseconds(ns, &sec, &nanosec);
+  w.Int32(sec);
+  w.Uint32(nanosec);
+}
+
+void PatchTime(uint8_t* at, int64_t ns) {  // sec at 0, nanosec at 4: both 4-aligned, as Time writes them
+  int32_t sec;
+  uint32_t nanosec;
+  SecondsAndNanoseconds(ns, &sec, &nanosec);
+  std::memcpy(at, &sec, 4);
+  std::memcpy(at + 4, &nanosec, 4);
+}
+
+void PatchFloat64s(uint8_t* at, const double* v, size_t n) { std::memcpy(at, v, 8 * n); }
+
+JointStateLayout JointState(CdrWriter& w, int64_t stamp_ns, const std::string& frame_id,
+                            const std::vector<std::string>& names, const double* position, const double* velocity,
+                            const double* effort, size_t n) {
+  JointStateLayout l;
+  l.stamp = w.bytes().size();  // 4: right after the encapsulation header, aligned
   Time(w, stamp_ns);
   w.String(frame_id);
   w.StringSequence(names);
-  w.Float64Sequence(position, position ? n : 0);
-  w.Float64Sequence(velocity, velocity ? n : 0);
-  w.Float64Sequence(effort, effort ? n : 0);
+  l.position = w.Float64Sequence(position, position ? n : 0);
+  l.velocity = w.Float64Sequence(velocity, velocity ? n : 0);
+  l.effort = w.Float64Sequence(effort, effort ? n : 0);
+  return l;
 }
 
-void Float64MultiArray(CdrWriter& w, const std::string& label, const double* data, size_t n) {
+size_t Float64MultiArray(CdrWriter& w, const std::string& label, const double* data, size_t n) {
   w.Uint32(1);  // layout.dim: one dimension
   w.String(label);
   w.Uint32(static_cast<uint32_t>(n));  // size
   w.Uint32(static_cast<uint32_t>(n));  // stride
   w.Uint32(0);                         // layout.data_offset
-  w.Float64Sequence(data, n);
+  return w.Float64Sequence(data, n);
 }
 
 const char* const kJointStateType = "sensor_msgs/msg/JointState";

@@ -21,7 +21,8 @@ class CdrWriter {
   void Uint32(uint32_t v) { Primitive(&v, 4); }
   void Float64(double v) { Primitive(&v, 8); }
   void String(const std::string& v);
-  void Float64Sequence(const double* v, size_t n);
+  // Returns the offset in bytes() of the first element (after its alignment).
+  size_t Float64Sequence(const double* v, size_t n);
   void StringSequence(const std::vector<std::string>& v);
   const std::vector<uint8_t>& bytes() const { return buf_; }
 
@@ -34,13 +35,26 @@ class CdrWriter {
 // builtin_interfaces/msg/Time of a time in ns: sec = floor(ns / 1e9), nanosec the rest.
 void Time(CdrWriter& w, int64_t ns);
 
+// Where the fields of a message encoded once lie in its bytes, so that a message of the same shape
+// (the same names, labels and counts) is the same bytes with these overwritten (PatchTime,
+// PatchFloat64s): offsets in bytes(), 0 for an empty array.
+struct JointStateLayout {
+  size_t stamp = 0, position = 0, velocity = 0, effort = 0;
+};
+
 // sensor_msgs/msg/JointState: header (stamp, frame_id), name, position, velocity, effort. Each array of
 // n values (`velocity` or `effort` null: an empty array, as the message allows).
-void JointState(CdrWriter& w, int64_t stamp_ns, const std::string& frame_id, const std::vector<std::string>& names,
-                const double* position, const double* velocity, const double* effort, size_t n);
+JointStateLayout JointState(CdrWriter& w, int64_t stamp_ns, const std::string& frame_id,
+                            const std::vector<std::string>& names, const double* position, const double* velocity,
+                            const double* effort, size_t n);
 
 // std_msgs/msg/Float64MultiArray of n values: layout one dimension {label, size n, stride n}, data_offset 0.
-void Float64MultiArray(CdrWriter& w, const std::string& label, const double* data, size_t n);
+// Returns the offset of data[0] (0 when n = 0).
+size_t Float64MultiArray(CdrWriter& w, const std::string& label, const double* data, size_t n);
+
+// Overwrite, in a message's bytes, a Time at `at` (as Time writes it) and n float64 at `at`.
+void PatchTime(uint8_t* at, int64_t ns);
+void PatchFloat64s(uint8_t* at, const double* v, size_t n);
 
 // The type names and ros2msg schema texts of the messages above.
 extern const char* const kJointStateType;         // "sensor_msgs/msg/JointState"

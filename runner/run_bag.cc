@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "formats/mcap_format.h"
@@ -85,64 +86,73 @@ std::unique_ptr<BagLog> RunBag::Open(BagLogKind kind, const std::vector<std::str
     if (i >= 0) used[static_cast<size_t>(i)] = true;
     return i;
   };
+  cdr::CdrWriter c;
+  std::vector<std::string> names;
   for (const JointColumns& j : measured ? std::vector<JointColumns>(std::begin(kMeasuredJoints), std::end(kMeasuredJoints))
                                         : std::vector<JointColumns>(std::begin(kTruthJoints), std::end(kTruthJoints))) {
     const int q = IndexOf(columns, j.position);
     if (q < 0) continue;
     log->joints_.push_back({j.name, take(q), take(IndexOf(columns, j.velocity)), take(IndexOf(columns, j.effort)),
                             j.effort_sign});
-    log->joint_names_.push_back(j.name);
+    names.push_back(j.name);
   }
-  if (!log->joints_.empty())
+  if (!log->joints_.empty()) {
     log->joint_channel_ = Channel(measured ? "/exo/joint_states" : "/exo/truth/joint_states", true);
-  for (const ArrayColumns& a : measured ? kMeasuredArrays : kTruthArrays) {
+    const std::vector<double> zero(names.size(), 0.0);
+    log->joint_layout_ = cdr::JointState(c, 0, "", names, zero.data(), zero.data(), zero.data(), names.size());
+    log->joint_message_ = c.bytes();
+  }
+  auto add_array = [&](const std::string& topic, std::vector<int> indexes) {
+    if (indexes.empty()) return;
     BagLog::Array array;
+    array.channel = Channel(topic, false);
+    const std::vector<double> zero(indexes.size(), 0.0);
+    c.Reset();
+    array.data_at = cdr::Float64MultiArray(c, Join(columns, indexes), zero.data(), zero.size());
+    array.message = c.bytes();
+    array.columns = std::move(indexes);
+    log->arrays_.push_back(std::move(array));
+  };
+  for (const ArrayColumns& a : measured ? kMeasuredArrays : kTruthArrays) {
+    std::vector<int> indexes;
     for (size_t i = 0; i < columns.size(); ++i)
       for (const std::string& name : a.names)
-        if (!used[i] && Matches(columns[i], name)) array.columns.push_back(take(static_cast<int>(i)));
-    if (array.columns.empty()) continue;
-    array.channel = Channel(a.topic, false);
-    array.label = Join(columns, array.columns);
-    log->arrays_.push_back(std::move(array));
+        if (!used[i] && Matches(columns[i], name)) indexes.push_back(take(static_cast<int>(i)));
+    add_array(a.topic, std::move(indexes));
   }
-  BagLog::Array other;
+  std::vector<int> other;
   for (size_t i = 0; i < columns.size(); ++i)
-    if (!used[i]) other.columns.push_back(static_cast<int>(i));
-  if (!other.columns.empty()) {
-    other.channel = Channel(measured ? "/exo/measured/other" : "/exo/truth/other", false);
-    other.label = Join(columns, other.columns);
-    log->arrays_.push_back(std::move(other));
-  }
+    if (!used[i]) other.push_back(static_cast<int>(i));
+  add_array(measured ? "/exo/measured/other" : "/exo/truth/other", std::move(other));
   return log;
 }
 
 void BagLog::Row(const double* values, size_t n, const double* velocity) {
-  auto value = [&](int i) { return i >= 0 && static_cast<size_t>(i) < n ? values[i] : 0.0; };  // missing: 0 (as the CSV)
-  const auto ns = static_cast<uint64_t>(std::llround((values[0] + epoch_) * 1e9));
+  auto value = [&](int i) { return i >= 0 && static_cast<size_t>(i) < n ? values[i] : 0.0; };
+  const auto ns = static_cast<int64_t>(std::llround((values[0] + epoch_) * 1e9));
   mcap::McapWriter& w = bag_->writer_;
-  cdr::CdrWriter& c = bag_->cdr_;
   if (!joints_.empty()) {
     position_.clear(), velocity_.clear(), effort_.clear();
-    bool has_velocity = true, has_effort = true;
     for (size_t j = 0; j < joints_.size(); ++j) {
       const Joint& jt = joints_[j];
       position_.push_back(value(jt.position));
-      has_velocity &= jt.velocity >= 0 || velocity;
-      velocity_.push_back(jt.velocity >= 0 ? value(jt.velocity) : velocity ? velocity[j] : 0.0);
-      has_effort &= jt.effort >= 0;
+      velocity_.push_back(jt.velocity >= 0 ? value(jt.velocity)
+                          : velocity      ? velocity[j]
+                                          : std::numeric_limits<double>::quiet_NaN());
       effort_.push_back(jt.effort_sign * value(jt.effort));
     }
-    c.Reset();
-    cdr::JointState(c, static_cast<int64_t>(ns), "", joint_names_, position_.data(),
-                    has_velocity ? velocity_.data() : nullptr, has_effort ? effort_.data() : nullptr, joints_.size());
-    w.Write(joint_channel_, ns, ns, c.bytes().data(), c.bytes().size());
+    uint8_t* m = joint_message_.data();
+    cdr::PatchTime(m + joint_layout_.stamp, ns);
+    cdr::PatchFloat64s(m + joint_layout_.position, position_.data(), joints_.size());
+    cdr::PatchFloat64s(m + joint_layout_.velocity, velocity_.data(), joints_.size());
+    cdr::PatchFloat64s(m + joint_layout_.effort, effort_.data(), joints_.size());
+    w.Write(joint_channel_, static_cast<uint64_t>(ns), static_cast<uint64_t>(ns), m, joint_message_.size());
   }
-  for (const Array& a : arrays_) {
+  for (Array& a : arrays_) {
     data_.clear();
     for (int i : a.columns) data_.push_back(value(i));
-    c.Reset();
-    cdr::Float64MultiArray(c, a.label, data_.data(), data_.size());
-    w.Write(a.channel, ns, ns, c.bytes().data(), c.bytes().size());
+    cdr::PatchFloat64s(a.message.data() + a.data_at, data_.data(), data_.size());
+    w.Write(a.channel, static_cast<uint64_t>(ns), static_cast<uint64_t>(ns), a.message.data(), a.message.size());
   }
 }
 

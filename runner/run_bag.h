@@ -38,8 +38,8 @@ class RunBag;
 // One log of a trial in the bag: each Row becomes one message on each of its topics.
 class BagLog {
  public:
-  // values[0..n) a row of the log's columns (values[0] = t, s); `velocity` (may be null) the measured
-  // JointState's velocity, one per joint in the message's order.
+  // values[0..n) a row of the log's columns (values[0] = t, s; missing columns 0, as the CSV); `velocity`
+  // the measured JointState's velocity, one per joint in the message's order (null: NaN, unknown).
   void Row(const double* values, size_t n, const double* velocity = nullptr);
 
  private:
@@ -49,16 +49,20 @@ class BagLog {
     int position = -1, velocity = -1, effort = -1;  // column indexes (-1: none)
     double effort_sign = 1;
   };
+  // Each topic's message encoded once (its names and labels fixed); a row overwrites its stamp and
+  // values (cdr::JointStateLayout).
   struct Array {
     uint16_t channel = 0;
-    std::string label;
     std::vector<int> columns;
+    std::vector<uint8_t> message;
+    size_t data_at = 0;
   };
   RunBag* bag_ = nullptr;
   double epoch_ = 0;
   uint16_t joint_channel_ = 0;
   std::vector<Joint> joints_;
-  std::vector<std::string> joint_names_;
+  std::vector<uint8_t> joint_message_;
+  cdr::JointStateLayout joint_layout_;
   std::vector<Array> arrays_;
   std::vector<double> position_, velocity_, effort_, data_;  // one row's fields, reused
 };
@@ -79,7 +83,6 @@ class RunBag {
   mcap::McapWriter writer_;
   uint16_t joint_state_schema_ = 0, array_schema_ = 0;
   std::vector<std::pair<std::string, uint16_t>> channels_;
-  cdr::CdrWriter cdr_;
 };
 
 }  // namespace exotwin
