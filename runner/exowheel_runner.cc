@@ -209,8 +209,10 @@ class ExowheelTrial : public CosimDevice {
     if (logs_.measured) {
       double row[15], trow[9];
       const auto& tel = Telemetry();
-      const double qd[2] = {tel.est[0].qd, tel.est[1].qd};  // the bag's JointState velocity
-      logs_.measured->Row(row, MeasuredRow(t, row), qd);
+      // The bag's JointState velocity: the controller's estimate (a controller in another process does
+      // not send it over the link: unknown, NaN).
+      const double qd[2] = {tel.est[0].qd, tel.est[1].qd};
+      logs_.measured->Row(row, MeasuredRow(t, row), opt_.remote ? nullptr : qd);
       logs_.truth->Row(trow, TruthRow(t, trow));
     }
     if (video_) AddVideoSample(t);

@@ -7,7 +7,8 @@
 //
 // Topics of the measured log (the rig's view):
 //   /exo/joint_states   sensor_msgs/msg/JointState  name [hip, knee] (HAL-3: [knee]); position q_*,
-//                       velocity the controller's estimate, effort -tau_* (the actuator torque -tau_S)
+//                       velocity the controller's estimate (NaN when unknown), effort -tau_* (the
+//                       actuator torque -tau_S)
 //   /exo/command, /exo/reference, /exo/emg, /exo/safety_state, /exo/assist (HAL-3)
 //                       std_msgs/msg/Float64MultiArray: data the log's cmd_*, ref_*, emg_*, state, and
 //                       E_ext E_flex mu_hat D_hat K_hat columns in order; layout.dim[0].label the
