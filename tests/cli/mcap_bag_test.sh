@@ -4,8 +4,8 @@
 # read_bag.mjs: indexed and streaming readers, every CRC, every message decoded from the file's own
 # schema text), then checked against the run's CSV logs (check_bag.py: counts = rows, values = the
 # CSV's, stamps = the run's clock, metadata = scenario and seed). Cases: an EXOwheel gait of two trials
-# long enough for several chunks, a HAL-3 run, a run interrupted by SIGINT (the bag holds what was
-# logged), and bad --mcap paths (exit 2). Skipped (exit 77) without node or tests/mcap_client's
+# long enough for several chunks, a HAL-3 run, serve with exotwin-controller (when built), a run
+# interrupted by SIGINT (the bag holds what was logged), and bad --mcap paths (exit 2). Skipped (exit 77) without node or tests/mcap_client's
 # node_modules (scripts/setup.sh installs them). Args: path of exotwin, source dir.
 set -uo pipefail
 EXO=$1
@@ -48,6 +48,29 @@ if [ "${chunks:-0}" -lt 2 ]; then echo "FAIL: gait: ${chunks:-no} chunks, expect
 # HAL-3 knee (one joint; assist estimates on a topic of their own), 5 s (settling 4 s).
 sed -E 's/duration: *[0-9.]+/duration: 5/' "$SRC/scenarios/hal3_exp2_assist.yaml" > "$T/hal.yaml"
 roundtrip hal hal3_exp2_assist 1 1 "$T/hal.yaml"
+
+# serve + exotwin-controller (lockstep, shared memory): the same bag, the measured velocity NaN (the
+# link does not carry the controller's estimate). The controller is looked for in ../deploy/.
+CTRL="$(dirname "$EXO")/../deploy/exotwin-controller"
+if [ -x "$CTRL" ]; then
+  sed -e 's/duration: 60/duration: 2/' "$SRC/scenarios/gait_2kmh.yaml" > "$T/serve.yaml"
+  bus="shm:exotwin_mcap_$$"
+  "$EXO" serve "$T/serve.yaml" --bus "$bus" --out "$T/serve" --mcap "$T/serve.mcap" >"$T/serve.log" 2>&1 &
+  spid=$!
+  "$CTRL" --config "$T/serve.yaml" --bus "$bus" >"$T/ctrl.log" 2>&1
+  wait $spid
+  rc=$?
+  if [ $rc -ne 0 ]; then
+    echo "FAIL: serve: exit $rc"; tail -3 "$T/serve.log"; fail=1
+  elif node "$CLIENT/read_bag.mjs" "$T/serve.mcap" >"$T/serve.json" 2>"$T/serve.err" &&
+    python3 "$CLIENT/check_bag.py" "$T/serve.json" gait_2kmh 1 "$T/serve" 1 --velocity-unknown >"$T/serve.check"; then
+    echo "ok: serve's bag: $(head -1 "$T/serve.check")"
+  else
+    echo "FAIL: serve's bag: $(cat "$T/serve.err" "$T/serve.check" 2>/dev/null)"; fail=1
+  fi
+else
+  echo "note: serve case not run: $CTRL not built (cmake --build build --target exotwin-controller)"
+fi
 
 # Interrupted by SIGINT mid-run: exit 130, and the bag holds every row the CSVs hold.
 sed -e 's/duration: 60/duration: 600/' "$SRC/scenarios/gait_2kmh.yaml" > "$T/long.yaml"

@@ -5,7 +5,9 @@ every value equals the CSV's (the CSV prints each double so that it reads back b
 CSV column is on a topic, the stamps are the run's clock (trial k shifted by k * trial_spacing_s), the
 metadata names the scenario and the seed.
 
-usage: check_bag.py BAG.json SCENARIO_NAME SEED CSV_DIR [TRIALS]
+usage: check_bag.py BAG.json SCENARIO_NAME SEED CSV_DIR [TRIALS] [--velocity-unknown]
+(--velocity-unknown: the measured JointState's velocity is NaN, JSON null: `serve` of an EXOwheel,
+whose link does not carry the controller's estimate; otherwise a finite number per joint)
 Exit 0 and one line per topic on success; 1 and the first mismatch otherwise.
 """
 import csv
@@ -36,8 +38,10 @@ ARRAY_TOPICS = {"measured": ["/exo/command", "/exo/reference", "/exo/emg", "/exo
 
 
 def main():
-    bag_json, name, seed, csv_dir = sys.argv[1:5]
-    trials = int(sys.argv[5]) if len(sys.argv) > 5 else 1
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    unknown_velocity = "--velocity-unknown" in sys.argv
+    bag_json, name, seed, csv_dir = args[:4]
+    trials = int(args[4]) if len(args) > 4 else 1
     bag = json.load(open(bag_json))
     meta = bag["metadata"].get("exotwin")
     if not meta or meta.get("scenario") != name or meta.get("seed") != seed:
@@ -75,8 +79,11 @@ def main():
                             fail(f"{topic}: effort[{i}] {js['effort'][i]} != {sign} * {tau} {r[ix[tau]]} at t = {r[0]}")
                         if qd is not None and js["velocity"][i] != r[ix[qd]]:
                             fail(f"{topic}: velocity[{i}] {js['velocity'][i]} != {qd} {r[ix[qd]]} at t = {r[0]}")
-                        if qd is None and (len(js["velocity"]) != len(names) or js["velocity"][i] != js["velocity"][i]):
-                            fail(f"{topic}: velocity {js['velocity']}: expected one finite estimate per joint")
+                        if qd is None and len(js["velocity"]) != len(names):
+                            fail(f"{topic}: velocity {js['velocity']}: expected one per joint")
+                        if qd is None and unknown_velocity != (js["velocity"][i] is None):
+                            fail(f"{topic}: velocity {js['velocity']}: expected "
+                                 f"{'NaN (unknown)' if unknown_velocity else 'a finite estimate'} per joint")
                         covered |= {q, tau} | ({qd} if qd else set())
                 seen[topic] += len(rows)
             for topic in ARRAY_TOPICS[kind]:
