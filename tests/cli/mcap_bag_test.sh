@@ -4,9 +4,10 @@
 # read_bag.mjs: indexed and streaming readers, every CRC, every message decoded from the file's own
 # schema text), then checked against the run's CSV logs (check_bag.py: counts = rows, values = the
 # CSV's, stamps = the run's clock, metadata = scenario and seed). Cases: an EXOwheel gait of two trials
-# long enough for several chunks, a HAL-3 run, serve with exotwin-controller (when built), a run
-# interrupted by SIGINT (the bag holds what was logged), and bad --mcap paths (exit 2). Skipped (exit 77) without node or tests/mcap_client's
-# node_modules (scripts/setup.sh installs them). Args: path of exotwin, source dir.
+# long enough for several chunks, a HAL-3 run, render's run and serve with exotwin-controller (when
+# built), a run interrupted by SIGINT (the bag holds what was logged), and bad --mcap paths (exit 2).
+# Skipped (exit 77) without node or tests/mcap_client's node_modules (scripts/setup.sh installs them).
+# Args: path of exotwin, source dir.
 set -uo pipefail
 EXO=$1
 SRC=$2
@@ -18,12 +19,13 @@ T=$(mktemp -d "${TMPDIR:-/tmp}"/exotwin_mcap_bag_XXXXXX)
 trap 'rm -rf "$T"' EXIT
 fail=0
 
-# roundtrip NAME SCENARIO_NAME SEED TRIALS ARGS...: run with --mcap, read the bag, check it against the CSVs.
+# roundtrip NAME SCENARIO_NAME SEED TRIALS COMMAND ARGS...: COMMAND (run, render) with --mcap, read the
+# bag, check it against the CSVs.
 roundtrip() {
   local name=$1 scenario=$2 seed=$3 trials=$4
   shift 4
   local rc=0
-  "$EXO" run "$@" --out "$T/$name" --mcap "$T/$name.mcap" >"$T/$name.log" 2>&1 || rc=$?
+  "$EXO" "$@" --out "$T/$name" --mcap "$T/$name.mcap" >"$T/$name.log" 2>&1 || rc=$?
   if [ $rc -gt 1 ]; then
     echo "FAIL: $name: exit $rc"; tail -5 "$T/$name.log"; fail=1; return
   fi
@@ -41,13 +43,21 @@ roundtrip() {
 # 4 s later.
 sed -e 's/duration: 60/duration: 3/' -e 's/trials: 1/trials: 2/' -e 's/ramp: 2.0/ramp: 0.1/' \
   "$SRC/scenarios/gait_2kmh.yaml" > "$T/gait.yaml"
-roundtrip gait gait_2kmh 5 2 "$T/gait.yaml" --seed 5
+roundtrip gait gait_2kmh 5 2 run "$T/gait.yaml" --seed 5
 chunks=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['statistics']['chunk_count'])" "$T/gait.json" 2>/dev/null)
 if [ "${chunks:-0}" -lt 2 ]; then echo "FAIL: gait: ${chunks:-no} chunks, expected several"; fail=1; fi
 
 # HAL-3 knee (one joint; assist estimates on a topic of their own), 5 s (settling 4 s).
 sed -E 's/duration: *[0-9.]+/duration: 5/' "$SRC/scenarios/hal3_exp2_assist.yaml" > "$T/hal.yaml"
-roundtrip hal hal3_exp2_assist 1 1 "$T/hal.yaml"
+roundtrip hal hal3_exp2_assist 1 1 run "$T/hal.yaml"
+
+# render's run (when the renderer is built), 0.3 s.
+if [ -n "${EXOTWIN_RENDER_PLUGIN:-}" ] || [ -e "$(dirname "$EXO")/libexotwin_render_plugin.so" ]; then
+  sed -e 's/duration: 60/duration: 0.3/' "$SRC/scenarios/gait_2kmh.yaml" > "$T/render.yaml"
+  roundtrip render gait_2kmh 1 1 render "$T/render.yaml" -o "$T/render.mp4"
+else
+  echo "note: render case not run: the render plugin is not built"
+fi
 
 # serve + exotwin-controller (lockstep, shared memory): the same bag, the measured velocity NaN (the
 # link does not carry the controller's estimate). The controller is looked for in ../deploy/.
