@@ -12,7 +12,7 @@ set -uo pipefail
 EXO=$1
 SRC=$2
 CLIENT="$SRC/tests/mcap_client"
-command -v node >/dev/null || { echo "SKIP: node is not installed (scripts/setup.sh installs it)"; exit 77; }
+command -v node >/dev/null || { echo "SKIP: node is not installed (Debian: nodejs, npm; then npm ci in tests/mcap_client)"; exit 77; }
 [ -d "$CLIENT/node_modules/@mcap/core" ] ||
   { echo "SKIP: $CLIENT/node_modules missing (run npm ci there; scripts/setup.sh does)"; exit 77; }
 T=$(mktemp -d "${TMPDIR:-/tmp}"/exotwin_mcap_bag_XXXXXX)
