@@ -96,7 +96,8 @@ nlohmann::ordered_json BenchClosedLoop(const BenchConfig& c);
 nlohmann::ordered_json BenchStartup(const BenchConfig& c);
 
 // `exotwin run scenarios/gait_2kmh.yaml` (60 s, both CSV logs) as a separate process, start-up
-// included, vs a bare mj_step loop of the same model and number of steps in this process.
+// included, vs a bare mj_step loop of the same model and number of steps in this process; and the
+// same run with `--mcap` (its ROS 2 bag too) vs without (goal <= 1.3x), the two alternated.
 nlohmann::ordered_json BenchRunCommand(const BenchConfig& c);
 
 // Render + H.264 encode at 1280x720 with overlays (3 s of video; quick: 1 s) vs no overlays and vs

@@ -201,15 +201,27 @@ json BenchRunCommand(const BenchConfig& c) {
     const ScopedCpuPin pin(FastestCpu(c.cpus));  // the run's main thread goes where the scheduler puts it
     bare = BareMjStepSeconds(c.repeat, n);
   }
-  const double run = BestOf(c.repeat, [&] { RunSelf({"run", file, "--out", c.scratch + "/run"}); });
+  // The run with and without its bag, alternated (a shared machine's load falls on both alike).
+  double run = std::numeric_limits<double>::infinity(), mcap = run;
+  for (int i = 0; i < std::max(1, c.repeat); ++i) {
+    run = std::min(run, BestOf(1, [&] { RunSelf({"run", file, "--out", c.scratch + "/run"}); }));
+    mcap = std::min(mcap, BestOf(1, [&] {
+                      RunSelf({"run", file, "--out", c.scratch + "/run_mcap", "--mcap", c.scratch + "/run.mcap"});
+                    }));
+  }
   return json{{"status", "ok"},
               {"steps", n},
               {"bare_mj_step_s", bare},
               {"run_s", run},
+              {"run_mcap_s", mcap},
               {"ratio_run_to_bare", run / bare},
+              {"ratio_run_mcap_to_run", mcap / run},
               {"rows", BenchRowsJson({{"exotwin run gait_2kmh.yaml (60 s, both CSV logs, start-up included)",
                                        run / bare, "x", "bare mj_step loop, same model and steps", "<= 2.5x",
-                                       Seconds(run) + " vs " + Seconds(bare)}})}};
+                                       Seconds(run) + " vs " + Seconds(bare)},
+                                      {"run --mcap vs run: gait_2kmh.yaml with its ROS 2 bag (zstd) too",
+                                       mcap / run, "x", "the same run with its CSV logs alone", "<= 1.3x",
+                                       Seconds(mcap) + " vs " + Seconds(run)}})}};
 }
 
 json BenchStartup(const BenchConfig& c) {

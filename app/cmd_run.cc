@@ -56,6 +56,9 @@ std::vector<std::string> WriteStorageCopies(const RunResult& r, const std::strin
   return written;
 }
 
+constexpr const char* kMcapHelp =
+    "also write the run's logs as a ROS 2 bag (MCAP, zstd chunks; topics in DESIGN.md \"ROS 2 bags (MCAP) in and out\")";
+
 // Adds `key: value` to the top level of the result.json at `path` (written whole, atomically).
 void AddToResultJson(const std::string& path, const std::string& key, const nlohmann::ordered_json& value) {
   nlohmann::ordered_json j = nlohmann::ordered_json::parse(ReadTextFile(path, "result", "JSON"));
@@ -65,7 +68,7 @@ void AddToResultJson(const std::string& path, const std::string& key, const nloh
 
 CommandRunner RegisterRun(CLI::App& app) {
   struct Opts {
-    std::string scenario, out = "out", can_log, video;
+    std::string scenario, out = "out", can_log, video, mcap;
     uint64_t seed = 0;
     bool sto = false;
   };
@@ -76,6 +79,7 @@ CommandRunner RegisterRun(CLI::App& app) {
   auto* seed = sub->add_option("--seed", o->seed, "seed (overrides the scenario's)");
   sub->add_option("--can-log", o->can_log, "candump log of every CAN frame");
   sub->add_option("--video", o->video, "render an MP4 video of the run");
+  sub->add_option("--mcap", o->mcap, kMcapHelp);
   sub->add_flag("--sto", o->sto,
                 "also write measured.csv and truth.csv as OpenSim storage files (measured.sto, truth.sto; "
                 "version-1 header, inDegrees=no, tab-separated)");
@@ -88,6 +92,7 @@ CommandRunner RegisterRun(CLI::App& app) {
     opt.out_dir = o->out;
     if (*seed) opt.seed = o->seed;
     opt.can_log = o->can_log;
+    opt.mcap = o->mcap;
     opt.progress = true;
     opt.video_path = o->video;
     const RunResult r = RunScenario(s, opt);
@@ -101,7 +106,7 @@ CommandRunner RegisterRun(CLI::App& app) {
 // first trial off-screen: side view, human and exoskeleton in distinct colours, overlays.
 CommandRunner RegisterRender(CLI::App& app) {
   struct Opts {
-    std::string scenario, video, out = "out/render";
+    std::string scenario, video, out = "out/render", mcap;
     bool sto = false;
   };
   auto o = std::make_shared<Opts>();
@@ -110,6 +115,7 @@ CommandRunner RegisterRender(CLI::App& app) {
   sub->add_option("-o,--output", o->video, "output MP4")->required();
   sub->add_option("--out", o->out, "folder for the run's logs and result.json");
   sub->add_flag("--sto", o->sto, "also write the logs as OpenSim storage files (as run --sto)");
+  sub->add_option("--mcap", o->mcap, kMcapHelp);
   return [sub, o]() -> int {
     if (!*sub) return -1;
     InstallStopSignalHandlers();
@@ -118,6 +124,7 @@ CommandRunner RegisterRender(CLI::App& app) {
     RunOptions opt;
     opt.out_dir = o->out;
     opt.video_path = o->video;
+    opt.mcap = o->mcap;
     opt.progress = true;
     const RunResult r = RunScenario(s, opt);
     if (o->sto)
@@ -133,7 +140,7 @@ CommandRunner RegisterRender(CLI::App& app) {
 // DIR/controller.yaml (the controller file of the scenario) before it waits for the controller.
 CommandRunner RegisterServe(CLI::App& app) {
   struct Opts {
-    std::string scenario, out = "out", bus, can, clock = "lockstep", can_log;
+    std::string scenario, out = "out", bus, can, clock = "lockstep", can_log, mcap;
     uint64_t seed = 0;
     double timeout = 10.0;
     double link_delay_ms = 0, link_jitter_ms = 0, link_loss = 0, rt_spin_us = 100, link_spin_us = 1e6 * kDefaultLinkSpin;
@@ -151,6 +158,7 @@ CommandRunner RegisterServe(CLI::App& app) {
   sub->add_option("--timeout", o->timeout, "s of wall clock without an answer after which the controller is gone")
       ->check(CLI::Range(0.01, 3600.0));
   sub->add_option("--can-log", o->can_log, "candump log of every CAN frame of the twin's bus");
+  sub->add_option("--mcap", o->mcap, kMcapHelp);
   sub->add_option("--link-delay", o->link_delay_ms, "ms of simulated time added to each device frame crossing the link");
   sub->add_option("--link-jitter", o->link_jitter_ms, "ms: each device frame further delayed by up to this (uniform, seeded)");
   sub->add_option("--link-loss", o->link_loss, "probability 0..1 that a device frame crossing the link is lost (seeded)");
@@ -178,6 +186,7 @@ CommandRunner RegisterServe(CLI::App& app) {
       RunOptions check;
       check.out_dir = o->out;
       check.can_log = o->can_log;
+      check.mcap = o->mcap;
       CheckScenarioRun(s, check);
     }
     const std::string controller_file = WriteControllerFile(s, o->out, *seed ? o->seed : s.seed);
@@ -201,6 +210,7 @@ CommandRunner RegisterServe(CLI::App& app) {
     opt.out_dir = o->out;
     if (*seed) opt.seed = o->seed;
     opt.can_log = o->can_log;
+    opt.mcap = o->mcap;
     opt.remote = &remote;
     RunResult r;
     try {

@@ -96,10 +96,10 @@ py::dict ResultDict(RunResult& r, LogCapture* logs) {
 
 namespace {
 
-// exotwin._run(scenario, seed, out): RunScenario on the scenario file with the logs kept in memory, the
+// exotwin._run(scenario, seed, out, mcap): RunScenario on the scenario file with the logs kept in memory, the
 // interpreter's lock released and SIGINT / SIGTERM ending the run as in the CLI (the Python package
 // raises KeyboardInterrupt with the partial result, python/exotwin/__init__.py).
-py::dict Run(const std::string& scenario, std::optional<uint64_t> seed, const std::string& out) {
+py::dict Run(const std::string& scenario, std::optional<uint64_t> seed, const std::string& out, const std::string& mcap) {
   RunResult r;
   LogCapture logs;
   {
@@ -109,6 +109,7 @@ py::dict Run(const std::string& scenario, std::optional<uint64_t> seed, const st
     RunOptions opt;
     opt.out_dir = out;
     opt.seed = seed;
+    opt.mcap = mcap;
     opt.capture = &logs;
     const StopSignalScope stop;
     r = RunScenario(s, opt);
@@ -119,7 +120,7 @@ py::dict Run(const std::string& scenario, std::optional<uint64_t> seed, const st
 }  // namespace
 
 void BindRun(py::module_& m) {
-  m.def("_run", &Run, py::arg("scenario"), py::arg("seed"), py::arg("out"),
+  m.def("_run", &Run, py::arg("scenario"), py::arg("seed"), py::arg("out"), py::arg("mcap") = "",
         "RunScenario on a scenario file (exotwin.run is the public form)");
 }
 

@@ -28,6 +28,8 @@ CosimSchedule ScheduleOf(const Scenario& s, double dt, CosimClock clock) {
   return c;
 }
 
+double TrialEpoch(const Scenario& s, int trial) { return trial * (s.protocol.duration + 1.0); }
+
 hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed) {
   hwsim::VirtualCanBusConfig c;
   c.bitrate = hw.can_bitrate;
@@ -39,11 +41,12 @@ hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed) {
 }
 
 TrialLog::TrialLog(const std::string& path, const std::vector<std::string>& columns,
-                   const std::vector<std::string>& comments, CapturedLog* capture)
-    : csv_(path, columns, comments), capture_(capture) {}
+                   const std::vector<std::string>& comments, CapturedLog* capture, std::unique_ptr<BagLog> bag)
+    : csv_(path, columns, comments), capture_(capture), bag_(std::move(bag)) {}
 
-void TrialLog::Row(const double* values, size_t n) {
+void TrialLog::Row(const double* values, size_t n, const double* velocity) {
   csv_.Row(values, n);
+  if (bag_) bag_->Row(values, n, velocity);
   if (!capture_) return;
   const size_t columns = capture_->columns.size();
   capture_->values.insert(capture_->values.end(), values, values + std::min(n, columns));
@@ -52,7 +55,8 @@ void TrialLog::Row(const double* values, size_t n) {
 
 TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
                         const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
-                        std::vector<std::string>* files, LogCapture* capture, size_t rows) {
+                        std::vector<std::string>* files, LogCapture* capture, size_t rows, RunBag* bag,
+                        double epoch) {
   const std::string suffix = trials > 1 ? "_trial" + std::to_string(trial + 1) : "";
   const std::string measured = "measured" + suffix + ".csv", truth = "truth" + suffix + ".csv";
   CapturedLog* captured[2] = {nullptr, nullptr};
@@ -62,8 +66,10 @@ TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std
     for (CapturedLog* c : captured) c->values.reserve(rows * c->columns.size());
   }
   TrialLogs logs;
-  logs.measured = std::make_unique<TrialLog>(dir + "/" + measured, measured_columns, comments, captured[0]);
-  logs.truth = std::make_unique<TrialLog>(dir + "/" + truth, truth_columns, comments, captured[1]);
+  logs.measured = std::make_unique<TrialLog>(dir + "/" + measured, measured_columns, comments, captured[0],
+                                             bag ? bag->Open(BagLogKind::kMeasured, measured_columns, epoch) : nullptr);
+  logs.truth = std::make_unique<TrialLog>(dir + "/" + truth, truth_columns, comments, captured[1],
+                                          bag ? bag->Open(BagLogKind::kTruth, truth_columns, epoch) : nullptr);
   files->push_back(measured);
   files->push_back(truth);
   return logs;

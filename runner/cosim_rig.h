@@ -32,6 +32,7 @@
 #include "hwsim/virtual_can_bus.h"
 #include "protocol/candump.h"
 #include "runner/progress_bar.h"
+#include "runner/run_bag.h"
 #include "runner/runner.h"
 #include "runner/scenario.h"
 #include "sim/muscles.h"
@@ -79,33 +80,42 @@ struct CosimSchedule {
 // rate is the physics rate divided by an integer.
 CosimSchedule ScheduleOf(const Scenario& s, double dt, CosimClock clock = CosimClock::kGrid);
 
+// The start of trial `trial` (0-based) on the clock of a run's CAN log and bag, s: the trials follow
+// each other, each duration + 1 s after the one before.
+double TrialEpoch(const Scenario& s, int trial);
+
 // The virtual CAN bus of a scenario's hardware (bitrate, latency, jitter, drop rate) with `seed`.
 hwsim::VirtualCanBusConfig BusConfigOf(const HardwareSpec& hw, uint64_t seed);
 
-// One log of a trial: its CSV file (CsvStreamWriter) and, with a capture, its copy in memory.
+// One log of a trial: its CSV file (CsvStreamWriter), with a capture its copy in memory, with a bag
+// log its messages in the run's bag (run_bag.h).
 class TrialLog {
  public:
   TrialLog(const std::string& path, const std::vector<std::string>& columns, const std::vector<std::string>& comments,
-           CapturedLog* capture);
-  // Appends one row: values[0..n), missing columns 0 (CsvStreamWriter::Row).
-  void Row(const double* values, size_t n);
+           CapturedLog* capture, std::unique_ptr<BagLog> bag = nullptr);
+  // Appends one row: values[0..n), missing columns 0 (CsvStreamWriter::Row); `velocity` (may be null)
+  // the bag's measured joint velocities (BagLog::Row).
+  void Row(const double* values, size_t n, const double* velocity = nullptr);
 
  private:
   CsvStreamWriter csv_;
   CapturedLog* capture_;
+  std::unique_ptr<BagLog> bag_;
 };
 
 // The two logs of trial `trial` (0-based) of `trials`: DIR/measured[_trialN].csv (the rig's view) and
 // DIR/truth[_trialN].csv (the plant's), N = trial + 1 when trials > 1, each with `comments`; their
 // names are appended to *files, and with `capture` (may be null) their copies in memory to it, room
-// made for `rows` rows up front (CosimSchedule::LogRows: the copy then never moves as it grows). Throws
-// InputError if a file cannot be opened.
+// made for `rows` rows up front (CosimSchedule::LogRows: the copy then never moves as it grows), and
+// with `bag` (may be null) their rows in it too, stamped from `epoch` s (TrialEpoch). Throws InputError
+// if a file cannot be opened.
 struct TrialLogs {
   std::unique_ptr<TrialLog> measured, truth;
 };
 TrialLogs OpenTrialLogs(const std::string& dir, int trial, int trials, const std::vector<std::string>& measured_columns,
                         const std::vector<std::string>& truth_columns, const std::vector<std::string>& comments,
-                        std::vector<std::string>* files, LogCapture* capture = nullptr, size_t rows = 0);
+                        std::vector<std::string>* files, LogCapture* capture = nullptr, size_t rows = 0,
+                        RunBag* bag = nullptr, double epoch = 0);
 
 // Progress of a run over several trials: Run() reports done + k steps to `bar` (may be null).
 struct CosimProgress {

@@ -57,12 +57,12 @@ struct ExowheelTotals {
 class ExowheelTrial : public CosimDevice {
  public:
   ExowheelTrial(const Scenario& s, const RunOptions& opt, const LegParams& truth, Plant& plant,
-                const CosimSchedule& schedule, int trial, CandumpWriter* can_log, RunResult* result,
+                const CosimSchedule& schedule, int trial, CandumpWriter* can_log, RunBag* bag, RunResult* result,
                 ExowheelTotals* totals)
-      : s_(s), opt_(opt), plant_(plant), schedule_(schedule), result_(result), totals_(totals), trial_(trial),
+      : s_(s), opt_(opt), plant_(plant), bag_(bag), schedule_(schedule), result_(result), totals_(totals), trial_(trial),
         seed_(result->seed * 7919ull + static_cast<uint64_t>(trial)),
         trajectory_(BuildTrajectory(s, trial)),
-        rig_(BusConfigOf(s.hardware, seed_), can_log, trial * (s.protocol.duration + 1.0)),  // trials follow each other
+        rig_(BusConfigOf(s.hardware, seed_), can_log, TrialEpoch(s, trial)),  // trials follow each other
         ctrl_ep_(rig_.bus().AddNode("controller", {msg::kIdJointStatusHip, msg::kIdJointStatusKnee, msg::kIdEmgSamples})),
         emg_ep_(rig_.bus().AddNode("emg_amplifier", {0x7FF})),  // sends only
         hip_(JointModuleSpecOf(s.hardware, 0, plant.effects().sensor[0], plant.timestep(), s.plant_effects_source),
@@ -208,7 +208,11 @@ class ExowheelTrial : public CosimDevice {
     ++totals_->samples;
     if (logs_.measured) {
       double row[15], trow[9];
-      logs_.measured->Row(row, MeasuredRow(t, row));
+      const auto& tel = Telemetry();
+      // The bag's JointState velocity: the controller's estimate (a controller in another process does
+      // not send it over the link: unknown, NaN).
+      const double qd[2] = {tel.est[0].qd, tel.est[1].qd};
+      logs_.measured->Row(row, MeasuredRow(t, row), opt_.remote ? nullptr : qd);
       logs_.truth->Row(trow, TruthRow(t, trow));
     }
     if (video_) AddVideoSample(t);
@@ -231,7 +235,7 @@ class ExowheelTrial : public CosimDevice {
         opt_.out_dir, trial, s_.protocol.trials, MeasuredColumns(), TruthColumns(),
         {"exotwin run " + s_.name + " trial " + std::to_string(trial + 1) + " seed " + std::to_string(result_->seed),
          "subject truth: L1 " + std::to_string(truth.L1) + (truth.human ? " with human" : " exo only")},
-        &result_->files, opt_.capture, schedule_.LogRows());
+        &result_->files, opt_.capture, schedule_.LogRows(), bag_, TrialEpoch(s_, trial));
   }
 
   void AddVideoSample(double t) {
@@ -257,6 +261,7 @@ class ExowheelTrial : public CosimDevice {
   const Scenario& s_;
   const RunOptions& opt_;
   Plant& plant_;
+  RunBag* bag_;
   const CosimSchedule schedule_;
   RunResult* result_;
   ExowheelTotals* totals_;
@@ -301,6 +306,7 @@ struct ExowheelSession::State {
   Plant plant;
   CosimSchedule schedule;
   std::unique_ptr<CandumpWriter> can_log;
+  std::unique_ptr<RunBag> bag;  // closed after the trial (declared before it)
   ExowheelTotals totals;
   std::chrono::steady_clock::time_point wall0;
   std::unique_ptr<ProgressBar> bar;
@@ -309,7 +315,7 @@ struct ExowheelSession::State {
   bool finished = false;
 
   void StartTrial() {
-    trial = std::make_unique<ExowheelTrial>(s, opt, truth, plant, schedule, trial_index, can_log.get(), &result,
+    trial = std::make_unique<ExowheelTrial>(s, opt, truth, plant, schedule, trial_index, can_log.get(), bag.get(), &result,
                                             &totals);
     trial->Begin();
   }
@@ -331,6 +337,7 @@ ExowheelSession::ExowheelSession(const Scenario& s, const RunOptions& opt) {
   st_->schedule = ScheduleOf(s, plant.timestep());
 
   if (!opt.can_log.empty()) st_->can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
+  if (!opt.mcap.empty()) st_->bag = std::make_unique<RunBag>(opt.mcap, s, result.seed);
 
   if (opt.remote)  // the controller in another process runs the scenario's controller file (ControllerNode)
     opt.remote->SetConfiguration(controller::ControllerFileYaml(
@@ -395,6 +402,10 @@ int ExowheelSession::safety_state() const {
 RunResult ExowheelSession::Finish() {
   State& st = *st_;
   st.trial.reset();
+  if (st.bag) {
+    st.bag->Close();
+    st.result.files.push_back(st.opt.mcap);
+  }
   if (!st.result.interrupted) st.bar->Update(static_cast<size_t>(st.s.protocol.trials * st.schedule.steps));
   st.bar->Finish();
 

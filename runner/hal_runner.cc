@@ -72,7 +72,7 @@ class ProjectedViscoelasticity {
 class HalTrial : public CosimDevice {
  public:
   HalTrial(const Scenario& s, const RunOptions& opt, uint64_t seed, double B_v, int run, int runs,
-           RunResult* result, CandumpWriter* can_log, double epoch)
+           RunResult* result, CandumpWriter* can_log, RunBag* bag, double epoch)
       : s_(s), opt_(opt), pp_(Hal3PlantParamsOf(s)), result_(result) {
     plant_.SetParams(pp_);
     dt_ = plant_.timestep();
@@ -118,7 +118,7 @@ class HalTrial : public CosimDevice {
                              "mu_contraction"},
                             {"exotwin run " + s.name + " (HAL-3) mode " + s.hal.mode + " B_v " +
                              std::to_string(B_v) + " seed " + std::to_string(result->seed)},
-                            &result->files, opt.capture, schedule_.LogRows());
+                            &result->files, opt.capture, schedule_.LogRows(), bag, epoch);
 
     const double w = 2 * kPi * s.hal.swing_freq;
     plant_.Reset(0.35, 0.65 * w, 0.0);
@@ -205,7 +205,7 @@ class HalTrial : public CosimDevice {
       const auto& o = rig_->emg_node()->last_output();
       const double row[] = {t, tel.th, tel.strain, tel.tau_cmd, o[0], o[1], o[2], o[3], o[4],
                             tel.E_e, tel.E_f, tel.assist.mu_hat, tel.assist.D, tel.assist.K};
-      logs_.measured->Row(row, 14);
+      logs_.measured->Row(row, 14, &tel.thd);  // the bag's JointState velocity: the controller's estimate
       const double trow[] = {t, th, thd, applied_, mu_, plant_.interaction_torque(), Dt_, Kt_, mu_c_};
       logs_.truth->Row(trow, 9);
     }
@@ -315,6 +315,8 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   CreateOutputFolder(opt.out_dir);
   std::unique_ptr<CandumpWriter> can_log;
   if (!opt.can_log.empty()) can_log = std::make_unique<CandumpWriter>(opt.can_log, "can0");
+  std::unique_ptr<RunBag> bag;
+  if (!opt.mcap.empty()) bag = std::make_unique<RunBag>(opt.mcap, s, result.seed);
   const auto wall0 = std::chrono::steady_clock::now();
   auto& m = result.metrics;
 
@@ -327,7 +329,7 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
   for (int i = 0; i < runs; ++i) {
     const double B_v = HalRunViscosity(s, i);
     const uint64_t seed = HalRunSeed(s, result.seed, i);
-    HalTrial trial(s, opt, seed, B_v, i, runs, &result, can_log.get(), i * (s.protocol.duration + 1.0));
+    HalTrial trial(s, opt, seed, B_v, i, runs, &result, can_log.get(), bag.get(), TrialEpoch(s, i));
     const size_t steps = static_cast<size_t>(trial.schedule().steps);
     if (!bar) bar = std::make_unique<ProgressBar>(runs * steps, s.name, opt.progress);
     per_run.push_back(trial.Run({bar.get(), done}, &result.interrupted));
@@ -338,6 +340,10 @@ RunResult RunHalScenario(const Scenario& s, const RunOptions& opt) {
     }
   }
   if (bar) bar->Update(done), bar->Finish();
+  if (bag) {
+    bag->Close();
+    result.files.push_back(opt.mcap);
+  }
   // Single run (or trials): the metrics of the last run; a sweep adds per-value metrics.
   for (const auto& kv : per_run.back()) m[kv.first] = kv.second;
   double samples = 0;

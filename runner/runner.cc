@@ -75,6 +75,17 @@ void CheckScenarioRun(const Scenario& s, const RunOptions& opt) {
     CreateParentFolders(opt.video_path);
   }
   if (!opt.can_log.empty()) CreateParentFolders(opt.can_log);
+  if (!opt.mcap.empty()) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(opt.mcap, ec))
+      throw InputError(opt.mcap + ": is a folder, expected the bag file to write (.mcap)");
+    if (s.emg_calibration)
+      throw InputError("--mcap: " + s.source + " is an emg_calibration protocol (its records are written per "
+                       "trial in its folders); a bag is written of an EXOwheel or HAL-3 run");
+    if (!s.log_measured_csv)
+      throw InputError("--mcap: " + s.source + " logs no rows (logs: measured_csv: false); the bag holds the logs' rows");
+    CreateParentFolders(opt.mcap);
+  }
 }
 
 RunResult RunScenario(const Scenario& s, const RunOptions& opt) {

@@ -36,6 +36,7 @@ struct RunOptions {
   std::string out_dir = "out";
   std::optional<uint64_t> seed;  // overrides the scenario's seed
   std::string can_log;           // candump log of every frame on the bus ("" = none)
+  std::string mcap;              // the run's logs as a ROS 2 bag (run_bag.h; "" = none)
   bool progress = false;         // progress bar on stderr
   std::string video_path;        // MP4 of the first trial (side view + overlays); "" = none
   // Called once per logged sample with (t, q_true[2], tau_applied[2]) (e.g. a video renderer).
@@ -90,8 +91,9 @@ ContractionProgramme IsometricProgrammeOf(const HumanSpec& h, uint64_t run_seed)
 
 // Everything the run of `s` with `opt` reads or writes besides the scenario file, checked before
 // anything runs: the subject's model file, the effects the plant carries (as the plant takes them),
-// the recorded trajectory of trajectory: file, an empty or folder video path; the folders of the
-// outputs (out_dir, video, CAN log) are created. Throws InputError. RunScenario calls it first; sweep
+// the recorded trajectory of trajectory: file, an empty or folder video path, a bag (opt.mcap) that is a
+// folder or of a scenario that logs no rows (an emg_calibration protocol, logs.measured_csv false); the
+// folders of the outputs (out_dir, video, CAN log, bag) are created. Throws InputError. RunScenario calls it first; sweep
 // and regress call it for every job before the first job starts. (The check metrics are checked
 // when the scenario is read: runner/scenario_metrics.h.)
 void CheckScenarioRun(const Scenario& s, const RunOptions& opt);

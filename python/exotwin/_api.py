@@ -84,23 +84,25 @@ def _raise_if_interrupted(result):
     raise e
 
 
-def run(scenario, seed=None, out=None):
-    """Runs a scenario as `exotwin run SCENARIO [--seed N] [--out DIR]` does, bit for bit.
+def run(scenario, seed=None, out=None, mcap=None):
+    """Runs a scenario as `exotwin run SCENARIO [--seed N] [--out DIR] [--mcap FILE]` does, bit for bit.
 
     scenario: the scenario file; seed: overrides the scenario's; out: the folder for result.json and
-    the logs (None: a temporary folder, removed afterwards; the logs stay in the result).
+    the logs (None: a temporary folder, removed afterwards; the logs stay in the result); mcap: a file
+    to write the run's logs to as a ROS 2 bag (None: none; kept when out is None).
     Returns a RunResult. Releases the interpreter's lock while it runs; Ctrl-C ends the run at a step's
     end and raises KeyboardInterrupt with the partial result as its `.result`.
     Raises InputError (bad scenario, a check naming an unknown metric) and SimulationError.
     """
     scenario = _path(scenario, "scenario")
     seed = _seed(seed)
+    mcap = "" if mcap is None else _path(mcap, "mcap")
     if out is not None:
-        result = RunResult(_exotwin._run(scenario, seed, _path(out, "out")))
+        result = RunResult(_exotwin._run(scenario, seed, _path(out, "out"), mcap))
     else:
         with tempfile.TemporaryDirectory(prefix="exotwin_run_") as tmp:
-            result = RunResult(_exotwin._run(scenario, seed, tmp))
-        result.files = []
+            result = RunResult(_exotwin._run(scenario, seed, tmp, mcap))
+        result.files = [mcap] if mcap else []
     _raise_if_interrupted(result)
     return result
 

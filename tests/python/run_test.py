@@ -105,3 +105,15 @@ def test_ctrl_c_stops_the_run_and_keeps_what_was_logged(tmp):
             pass
     # and a stop request does not outlive its run
     assert exotwin.run(short_gait(tmp, duration=0.2), seed=1).interrupted is None
+
+
+def test_mcap_is_the_cli_bag_byte_for_byte(tmp):
+    # exotwin.run(..., mcap=) writes the bag `exotwin run --mcap` writes (DESIGN.md "ROS 2 bags (MCAP)
+    # in and out"; read back by Foxglove's libraries in tests/cli/mcap_bag_test.sh), kept with out=None.
+    scenario = short_gait(tmp, duration=1.0)
+    cli("run", scenario, "--seed", 4, "--out", tmp / "cli", "--mcap", tmp / "cli.mcap")
+    r = exotwin.run(scenario, seed=4, mcap=tmp / "py.mcap")
+    assert r.files == [str(tmp / "py.mcap")]
+    assert (tmp / "py.mcap").read_bytes() == (tmp / "cli.mcap").read_bytes()
+    with pytest.raises(exotwin.InputError, match="is a folder"):
+        exotwin.run(scenario, seed=4, mcap=tmp)
