@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Compares two corpora of diagnoses (scripts/diagnosis_corpus.sh): every case's diagnosis.json and
 extended.yaml. JSON: the same keys, the same strings, every number within 1e-6 relative (1e-12
-absolute); keys that measure the machine (timings, threads) are skipped. Prints each difference with
+absolute); keys that measure the machine (timings, threads) and the records' paths are skipped. Prints each difference with
 its path; exit 1 when any."""
 import json, math, os, sys
 
-SKIP = {"seconds", "wall_s", "cpu_s", "threads", "timing", "elapsed_s"}
+SKIP = {"seconds", "wall_s", "cpu_s", "threads", "timing", "elapsed_s",
+        "source"}  # the record's path: the corpus's own folder, which differs between runs
 
 
 def close(a, b):
