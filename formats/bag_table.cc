@@ -4,14 +4,11 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <memory>
 
 #include "core/error.h"
 #include "core/file_text.h"
 #include "formats/mcap_format.h"
-#include "formats/mcap_reader.h"
 #include "formats/measured_data.h"
-#include "formats/ros2msg.h"
 
 namespace exotwin {
 namespace {
@@ -25,28 +22,6 @@ struct Source {
   std::string context;  // "MAP: columns.q_hip.from (line 3)"
   int channel = -1;
   FieldPath path;
-};
-
-// The channel's decoder: CDR by its ros2msg schema, or JSON.
-class Decoder {
- public:
-  Decoder(const McapChannel& c, const std::string& bag, const std::string& context) {
-    const std::string topic = ShownText(c.topic);
-    if (c.message_encoding == mcap::kMessageEncodingCdr && c.schema.encoding == mcap::kSchemaEncodingRos2Msg) {
-      schema_ = std::make_unique<Ros2MsgSchema>(c.schema.name, c.schema.data,
-                                                bag + ": topic " + topic + ": schema " + ShownText(c.schema.name));
-    } else if (c.message_encoding != mcap::kMessageEncodingJson) {
-      throw InputError(context + ": topic " + topic + " of " + bag + " holds messages encoded '" +
-                       ShownText(c.message_encoding) + "' (schema encoding '" + ShownText(c.schema.encoding) +
-                       "'), expected cdr with a ros2msg schema, or json");
-    }
-  }
-  MsgValue operator()(const McapMessage& m, const std::string& where) const {
-    return schema_ ? schema_->Decode(m.data, where) : DecodeJsonMessage(m.data, where);
-  }
-
- private:
-  std::unique_ptr<Ros2MsgSchema> schema_;
 };
 
 // A time (builtin_interfaces/Time: sec + nanosec; nsec as Foxglove's JSON writes it) in ns.
@@ -83,6 +58,22 @@ int64_t TimeNs(const McapMessage& m, const MsgValue& v, TimeOf how, const FieldP
 double Seconds(int64_t ns, int64_t origin) { return static_cast<double>(ns - origin) / 1e9; }
 
 }  // namespace
+
+ChannelDecoder::ChannelDecoder(const McapChannel& c, const std::string& bag, const std::string& context) {
+  const std::string topic = ShownText(c.topic);
+  if (c.message_encoding == mcap::kMessageEncodingCdr && c.schema.encoding == mcap::kSchemaEncodingRos2Msg) {
+    schema_ = std::make_shared<Ros2MsgSchema>(c.schema.name, c.schema.data,
+                                              bag + ": topic " + topic + ": schema " + ShownText(c.schema.name));
+  } else if (c.message_encoding != mcap::kMessageEncodingJson) {
+    throw InputError(context + ": topic " + topic + " of " + bag + " holds messages encoded '" +
+                     ShownText(c.message_encoding) + "' (schema encoding '" + ShownText(c.schema.encoding) +
+                     "'), expected cdr with a ros2msg schema, or json");
+  }
+}
+
+MsgValue ChannelDecoder::operator()(const McapMessage& m, const std::string& where) const {
+  return schema_ ? schema_->Decode(m.data, where) : DecodeJsonMessage(m.data, where);
+}
 
 CsvTable BagTable(const std::string& path, const ColumnMap& map) {
   const McapRecord bag = ReadMcapRecord(path);
@@ -130,7 +121,7 @@ CsvTable BagTable(const std::string& path, const ColumnMap& map) {
   for (auto& [channel, ks] : of_channel) {
     const McapChannel& c = bag.channels[channel];
     const std::string topic = ShownText(c.topic);
-    const Decoder decode(c, path, sources[ks.empty() ? 0 : ks.front()].context);
+    const ChannelDecoder decode(c, path, sources[ks.empty() ? 0 : ks.front()].context);
     const bool is_t = channel == t_channel;
     TimeOf how = t_how;
     bool first = true;

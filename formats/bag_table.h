@@ -2,12 +2,28 @@
 // (MCAP) in and out"): one column per distinct `from` of the map, named by it, one row per message of
 // t's topic; ApplyColumnMap then takes the table as it takes a foreign CSV.
 #pragma once
+#include <memory>
 #include <string>
 
 #include "formats/column_map.h"
 #include "formats/csv_table.h"
+#include "formats/mcap_reader.h"
+#include "formats/ros2msg.h"
 
 namespace exotwin {
+
+// The decoder of one channel's messages: CDR by its ros2msg schema (parsed once), or JSON. Throws
+// InputError ("<context>: topic T of <bag> holds messages encoded ...") for another encoding, and
+// what Ros2MsgSchema throws for a schema that does not parse.
+class ChannelDecoder {
+ public:
+  ChannelDecoder(const McapChannel& channel, const std::string& bag, const std::string& context);
+  // The message as a tree; InputError naming `where` for bytes its type does not decode.
+  MsgValue operator()(const McapMessage& m, const std::string& where) const;
+
+ private:
+  std::shared_ptr<const Ros2MsgSchema> schema_;  // null: JSON
+};
 
 // The map's sources read from the bag at `path` (an .mcap file or a rosbag2 folder):
 //   `TOPIC.path.to.field`, `TOPIC.array[N]`, `TOPIC.array[NAME]` (NAME's index in the message's

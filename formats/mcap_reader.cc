@@ -251,7 +251,7 @@ class FileReader {
     if (schema_id != 0) {
       const auto s = schemas_.find(schema_id);
       if (s == schemas_.end())
-        throw InputError(f.where() + ": channel " + std::to_string(id) + " (" + c.topic + ") names schema " +
+        throw InputError(f.where() + ": channel " + std::to_string(id) + " (" + ShownText(c.topic) + ") names schema " +
                          std::to_string(schema_id) + ", which no Schema record before it defines");
       c.schema = s->second;
     }
@@ -260,8 +260,9 @@ class FileReader {
       if (o.topic != c.topic) continue;
       if (o.message_encoding != c.message_encoding || o.schema.name != c.schema.name ||
           o.schema.encoding != c.schema.encoding || o.schema.data != c.schema.data)
-        throw InputError(f.where() + ": topic " + c.topic + " again with another message type (" + c.schema.name +
-                         ", " + c.message_encoding + "; before: " + o.schema.name + ", " + o.message_encoding +
+        throw InputError(f.where() + ": topic " + ShownText(c.topic) + " again with another message type (" +
+                         ShownText(c.schema.name) + ", " + ShownText(c.message_encoding) + "; before: " +
+                         ShownText(o.schema.name) + ", " + ShownText(o.message_encoding) +
                          "), expected one type per topic");
       channels_[id] = i;
       return;
@@ -360,7 +361,7 @@ class FileReader {
         pos += src, used += dst;
       }
     } else {
-      throw InputError(where + ": unknown compression '" + compression + "', expected none (''), zstd or lz4");
+      throw InputError(where + ": unknown compression '" + ShownText(compression) + "', expected none (''), zstd or lz4");
     }
     if (used != size) throw wrong_size(used);
     out.resize(used);

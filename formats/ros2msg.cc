@@ -171,6 +171,7 @@ std::string MsgValue::FieldNames() const {
 }
 
 Ros2MsgSchema::Ros2MsgSchema(const std::string& name, const std::string& text, const std::string& source) {
+  CheckText(name, source, "a type name (text)");
   CheckText(text, source, "a ros2msg message definition (text)");
   // Split into definitions: lines of '=' separate them; each after the first opens with "MSG: name".
   std::vector<std::pair<std::string, int>> lines;  // text, 1-based line
@@ -352,7 +353,7 @@ MsgValue DecodeJsonMessage(const std::string& bytes, const std::string& where) {
   try {
     j = nlohmann::json::parse(bytes);
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(where + ": not JSON (" + e.what() + "), expected a JSON object");
+    throw InputError(where + ": not JSON (" + ShownText(e.what()) + "), expected a JSON object");
   }
   if (!j.is_object()) throw InputError(where + ": expected a JSON object, got " + j.type_name());
   std::function<MsgValue(const nlohmann::json&, int)> tree = [&](const nlohmann::json& x, int depth) {

@@ -20,6 +20,7 @@
 
 #include "core/error.h"
 #include "core/file_text.h"
+#include "formats/bag_table.h"
 #include "formats/column_map.h"
 #include "formats/mcap_format.h"
 #include "formats/ros2msg.h"
@@ -117,10 +118,6 @@ std::string Match(const MsgValue& v, const json& e, const std::string& at) {
   return at + ": unexpected " + e.dump();
 }
 
-MsgValue DecodeOn(const McapChannel& c, const McapMessage& m) {
-  if (c.message_encoding == mcap::kMessageEncodingJson) return DecodeJsonMessage(m.data, m.where);
-  return Ros2MsgSchema(c.schema.name, c.schema.data, c.schema.name).Decode(m.data, m.where);
-}
 
 uint64_t Big(const json& e) { return std::stoull(e["$bigint"].get<std::string>()); }
 
@@ -134,11 +131,12 @@ void ExpectWritten(const McapRecord& r, const json& expected) {
     for (const McapMessage& m : r.messages)
       if (m.channel == static_cast<size_t>(c)) got.push_back(&m);
     ASSERT_EQ(got.size(), msgs.size()) << topic;
+    const ChannelDecoder decode(r.channels[c], r.source, "test");
     for (size_t k = 0; k < got.size(); ++k) {
       EXPECT_EQ(got[k]->log_time, Big(msgs[k]["log_time"])) << topic << " " << k;
       EXPECT_EQ(got[k]->publish_time, Big(msgs[k]["publish_time"])) << topic << " " << k;
       EXPECT_EQ(got[k]->sequence, msgs[k]["sequence"].get<uint32_t>()) << topic << " " << k;
-      EXPECT_EQ(Match(DecodeOn(r.channels[c], *got[k]), msgs[k]["message"], topic), "") << "message " << k;
+      EXPECT_EQ(Match(decode(*got[k], got[k]->where), msgs[k]["message"], topic), "") << "message " << k;
     }
   }
 }
@@ -343,7 +341,7 @@ TEST(McapReader, NoByteStringCrashesTheReader) {
         const McapRecord r = ParseMcap(bytes, "f.mcap");
         for (const McapMessage& m : r.messages) {
           try {
-            DecodeOn(r.channels[m.channel], m);
+            ChannelDecoder(r.channels[m.channel], "f.mcap", "test")(m, m.where);
           } catch (const InputError&) {
           }
         }

@@ -14,6 +14,9 @@
 //     at another rate, no header), /exo/probe (a message type exotwin has never seen: nested, arrays,
 //     bounded arrays and strings, constants, a default), /exo/json_states (json, jsonschema) and
 //     /exo/big_endian (CDR big-endian, written field by field with @foxglove/cdr).
+//   node write_bag.mjs fuzz-seeds OUTDIR
+//     The fuzz target's seeds (fuzz/corpus/fuzz_mcap): small bags of every topic, no chunks / zstd
+//     without a summary / lz4 with indexes, one cut short, one with a bad data-section CRC.
 //   node write_bag.mjs from-csv DATA.csv OUT.mcap OUT.csv
 //     The measured-data CSV as a JointState bag (names hip, knee; position q_*, velocity qd_* when
 //     present, effort -tau_*; header.stamp = 1733580000.123456789 s + t), zstd chunks with indexes;
@@ -150,32 +153,32 @@ function bigEndianBytes(m) {
 }
 
 // Every topic's messages in log-time order: [{topic, logTime, publishTime, sequence, message, data}].
-function allMessages() {
+function allMessages(n = { joint: 300, command: 76, probe: 5, json: 15, be: 3 }) {
   const out = [];
   const joint = writerOf(JOINT_STATE), command = writerOf(MULTI_ARRAY), probe = writerOf(PROBE);
-  for (let i = 0; i < 300; ++i) {
+  for (let i = 0; i < n.joint; ++i) {
     const m = jointMessage(i);
     const stamp = EPOCH_NS + BigInt(i) * 1000000n;
     out.push({ topic: "/exo/joint_states", logTime: stamp + 200000n, publishTime: stamp + 100000n, sequence: i,
                message: m, data: joint.writeMessage(m) });
   }
-  for (let k = 0; k < 76; ++k) {  // 250 Hz from 0.5 ms after the first joint state
+  for (let k = 0; k < n.command; ++k) {  // 250 Hz from 0.5 ms after the first joint state
     const m = commandMessage(k);
     const t = EPOCH_NS + 500000n + BigInt(k) * 4000000n;
     out.push({ topic: "/exo/command", logTime: t, publishTime: t, sequence: k, message: m, data: command.writeMessage(m) });
   }
-  for (let k = 0; k < 5; ++k) {
+  for (let k = 0; k < n.probe; ++k) {
     const m = probeMessage(k);
     const t = EPOCH_NS + BigInt(k) * 50000000n + 7n;
     out.push({ topic: "/exo/probe", logTime: t, publishTime: t - 1n, sequence: 1000 + k, message: m, data: probe.writeMessage(m) });
   }
-  for (let k = 0; k < 15; ++k) {
+  for (let k = 0; k < n.json; ++k) {
     const m = jsonMessage(k);
     const t = EPOCH_NS + BigInt(k) * 20000000n + 3n;
     out.push({ topic: "/exo/json_states", logTime: t, publishTime: t, sequence: k, message: m,
                data: new TextEncoder().encode(JSON.stringify(m)) });
   }
-  for (let k = 0; k < 3; ++k) {
+  for (let k = 0; k < n.be; ++k) {
     const m = bigEndianMessage(k);
     const t = EPOCH_NS + BigInt(k) * 100000000n + 11n;
     out.push({ topic: "/exo/big_endian", logTime: t, publishTime: t, sequence: k, message: m, data: bigEndianBytes(m) });
@@ -312,10 +315,26 @@ async function fromCsv(csvPath, bagPath, outCsv) {
   fs.writeFileSync(outCsv, out.join("\n") + "\n");
 }
 
+// The seed corpus of the fuzz target (fuzz/corpus/fuzz_mcap): small bags of every topic.
+async function fuzzSeeds(dir) {
+  await zstd.isLoaded;
+  fs.mkdirSync(dir, { recursive: true });
+  const messages = allMessages({ joint: 12, command: 3, probe: 2, json: 2, be: 1 });
+  await writeBag(path.join(dir, "valid_plain.mcap"), messages, TOPICS, "none", "plain");
+  await writeBag(path.join(dir, "valid_zstd_linear.mcap"), messages, TOPICS, "zstd", "linear");
+  await writeBag(path.join(dir, "valid_lz4_indexed.mcap"), messages, TOPICS, "lz4", "indexed");
+  const whole = fs.readFileSync(path.join(dir, "valid_plain.mcap"));
+  fs.writeFileSync(path.join(dir, "invalid_truncated.mcap"), whole.subarray(0, Math.floor(whole.length * 0.6)));
+  const flipped = Buffer.from(whole);
+  flipped[flipped.indexOf("exotwin tests/mcap_client")] ^= 0x20;  // in the Header record: the data CRC
+  fs.writeFileSync(path.join(dir, "invalid_bad_crc.mcap"), flipped);
+}
+
 const [mode, ...args] = process.argv.slice(2);
 if (mode === "variants" && args.length === 1) await variants(args[0]);
+else if (mode === "fuzz-seeds" && args.length === 1) await fuzzSeeds(args[0]);
 else if (mode === "from-csv" && args.length === 3) await fromCsv(...args);
 else {
-  console.error("usage: node write_bag.mjs variants OUTDIR | from-csv DATA.csv OUT.mcap OUT.csv");
+  console.error("usage: node write_bag.mjs variants OUTDIR | from-csv DATA.csv OUT.mcap OUT.csv | fuzz-seeds OUTDIR");
   process.exit(2);
 }
