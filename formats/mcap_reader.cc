@@ -131,13 +131,12 @@ class FileReader {
                            " is outside the file's records (bytes 8 .. " + std::to_string(footer_at) + ")");
         CheckSummaryCrc(footer_at, summary_start);
         ReadRecords(summary_start, footer_at, Section::kSummary);
-        if (!chunk_indexes_.empty()) {
-          ReadIndexed(summary_start);
+        if (!chunk_indexes_.empty() && ReadIndexed(summary_start)) {
           CheckStatistics();
           return true;
         }
-        // No chunk index: the data section is read record by record; its Schema and Channel
-        // records repeat the summary's.
+        // No chunk index, or messages outside the chunks: the data section is read record by
+        // record; its Schema and Channel records repeat the summary's.
       }
     }
     ReadRecords(sizeof mcap::kMagic, n, Section::kData);
@@ -149,7 +148,9 @@ class FileReader {
   }
 
  private:
-  enum class Section { kData, kSummary, kChunk };
+  // kDefinitions: the data section's own Schema and Channel records only (chunks and messages
+  // skipped), before its chunks are read through the indexes.
+  enum class Section { kData, kSummary, kChunk, kDefinitions };
 
   std::string At(size_t offset) const { return src_ + ": byte " + std::to_string(offset) + ": "; }
 
@@ -195,21 +196,24 @@ class FileReader {
       const size_t next = at + kRecordPrefix + static_cast<size_t>(len);
       switch (op) {
         case mcap::kHeader:
-          if (section != Section::kData || at != sizeof mcap::kMagic)
+          if ((section != Section::kData && section != Section::kDefinitions) || at != sizeof mcap::kMagic)
             throw InputError(rec + ": a Header record only opens the file (byte 8)");
           break;
         case mcap::kSchema: Schema(f); break;
         case mcap::kChannel: Channel(f); break;
         case mcap::kMessage:
           if (section == Section::kSummary) throw InputError(rec + ": a Message record in the summary section");
-          Message(f, where);
+          if (section == Section::kDefinitions) loose_messages_ = true;
+          else Message(f, where);
           break;
         case mcap::kChunk:
-          if (section != Section::kData) throw InputError(rec + ": a Chunk record outside the data section");
-          Chunk(f, at);
+          if (section == Section::kData) Chunk(f, at);
+          else if (section != Section::kDefinitions) throw InputError(rec + ": a Chunk record outside the data section");
           break;
         case mcap::kDataEnd:
-          if (section != Section::kData) throw InputError(rec + ": a Data End record outside the data section");
+          if (section != Section::kData)
+            throw InputError(rec + ": a Data End record " +
+                             (section == Section::kDefinitions ? "before the end of the data section" : "outside it"));
           DataEnd(f, at);
           section = Section::kSummary;
           break;
@@ -399,9 +403,11 @@ class FileReader {
     return i;
   }
 
-  // The data section through the summary: the chunks the Chunk Index records point at, in
-  // message_start_time order (a stable sort: file order among equal times).
-  void ReadIndexed(size_t summary_start) {
+  // The data section through the summary: its own Schema and Channel records, then the chunks the
+  // Chunk Index records point at, in message_start_time order (a stable sort: file order among
+  // equal times). False, having read no message, when the data section holds messages outside its
+  // chunks (the indexes do not cover them).
+  bool ReadIndexed(size_t summary_start) {
     if (summary_start < sizeof mcap::kMagic + kDataEndRecord ||
         static_cast<uint8_t>(b_[summary_start - kDataEndRecord]) != mcap::kDataEnd ||
         Le(summary_start - kDataEndRecord + 1, 8) != 4)
@@ -410,6 +416,8 @@ class FileReader {
       Fields f(b_.data() + summary_start - 4, 4, At(summary_start - kDataEndRecord) + "Data End record");
       DataEnd(f, summary_start - kDataEndRecord);
     }
+    ReadRecords(sizeof mcap::kMagic, summary_start - kDataEndRecord, Section::kDefinitions);
+    if (loose_messages_) return false;
     std::stable_sort(chunk_indexes_.begin(), chunk_indexes_.end(),
                      [](const Index& a, const Index& b) { return a.start_time < b.start_time; });
     const size_t data_end = summary_start - kDataEndRecord;
@@ -421,6 +429,7 @@ class FileReader {
                          std::to_string(i.length) + " do not hold a Chunk record of the data section");
       ReadRecords(i.offset, i.offset + i.length, Section::kData);
     }
+    return true;
   }
 
   void CheckStatistics() const {
@@ -437,7 +446,7 @@ class FileReader {
   std::map<uint16_t, McapSchema> schemas_;
   std::map<uint16_t, size_t> channels_;  // channel id -> index in out_->channels
   std::vector<Index> chunk_indexes_;
-  bool footer_seen_ = false, has_statistics_ = false;
+  bool footer_seen_ = false, has_statistics_ = false, loose_messages_ = false;
   uint64_t statistics_count_ = 0;
 };
 

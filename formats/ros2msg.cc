@@ -244,10 +244,10 @@ Ros2MsgSchema::Ros2MsgSchema(const std::string& name, const std::string& text, c
           f.array = MsgField::kSequence;
         } else if (inside.rfind("<=", 0) == 0 && ParseCount(inside.substr(2), &f.array_size)) {
           f.array = MsgField::kBounded;
-        } else if (ParseCount(inside, &f.array_size)) {
+        } else if (ParseCount(inside, &f.array_size) && f.array_size > 0) {  // IDL: a positive size
           f.array = MsgField::kFixed;
         } else {
-          throw InputError(at + "'" + inside + "': expected an array size N, <=N or nothing");
+          throw InputError(at + "'" + inside + "': expected an array size N > 0, <=N or nothing");
         }
       }
       if (type.rfind("string<=", 0) == 0) {

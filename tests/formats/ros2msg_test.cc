@@ -131,6 +131,7 @@ TEST(Ros2Msg, BadDefinitionsNameTheLine) {
   ExpectInputError([] { Ros2MsgSchema("p/T", "float64 2x\n", "s"); }, {"s: line 1", "expected a field name"});
   ExpectInputError([] { Ros2MsgSchema("p/T", "float64[x] a\n", "s"); }, {"s: line 1", "expected an array size"});
   ExpectInputError([] { Ros2MsgSchema("p/T", "string<=0 a\n", "s"); }, {"s: line 1", "string<=N"});
+  ExpectInputError([] { Ros2MsgSchema("p/T", "int8[0] a\n", "s"); }, {"s: line 1", "expected an array size N > 0"});
   ExpectInputError([] { Ros2MsgSchema("p/T", "wstring a\n", "s"); }, {"s: line 1", "wstring is not decoded"});
   ExpectInputError([] { Ros2MsgSchema("p/T", "int8 a\n=====\nint8 b\n", "s"); }, {"s: line 3", "expected 'MSG: pkg/Type'"});
   ExpectInputError([] { Ros2MsgSchema("p/T", "U u\n====\nMSG: p/U\nT t\n", "s"); }, {"s: p/U contains itself", "'t'"});
