@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 
@@ -465,7 +466,10 @@ int McapRecord::Find(const std::string& topic) const {
 bool IsBagPath(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) return fs::exists(fs::path(path) / "metadata.yaml", ec);
-  return path.size() > 5 && path.compare(path.size() - 5, 5, ".mcap") == 0;
+  if (path.size() > 5 && path.compare(path.size() - 5, 5, ".mcap") == 0) return true;
+  char head[sizeof mcap::kMagic] = {};
+  std::ifstream in(path, std::ios::binary);
+  return in.read(head, sizeof head) && std::memcmp(head, mcap::kMagic, sizeof head) == 0;
 }
 
 McapRecord ParseMcap(const std::string& bytes, const std::string& source) {

@@ -48,7 +48,8 @@ struct McapRecord {
   int Find(const std::string& topic) const;
 };
 
-// True for a path ReadMcapRecord takes: a file ending in ".mcap" or a folder holding metadata.yaml.
+// True for a path ReadMcapRecord takes: a file ending in ".mcap" or starting with the MCAP magic, or a
+// folder holding metadata.yaml (a rosbag2 folder).
 bool IsBagPath(const std::string& path);
 
 // Reads one MCAP file's bytes (`source` names it in messages). Throws InputError naming the source

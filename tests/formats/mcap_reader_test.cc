@@ -157,6 +157,11 @@ TEST(McapReader, ARosbag2FolderIsOneRecordOfItsFiles) {
   REQUIRE_CLIENT(dir);
   EXPECT_TRUE(IsBagPath(dir + "/rosbag2"));
   EXPECT_FALSE(IsBagPath(dir));  // a folder without metadata.yaml
+  EXPECT_TRUE(IsBagPath(dir + "/plain.mcap"));
+  EXPECT_FALSE(IsBagPath(dir + "/expected.json"));
+  const testing::ScopedTempDir tmp("mcap_sniff");
+  std::filesystem::copy_file(dir + "/plain.mcap", tmp.File("bag.bin"));
+  EXPECT_TRUE(IsBagPath(tmp.File("bag.bin")));  // by its magic
   const McapRecord r = ReadMcapRecord(dir + "/rosbag2");
   EXPECT_FALSE(r.indexed);  // its second file has no summary
   ExpectWritten(r, Expected(dir));
