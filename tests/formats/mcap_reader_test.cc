@@ -306,6 +306,49 @@ TEST(McapReader, NotMcapTruncatedAndCorruptFilesNameTheFileAndTheByte) {
   ExpectInputError([&] { ReadMeasured(tmp.File("cut.mcap"), map); }, {tmp.File("cut.mcap") + ": byte ", "truncated"});
 }
 
+uint64_t Le64(const std::string& b, size_t at) {
+  uint64_t v = 0;
+  for (int i = 8; i-- > 0;) v = (v << 8) | static_cast<unsigned char>(b[at + i]);
+  return v;
+}
+
+void PutLe64(std::string* b, size_t at, uint64_t v) {
+  for (int i = 0; i < 8; ++i) (*b)[at + i] = static_cast<char>(v >> (8 * i));
+}
+
+// The summary of an indexed file, its CRC cleared (0: not computed) so that a changed record is read:
+// a Statistics count the file does not hold, a Chunk Index pointing off its chunk.
+TEST(McapReader, TheSummarysIndexesAndStatisticsAreChecked) {
+  REQUIRE_CLIENT(dir);
+  const std::string good = Bytes(dir + "/lz4_indexed.mcap");
+  const size_t footer = good.size() - 8 - 9 - 20;
+  ASSERT_EQ(good[footer], static_cast<char>(mcap::kFooter));
+  const size_t summary = Le64(good, footer + 9);
+  const auto first = [&](uint8_t op) {
+    for (size_t at = summary; at < footer; at += 9 + Le64(good, at + 1))
+      if (static_cast<uint8_t>(good[at]) == op) return at;
+    return std::string::npos;
+  };
+  std::string b = good;
+  b.replace(footer + 9 + 16, 4, std::string(4, '\0'));
+  EXPECT_EQ(ParseMcap(b, "f.mcap").messages.size(), 399u);  // no summary CRC: read as it is
+  const size_t stats = first(mcap::kStatistics), index = first(mcap::kChunkIndex);
+  ASSERT_NE(stats, std::string::npos);
+  ASSERT_NE(index, std::string::npos);
+  std::string bad = b;
+  PutLe64(&bad, stats + 9, 400);
+  ExpectInputError([&] { ParseMcap(bad, "s.mcap"); },
+                   {"s.mcap: Statistics record: message_count 400 but the file holds 399"});
+  bad = b;
+  PutLe64(&bad, index + 9 + 16, Le64(b, index + 9 + 16) + 1);  // chunk_start_offset
+  ExpectInputError([&] { ParseMcap(bad, "i.mcap"); },
+                   {"i.mcap: byte " + std::to_string(index) + ": Chunk Index record", "do not hold a Chunk record"});
+  // The footer's summary_start beyond the records.
+  bad = good;
+  PutLe64(&bad, footer + 9, footer + 1);
+  ExpectInputError([&] { ParseMcap(bad, "o.mcap"); }, {"o.mcap: byte " + std::to_string(footer) + ": Footer record: summary_start"});
+}
+
 TEST(McapReader, AMapNamingWhatTheBagLacksNamesTheTopicAndTheField) {
   REQUIRE_CLIENT(dir);
   const testing::ScopedTempDir tmp("mcap_badmap");
