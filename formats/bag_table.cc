@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "core/error.h"
 #include "core/file_text.h"
@@ -121,9 +122,12 @@ CsvTable BagTable(const std::string& path, const ColumnMap& map) {
   for (auto& [channel, ks] : of_channel) {
     const McapChannel& c = bag.channels[channel];
     const std::string topic = ShownText(c.topic);
-    const ChannelDecoder decode(c, path, sources[ks.empty() ? 0 : ks.front()].context);
     const bool is_t = channel == t_channel;
     TimeOf how = t_how;
+    // t's topic placed by log_time or publish_time with no other source on it is not decoded (its
+    // messages may be of any encoding).
+    std::optional<ChannelDecoder> decode;
+    if (!ks.empty() || how == TimeOf::kStamp) decode.emplace(c, path, sources[ks.empty() ? 0 : ks.front()].context);
     bool first = true;
     size_t number = 0;
     std::vector<int64_t>& ns = is_t ? t_ns : times[channel];
@@ -131,7 +135,7 @@ CsvTable BagTable(const std::string& path, const ColumnMap& map) {
       if (m.channel != static_cast<size_t>(channel)) continue;
       ++number;
       const std::string where = m.where + ": topic " + topic + ", message " + std::to_string(number);
-      const MsgValue v = decode(m, where);
+      const MsgValue v = decode ? (*decode)(m, where) : MsgValue();
       if (first && !is_t && how == TimeOf::kStamp) {
         const MsgValue* h = v.Field("header");
         if (!h || !h->Field("stamp")) how = TimeOf::kLogTime;  // no stamp of its own: placed by log_time

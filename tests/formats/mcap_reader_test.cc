@@ -254,6 +254,31 @@ TEST(McapReader, JsonAndBigEndianTopicsThroughTheMap) {
   EXPECT_EQ(d.tau_knee().back(), -3.0);
 }
 
+// A topic of an encoding exotwin does not decode: its log_time can still be t's time base; a field of it
+// is refused naming the encoding. (plain.mcap with its CRCs cleared: 0 = not computed.)
+TEST(McapReader, ATopicOfAnotherEncodingGivesItsLogTimeButNoField) {
+  REQUIRE_CLIENT(dir);
+  const testing::ScopedTempDir tmp("mcap_enc");
+  std::string b = ReadBinaryFile(dir + "/plain.mcap", "");
+  const std::string json_encoding("\x04\0\0\0json", 8);
+  for (size_t at = 0; (at = b.find(json_encoding, at)) != std::string::npos; at += 8) b[at + 7] = 'x';
+  const size_t footer = b.size() - 8 - 9 - 20;
+  uint64_t summary = 0;
+  for (int i = 8; i-- > 0;) summary = (summary << 8) | static_cast<unsigned char>(b[footer + 9 + i]);
+  b.replace(summary - 4, 4, std::string(4, '\0'));     // Data End's CRC
+  b.replace(footer + 9 + 16, 4, std::string(4, '\0'));  // the summary's
+  std::ofstream(tmp.File("enc.mcap"), std::ios::binary) << b;
+  std::string map = kJointMap;
+  map.replace(map.find("/exo/joint_states.header.stamp"), 30, "/exo/json_states.log_time");
+  const MeasuredData d = ReadMeasured(tmp.File("enc.mcap"), WriteMap(tmp, "m.yaml", map), 2);
+  EXPECT_EQ(d.size(), 15u);
+  EXPECT_EQ(d.t()[1], 0.02);
+  map = kJointMap;
+  map.replace(map.find("/exo/joint_states.header.stamp"), 30, "/exo/json_states.header.stamp");
+  ExpectInputError([&] { ReadMeasured(tmp.File("enc.mcap"), WriteMap(tmp, "m.yaml", map), 2); },
+                   {"m.yaml: columns.t.from (line 2): topic /exo/json_states of ", "holds messages encoded 'jsox'"});
+}
+
 // --- bad input -----------------------------------------------------------------------------------
 
 std::string Bytes(const std::string& path) { return ReadBinaryFile(path, ""); }
