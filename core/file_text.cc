@@ -231,6 +231,13 @@ std::string ReadWhole(TextFileChunks& in) {
 
 }  // namespace
 
+std::string Trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t\r");
+  if (a == std::string::npos) return "";
+  const size_t b = s.find_last_not_of(" \t\r");
+  return s.substr(a, b - a + 1);
+}
+
 std::string ShownText(std::string_view s) {
   if (!FindTextFault(s)) return std::string(s);
   return "<" + std::to_string(s.size()) + " bytes, not text>";

@@ -45,6 +45,9 @@ class TextCheck {
 // The first fault of a whole text (none: valid text).
 std::optional<TextFault> FindTextFault(std::string_view text);
 
+// `s` without the spaces, tabs and CRs at either end (a line of a text file, a field of it).
+std::string Trim(const std::string& s);
+
 // A string taken from a binary file (a topic, a name in a message) as a message may quote it: itself
 // when it is valid text, else "<N bytes, not text>".
 std::string ShownText(std::string_view s);

@@ -64,12 +64,6 @@ bool ParseCount(const std::string& s, uint64_t* v) {
   return true;
 }
 
-std::string Trim(const std::string& s) {
-  const size_t a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return "";
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
-
 // The bytes of one CDR message after the encapsulation header, with alignment counted from there.
 class CdrReader {
  public:
