@@ -56,6 +56,12 @@ int64_t TimeNs(const McapMessage& m, const MsgValue& v, TimeOf how, const FieldP
   return ns;
 }
 
+// True when the source `from` is a field of `topic`: "TOPIC.field...".
+bool Names(const std::string& from, const std::string& topic) {
+  return !topic.empty() && from.size() > topic.size() + 1 && from.compare(0, topic.size(), topic) == 0 &&
+         from[topic.size()] == '.';
+}
+
 double Seconds(int64_t ns, int64_t origin) { return static_cast<double>(ns - origin) / 1e9; }
 
 }  // namespace
@@ -77,7 +83,10 @@ MsgValue ChannelDecoder::operator()(const McapMessage& m, const std::string& whe
 }
 
 CsvTable BagTable(const std::string& path, const ColumnMap& map) {
-  const McapRecord bag = ReadMcapRecord(path);
+  // Only the messages of topics a source names are kept (a bag's camera topics are not copied).
+  const McapRecord bag = ReadMcapRecord(path, [&map](const std::string& topic) {
+    return std::any_of(map.columns.begin(), map.columns.end(), [&](const ColumnSpec& s) { return Names(s.from, topic); });
+  });
   // The sources: the longest topic of the bag that `from` starts with, then the field path.
   std::vector<Source> sources;
   TimeOf t_how = TimeOf::kStamp;
@@ -89,9 +98,7 @@ CsvTable BagTable(const std::string& path, const ColumnMap& map) {
     size_t best = 0;
     for (size_t c = 0; c < bag.channels.size(); ++c) {
       const std::string& topic = bag.channels[c].topic;
-      if (!topic.empty() && topic.size() > best && s.from.size() > topic.size() + 1 &&
-          s.from.compare(0, topic.size(), topic) == 0 && s.from[topic.size()] == '.')
-        best = topic.size(), src.channel = static_cast<int>(c);
+      if (topic.size() > best && Names(s.from, topic)) best = topic.size(), src.channel = static_cast<int>(c);
     }
     if (src.channel < 0) {
       std::string topics;

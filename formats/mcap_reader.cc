@@ -108,8 +108,8 @@ class Fields {
 // The records of one file, gathered into a McapRecord.
 class FileReader {
  public:
-  FileReader(const std::string& bytes, const std::string& source, McapRecord* out)
-      : b_(bytes), src_(source), out_(out) {}
+  FileReader(const std::string& bytes, const std::string& source, const TopicFilter& wanted, McapRecord* out)
+      : b_(bytes), src_(source), wanted_(wanted), out_(out) {}
 
   // Returns true when the file was read through its summary's chunk indexes.
   bool Read() {
@@ -222,7 +222,7 @@ class FileReader {
           if (section == Section::kSummary) chunk_indexes_.push_back(ChunkIndex(f));
           break;
         case mcap::kStatistics:
-          if (section == Section::kSummary) statistics_count_ = f.U64("message_count"), has_statistics_ = true;
+          if (section == Section::kSummary) Statistics(f);
           break;
         case mcap::kFooter:
           if (section == Section::kChunk) throw InputError(rec + ": a Footer record inside a chunk");
@@ -287,6 +287,8 @@ class FileReader {
     if (c == channels_.end())
       throw InputError(f.where() + ": message of channel " + std::to_string(id) +
                        ", which no Channel record before it defines");
+    ++seen_[id];
+    if (!Wanted(c->second)) return;
     m.channel = c->second;
     m.where = where;
     out_->messages.push_back(std::move(m));
@@ -306,6 +308,7 @@ class FileReader {
         throw InputError(f.where() + ": uncompressed CRC " + Hex(crc) + " but the records have CRC " + Hex(computed) +
                          " (a corrupt chunk)");
     }
+    ++out_->chunks_read;
     ReadRecords(0, data.size(), Section::kChunk, &data, at);
   }
 
@@ -392,6 +395,7 @@ class FileReader {
 
   struct Index {
     uint64_t start_time, offset, length;
+    std::vector<uint16_t> channels;  // the channels its message index names (empty: none given)
     std::string where;
   };
   Index ChunkIndex(Fields& f) {
@@ -400,6 +404,10 @@ class FileReader {
     f.U64("message_end_time");
     i.offset = f.U64("chunk_start_offset");
     i.length = f.U64("chunk_length");
+    const std::string offsets = f.Bytes32("message_index_offsets");  // uint16 channel id -> uint64 offset
+    for (size_t k = 0; k + 10 <= offsets.size(); k += 10)
+      i.channels.push_back(static_cast<uint16_t>(static_cast<unsigned char>(offsets[k]) |
+                                                 static_cast<unsigned char>(offsets[k + 1]) << 8));
     i.where = f.where();
     return i;
   }
@@ -428,31 +436,76 @@ class FileReader {
           Le(i.offset + 1, 8) != i.length - kRecordPrefix)
         throw InputError(i.where + ": chunk_start_offset " + std::to_string(i.offset) + ", chunk_length " +
                          std::to_string(i.length) + " do not hold a Chunk record of the data section");
+      // A chunk holding only other topics' messages (its channels all defined) is not read.
+      if (wanted_ && !i.channels.empty() &&
+          std::all_of(i.channels.begin(), i.channels.end(), [&](uint16_t id) {
+            const auto c = channels_.find(id);
+            return c != channels_.end() && !Wanted(c->second);
+          })) {
+        skipped_chunks_ = true;
+        ++out_->chunks_skipped;
+        continue;
+      }
       ReadRecords(i.offset, i.offset + i.length, Section::kData);
     }
     return true;
   }
 
+  bool Wanted(size_t channel) const { return !wanted_ || wanted_(out_->channels[channel].topic); }
+
+  void Statistics(Fields& f) {
+    has_statistics_ = true;
+    statistics_count_ = f.U64("message_count");
+    f.U16("schema_count");
+    for (const char* n : {"channel_count", "attachment_count", "metadata_count", "chunk_count"}) f.U32(n);
+    f.U64("message_start_time");
+    f.U64("message_end_time");
+    const std::string counts = f.Bytes32("channel_message_counts");  // uint16 channel id -> uint64 count
+    for (size_t k = 0; k + 10 <= counts.size(); k += 10) {
+      uint64_t n = 0;
+      for (int b = 10; b-- > 2;) n = (n << 8) | static_cast<unsigned char>(counts[k + b]);
+      channel_counts_[static_cast<uint16_t>(static_cast<unsigned char>(counts[k]) |
+                                            static_cast<unsigned char>(counts[k + 1]) << 8)] = n;
+    }
+  }
+
+  // The Statistics' message_count against the messages read; with chunks left unread, each wanted
+  // channel's count in channel_message_counts.
   void CheckStatistics() const {
-    if (has_statistics_ && statistics_count_ != out_->messages.size() - messages_before_)
+    if (!has_statistics_) return;
+    uint64_t seen = 0;
+    for (const auto& [id, n] : seen_) seen += n;
+    if (!skipped_chunks_ && statistics_count_ != seen)
       throw InputError(src_ + ": Statistics record: message_count " + std::to_string(statistics_count_) +
-                       " but the file holds " + std::to_string(out_->messages.size() - messages_before_) +
-                       " messages (a corrupt or truncated file)");
+                       " but the file holds " + std::to_string(seen) + " messages (a corrupt or truncated file)");
+    if (!skipped_chunks_) return;
+    for (const auto& [id, n] : channel_counts_) {
+      const auto c = channels_.find(id);
+      if (c == channels_.end() || !Wanted(c->second)) continue;
+      const auto s = seen_.find(id);
+      const uint64_t got = s == seen_.end() ? 0 : s->second;
+      if (got != n)
+        throw InputError(src_ + ": Statistics record: channel " + std::to_string(id) + " (" +
+                         ShownText(out_->channels[c->second].topic) + ") has " + std::to_string(n) +
+                         " messages, the chunks hold " + std::to_string(got) + " (a corrupt file)");
+    }
   }
 
   const std::string& b_;
   const std::string& src_;
+  const TopicFilter& wanted_;
   McapRecord* out_;
-  size_t messages_before_ = out_->messages.size();
   std::map<uint16_t, McapSchema> schemas_;
   std::map<uint16_t, size_t> channels_;  // channel id -> index in out_->channels
   std::vector<Index> chunk_indexes_;
-  bool footer_seen_ = false, has_statistics_ = false, loose_messages_ = false;
+  bool footer_seen_ = false, has_statistics_ = false, loose_messages_ = false, skipped_chunks_ = false;
   uint64_t statistics_count_ = 0;
+  std::map<uint16_t, uint64_t> channel_counts_;  // the Statistics' channel_message_counts
+  std::map<uint16_t, uint64_t> seen_;            // messages read per channel id, kept or not
 };
 
-bool ParseInto(const std::string& bytes, const std::string& source, McapRecord* out) {
-  return FileReader(bytes, source, out).Read();
+bool ParseInto(const std::string& bytes, const std::string& source, const TopicFilter& wanted, McapRecord* out) {
+  return FileReader(bytes, source, wanted, out).Read();
 }
 
 }  // namespace
@@ -472,16 +525,16 @@ bool IsBagPath(const std::string& path) {
   return in.read(head, sizeof head) && std::memcmp(head, mcap::kMagic, sizeof head) == 0;
 }
 
-McapRecord ParseMcap(const std::string& bytes, const std::string& source) {
+McapRecord ParseMcap(const std::string& bytes, const std::string& source, const TopicFilter& wanted) {
   McapRecord r;
   r.source = source;
-  r.indexed = ParseInto(bytes, source, &r);
+  r.indexed = ParseInto(bytes, source, wanted, &r);
   return r;
 }
 
-McapRecord ReadMcapRecord(const std::string& path) {
+McapRecord ReadMcapRecord(const std::string& path, const TopicFilter& wanted) {
   std::error_code ec;
-  if (!fs::is_directory(path, ec)) return ParseMcap(ReadBinaryFile(path, "MCAP"), path);
+  if (!fs::is_directory(path, ec)) return ParseMcap(ReadBinaryFile(path, "MCAP"), path, wanted);
   // A rosbag2 folder (github.com/ros2/rosbag2, metadata.yaml): its files in order, one record.
   const std::string meta = (fs::path(path) / "metadata.yaml").string();
   const YAML::Node root = ParseYaml(ReadYamlText(meta, "rosbag2 metadata"), meta);
@@ -503,7 +556,7 @@ McapRecord ReadMcapRecord(const std::string& path) {
       c.Fail("rosbag2_bagfile_information.relative_file_paths", "expected file names" + YamlLine(f));
     const std::string file = (fs::path(path) / f.Scalar()).string();
     // Each file has its own channel ids; topics are merged by name into r.
-    r.indexed = ParseInto(ReadBinaryFile(file, "MCAP"), file, &r) && r.indexed;
+    r.indexed = ParseInto(ReadBinaryFile(file, "MCAP"), file, wanted, &r) && r.indexed;
   }
   return r;
 }

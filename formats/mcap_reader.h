@@ -11,6 +11,7 @@
 // data-section CRC, each chunk's uncompressed CRC, the footer's summary CRC.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,8 +43,10 @@ struct McapMessage {
 struct McapRecord {
   std::string source;                 // the path given
   std::vector<McapChannel> channels;  // in order of first appearance
-  std::vector<McapMessage> messages;  // per file: data-section order (chunks in index order); files in order
+  std::vector<McapMessage> messages;  // per file: data-section order (chunks in index order); files in order;
+                                      // only the wanted topics' (ParseMcap's `wanted`)
   bool indexed = false;               // every file read through its summary's chunk indexes
+  size_t chunks_read = 0, chunks_skipped = 0;  // skipped: through the indexes, no wanted topic in it
   // The channel of `topic`, -1 if none.
   int Find(const std::string& topic) const;
 };
@@ -52,18 +55,24 @@ struct McapRecord {
 // folder holding metadata.yaml (a rosbag2 folder).
 bool IsBagPath(const std::string& path);
 
-// Reads one MCAP file's bytes (`source` names it in messages). Throws InputError naming the source
+// The topics whose messages a reader keeps (every channel is listed whatever it says); empty: all.
+using TopicFilter = std::function<bool(const std::string& topic)>;
+
+// Reads one MCAP file's bytes (`source` names it in messages), keeping the messages of the topics
+// `wanted` takes. Through the chunk indexes, a chunk whose message index names only channels of
+// other topics is not read; the Statistics are then checked per wanted channel
+// (channel_message_counts). Throws InputError naming the source
 // and the byte offset for: no MCAP magic at the start or end (not MCAP), a record running past the
 // end (truncated), a record field running past its record, a bad CRC (which one, stored and
 // computed), an unknown compression, a chunk that does not decompress to its uncompressed_size, a
 // message of a channel never defined, a channel of a schema never defined, a Chunk Index that does
 // not point at a chunk, a Statistics message count the file does not hold.
-McapRecord ParseMcap(const std::string& bytes, const std::string& source);
+McapRecord ParseMcap(const std::string& bytes, const std::string& source, const TopicFilter& wanted = {});
 
 // ParseMcap of the file at `path`, or of each file of the rosbag2 folder at `path` (metadata.yaml's
 // rosbag2_bagfile_information.relative_file_paths, in order, relative to the folder; storage_identifier
 // mcap). Throws InputError for an unreadable file, a metadata.yaml without those keys, a file it
 // names that is missing, a topic whose schema or encoding differs between files.
-McapRecord ReadMcapRecord(const std::string& path);
+McapRecord ReadMcapRecord(const std::string& path, const TopicFilter& wanted = {});
 
 }  // namespace exotwin

@@ -153,6 +153,34 @@ TEST(McapReader, ReadsExactlyWhatFoxglovesLibrariesWroteInEveryCompressionAndLay
   }
 }
 
+// A topic filter keeps one topic's messages, and through the indexes the chunks without it are not
+// read: the values are still exactly the client's, and the Statistics are checked per channel.
+TEST(McapReader, ATopicFilterSkipsTheChunksWithoutItsTopic) {
+  REQUIRE_CLIENT(dir);
+  const auto probe = [](const std::string& topic) { return topic == "/exo/probe"; };
+  for (const char* v : {"zstd_indexed", "zstd_linear", "plain"}) {
+    SCOPED_TRACE(v);
+    const McapRecord all = ReadMcapRecord(dir + "/" + v + ".mcap");
+    const McapRecord one = ReadMcapRecord(dir + "/" + v + ".mcap", probe);
+    EXPECT_EQ(one.channels.size(), all.channels.size());  // every channel listed
+    json want = Expected(dir);
+    for (auto it = want["topics"].begin(); it != want["topics"].end();)
+      it = it.key() == "/exo/probe" ? std::next(it) : want["topics"].erase(it);
+    ASSERT_EQ(one.messages.size(), 5u);
+    const int c = one.Find("/exo/probe");
+    const ChannelDecoder decode(one.channels[c], v, "test");
+    for (size_t k = 0; k < 5; ++k)
+      EXPECT_EQ(Match(decode(one.messages[k], ""), want["topics"]["/exo/probe"][k]["message"], "probe"), "");
+    EXPECT_EQ(all.chunks_skipped, 0u);
+    if (std::string(v) == "zstd_indexed") {
+      EXPECT_GT(one.chunks_skipped, 0u);
+      EXPECT_EQ(one.chunks_read + one.chunks_skipped, all.chunks_read);
+    } else {
+      EXPECT_EQ(one.chunks_skipped, 0u);  // no index: every chunk read
+    }
+  }
+}
+
 TEST(McapReader, ARosbag2FolderIsOneRecordOfItsFiles) {
   REQUIRE_CLIENT(dir);
   EXPECT_TRUE(IsBagPath(dir + "/rosbag2"));
