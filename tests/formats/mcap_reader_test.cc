@@ -193,6 +193,18 @@ TEST(McapReader, ARosbag2FolderIsOneRecordOfItsFiles) {
   const McapRecord r = ReadMcapRecord(dir + "/rosbag2");
   EXPECT_FALSE(r.indexed);  // its second file has no summary
   ExpectWritten(r, Expected(dir));
+  // Bad metadata: the key and the file named.
+  const testing::ScopedTempDir bad("mcap_rosbag2");
+  const auto meta = [&](const std::string& text) { std::ofstream(bad.File("metadata.yaml")) << text; };
+  meta("rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths: [a.db3]\n");
+  ExpectInputError([&] { ReadMcapRecord(bad.path()); },
+                   {bad.File("metadata.yaml"), "storage_identifier", "'sqlite3', expected mcap"});
+  meta("rosbag2_bagfile_information:\n  storage_identifier: mcap\n");
+  ExpectInputError([&] { ReadMcapRecord(bad.path()); }, {"relative_file_paths", "missing or empty"});
+  meta("rosbag2_bagfile_information:\n  relative_file_paths: [gone.mcap]\n");
+  ExpectInputError([&] { ReadMcapRecord(bad.path()); }, {bad.File("gone.mcap") + ": cannot open MCAP file"});
+  meta("a: [\n");
+  ExpectInputError([&] { ReadMcapRecord(bad.path()); }, {bad.File("metadata.yaml"), "malformed YAML"});
 }
 
 std::string WriteMap(const testing::ScopedTempDir& tmp, const std::string& name, const std::string& text) {
