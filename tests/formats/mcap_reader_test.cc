@@ -37,8 +37,8 @@ using testing::ExpectInputError;
 const char* const kVariants[] = {"none_indexed", "none_linear", "zstd_indexed", "zstd_linear",
                                  "lz4_indexed",  "lz4_linear",  "plain"};
 
-// The client's bags, written once per test process; empty (with the reason in *why) when the client
-// cannot run here.
+// The client's bags, written once per test process; empty (with the reason in *why) when node or
+// the client's node_modules are missing (the tests then skip), "FAILED: ..." when the client failed.
 const std::string& ClientBags(std::string* why) {
   static const testing::ScopedTempDir tmp("mcap_client");
   static std::string reason;
@@ -52,13 +52,9 @@ const std::string& ClientBags(std::string* why) {
       reason = "tests/mcap_client/node_modules is missing (npm ci there; scripts/setup.sh does it)";
       return std::string();
     }
-    if (std::system("lz4 --version >/dev/null 2>&1") != 0) {
-      reason = "the lz4 command is not installed (Debian's lz4; scripts/setup.sh)";
-      return std::string();
-    }
     const std::string out = tmp.File("bags");
     const std::string cmd = "cd '" + client + "' && node write_bag.mjs variants '" + out + "' 2>&1";
-    if (std::system(cmd.c_str()) != 0) {
+    if (std::system(cmd.c_str()) != 0) {  // e.g. no lz4 command (scripts/setup.sh installs it): a failure
       reason = "FAILED: " + cmd;
       return std::string();
     }
