@@ -6,8 +6,9 @@
 // Message, Chunk; the others skipped, unknown opcodes too, as the spec asks); chunks stored
 // uncompressed, zstd (libzstd) or lz4 (liblz4's frame format); the summary section when the footer
 // points at one: its Schema and Channel records, its Chunk Index records (the chunks are then read
-// through them, in message_start_time order), its Statistics (message count checked). A file without
-// a summary is read linearly. CRC-32 (zlib's crc32; 0 = not computed) checked: the Data End record's
+// through them, in message_start_time order, after the data section's own Schema and Channel
+// records), its Statistics (message count checked). A file without a summary, without chunk indexes,
+// or with messages outside its chunks is read linearly. CRC-32 (zlib's crc32; 0 = not computed) checked: the Data End record's
 // data-section CRC, each chunk's uncompressed CRC, the footer's summary CRC.
 #pragma once
 #include <cstdint>
@@ -61,8 +62,8 @@ using TopicFilter = std::function<bool(const std::string& topic)>;
 // Reads one MCAP file's bytes (`source` names it in messages), keeping the messages of the topics
 // `wanted` takes. Through the chunk indexes, a chunk whose message index names only channels of
 // other topics is not read; the Statistics are then checked per wanted channel
-// (channel_message_counts). Throws InputError naming the source
-// and the byte offset for: no MCAP magic at the start or end (not MCAP), a record running past the
+// (channel_message_counts). Throws InputError naming the source and the byte offset for: no MCAP
+// magic at the start (not MCAP), a record running past the
 // end (truncated), a record field running past its record, a bad CRC (which one, stored and
 // computed), an unknown compression, a chunk that does not decompress to its uncompressed_size, a
 // message of a channel never defined, a channel of a schema never defined, a Chunk Index that does
