@@ -1,7 +1,6 @@
 #include "formats/mcap_reader.h"
 
 #include <lz4frame.h>
-#include <zlib.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -23,20 +22,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr size_t kRecordPrefix = 9;  // opcode (uint8) + length (uint64)
-constexpr size_t kFooterLength = 20;  // summary_start, summary_offset_start (uint64), summary_crc (uint32)
-constexpr size_t kDataEndRecord = kRecordPrefix + 4;
-
-// zlib's CRC-32 (ISO-HDLC) of n bytes; crc32 takes at most a uInt of them per call.
-uint32_t Crc32(const char* p, size_t n) {
-  uLong crc = crc32(0L, Z_NULL, 0);
-  while (n > 0) {
-    const uInt part = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
-    crc = crc32(crc, reinterpret_cast<const Bytef*>(p), part);
-    p += part, n -= part;
-  }
-  return static_cast<uint32_t>(crc);
-}
+using mcap::Crc32;
+using mcap::kFooterLength;
+using mcap::kRecordPrefix;
+constexpr size_t kDataEndRecord = kRecordPrefix + 4;  // a Data End record: prefix and data_section_crc
 
 std::string Hex(uint32_t v) {
   char b[16];
