@@ -4,8 +4,8 @@
 # (tests/mcap_client/write_bag.mjs: Foxglove's @mcap/core and ROS 2 serializer, zstd chunks, epoch
 # header stamps) and as the CSV of the same data; `diagnose`, `predict` and `convert` given the bag
 # and a column map must give exactly what they give from the CSV (diagnosis.json's effects, values and
-# gains; the predicted torque; the converted record), `identify` and `replay` must take the bag and
-# its rosbag2 folder. Bad bags and maps exit 2 naming the file and the byte offset or the topic.
+# gains; the predicted torque; the converted record), `identify`, `replay` and `render-replay` must
+# take the bag and its rosbag2 folder. Bad bags and maps exit 2 naming the file and the byte offset or the topic.
 # Exit 77 (skipped) without node or tests/mcap_client/node_modules. Args: path of exotwin, source dir.
 set -uo pipefail
 EXO=$1
@@ -116,6 +116,9 @@ cmp -s <(grep -v '^#' "$T/conv.csv") <(grep -v '^#' "$T/conv2.csv") ||
   { echo "FAIL: the rosbag2 folder converts to another record than its .mcap"; fail=1; }
 run replay_bag replay --params "$S1" --measured "$T/bag2" --map "$T/map.yaml" --horizon 0.5 --out "$T/r_bag"
 [ -s "$T/r_bag/replay.csv" ] || { echo "FAIL: replay wrote no replay.csv from the bag"; fail=1; }
+run render_bag render-replay --params "$S1" --measured "$T/bag2" --map "$T/map.yaml" --width 64 --height 48 \
+  --fps 2 -o "$T/v.mp4"
+[ -s "$T/v.mp4" ] || { echo "FAIL: render-replay wrote no video from the bag"; fail=1; }
 
 # Bad input: exit 2, the file and the offset or topic named.
 expect2() {  # expect2 NAME PATTERN ARGS...
