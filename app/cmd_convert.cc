@@ -1,5 +1,5 @@
-// `exotwin convert --map MAP.yaml IN.csv --out DATA.csv` (DESIGN.md): a foreign CSV through a column
-// map into the measured-data schema; what the map did (rows, repeated time stamps, time step and
+// `exotwin convert --map MAP.yaml IN.csv --out DATA.csv` (DESIGN.md): a foreign CSV or a ROS 2 bag
+// through a column map into the measured-data schema; what the map did (rows, repeated time stamps, time step and
 // jitter) goes to stderr. The output is written whole or not at all (WriteCsv).
 #include <CLI/CLI.hpp>
 
@@ -20,7 +20,7 @@ CommandRunner RegisterConvert(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "convert", "Foreign CSV -> measured-data CSV through a column map (rename, scale, offset, units, sign)");
   sub->add_option("--map", o->map, "column map (YAML, DESIGN.md \"Column map\")")->required();
-  sub->add_option("input", o->in, "foreign CSV to convert")->required();
+  sub->add_option("input", o->in, "foreign CSV or ROS 2 bag (.mcap, rosbag2 folder) to convert")->required();
   sub->add_option("--out", o->out, "measured-data CSV to write")->required();
   return [sub, o]() -> int {
     if (!*sub) return -1;

@@ -28,12 +28,12 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
       "diagnose", "Where twin and measured data disagree, the cause, the extended model and its gain");
   sub->add_option("--params", o->params, "MODEL.yaml of the twin")->required();
   sub->add_option("--measured", o->measured,
-                  "measured-data CSV; repeat for several records of one device (one set of effects, "
+                  "measured-data CSV or ROS 2 bag (with --map); repeat for several records of one device (one set of effects, "
                   "validated on whole records left out)")->required();
   sub->add_option("--out", o->out, "output folder (diagnosis.json, extended.yaml, report.html)")->required();
   sub->add_option("--holdout", o->holdout, "held-out fraction at the end of the record (default 0.3)");
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
-  sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs into the schema");
+  sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs or ROS 2 bags into the schema");
   sub->add_option("--cutoff", o->cutoff,
                   "derivative filter cutoff in Hz, the torque filtered alike, or 'auto' (default: "
                   "chosen from the data by held-out prediction error)");

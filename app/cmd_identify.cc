@@ -17,6 +17,7 @@
 #include "identification/identification.h"
 #include "identification/one_joint_identification.h"
 #include "model/one_joint.h"
+#include "formats/mcap_reader.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "formats/number_text.h"
@@ -29,11 +30,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Reads one --measured argument: a CSV file, or a folder of CSVs (sorted by name), through the column
-// map `map` when not empty.
+// Reads one --measured argument: a CSV file, a ROS 2 bag (an .mcap file or a rosbag2 folder), or a
+// folder of CSVs (sorted by name), through the column map `map` when not empty.
 void ReadMeasuredArg(const std::string& arg, const std::string& map, std::vector<MeasuredData>* out) {
   std::error_code ec;
-  if (!fs::is_directory(arg, ec)) {
+  if (!fs::is_directory(arg, ec) || IsBagPath(arg)) {
     out->push_back(ReadMeasured(arg, map));
     return;
   }
@@ -104,9 +105,10 @@ CommandRunner RegisterIdentify(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "identify", "Least-squares identification of the lumped parameters (Hwang & Jeon 2015, steps 1-4)");
   sub->add_option("--measured", o->measured,
-                  "measured-data CSV or folder of CSVs: the knee-swing and hip-swing recordings, any order")
+                  "measured-data CSV, folder of CSVs or ROS 2 bag (with --map): the knee-swing and hip-swing "
+                  "recordings, any order")
       ->required();
-  sub->add_option("--map", o->map, "column map (YAML) applied to every --measured file (foreign CSVs)");
+  sub->add_option("--map", o->map, "column map (YAML) applied to every --measured file (foreign CSVs, ROS 2 bags)");
   sub->add_option("--known", o->known, "MODEL.yaml holding the exoskeleton (exo:); identifies the human");
   sub->add_option("--out", o->out, "MODEL.yaml to write")->required();
   sub->add_option("--L1", o->L1, "thigh length, m (default: from --known, else 0.41)");

@@ -32,10 +32,11 @@ CommandRunner RegisterPredict(CLI::App& app) {
       "predict", "Torque-sensor reading the twin predicts for measured kinematics (t,tau_hip,tau_knee)");
   sub->add_option("--params", o->params, "MODEL.yaml (lumped parameters, passive model, effects)")->required();
   sub->add_option("--measured", o->measured,
-                  "measured-data CSV (t, q_hip, q_knee, ...), or an OpenSim .mot/.sto motion file (kinematics only)")
+                  "measured-data CSV (t, q_hip, q_knee, ...), a ROS 2 bag (.mcap or rosbag2 folder, with --map), or an "
+                  "OpenSim .mot/.sto motion file (kinematics only)")
       ->required();
   sub->add_option("--side", o->side, "leg of an OpenSim motion file: r (hip_flexion_r, knee_angle_r) or l");
-  sub->add_option("--map", o->map, "column map (YAML) turning a foreign --measured CSV into the schema");
+  sub->add_option("--map", o->map, "column map (YAML) turning a foreign --measured CSV or a ROS 2 bag into the schema");
   sub->add_option("--out", o->out, "output CSV of the prediction")->required();
   sub->add_option("--mjcf", o->mjcf, "MJCF model to use instead of the shipped one");
   sub->add_option("--cutoff", o->cutoff,

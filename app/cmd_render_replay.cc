@@ -147,7 +147,7 @@ CommandRunner RegisterRenderReplay(CLI::App& app) {
   sub->add_option("-o,--out", o->out, "output video (MP4, H.264)")->required();
   sub->add_option("--predicted", o->predicted,
                   "twin's prediction CSV (t,tau_hip,tau_knee, as written by `predict`); computed if absent");
-  sub->add_option("--map", o->map, "column map of a foreign --measured CSV (as `predict`'s)");
+  sub->add_option("--map", o->map, "column map of a foreign --measured CSV or a ROS 2 bag (as `predict`'s)");
   sub->add_option("--sim", o->sims,
                   "a `replay` output (DIR/replay.csv) of this record: adds a translucent ghost leg at its "
                   "simulated angles (red, then green, magenta, orange); repeatable");

@@ -43,9 +43,9 @@ CommandRunner RegisterReplay(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "replay", "Forward simulation of measured records by the twin with its effects in the plant");
   sub->add_option("--params", o->params, "MODEL.yaml of the twin (its effects carried by the MuJoCo plant)")->required();
-  sub->add_option("--measured", o->measured, "measured-data CSV; repeat for several records")->required();
+  sub->add_option("--measured", o->measured, "measured-data CSV or ROS 2 bag (with --map); repeat for several records")->required();
   sub->add_option("--out", o->out, "output folder (replay.csv, replay.json)")->required();
-  sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs into the schema");
+  sub->add_option("--map", o->map, "column map (YAML) turning foreign --measured CSVs or ROS 2 bags into the schema");
   sub->add_option("--input", o->input,
                   "torque (tau_R = -tau_S of the record, sensor effects inverted; default) or command (cmd_* columns)");
   sub->add_option("--between-samples", o->between,

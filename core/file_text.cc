@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -165,6 +166,16 @@ TextFileChunks::TextFileChunks(const std::string& path, const std::string& what,
   if (S_ISREG(st.st_mode)) size_ = static_cast<size_t>(st.st_size);
 }
 
+TextFileChunks TextFileChunks::Binary(const std::string& path, const std::string& what) {
+  TextFileChunks f(path, what, "");
+  f.text_ = false;
+  return f;
+}
+
+TextFileChunks::TextFileChunks(TextFileChunks&& o) noexcept
+    : path_(std::move(o.path_)), role_(std::move(o.role_)), expected_(std::move(o.expected_)),
+      check_(o.check_), fd_(std::exchange(o.fd_, -1)), size_(o.size_), text_(o.text_) {}
+
 TextFileChunks::~TextFileChunks() {
   if (fd_ >= 0) ::close(fd_);
 }
@@ -186,7 +197,7 @@ size_t TextFileChunks::Read(char* buf, size_t n) {
     if (r == 0) break;
     got += static_cast<size_t>(r);
   }
-  if (!check_.Feed(buf, got) || (got < n && !check_.End())) FailText();
+  if (text_ && (!check_.Feed(buf, got) || (got < n && !check_.End()))) FailText();
   return got;
 }
 
@@ -200,8 +211,9 @@ size_t TextFileChunks::DrainCountingNewlines(bool* ends_with_newline) {
   return newlines;
 }
 
-std::string ReadTextFile(const std::string& path, const std::string& what, const std::string& expected) {
-  TextFileChunks in(path, what, expected);
+namespace {
+
+std::string ReadWhole(TextFileChunks& in) {
   std::string text;
   // One read of a regular file's size (no stream buffer copies); a pipe or a growing file in chunks.
   size_t chunk = std::max<size_t>(in.size() + 1, 1 << 16);
@@ -215,6 +227,30 @@ std::string ReadTextFile(const std::string& path, const std::string& what, const
     }
     chunk = std::max<size_t>(chunk, 1 << 20);
   }
+}
+
+}  // namespace
+
+std::string Trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t\r");
+  if (a == std::string::npos) return "";
+  const size_t b = s.find_last_not_of(" \t\r");
+  return s.substr(a, b - a + 1);
+}
+
+std::string ShownText(std::string_view s) {
+  if (!FindTextFault(s)) return std::string(s);
+  return "<" + std::to_string(s.size()) + " bytes, not text>";
+}
+
+std::string ReadTextFile(const std::string& path, const std::string& what, const std::string& expected) {
+  TextFileChunks in(path, what, expected);
+  return ReadWhole(in);
+}
+
+std::string ReadBinaryFile(const std::string& path, const std::string& what) {
+  TextFileChunks in = TextFileChunks::Binary(path, what);
+  return ReadWhole(in);
 }
 
 }  // namespace exotwin

@@ -45,6 +45,13 @@ class TextCheck {
 // The first fault of a whole text (none: valid text).
 std::optional<TextFault> FindTextFault(std::string_view text);
 
+// `s` without the spaces, tabs and CRs at either end (a line of a text file, a field of it).
+std::string Trim(const std::string& s);
+
+// A string taken from a binary file (a topic, a name in a message) as a message may quote it: itself
+// when it is valid text, else "<N bytes, not text>".
+std::string ShownText(std::string_view s);
+
 // Throws InputError("<source>: <fault.Where()>, expected <expected>") for a text that is not valid.
 void CheckText(std::string_view text, const std::string& source, const std::string& expected);
 
@@ -60,6 +67,9 @@ void CheckCommandLine(int argc, const char* const* argv);
 //   "binary data (NUL byte)", "invalid UTF-8 (byte 0xC1)", "control character 0x1B", ...).
 std::string ReadTextFile(const std::string& path, const std::string& what, const std::string& expected);
 
+// The whole content of a binary file (an MCAP bag), unchecked; the open errors as ReadTextFile's.
+std::string ReadBinaryFile(const std::string& path, const std::string& what);
+
 // A text file read in chunks (for files too large to hold twice), with ReadTextFile's checks and
 // messages: the constructor throws what ReadTextFile throws for a missing, directory or unreadable
 // file; Read throws the text error for the first fault in the file so far (and "read error" if
@@ -67,8 +77,11 @@ std::string ReadTextFile(const std::string& path, const std::string& what, const
 class TextFileChunks {
  public:
   TextFileChunks(const std::string& path, const std::string& what, const std::string& expected);
+  // A binary file: the same reads and open errors, no text check.
+  static TextFileChunks Binary(const std::string& path, const std::string& what);
   ~TextFileChunks();
   TextFileChunks(const TextFileChunks&) = delete;
+  TextFileChunks(TextFileChunks&& o) noexcept;
   TextFileChunks& operator=(const TextFileChunks&) = delete;
 
   // Reads up to `n` bytes into `buf`; returns how many (0 only at the end of the file).
@@ -87,6 +100,7 @@ class TextFileChunks {
   TextCheck check_;
   int fd_ = -1;
   size_t size_ = 0;
+  bool text_ = true;  // the text check applies
 };
 
 }  // namespace exotwin

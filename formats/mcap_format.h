@@ -1,9 +1,14 @@
 // The MCAP container format (mcap.dev/spec, version 0), shared by the reader (formats/mcap_reader.h)
-// and the writer (formats/mcap_writer.h): the magic bytes and the record opcodes. Every integer in a
-// record is little-endian; a record is opcode (uint8), length (uint64), then that many bytes; strings
-// are uint32 length + UTF-8 bytes; maps and arrays are uint32 byte length + entries. CRCs are
-// CRC-32 (ISO-HDLC, zlib's crc32), 0 meaning "not computed".
+// and the writer (formats/mcap_writer.h): the magic bytes, the record opcodes, the record prefix and
+// the footer's size, and the CRC. Every integer in a record is little-endian; a record is opcode
+// (uint8), length (uint64), then that many bytes; strings are uint32 length + UTF-8 bytes; maps and
+// arrays are uint32 byte length + entries. CRCs are CRC-32 (ISO-HDLC, zlib's crc32), 0 meaning "not
+// computed".
 #pragma once
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 
 namespace exotwin::mcap {
@@ -28,6 +33,24 @@ enum Opcode : uint8_t {
   kSummaryOffset = 0x0E,
   kDataEnd = 0x0F,
 };
+
+// Bytes before a record's content: opcode (uint8) and length (uint64).
+constexpr size_t kRecordPrefix = 9;
+// The Footer record's content: summary_start, summary_offset_start (uint64), summary_crc (uint32).
+constexpr size_t kFooterLength = 20;
+
+// CRC-32 (ISO-HDLC) of n bytes continuing `crc` (0 to start), as the spec's CRC fields hold it: zlib's
+// crc32, which takes at most a uInt of bytes per call.
+inline uint32_t Crc32(const void* data, size_t n, uint32_t crc = 0) {
+  const auto* p = static_cast<const Bytef*>(data);
+  uLong c = crc;
+  while (n > 0) {
+    const uInt part = static_cast<uInt>(std::min<size_t>(n, size_t{1} << 30));
+    c = crc32(c, p, part);
+    p += part, n -= part;
+  }
+  return static_cast<uint32_t>(c);
+}
 
 // The profile and encodings exotwin reads and writes (mcap.dev/spec/registry).
 constexpr const char* kProfileRos2 = "ros2";

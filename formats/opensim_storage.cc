@@ -16,13 +16,6 @@
 namespace exotwin {
 namespace {
 
-std::string Trim(const std::string& s) {
-  const size_t a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return "";
-  const size_t b = s.find_last_not_of(" \t\r");
-  return s.substr(a, b - a + 1);
-}
-
 // Fields separated by runs of tabs and spaces; leading and trailing separators ignored.
 std::vector<std::string> Fields(const std::string& line) {
   std::vector<std::string> out;

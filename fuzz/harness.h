@@ -11,8 +11,10 @@
 
 #include "core/error.h"
 #include "core/file_text.h"
+#include "formats/bag_table.h"
 #include "formats/column_map.h"
 #include "formats/csv_table.h"
+#include "formats/mcap_reader.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "formats/opensim_kinematics.h"
@@ -132,6 +134,59 @@ inline bool StorageText(const std::string& text, const std::string& dir) {
       WriteMeasuredBack(d, {"source: fuzz.sto"}, dir + "/kin.csv");
     } catch (const InputError&) {
     }
+  }
+  return true;
+}
+
+// The column map the bag target applies: the topics of its seeds (fuzz/corpus/fuzz_mcap, written by
+// tests/mcap_client/write_bag.mjs fuzz-seeds): a JointState by names, another topic interpolated.
+inline constexpr char kBagMap[] =
+    "columns:\n"
+    "  t:        {from: /exo/joint_states.header.stamp}\n"
+    "  q_hip:    {from: \"/exo/joint_states.position[hip_flexion_joint]\"}\n"
+    "  q_knee:   {from: \"/exo/joint_states.position[knee_joint]\"}\n"
+    "  tau_hip:  {from: \"/exo/joint_states.effort[1]\", sign: -1}\n"
+    "  tau_knee: {from: \"/exo/joint_states.effort[knee_joint]\", sign: -1}\n"
+    "  cmd_knee: {from: \"/exo/command.data[1]\"}\n";
+
+// An MCAP file's bytes (via a scratch file in `dir`): parsed (ParseMcap through ReadMcapRecord), every
+// message of every channel decoded by its channel (CDR by its ros2msg schema, JSON), then read through
+// kBagMap as `convert --map` reads it, and written back. The messages of the InputErrors must be valid
+// text (the bag's bytes are quoted only through ShownText). Returns true if the file parsed.
+inline bool McapBytes(const std::string& input, const std::string& dir) {
+  const std::string bag = dir + "/in.mcap", map = dir + "/map.yaml";
+  WriteFileAtomic(bag, input);
+  const auto refused = [](const InputError& e) { ExpectValidOutput(e.what(), "InputError message"); };
+  McapRecord r;
+  try {
+    r = ReadMcapRecord(bag);
+  } catch (const InputError& e) {
+    refused(e);
+    return false;
+  }
+  for (size_t c = 0; c < r.channels.size(); ++c) {
+    try {
+      const ChannelDecoder decode(r.channels[c], bag, "fuzz");
+      for (const McapMessage& m : r.messages) {
+        if (m.channel != c) continue;
+        try {
+          decode(m, m.where);
+        } catch (const InputError& e) {
+          refused(e);
+        }
+      }
+    } catch (const InputError& e) {
+      refused(e);
+    }
+  }
+  WriteFileAtomic(map, kBagMap);
+  try {
+    MapReport report;
+    const MeasuredData d = ReadMeasured(bag, map, 2, &report);
+    ExpectValidOutput(report.Summary(), "MapReport::Summary");
+    WriteMeasuredBack(d, {"source: " + bag, "map: " + map}, dir + "/out.csv");
+  } catch (const InputError& e) {
+    refused(e);
   }
   return true;
 }

@@ -13,6 +13,7 @@ PKGS=(
   libavcodec-dev libavformat-dev libswscale-dev  # MP4 encoding (render/mp4_writer.cc), x264 inside
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   zlib1g-dev libzstd-dev liblz4-dev   # MCAP (formats/mcap_*): CRC-32, zstd and lz4 chunks
+  lz4                                 # the reference lz4 command: lz4 chunks of the bag tests (tests/mcap_client)
   libgtest-dev libgmock-dev libbenchmark-dev
   can-utils                           # log2asc for the candump round-trip test
   clang libclang-rt-14-dev            # libFuzzer targets in fuzz/ (-DEXOTWIN_FUZZ=ON, -fsanitize=fuzzer)

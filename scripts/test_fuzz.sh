@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-${FUZZ_SECONDS:-20}}"
 SEED="${FUZZ_SEED:-1}"
 JOBS="${JOBS:-2}"
-TARGETS="fuzz_csv fuzz_model_yaml fuzz_scenario_yaml fuzz_candump fuzz_column_map fuzz_opensim_storage fuzz_controller_yaml"
+TARGETS="fuzz_csv fuzz_model_yaml fuzz_scenario_yaml fuzz_candump fuzz_column_map fuzz_opensim_storage fuzz_controller_yaml fuzz_mcap"
 command -v clang++ >/dev/null || { echo "test_fuzz: clang++ not found (scripts/setup.sh installs clang and libclang-rt-14-dev)"; exit 1; }
 
 start=$(date +%s)

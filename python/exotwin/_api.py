@@ -240,7 +240,8 @@ def read_csv(path):
 
 def read_measured(path, map=None):
     """A measured-data record as predict / diagnose / replay read it (formats/column_map.h ReadMeasured,
-    with a column map YAML for a foreign CSV): {column: float64 array}, the schema's names."""
+    with a column map YAML for a foreign CSV or a ROS 2 bag: an .mcap file or a rosbag2 folder):
+    {column: float64 array}, the schema's names."""
     return _exotwin._read_measured(_path(path, "path"), "" if map is None else _path(map, "map"))
 
 

@@ -52,6 +52,26 @@ TEST(FileText, MissingFileDirectoryAndNulAreInputErrorsNamingThePath) {
             dir + "/cut.yaml: invalid UTF-8 (sequence 0xC3 cut by the end of the text) at line 1, byte 10, expected a YAML text file");
 }
 
+// ReadBinaryFile: every byte as stored (NUL, invalid UTF-8), the open errors as ReadTextFile's.
+// ShownText: a string from a binary file quoted only when it is valid text.
+TEST(FileText, BinaryFilesAndShownText) {
+  const testing::ScopedTempDir tmp("file_text");
+  const std::string& dir = tmp.path();
+  const std::string bytes("\x89MCAP0\r\n\0\xff\xc3", 11);
+  std::ofstream(dir + "/b.mcap", std::ios::binary) << bytes;
+  EXPECT_EQ(ReadBinaryFile(dir + "/b.mcap", "MCAP"), bytes);
+  try {
+    ReadBinaryFile(dir + "/none.mcap", "MCAP");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), dir + "/none.mcap: cannot open MCAP file (No such file or directory)");
+  }
+  EXPECT_EQ(ShownText("/exo/joint_states"), "/exo/joint_states");
+  EXPECT_EQ(ShownText("caf\xc3\xa9"), "caf\xc3\xa9");
+  EXPECT_EQ(ShownText(std::string("a\0b", 3)), "<3 bytes, not text>");
+  EXPECT_EQ(ShownText("\xff"), "<1 bytes, not text>");
+}
+
 }  // namespace
 }  // namespace exotwin
 

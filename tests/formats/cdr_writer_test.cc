@@ -1,7 +1,7 @@
 // The CDR encoder against byte strings computed by hand from the OMG CDR rules (little-endian, the
 // encapsulation header 00 01 00 00, each primitive aligned to its size from the end of the header), and
 // the MCAP writer's file closed by its destructor while an exception unwinds (the bags' round trip
-// through Foxglove's reader is tests/cli/mcap_bag_test.sh).
+// through Foxglove's reader is tests/cli/mcap_write_test.sh).
 #include "formats/cdr_writer.h"
 
 #include <gtest/gtest.h>

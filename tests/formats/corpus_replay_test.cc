@@ -1,5 +1,5 @@
 // Smoke run of the fuzz targets in the normal test suite (works without clang): every file of the
-// fuzz corpora (fuzz/corpus/fuzz_csv, fuzz_model_yaml, fuzz_column_map, fuzz_opensim_storage: seeds and
+// fuzz corpora (fuzz/corpus/fuzz_csv, fuzz_model_yaml, fuzz_column_map, fuzz_opensim_storage, fuzz_mcap: seeds and
 // the crashers the fuzzers found) goes through the same contract as the fuzzers (fuzz/harness.h): it
 // either parses or throws InputError, and what parses is written and read back; any other exception
 // is a failure (a crash fails the whole test binary).
@@ -85,6 +85,8 @@ void ReplayTextCorpus(const std::string& target, Harness harness) {
 TEST(CorpusReplay, ColumnMapsApplyOrThrowInputError) { ReplayTextCorpus("fuzz_column_map", fuzz::ColumnMapText); }
 
 TEST(CorpusReplay, OpenSimStorageParsesOrThrowsInputError) { ReplayTextCorpus("fuzz_opensim_storage", fuzz::StorageText); }
+
+TEST(CorpusReplay, McapBagsParseOrThrowInputError) { ReplayTextCorpus("fuzz_mcap", fuzz::McapBytes); }
 
 }  // namespace
 }  // namespace exotwin

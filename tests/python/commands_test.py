@@ -1,12 +1,14 @@
 # The commands as functions and the readers (python/module_commands.cc, python/exotwin/_api.py):
 # the same numbers as the program's files, the CLI's error text.
 import json
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
 
 import exotwin
-from conftest import cli, read_csv, same_bits
+from conftest import SOURCE, cli, read_csv, same_bits
 
 
 @pytest.fixture
@@ -96,6 +98,28 @@ def test_readers(tmp, record):
     ref = read_csv(tmp / "run" / "measured.csv")
     assert same_bits(s["time"], ref["t"]) and same_bits(s["q_knee"], ref["q_knee"])
     del sto
+
+
+def test_read_measured_takes_a_ros2_bag(tmp, record):
+    # The record as a JointState bag written by Foxglove's libraries (tests/mcap_client) and as the CSV
+    # of the bag's own times: read_measured gives the same bits from both (DESIGN.md "ROS 2 bags").
+    client = SOURCE / "tests" / "mcap_client"
+    if shutil.which("node") is None or not (client / "node_modules" / "@mcap" / "core").is_dir():
+        pytest.skip("node or tests/mcap_client/node_modules missing (scripts/setup.sh)")
+    _, path, _ = record
+    subprocess.run(["node", "write_bag.mjs", "from-csv", str(path), str(tmp / "rec.mcap"), str(tmp / "bag.csv")],
+                   cwd=client, check=True)
+    (tmp / "map.yaml").write_text(
+        "columns:\n  t: {from: /exo/joint_states.header.stamp}\n"
+        "  q_hip: {from: \"/exo/joint_states.position[hip]\"}\n  q_knee: {from: \"/exo/joint_states.position[knee]\"}\n"
+        "  tau_hip: {from: \"/exo/joint_states.effort[hip]\", sign: -1}\n"
+        "  tau_knee: {from: \"/exo/joint_states.effort[knee]\", sign: -1}\n")
+    bag = exotwin.read_measured(tmp / "rec.mcap", map=tmp / "map.yaml")
+    csv = exotwin.read_measured(tmp / "bag.csv")
+    assert list(bag) == ["t", "q_hip", "q_knee", "tau_hip", "tau_knee"]
+    assert all(same_bits(bag[k], csv[k]) for k in bag)
+    with pytest.raises(exotwin.InputError, match="a ROS 2 bag needs a column map"):
+        exotwin.read_measured(tmp / "rec.mcap")
 
 
 def test_bad_input_is_the_programs_text(tmp):

@@ -109,7 +109,7 @@ def test_ctrl_c_stops_the_run_and_keeps_what_was_logged(tmp):
 
 def test_mcap_is_the_cli_bag_byte_for_byte(tmp):
     # exotwin.run(..., mcap=) writes the bag `exotwin run --mcap` writes (DESIGN.md "ROS 2 bags (MCAP)
-    # in and out"; read back by Foxglove's libraries in tests/cli/mcap_bag_test.sh), kept with out=None.
+    # in and out"; read back by Foxglove's libraries in tests/cli/mcap_write_test.sh), kept with out=None.
     scenario = short_gait(tmp, duration=1.0)
     cli("run", scenario, "--seed", 4, "--out", tmp / "cli", "--mcap", tmp / "cli.mcap")
     r = exotwin.run(scenario, seed=4, mcap=tmp / "py.mcap")
