@@ -56,9 +56,7 @@ std::string Record(Opcode op, const std::string& body) {
   return r.s;
 }
 
-uint32_t Crc(uint32_t crc, std::string_view bytes) {
-  return static_cast<uint32_t>(crc32_z(crc, reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
-}
+uint32_t Crc(uint32_t crc, std::string_view bytes) { return Crc32(bytes.data(), bytes.size(), crc); }
 
 }  // namespace
 
