@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "formats/number_text.h"
+#include "model/effect_families.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
 #include "sim/plant_effects.h"
@@ -416,7 +417,12 @@ std::string Label(const ColumnBank& bank, const std::vector<int>& set) {
 }  // namespace
 
 bool Conflicts(const Candidate& a, const Candidate& b) {
-  if (a.name == b.name && a.joint == b.joint) return true;  // gravity X and Y: one at a time
+  if (a.joint == b.joint) {
+    if (a.name == b.name) return true;  // gravity X and Y: one at a time
+    // One of an exclusive group per joint (EffectFamily::exclusive: the plant's one internal hinge).
+    const EffectFamily *fa = FindFamily(a.name), *fb = FindFamily(b.name);
+    if (fa && fb && *fa->exclusive && std::string(fa->exclusive) == fb->exclusive) return true;
+  }
   for (int x : a.cols)
     if (std::find(b.cols.begin(), b.cols.end(), x) != b.cols.end()) return true;  // nested (offset)
   return false;

@@ -127,7 +127,9 @@ DiagnosedEffect ToEffect(const Candidate& c, const Eigen::VectorXd& coef, const 
 bool Plausible(const DiagnosedEffect& e, const PhysicalScale& s, std::string* why = nullptr);
 
 // Two candidates that cannot be named together: the same effect at the same joint (gravity_error's X
-// and Y axes, one at a time) or a shared column (joint_stiffness's offset and sensor_offset).
+// and Y axes, one at a time), two families of one exclusive group at the same joint (a dead band and
+// a strap: the plant's one internal hinge, EffectFamily::exclusive) or a shared column
+// (joint_stiffness's offset and sensor_offset).
 bool Conflicts(const Candidate& a, const Candidate& b);
 
 struct SelectionTrace {

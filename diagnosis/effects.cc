@@ -12,18 +12,7 @@
 
 namespace exotwin {
 
-int EffectJoint(const Effect& e) { return e.joint == "hip" ? 0 : 1; }
-
 namespace {
-
-double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
-
-// Value of signal x at times t - delay (linear interpolation, held at the first sample).
-std::vector<double> Delayed(const std::vector<double>& t, const std::vector<double>& x, double delay) {
-  std::vector<double> tq(t.size());
-  for (size_t i = 0; i < t.size(); ++i) tq[i] = t[i] - delay;
-  return Interpolate(t, x, tq);
-}
 
 Eigen::Vector2d At(const std::vector<double> v[2], size_t i) { return {v[0][i], v[1][i]}; }
 
@@ -55,73 +44,80 @@ std::vector<std::vector<double>> EmgEnvelopes(const std::vector<double>& t,
   return dsp::ZeroPhaseEnvelopes(hp, lp, emg, pad);
 }
 
+namespace {
+
+// The forms that need more than one sample's state (no EffectFamily::link_torque): added to tau_R.
+// backlash: the link's dynamics at q_link,j = q_j - (b/2) s(tau_rigid,j) (header); series_compliance:
+// the compliant part at its quasi-static angle (CompliantAngle); muscle_activity: the EMG envelopes.
+void AddRecordForm(const EffectFamily& f, const Effect& e, const LegParams& rigid, const Kinematics& kin,
+                   const std::vector<double> tau_rigid[2], std::vector<double> tau_R[2]) {
+  const size_t n = kin.t.size();
+  const int j = EffectJoint(e);
+  if (f.carrier == PlantCarrier::kDeadBandHinge) {
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2d q = At(kin.q, i), qd = At(kin.qd, i), qdd = At(kin.qdd, i);
+      Eigen::Vector2d ql = q;
+      ql[j] -= 0.5 * e.value * std::tanh(tau_rigid[j][i] / kBacklashTorqueWidth);
+      const Eigen::Vector2d d = ActuatorTorque(rigid, ql, qd, qdd) - ActuatorTorque(rigid, q, qd, qdd);
+      tau_R[0][i] += d[0];
+      tau_R[1][i] += d[1];
+    }
+  } else if (f.carrier == PlantCarrier::kStrapHinge) {
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2d q = At(kin.q, i), qd = At(kin.qd, i), qdd = At(kin.qdd, i);
+      const Eigen::Vector2d qc = CompliantAngle(rigid, j, e.value, q, qd, qdd);
+      const Eigen::Vector2d d = CompliantPartTorque(rigid, qc, qd, qdd) - CompliantPartTorque(rigid, q, qd, qdd);
+      tau_R[0][i] += d[0];
+      tau_R[1][i] += d[1];
+    }
+  } else if (f.carrier == PlantCarrier::kNotCarried) {
+    bool any = false;
+    for (const auto& w : e.fields) {
+      if (w.first.rfind("w_", 0) != 0) continue;
+      const std::string ch = w.first.substr(2);
+      const auto it = kin.emg.find(ch);
+      if (it == kin.emg.end())
+        throw InputError("effect " + e.name + " (" + e.joint + "): weight for channel '" + ch +
+                         "' but the measured data have no column 'emg_" + ch + "'");
+      const std::vector<double> env = EmgEnvelope(kin.t, it->second);
+      for (size_t i = 0; i < n; ++i) tau_R[j][i] += e.value * w.second * env[i];
+      any = true;
+    }
+    if (!any)
+      throw InputError("effect " + e.name + " (" + e.joint +
+                       "): expected weights {channel: N m per V} for at least one EMG channel");
+  } else {
+    throw std::logic_error("effect family " + std::string(f.name) + ": no closed form on the link");
+  }
+}
+
+}  // namespace
+
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
                   std::vector<double> tau_S[2]) {
   const size_t n = kin.t.size();
   LegParams rigid = params;
   rigid.effects.clear();
-  std::vector<double> tau_rigid[2];  // the rigid torque, for the effects that depend on it (backlash)
+  std::vector<double> tau_rigid[2];  // the rigid torque, for the forms that depend on it (the dead band)
   for (const Effect& e : params.effects)
-    if (e.name == "backlash") {
+    if (FamilyOf(e).carrier == PlantCarrier::kDeadBandHinge) {
       tau_rigid[0] = tau_R[0], tau_rigid[1] = tau_R[1];
       break;
     }
   for (const Effect& e : params.effects) {
-    const int j = EffectJoint(e);
-    auto& tr = tau_R[j];
-    if (e.name == "coulomb_friction") {
-      for (size_t i = 0; i < n; ++i) tr[i] += e.value * Sign(kin.qd[j][i]);
-    } else if (e.name == "viscous_friction") {
-      for (size_t i = 0; i < n; ++i) tr[i] += e.value * kin.qd[j][i];
-    } else if (e.name == "inertia_error") {
-      for (size_t i = 0; i < n; ++i) tr[i] += e.value * kin.qdd[j][i];
-    } else if (e.name == "joint_stiffness") {
-      const double q0 = e.fields.at("q0");
-      for (size_t i = 0; i < n; ++i) tr[i] += e.value * (kin.q[j][i] - q0);
-    } else if (e.name == "torque_ripple") {
-      for (size_t i = 0; i < n; ++i) tr[i] += TorqueRippleTorque(e, kin.q[j][i]);
-    } else if (e.name == "passive_moment") {
-      for (size_t i = 0; i < n; ++i) tr[i] += PassiveMomentTorque(e, At(kin.q, i));
-    } else if (e.name == "gravity_error") {
-      for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector2d dG = GravityErrorTorque(e, params.g, At(kin.q, i));
-        tau_R[0][i] += dG[0];
-        if (j == 1) tau_R[1][i] += dG[1];
-      }
-    } else if (e.name == "backlash") {
-      for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector2d q = At(kin.q, i), qd = At(kin.qd, i), qdd = At(kin.qdd, i);
-        Eigen::Vector2d ql = q;
-        ql[j] -= 0.5 * e.value * std::tanh(tau_rigid[j][i] / kBacklashTorqueWidth);
-        const Eigen::Vector2d d = ActuatorTorque(rigid, ql, qd, qdd) - ActuatorTorque(rigid, q, qd, qdd);
-        tau_R[0][i] += d[0];
-        tau_R[1][i] += d[1];
-      }
-    } else if (e.name == "series_compliance") {
-      for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector2d q = At(kin.q, i), qd = At(kin.qd, i), qdd = At(kin.qdd, i);
-        const Eigen::Vector2d qc = CompliantAngle(rigid, j, e.value, q, qd, qdd);
-        const Eigen::Vector2d d =
-            CompliantPartTorque(rigid, qc, qd, qdd) - CompliantPartTorque(rigid, q, qd, qdd);
-        tau_R[0][i] += d[0];
-        tau_R[1][i] += d[1];
-      }
-    } else if (e.name == "muscle_activity") {
-      bool any = false;
-      for (const auto& f : e.fields) {
-        if (f.first.rfind("w_", 0) != 0) continue;
-        const std::string ch = f.first.substr(2);
-        const auto it = kin.emg.find(ch);
-        if (it == kin.emg.end())
-          throw InputError("effect muscle_activity (" + e.joint + "): weight for channel '" + ch +
-                           "' but the measured data have no column 'emg_" + ch + "'");
-        const std::vector<double> env = EmgEnvelope(kin.t, it->second);
-        for (size_t i = 0; i < n; ++i) tr[i] += e.value * f.second * env[i];
-        any = true;
-      }
-      if (!any)
-        throw InputError("effect muscle_activity (" + e.joint +
-                         "): expected weights {channel: N m per V} for at least one EMG channel");
+    const EffectFamily& f = FamilyOf(e);
+    if (f.stage != EffectStage::kLink) continue;
+    if (!f.link_torque) {
+      AddRecordForm(f, e, rigid, kin, tau_rigid, tau_R);
+      continue;
+    }
+    EffectState s;
+    s.g = params.g;
+    for (size_t i = 0; i < n; ++i) {
+      s.q = At(kin.q, i), s.qd = At(kin.qd, i), s.qdd = At(kin.qdd, i);
+      const Eigen::Vector2d d = f.link_torque(e, s);
+      tau_R[0][i] += d[0];
+      tau_R[1][i] += d[1];
     }
   }
   for (int j = 0; j < 2; ++j) {
@@ -129,14 +125,8 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
     for (size_t i = 0; i < n; ++i) tau_S[j][i] = -tau_R[j][i];
   }
   for (const Effect& e : params.effects) {
-    const int j = EffectJoint(e);
-    if (e.name == "sensor_offset") {
-      for (double& v : tau_S[j]) v += e.value;
-    } else if (e.name == "sensor_gain") {
-      for (double& v : tau_S[j]) v *= 1.0 + e.value;
-    } else if (e.name == "sensor_delay") {
-      tau_S[j] = Delayed(kin.t, tau_S[j], e.value);
-    }
+    const EffectFamily& f = FamilyOf(e);
+    if (f.stage == EffectStage::kSensor) f.on_reading(e, kin.t, &tau_S[EffectJoint(e)]);
   }
 }
 

@@ -27,9 +27,6 @@
 
 namespace exotwin {
 
-// Joint index of an effect ("hip" -> 0, "knee" -> 1).
-int EffectJoint(const Effect& e);
-
 // Adds the link-side effects to tau_R[j] (actuator torque, N m) for the kinematics `kin`, then forms
 // the sensor reading tau_S = -tau_R and applies the sensor effects (offset, gain, delay). `params`
 // gives L1, g and the lumped parameters for the closed-form terms. tau_R[j] must have kin.t.size()

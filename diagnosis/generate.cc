@@ -6,6 +6,7 @@
 #include "formats/csv_table.h"
 #include "diagnosis/effects.h"
 #include "diagnosis/predict.h"
+#include "model/effect_families.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/units.h"
@@ -14,10 +15,12 @@
 namespace exotwin {
 
 const std::vector<std::string>& AllEffectNames() {
-  static const std::vector<std::string> k = {
-      "coulomb_friction", "viscous_friction", "inertia_error",  "gravity_error",
-      "joint_stiffness",  "backlash",         "series_compliance", "torque_ripple",
-      "sensor_offset",    "sensor_gain",      "sensor_delay",   "muscle_activity"};
+  static const std::vector<std::string> k = [] {
+    std::vector<std::string> names;
+    for (const EffectFamily& f : EffectFamilies())
+      if (f.drawn) names.push_back(f.name);
+    return names;
+  }();
   return k;
 }
 
@@ -40,41 +43,42 @@ Effect DrawEffect(Rng& rng, const std::string& name, int joint, bool one_joint) 
   e.name = name;
   e.joint = joint == 0 ? "hip" : "knee";
   if (name == "coulomb_friction") {
-    e.value = rng.Uniform(0.3, 1.5), e.unit = "N m";
+    e.value = rng.Uniform(0.3, 1.5);
   } else if (name == "viscous_friction") {
-    e.value = rng.Uniform(0.3, 2.0), e.unit = "N m s/rad";
+    e.value = rng.Uniform(0.3, 2.0);
   } else if (name == "inertia_error") {
-    e.value = rng.Sign() * rng.Uniform(0.05, 0.3), e.unit = "kg m^2";
+    e.value = rng.Sign() * rng.Uniform(0.05, 0.3);
   } else if (name == "gravity_error") {
-    e.value = rng.Sign() * rng.Uniform(0.05, 0.3), e.unit = "kg m";
+    e.value = rng.Sign() * rng.Uniform(0.05, 0.3);
     e.axis = rng.Uniform() < 0.5 ? "X" : "Y";
   } else if (name == "joint_stiffness") {
-    e.value = rng.Uniform(3.0, 15.0), e.unit = "N m/rad";
+    e.value = rng.Uniform(3.0, 15.0);
     e.fields["q0"] = one_joint ? rng.Uniform(kOneJointLo, kOneJointHi) : rng.Uniform(kJointLo[joint], kJointHi[joint]);
   } else if (name == "backlash") {
-    e.value = rng.Uniform(0.3, 1.7) * kRadPerDeg, e.unit = "rad";
+    e.value = rng.Uniform(0.3, 1.7) * kRadPerDeg;
   } else if (name == "series_compliance") {
     // The quasi-static strap model holds well below the strap's resonance sqrt(k / J_c): at the
     // hip J_c is the whole leg's (~2.5 kg m^2 against ~0.4 at the knee), so for the same margin
     // above the gait's frequencies the hip's straps are drawn stiffer (effects.h).
-    e.value = joint == 0 ? rng.Uniform(800.0, 3000.0) : rng.Uniform(150.0, 800.0), e.unit = "N m/rad";
+    e.value = joint == 0 ? rng.Uniform(800.0, 3000.0) : rng.Uniform(150.0, 800.0);
   } else if (name == "torque_ripple") {
-    e.value = rng.Uniform(0.2, 1.0), e.unit = "N m";
+    e.value = rng.Uniform(0.2, 1.0);
     e.fields["cycles_per_rad"] = rng.Uniform(2.0, 8.0);
     e.fields["phase"] = rng.Uniform(-M_PI, M_PI);
   } else if (name == "sensor_offset") {
-    e.value = rng.Sign() * rng.Uniform(0.2, 2.0), e.unit = "N m";
+    e.value = rng.Sign() * rng.Uniform(0.2, 2.0);
   } else if (name == "sensor_gain") {
-    e.value = rng.Sign() * rng.Uniform(0.02, 0.10), e.unit = "relative";
+    e.value = rng.Sign() * rng.Uniform(0.02, 0.10);
   } else if (name == "sensor_delay") {
-    e.value = rng.Uniform(0.005, 0.030), e.unit = "s";
+    e.value = rng.Uniform(0.005, 0.030);
   } else if (name == "muscle_activity") {
-    e.value = 1.0, e.unit = "-";
+    e.value = 1.0;
     const char* ch[2][2] = {{"GMAX", "RF"}, {"VM", "ST"}};
     for (const char* c : ch[joint]) e.fields[std::string("w_") + c] = rng.Sign() * rng.Uniform(3.0, 10.0);
   } else {
     throw InputError("generate: unknown effect '" + name + "'");
   }
+  e.unit = FamilyOf(e).unit;
   return e;
 }
 

@@ -26,7 +26,7 @@ struct GeneratedData {
   double torque_noise = 0;  // sensor noise standard deviation, N m
 };
 
-// Names of every effect in DESIGN.md, in table order.
+// Names of the effect families generate may hide (EffectFamily::drawn), in DESIGN.md's table order.
 const std::vector<std::string>& AllEffectNames();
 
 // Draws one effect of `name` at `joint` (0 hip, 1 knee) with a magnitude in its realistic range:

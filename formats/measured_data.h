@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/interpolate.h"  // Interpolate
+
 #include "formats/csv_table.h"
 #include "dsp/butterworth.h"
 
@@ -172,8 +174,5 @@ void DeriveAngleRatesInto(const Sampling& s, const std::vector<double>& t, const
 // Median sample period (s) of strictly increasing times (>= 2 samples: else std::invalid_argument).
 double MedianStep(const std::vector<double>& t);
 
-// Linear interpolation of (x, y) at xq (x strictly increasing; clamped at the ends).
-std::vector<double> Interpolate(const std::vector<double>& x, const std::vector<double>& y,
-                                const std::vector<double>& xq);
 
 }  // namespace exotwin

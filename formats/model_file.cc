@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/yaml_fields.h"
+#include "model/effect_families.h"
 #include "model/one_joint.h"
 
 namespace exotwin {
@@ -33,45 +34,15 @@ LumpedParams ReadLumped(const YamlContext& c, const YAML::Node& n, const std::st
   return p;
 }
 
-struct EffectSpec {
-  const char* name;
-  const char* unit;
-  double lo, hi;
-  std::set<std::string> fields;  // extra numeric fields (required)
-};
-
-const std::vector<EffectSpec>& EffectSpecs() {
-  static const std::vector<EffectSpec> kSpecs = {
-      {"coulomb_friction", "N m", 0.0, 100.0, {}},
-      {"viscous_friction", "N m s/rad", -100.0, 100.0, {}},
-      {"inertia_error", "kg m^2", -10.0, 10.0, {}},
-      {"gravity_error", "kg m", -20.0, 20.0, {}},
-      {"joint_stiffness", "N m/rad", -1000.0, 1000.0, {"q0"}},
-      {"backlash", "rad", 0.0, 0.5, {}},
-      {"series_compliance", "N m/rad", 1.0, 1e6, {}},
-      {"torque_ripple", "N m", 0.0, 100.0, {"cycles_per_rad", "phase"}},
-      {"passive_moment", "relative", -1.0, 10.0, {}},
-      {"sensor_offset", "N m", -100.0, 100.0, {}},
-      {"sensor_gain", "relative", -0.9, 10.0, {}},
-      {"sensor_delay", "s", 0.0, 1.0, {}},
-      {"muscle_activity", "-", -1e6, 1e6, {}},
-  };
-  return kSpecs;
-}
-
 Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& key) {
   if (!n.IsMap()) c.Fail(key, "expected a mapping {name, joint, value, unit, ...}" + YamlLine(n));
   if (!n["name"] || !n["name"].IsScalar()) c.Fail(key + ".name", "missing, expected an effect name");
   Effect e;
   e.name = n["name"].Scalar();
-  const EffectSpec* spec = nullptr;
-  for (const auto& s : EffectSpecs())
-    if (e.name == s.name) spec = &s;
-  if (!spec) {
-    std::string list;
-    for (const auto& s : EffectSpecs()) list += (list.empty() ? "" : ", ") + std::string(s.name);
-    c.Fail(key + ".name", "unknown effect '" + e.name + "', expected one of: " + list);
-  }
+  const EffectFamily* spec = FindFamily(e.name);
+  if (!spec)
+    c.Fail(key + ".name", "unknown effect '" + e.name + "', expected one of: " +
+                              FamilyNames([](const EffectFamily&) { return true; }));
   std::set<std::string> allowed = {"name", "joint", "value", "unit", "ci95", "explained_pct"};
   allowed.insert(spec->fields.begin(), spec->fields.end());
   if (e.name == "gravity_error") allowed.insert("axis");

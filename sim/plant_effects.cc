@@ -11,21 +11,17 @@
 #include "model/passive_torque.h"
 
 namespace exotwin {
+namespace {
 
-Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q) {
-  const int j = e.joint == "hip" ? 0 : 1;
-  const double ang = j == 0 ? q[0] : q[0] + q[1];
-  const double dG = g * e.value * (e.axis == "Y" ? std::cos(ang) : std::sin(ang));
-  return {dG, j == 1 ? dG : 0.0};
+// The torque (N m) a kSubjectForce family needs at the human's angles q (its closed form; the
+// velocities play no part in it).
+Eigen::Vector2d SubjectTorque(const Effect& e, double g, const Eigen::Vector2d& q) {
+  EffectState s;
+  s.q = q, s.qd.setZero(), s.qdd.setZero(), s.g = g;
+  return FamilyOf(e).link_torque(e, s);
 }
 
-double TorqueRippleTorque(const Effect& e, double q_j) {
-  return e.value * std::sin(2 * M_PI * e.fields.at("cycles_per_rad") * q_j + e.fields.at("phase"));
-}
-
-double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q) {
-  return e.value * PassiveElasticTorque(PassiveModel::kRiener1999, q)[e.joint == "hip" ? 0 : 1];
-}
+}  // namespace
 
 Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector2d& q,
                                     const Eigen::Vector2d& qd, const Eigen::Vector2d& qdd) {
@@ -33,7 +29,7 @@ Eigen::Vector2d CompliantPartTorque(const LegParams& params, const Eigen::Vector
   Eigen::Vector2d tau = RigidInverseDynamics(*params.human, params.L1, params.g, q, qd, qdd) +
                         PassiveElasticTorque(params.passive, q);
   for (const Effect& e : params.effects)  // the subject's passive moment acts on the human's segments
-    if (e.name == "passive_moment") tau[e.joint == "hip" ? 0 : 1] += PassiveMomentTorque(e, q);
+    if (FamilyOf(e).carrier == PlantCarrier::kSubjectForce) tau += SubjectTorque(e, params.g, q);
   return tau;
 }
 
@@ -66,7 +62,7 @@ bool PlantEffects::link_empty() const {
 Eigen::Vector2d PlantEffects::SubjectPassiveForce(const Eigen::Vector2d& q_follower) const {
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   for (const Effect& e : applied)
-    if (e.name == "passive_moment") f[e.joint == "hip" ? 0 : 1] -= PassiveMomentTorque(e, q_follower);
+    if (FamilyOf(e).carrier == PlantCarrier::kSubjectForce) f -= SubjectTorque(e, g, q_follower);
   return f;
 }
 
@@ -78,16 +74,10 @@ bool PlantEffects::empty() const { return link_empty() && sensor[0].empty() && s
 
 Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q) const {
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
-  for (const Effect& e : applied) {
-    if (e.name == "gravity_error") {
-      f -= GravityErrorTorque(e, g, q);
-    } else if (e.name == "passive_moment") {
-      continue;  // SubjectPassiveForce
-    } else {
-      const int j = e.joint == "hip" ? 0 : 1;
-      f[j] -= TorqueRippleTorque(e, q[j]);
-    }
-  }
+  EffectState s;
+  s.q = q, s.qd.setZero(), s.qdd.setZero(), s.g = g;
+  for (const Effect& e : applied)
+    if (FamilyOf(e).carrier == PlantCarrier::kAppliedForce) f -= FamilyOf(e).link_torque(e, s);
   return f;
 }
 
@@ -117,57 +107,67 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
     const Effect& e = params.effects[i];
     const int j = e.joint == "hip" ? 0 : 1;
     const std::string where = source + ": effects[" + std::to_string(i) + "] (" + e.name + ", " + e.joint + ")";
-    if (e.name == "coulomb_friction") {
-      if (e.value < 0) throw InputError(where + ": a negative Coulomb friction cannot be a MuJoCo frictionloss");
-      fx.frictionloss[j] += e.value;
-    } else if (e.name == "viscous_friction") {
-      fx.damping[j] += e.value;
-    } else if (e.name == "inertia_error") {
-      fx.armature[j] += e.value;
-    } else if (e.name == "joint_stiffness") {
-      if (fx.stiffness[j] != 0)
-        throw InputError(where + ": a second joint_stiffness at this joint; the plant carries one spring per joint");
-      fx.stiffness[j] = e.value;
-      fx.springref[j] = e.fields.at("q0");
-    } else if (e.name == "gravity_error" || e.name == "torque_ripple") {
-      fx.applied.push_back(e);
-    } else if (e.name == "passive_moment") {
-      if (params.one_joint)
-        throw InputError(where + ": Riener & Edrich's curves are the two-joint leg's (hip and knee angles of HJ15); "
-                         "a one-joint model cannot carry a passive_moment");
-      if (!(e.value > -1 && e.value <= kMaxPassiveScale - 1))
-        throw InputError(where + ": a passive moment " + std::to_string(1 + e.value) +
-                         " times Riener & Edrich's; expected -1 < value <= " + std::to_string(kMaxPassiveScale - 1));
-      fx.applied.push_back(e);
-    } else if (e.name == "sensor_offset" || e.name == "sensor_gain" || e.name == "sensor_delay") {
-      if (e.name == "sensor_gain" && !(e.value > -1))
-        throw InputError(where + ": a sensor gain of " + std::to_string(e.value) + " reads no torque; expected > -1");
-      if (e.name == "sensor_delay" && e.value < 0)
-        throw InputError(where + ": expected a delay >= 0 s");
-      fx.sensor[j].push_back({e.name, e.value});
-    } else if (e.name == "backlash" || e.name == "series_compliance") {
-      if (fx.backlash[j] != 0 || fx.compliance[j] != 0)
-        throw InputError(where + ": a second backlash or series_compliance at this joint; the plant carries one "
-                         "internal hinge per joint");
-      if (e.name == "backlash") {
-        if (!(e.value > 0 && e.value <= 0.1))
-          throw InputError(where + ": a dead band of " + std::to_string(e.value) + " rad; expected 0 < value <= 0.1");
-        fx.backlash[j] = e.value;
-      } else {
-        if (!(e.value > 0))
-          throw InputError(where + ": a strap stiffness of " + std::to_string(e.value) + " N m/rad; expected > 0");
-        if (j == 0 && params.human)
-          throw InputError(where + ": the forward plant cannot carry a series compliance at the hip of a model "
-                           "with a human (the human leg would turn about the hip while its knee follows the "
-                           "exoskeleton's: a closed chain); carried at the knee, or at the hip without a human");
-        fx.compliance[j] = e.value;
-      }
-    } else {
-      throw InputError(where + ": the forward plant cannot carry this effect (no muscles in the plant of a "
-                       "measured record: muscle_activity is the subject's EMG, an input the record carries, not a "
-                       "property of the plant); carried: coulomb_friction, viscous_friction, inertia_error, "
-                       "joint_stiffness, gravity_error, torque_ripple, passive_moment, backlash, series_compliance, "
-                       "sensor_offset, sensor_gain, sensor_delay");
+    const EffectFamily* f = FindFamily(e.name);
+    if (!f) throw InputError(where + ": unknown effect; expected one of " + FamilyNames([](const EffectFamily&) { return true; }));
+    switch (f->carrier) {
+      case PlantCarrier::kFrictionLoss:
+        if (e.value < 0) throw InputError(where + ": a negative Coulomb friction cannot be a MuJoCo frictionloss");
+        fx.frictionloss[j] += e.value;
+        break;
+      case PlantCarrier::kDamping:
+        fx.damping[j] += e.value;
+        break;
+      case PlantCarrier::kArmature:
+        fx.armature[j] += e.value;
+        break;
+      case PlantCarrier::kSpring:
+        if (fx.stiffness[j] != 0)
+          throw InputError(where + ": a second " + e.name + " at this joint; the plant carries one spring per joint");
+        fx.stiffness[j] = e.value;
+        fx.springref[j] = e.fields.at("q0");
+        break;
+      case PlantCarrier::kAppliedForce:
+        fx.applied.push_back(e);
+        break;
+      case PlantCarrier::kSubjectForce:
+        if (params.one_joint)
+          throw InputError(where + ": Riener & Edrich's curves are the two-joint leg's (hip and knee angles of HJ15); "
+                           "a one-joint model cannot carry a " + e.name);
+        if (!(e.value > -1 && e.value <= kMaxPassiveScale - 1))
+          throw InputError(where + ": a passive moment " + std::to_string(1 + e.value) +
+                           " times Riener & Edrich's; expected -1 < value <= " + std::to_string(kMaxPassiveScale - 1));
+        fx.applied.push_back(e);
+        break;
+      case PlantCarrier::kReading:
+        // The model file's range of the family (a gain above -1 reads a torque; a delay >= 0).
+        if (!(e.value >= f->lo && e.value <= f->hi))
+          throw InputError(where + ": " + std::to_string(e.value) + " " + f->unit + ", expected " +
+                           std::to_string(f->lo) + " .. " + std::to_string(f->hi));
+        fx.sensor[j].push_back({e.name, e.value});
+        break;
+      case PlantCarrier::kDeadBandHinge:
+      case PlantCarrier::kStrapHinge:
+        if (fx.backlash[j] != 0 || fx.compliance[j] != 0)
+          throw InputError(where + ": a second internal hinge (backlash or series_compliance) at this joint; the "
+                           "plant carries one internal hinge per joint");
+        if (f->carrier == PlantCarrier::kDeadBandHinge) {
+          if (!(e.value > 0 && e.value <= 0.1))
+            throw InputError(where + ": a dead band of " + std::to_string(e.value) + " rad; expected 0 < value <= 0.1");
+          fx.backlash[j] = e.value;
+        } else {
+          if (!(e.value > 0))
+            throw InputError(where + ": a strap stiffness of " + std::to_string(e.value) + " N m/rad; expected > 0");
+          if (j == 0 && params.human)
+            throw InputError(where + ": the forward plant cannot carry a series compliance at the hip of a model "
+                             "with a human (the human leg would turn about the hip while its knee follows the "
+                             "exoskeleton's: a closed chain); carried at the knee, or at the hip without a human");
+          fx.compliance[j] = e.value;
+        }
+        break;
+      case PlantCarrier::kNotCarried:
+        throw InputError(where + ": the forward plant cannot carry this effect (an input the record carries, such "
+                         "as the subject's EMG, not a property of the plant); carried: " +
+                         FamilyNames([](const EffectFamily& g) { return g.carrier != PlantCarrier::kNotCarried; }));
     }
   }
   for (int j = 0; j < 2; ++j)

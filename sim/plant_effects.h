@@ -40,23 +40,10 @@
 
 #include <Eigen/Core>
 
+#include "model/effect_families.h"  // the families' closed forms (GravityErrorTorque, ...)
 #include "model/lumped_params.h"
 
 namespace exotwin {
-
-// The torque (N m) the actuator needs in addition, at both joints, for a gravity_error effect:
-// the lumped X (or Y) of the segment distal to the effect's joint off by e.value, HJ15 eq. 7
-// (thigh: the hip row only; lower leg: both rows, at the absolute angle th1 + th2).
-Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q);
-
-// The torque (N m) the actuator needs in addition at the effect's joint for a torque_ripple effect
-// (fields cycles_per_rad, phase): value sin(2 pi cycles_per_rad q_j + phase).
-double TorqueRippleTorque(const Effect& e, double q_j);
-
-// The torque (N m) the actuator needs in addition at the effect's joint for a passive_moment effect:
-// value P_j(q), P the passive elastic torque of Riener & Edrich 1999 (model/passive_torque.h; HJ15 eq. 1,
-// 12), whatever passive model the twin itself subtracts.
-double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q);
 
 // Torque-sensor effects of one joint, in the order the model file lists them (DESIGN.md: tau_S +=
 // offset, tau_S *= 1 + gain, tau_S(t) = true reading at t - delay).

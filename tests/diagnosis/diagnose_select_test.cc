@@ -9,6 +9,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/error.h"
 #include "core/rng.h"
 #include "diagnosis/effects.h"
 #include "formats/model_file.h"
@@ -138,6 +139,31 @@ TEST(PhysicalScale, StrapsBelowTheAnglesMaterialityAreOutsideTheirRange) {
   EXPECT_TRUE(Plausible(effect("series_compliance", 0.9 * k_floor), s, &why)) << why;
   // The issue's straps (300-1500 N m/rad) on this motion: far above the floor.
   EXPECT_GT(k_floor, 3 * 1500.0);
+}
+
+// A dead band and a strap at one joint are one internal hinge too many for the forward plant
+// (ToPlantEffects refuses the pair): the selection never names both there (issue 62's first defect:
+// the torque fit could name both, and the extended twin then could not be simulated). At two joints
+// they are two hinges, which the plant carries.
+TEST(Conflicts, ADeadBandAndAStrapAtOneJointExcludeEachOther) {
+  auto cand = [](const std::string& name, int joint, int col) {
+    Candidate c;
+    c.name = name, c.joint = joint, c.cols = {col};
+    return c;
+  };
+  EXPECT_TRUE(Conflicts(cand("backlash", 1, 3), cand("series_compliance", 1, 4)));
+  EXPECT_TRUE(Conflicts(cand("series_compliance", 0, 4), cand("backlash", 0, 3)));
+  EXPECT_FALSE(Conflicts(cand("backlash", 1, 3), cand("series_compliance", 0, 4)));
+  // The plant agrees: the pair at one joint is refused, at two joints carried.
+  LegParams p;
+  p.exo = {1.0, 0.3, 0.8, 0.3, 0.0, 0.0};
+  Effect b, s;
+  b.name = "backlash", b.joint = "knee", b.value = 0.01;
+  s.name = "series_compliance", s.joint = "knee", s.value = 500;
+  p.effects = {b, s};
+  EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError);
+  p.effects[1].joint = "hip";
+  EXPECT_NO_THROW(ToPlantEffects(p, "m.yaml"));
 }
 
 }  // namespace

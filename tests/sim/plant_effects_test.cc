@@ -170,5 +170,47 @@ TEST(PlantEffects, RefusesWhatThePlantCannotCarryNamingTheEffect) {
   EXPECT_EQ(fx.sensor[1][0].name, "sensor_gain");
 }
 
+// The plant's applied generalized force is each applied family's own closed form (issue 62's second
+// defect: every applied effect but gravity and the passive moment was taken for a torque ripple). For
+// every family the registry applies as a force, with the fields it needs, at several angles: minus the
+// torque its closed form needs, and nothing of the others'; an effect of no family is refused, not
+// simulated as a ripple.
+TEST(PlantEffects, AppliedForceIsEachAppliedFamilysClosedForm) {
+  for (const EffectFamily& f : EffectFamilies()) {
+    if (f.carrier != PlantCarrier::kAppliedForce) continue;
+    for (const char* joint : {"hip", "knee"}) {
+      Effect e;
+      e.name = f.name, e.joint = joint, e.value = 0.3, e.axis = "Y";
+      for (const std::string& field : f.fields) e.fields[field] = 0.7;
+      PlantEffects fx;
+      fx.g = 9.81;
+      fx.applied = {e};
+      for (double a : {-0.9, 0.2, 1.1}) {
+        EffectState s;
+        s.q = {a, -0.5 * a}, s.qd.setZero(), s.qdd.setZero(), s.g = 9.81;
+        EXPECT_EQ(fx.AppliedForce(s.q), -f.link_torque(e, s)) << f.name << " " << joint;
+      }
+    }
+  }
+  // torque_ripple and gravity_error against the table's formulas written out (DESIGN.md "Effects").
+  Effect r, g;
+  r.name = "torque_ripple", r.joint = "knee", r.value = 0.4, r.fields = {{"cycles_per_rad", 3.0}, {"phase", 0.5}};
+  g.name = "gravity_error", g.joint = "hip", g.value = 0.2, g.axis = "X";
+  PlantEffects fx;
+  fx.g = 9.81;
+  fx.applied = {r, g};
+  const Eigen::Vector2d q(0.3, -0.6);
+  const Eigen::Vector2d f = fx.AppliedForce(q);
+  EXPECT_NEAR(f[0], -9.81 * 0.2 * std::sin(0.3), 1e-14);
+  EXPECT_NEAR(f[1], -0.4 * std::sin(2 * M_PI * 3.0 * -0.6 + 0.5), 1e-14);
+  Effect unknown = r;
+  unknown.name = "gear_friction";
+  fx.applied = {unknown};
+  EXPECT_THROW(fx.AppliedForce(q), std::invalid_argument);
+  LegParams p;
+  p.effects = {unknown};
+  EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError);
+}
+
 }  // namespace
 }  // namespace exotwin

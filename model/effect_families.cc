@@ -1,0 +1,125 @@
+#include "model/effect_families.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "core/interpolate.h"
+#include "model/passive_torque.h"
+
+namespace exotwin {
+namespace {
+
+double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+// value * f at the effect's joint, 0 at the other.
+Eigen::Vector2d AtJoint(const Effect& e, double f) {
+  Eigen::Vector2d t = Eigen::Vector2d::Zero();
+  t[EffectJoint(e)] = f;
+  return t;
+}
+
+Eigen::Vector2d Coulomb(const Effect& e, const EffectState& s) {
+  return AtJoint(e, e.value * Sign(s.qd[EffectJoint(e)]));
+}
+Eigen::Vector2d Viscous(const Effect& e, const EffectState& s) { return AtJoint(e, e.value * s.qd[EffectJoint(e)]); }
+Eigen::Vector2d Inertia(const Effect& e, const EffectState& s) { return AtJoint(e, e.value * s.qdd[EffectJoint(e)]); }
+Eigen::Vector2d Gravity(const Effect& e, const EffectState& s) { return GravityErrorTorque(e, s.g, s.q); }
+Eigen::Vector2d Stiffness(const Effect& e, const EffectState& s) {
+  return AtJoint(e, e.value * (s.q[EffectJoint(e)] - e.fields.at("q0")));
+}
+Eigen::Vector2d Ripple(const Effect& e, const EffectState& s) {
+  return AtJoint(e, TorqueRippleTorque(e, s.q[EffectJoint(e)]));
+}
+Eigen::Vector2d Passive(const Effect& e, const EffectState& s) { return AtJoint(e, PassiveMomentTorque(e, s.q)); }
+
+// DESIGN.md: tau_S += offset, tau_S *= 1 + gain, tau_S(t) = true reading at t - delay.
+void Offset(const Effect& e, const std::vector<double>&, std::vector<double>* tau_S) {
+  for (double& v : *tau_S) v += e.value;
+}
+void Gain(const Effect& e, const std::vector<double>&, std::vector<double>* tau_S) {
+  for (double& v : *tau_S) v *= 1.0 + e.value;
+}
+void Delay(const Effect& e, const std::vector<double>& t, std::vector<double>* tau_S) {
+  std::vector<double> tq(t.size());
+  for (size_t i = 0; i < t.size(); ++i) tq[i] = t[i] - e.value;
+  *tau_S = Interpolate(t, *tau_S, tq);
+}
+
+using S = EffectStage;
+using C = PlantCarrier;
+
+}  // namespace
+
+const std::vector<EffectFamily>& EffectFamilies() {
+  static const std::vector<EffectFamily> k = {
+      {"coulomb_friction", "N m", 0.0, 100.0, {}, S::kLink, C::kFrictionLoss, "",
+       "tau_R += value * sign(qd) (value > 0)", true, Coulomb},
+      {"viscous_friction", "N m s/rad", -100.0, 100.0, {}, S::kLink, C::kDamping, "", "tau_R += value * qd", true,
+       Viscous},
+      {"inertia_error", "kg m^2", -10.0, 10.0, {}, S::kLink, C::kArmature, "",
+       "tau_R += value * qdd (extra inertia of that joint alone, like armature)", true, Inertia},
+      {"gravity_error", "kg m", -20.0, 20.0, {}, S::kLink, C::kAppliedForce, "",
+       "the lumped X or Y (field `axis`) of the segment distal to that joint is off by value", true, Gravity},
+      {"joint_stiffness", "N m/rad", -1000.0, 1000.0, {"q0"}, S::kLink, C::kSpring, "",
+       "tau_R += value * (q - q0) (field `q0`, rad)", true, Stiffness},
+      // One internal hinge per joint: a dead band and a strap at one joint are one hinge too many.
+      {"backlash", "rad", 0.0, 0.5, {}, S::kLink, C::kDeadBandHinge, "internal_hinge",
+       "the transmission has a dead band of total width value", true},
+      {"series_compliance", "N m/rad", 1.0, 1e6, {}, S::kLink, C::kStrapHinge, "internal_hinge",
+       "the link follows the exoskeleton through a spring of that stiffness (straps, cuffs)", true},
+      {"torque_ripple", "N m", 0.0, 100.0, {"cycles_per_rad", "phase"}, S::kLink, C::kAppliedForce, "",
+       "tau_R += value * sin(2 pi cycles_per_rad q + phase) (fields `cycles_per_rad`, `phase`)", true, Ripple},
+      {"passive_moment", "relative", -1.0, 10.0, {}, S::kLink, C::kSubjectForce, "",
+       "the subject's passive moment is 1 + value times Riener & Edrich 1999's (HJ15 eq. 12 as rebuilt, "
+       "`model/passive_torque.h`): tau_R += value * P_j(q), whatever passive model the twin subtracts "
+       "(optional field `cv`: see \"Realistic EXOwheel\")",
+       false, Passive},
+      {"sensor_offset", "N m", -100.0, 100.0, {}, S::kSensor, C::kReading, "", "tau_S += value", true, nullptr,
+       Offset},
+      {"sensor_gain", "relative", -0.9, 10.0, {}, S::kSensor, C::kReading, "",
+       "tau_S *= 1 + value (0.05 = reads 5 % high)", true, nullptr, Gain},
+      {"sensor_delay", "s", 0.0, 1.0, {}, S::kSensor, C::kReading, "", "tau_S(t) is the true reading at t - value",
+       true, nullptr, Delay},
+      {"muscle_activity", "-", -1e6, 1e6, {}, S::kLink, C::kNotCarried, "",
+       "the subject was not relaxed: residual explained by EMG envelopes", true},
+  };
+  return k;
+}
+
+const EffectFamily* FindFamily(const std::string& name) {
+  for (const EffectFamily& f : EffectFamilies())
+    if (name == f.name) return &f;
+  return nullptr;
+}
+
+const EffectFamily& FamilyOf(const Effect& e) {
+  const EffectFamily* f = FindFamily(e.name);
+  if (!f) throw std::invalid_argument("unknown effect family '" + e.name + "'");
+  return *f;
+}
+
+std::string FamilyNames(bool (*keep)(const EffectFamily&)) {
+  std::string s;
+  for (const EffectFamily& f : EffectFamilies())
+    if (keep(f)) s += (s.empty() ? "" : ", ") + std::string(f.name);
+  return s;
+}
+
+int EffectJoint(const Effect& e) { return e.joint == "hip" ? 0 : 1; }
+
+Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q) {
+  const int j = EffectJoint(e);
+  const double ang = j == 0 ? q[0] : q[0] + q[1];
+  const double dG = g * e.value * (e.axis == "Y" ? std::cos(ang) : std::sin(ang));
+  return {dG, j == 1 ? dG : 0.0};
+}
+
+double TorqueRippleTorque(const Effect& e, double q_j) {
+  return e.value * std::sin(2 * M_PI * e.fields.at("cycles_per_rad") * q_j + e.fields.at("phase"));
+}
+
+double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q) {
+  return e.value * PassiveElasticTorque(PassiveModel::kRiener1999, q)[EffectJoint(e)];
+}
+
+}  // namespace exotwin

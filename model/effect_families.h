@@ -1,0 +1,92 @@
+// The effect families of DESIGN.md "Effects": one registry that every stage iterates instead of
+// branching on an effect's name. A family's row holds what every layer needs of it: its identity
+// (name, unit, the model file's range and fields, link or sensor stage), how the forward plant carries
+// it (PlantCarrier), which families exclude each other at one joint (exclusive group), the table's
+// words (DESIGN.md's effect table is checked against them, tests/model/effect_families_test.cc) and
+// its closed forms where they are a function of one sample's state:
+//  - link_torque: the torque (N m) the actuator needs in addition at both joints, DESIGN.md's form;
+//  - on_reading: the sensor effect on the reading tau_S of its joint (a whole series: the delay needs
+//    the record's times).
+// Families whose form needs more than one sample's state (backlash and series_compliance: the rigid
+// torque and the compliant part's; muscle_activity: the record's EMG envelopes) have no link_torque;
+// their forms live with the code that has those inputs (diagnosis/effects.cc), named by carrier.
+// This is the model layer: the fit's behaviour of a family (its columns, physical ranges against the
+// records) sits in diagnosis/, found there by the family's name.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "model/lumped_params.h"
+
+namespace exotwin {
+
+// Where the forward MuJoCo plant carries a family (sim/plant_effects.h, DESIGN.md "Effects in the
+// forward plant").
+enum class PlantCarrier {
+  kFrictionLoss,   // dof_frictionloss (Coulomb friction)
+  kDamping,        // dof_damping
+  kArmature,       // dof_armature
+  kSpring,         // jnt_stiffness + qpos_spring (field q0)
+  kAppliedForce,   // qfrc_applied = -link_torque at the measured angles each step
+  kSubjectForce,   // qfrc_applied = -link_torque at the human's angles (behind a strap or dead band)
+  kDeadBandHinge,  // an internal hinge limited to +-value/2 (sim/internal_joints.h)
+  kStrapHinge,     // an internal hinge with stiffness value (sim/internal_joints.h)
+  kReading,        // where the reading tau_S is formed (not on the link)
+  kNotCarried,     // an input of the record, not a property of the plant (EMG)
+};
+
+enum class EffectStage { kLink, kSensor };
+
+// One sample's state for a closed form: angles, velocities, accelerations (rad, rad/s, rad/s^2; [0]
+// hip, [1] knee) and gravity (m/s^2).
+struct EffectState {
+  Eigen::Vector2d q, qd, qdd;
+  double g = 9.81;
+};
+
+struct EffectFamily {
+  const char* name;
+  const char* unit;
+  double lo, hi;                    // the model file's accepted values (physical sense, not the fit's range)
+  std::vector<std::string> fields;  // required numeric fields (e.g. q0)
+  EffectStage stage;
+  PlantCarrier carrier;
+  const char* exclusive;            // families of one group exclude each other at one joint ("" none)
+  const char* table;                // DESIGN.md's "what the rig does that the rigid twin does not"
+  bool drawn;                       // `generate` may hide it (DESIGN.md "Effects")
+  // Torque (N m) the actuator needs in addition at both joints; nullptr where one sample's state
+  // does not determine it.
+  Eigen::Vector2d (*link_torque)(const Effect& e, const EffectState& s) = nullptr;
+  // Applies a sensor family to its joint's reading tau_S (samples at times t); nullptr for link families.
+  void (*on_reading)(const Effect& e, const std::vector<double>& t, std::vector<double>* tau_S) = nullptr;
+};
+
+// Every family, in DESIGN.md's table order.
+const std::vector<EffectFamily>& EffectFamilies();
+
+// The family of `name`; nullptr for an unknown name.
+const EffectFamily* FindFamily(const std::string& name);
+
+// The family of an effect; throws std::invalid_argument for an unknown name (a model file's reader
+// refuses those first, with InputError).
+const EffectFamily& FamilyOf(const Effect& e);
+
+// The names of the families for which `keep` holds, joined by ", " (messages).
+std::string FamilyNames(bool (*keep)(const EffectFamily&));
+
+// Joint index of an effect ("hip" -> 0, "knee" -> 1).
+int EffectJoint(const Effect& e);
+
+// The closed forms shared with the fit's columns and the forward plant:
+// gravity_error: the lumped X (or Y) of the segment distal to the effect's joint off by e.value,
+// HJ15 eq. 7 (thigh: the hip row only; lower leg: both rows, at the absolute angle th1 + th2).
+Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q);
+// torque_ripple (fields cycles_per_rad, phase): value sin(2 pi cycles_per_rad q_j + phase).
+double TorqueRippleTorque(const Effect& e, double q_j);
+// passive_moment: value P_j(q), P the passive elastic torque of Riener & Edrich 1999
+// (model/passive_torque.h; HJ15 eq. 1, 12), whatever passive model the twin itself subtracts.
+double PassiveMomentTorque(const Effect& e, const Eigen::Vector2d& q);
+
+}  // namespace exotwin
