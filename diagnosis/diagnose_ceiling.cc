@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "diagnosis/fit_families.h"
 #include "diagnosis/diagnose_internal.h"
 #include "diagnosis/diagnose_select.h"
 
@@ -17,14 +18,12 @@ constexpr double kNullShifts[] = {0.2, 0.35, 0.5, 0.65, 0.8};
 }  // namespace
 
 std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]) {
-  static const std::set<std::string> kNonNegative = {"coulomb_friction", "viscous_friction", "backlash",
-                                                     "series_compliance", "sensor_delay", "joint_stiffness"};
   std::vector<CeilingScores> out(banks.size());
   for (size_t r = 0; r < banks.size(); ++r) {
     const ColumnBank& b = banks[r];
     std::vector<int> sign(static_cast<size_t>(b.X.cols()), 0);
     for (const Candidate& c : b.candidates)
-      if (kNonNegative.count(c.name)) sign[static_cast<size_t>(c.cols[0])] = 1;
+      if (FitFamilyOf(c.name).ceiling_sign > 0) sign[static_cast<size_t>(c.cols[0])] = 1;
     // The normal equations of the columns this record moves (a column of zeros, e.g. a held hip's,
     // stays at 0), diagonal regularized by 1e-6 of itself: collinear candidates (the kitchen sink of
     // one record) pass SolveSigned's conditioning test (1e-8 of the largest

@@ -8,6 +8,7 @@
 #include "core/parallel_for.h"
 #include "dsp/grid_phasors.h"
 #include "diagnosis/effects.h"
+#include "diagnosis/fit_families.h"
 #include "dsp/butterworth.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
@@ -22,8 +23,6 @@ std::string Candidate::Label() const {
 namespace {
 
 constexpr size_t kPendingColumns = 4;  // PendingColumns::kPending, and SetColumn's two
-
-double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
 // f(i) for i = 0 .. n - 1 on the machine's cores, each thread a contiguous range: for the loops that
 // evaluate a column on every sample of a record (f writes only sample i's values, into vectors sized
@@ -221,26 +220,38 @@ int AddJointColumn(PendingColumns& p, const double w[2], int j, G g) {
   return c;
 }
 
-// Appends a column whose hip and knee rows hold the same g(i) (the column SetColumn gives for
-// (g(i), g(i)): both rows filtered alike, from one record-long temporary).
-template <class G>
-int AddBothJointsColumn(PendingColumns& p, const double w[2], G g) {
+// Appends the column -f.link_torque(unit, state_i) (both joints' rows; `unit` at joint j with value
+// 1): the first-order column of a family linear in its value. A row series that is zero throughout (the
+// other joint of a one-joint form) is stored as AddJointColumn stores it.
+int AddLinearColumn(PendingColumns& p, const double w[2], int j, const Effect& unit, const EffectFamily& f,
+                    const Kinematics& kin, double g) {
   ColumnBank& b = p.bank();
+  auto u = [&](size_t i) {
+    EffectState s;
+    s.q = {kin.q[0][i], kin.q[1][i]}, s.qd = {kin.qd[0][i], kin.qd[1][i]}, s.qdd = {kin.qdd[0][i], kin.qdd[1][i]};
+    s.g = g;
+    return Eigen::Vector2d(-f.link_torque(unit, s));
+  };
+  bool other_zero = true;  // the other joint's rows, on every sample
+  std::vector<double> x[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
+  ForEachSample(b, b.n, [&](size_t i) {
+    const Eigen::Vector2d v = u(i);
+    x[0][i] = v[0], x[1][i] = v[1];
+  });
+  for (double v : x[1 - j]) other_zero = other_zero && v == 0.0;
+  if (other_zero) {
+    std::vector<double>().swap(x[1 - j]);
+    const std::vector<double> own = std::move(x[j]);
+    return AddJointColumn(p, w, j, [&](size_t i) { return own[i]; });
+  }
   const int c = NewColumn(b);
-  const size_t m = b.sample.size();
   if (b.filter) {
-    std::vector<double> x(b.n);
-    ForEachSample(b, b.n, [&](size_t i) { x[i] = g(i); });
-    p.Add(std::move(x), [&b, w, c](const std::vector<double>& filtered) {
-      for (int j = 0; j < 2; ++j) PlaceJointRows(b, c, w, j, filtered);
-    });
+    for (int k = 0; k < 2; ++k)
+      p.Add(std::move(x[k]), [&b, w, c, k](const std::vector<double>& v) { PlaceJointRows(b, c, w, k, v); });
     return c;
   }
-  for (size_t k = 0; k < m; ++k) {
-    const double v = g(b.sample[k]);
-    b.X(k, c) = w[0] * v;
-    b.X(m + k, c) = w[1] * v;
-  }
+  const size_t m = b.sample.size();
+  for (size_t k = 0; k < m; ++k) b.X(k, c) = w[0] * x[0][b.sample[k]], b.X(m + k, c) = w[1] * x[1][b.sample[k]];
   return c;
 }
 
@@ -295,26 +306,16 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin,
       return &b.candidates.back();
     };
     const int off = AddJointColumn(pc, w, j, [&](size_t) { return 1.0; });
-    add("coulomb_friction", {AddJointColumn(pc, w, j, [&](size_t i) { return -Sign(kin.qd[j][i]); })});
-    add("viscous_friction", {AddJointColumn(pc, w, j, [&](size_t i) { return -kin.qd[j][i]; })});
-    add("inertia_error", {AddJointColumn(pc, w, j, [&](size_t i) { return -kin.qdd[j][i]; })});
-    for (const char* axis : {"X", "Y"}) {
-      const bool is_x = axis[0] == 'X';
-      // The hip's angle moves the hip rows only; the thigh + shank angle both joints' rows alike.
-      auto G = [&](size_t i) {
-        const double ang = j == 0 ? kin.q[0][i] : kin.q[0][i] + kin.q[1][i];
-        return -g * (is_x ? std::sin(ang) : std::cos(ang));
-      };
-      add("gravity_error", {j == 0 ? AddJointColumn(pc, w, 0, G) : AddBothJointsColumn(pc, w, G)}, axis);
+    // The families linear in their value (FitFamily::linear_column): -link_torque at value 1.
+    for (const FitFamily& ff : FitFamilies()) {
+      if (!ff.linear_column || (ff.candidate_for && !ff.candidate_for(params))) continue;
+      for (const std::string& axis : ff.axes.empty() ? std::vector<std::string>{""} : ff.axes) {
+        Effect unit;
+        unit.name = ff.family->name, unit.joint = j == 0 ? "hip" : "knee", unit.value = 1.0, unit.axis = axis;
+        add(ff.family->name, {AddLinearColumn(pc, w, j, unit, *ff.family, kin, g)}, axis);
+      }
     }
     add("joint_stiffness", {AddJointColumn(pc, w, j, [&](size_t i) { return -kin.q[j][i]; }), off});
-    // The subject's passive moment off Riener & Edrich's curves by a factor: Delta tau_S = -value P_j(q)
-    // (a two-joint model with a human only: the curves are a human leg's in HJ15's two-joint angles).
-    if (params.human && !params.one_joint) {
-      Effect unit_passive;
-      unit_passive.joint = j == 0 ? "hip" : "knee", unit_passive.value = 1.0;
-      add("passive_moment", {AddJointColumn(pc, w, j, [&](size_t i) { return -PassiveMomentTorque(unit_passive, Q(i)); })});
-    }
     // Backlash: Delta tau_S = (b/2) s(tau_R,j) dtau/dq_j (first order in b). Straps: Delta tau_S =
     // (1/k) dtau_C/dq_j tau_C,j (first order in 1/k). Both columns in one pass over the samples.
     {

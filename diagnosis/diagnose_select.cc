@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "formats/number_text.h"
+#include "diagnosis/fit_families.h"
 #include "model/effect_families.h"
 #include "model/leg_dynamics.h"
 #include "model/passive_torque.h"
@@ -18,7 +19,6 @@ namespace exotwin {
 namespace {
 
 const char* kJoint[2] = {"hip", "knee"};
-constexpr double kStrapDynamics = 0.25;  // (motion frequency / strap resonance)^2: resonance >= 2x
 
 std::string Num(double v) { return NumberText(v, 4); }
 
@@ -266,75 +266,14 @@ DiagnosedEffect ToEffect(const Candidate& c, const Fit& f) {
   const double v = CoefOf(f, c.cols[0]), se = SeOf(f, c.cols[0]);
   d.ci_lo = v - 1.96 * se, d.ci_hi = v + 1.96 * se;
   e.value = v;
-  static const std::map<std::string, std::string> units = {
-      {"coulomb_friction", "N m"}, {"viscous_friction", "N m s/rad"}, {"inertia_error", "kg m^2"},
-      {"gravity_error", "kg m"}, {"joint_stiffness", "N m/rad"}, {"backlash", "rad"},
-      {"series_compliance", "N m/rad"}, {"torque_ripple", "N m"}, {"sensor_offset", "N m"},
-      {"sensor_gain", "relative"}, {"sensor_delay", "s"}, {"muscle_activity", "-"},
-      {"passive_moment", "relative"}};
-  e.unit = units.at(c.name);
-  if (c.name == "joint_stiffness") {
-    e.fields["q0"] = std::abs(v) > 0 ? CoefOf(f, c.cols[1]) / v : 0.0;
-  } else if (c.name == "series_compliance") {
-    e.value = v > 0 ? 1.0 / v : -1.0;  // compliance 1/k was fitted; a negative one is no spring
-    d.ci_lo = v + 1.96 * se > 0 ? 1.0 / (v + 1.96 * se) : 1.0;
-    d.ci_hi = v - 1.96 * se > 0 ? 1.0 / (v - 1.96 * se) : 1e6;
-  } else if (c.name == "torque_ripple") {
-    const double b = CoefOf(f, c.cols[1]), sb = SeOf(f, c.cols[1]);
-    e.value = std::hypot(v, b);
-    const double sA = e.value > 0 ? std::sqrt(std::pow(v * se, 2) + std::pow(b * sb, 2)) / e.value : 0;
-    d.ci_lo = e.value - 1.96 * sA, d.ci_hi = e.value + 1.96 * sA;
-    e.fields["cycles_per_rad"] = c.ripple_f;
-    e.fields["phase"] = std::atan2(b, v);
-  } else if (c.name == "muscle_activity") {
-    e.value = 1.0, d.ci_lo = d.ci_hi = 1.0;
-    for (size_t k = 0; k < c.cols.size(); ++k)
-      if (std::abs(CoefOf(f, c.cols[k])) > 2.0 * SeOf(f, c.cols[k]))
-        e.fields["w_" + c.channels[k]] = CoefOf(f, c.cols[k]);
-    if (e.fields.empty()) e.fields["w_" + c.channels[0]] = CoefOf(f, c.cols[0]);
-  }
+  const FitFamily& family = FitFamilyOf(c.name);
+  e.unit = family.family->unit;
+  if (family.to_effect) family.to_effect(c, f, &d);
   return d;
 }
 
 bool Plausible(const DiagnosedEffect& d, const PhysicalScale& s, std::string* why) {
-  const Effect& e = d.effect;
-  const int j = e.joint == "hip" ? 0 : 1;
-  const double v = e.value;
-  std::string no;
-  const double range = s.q_max[j] - s.q_min[j];
-  if (e.name == "coulomb_friction" && !(v > 0 && v <= 0.5 * s.tau_max[j]))
-    no = "Coulomb friction outside (0, half the largest torque " + Num(0.5 * s.tau_max[j]) + "] N m";
-  if (e.name == "viscous_friction" && !(v > 0)) no = "negative viscous friction";
-  if (e.name == "inertia_error" && !(v > -0.5 * s.M_jj[j] && v < s.M_jj[j]))
-    no = "inertia change outside -50 % .. +100 % of the joint's inertia " + Num(s.M_jj[j]) + " kg m^2";
-  if (e.name == "gravity_error" && !(std::abs(v) <= 0.5 * s.distal_moment[j] + 0.05))
-    no = "gravity moment change beyond half the distal segments' " + Num(s.distal_moment[j]) + " kg m";
-  if (e.name == "joint_stiffness") {
-    const double q0 = e.fields.count("q0") ? e.fields.at("q0") : 0.0;
-    if (!(v > 0)) no = "negative stiffness";
-    else if (!(q0 >= s.q_min[j] - 0.5 && q0 <= s.q_max[j] + 0.5))
-      no = "rest angle q0 " + Num(q0) + " rad outside the recorded range widened by 0.5 rad";
-  }
-  // A strap whose RMS static deflection under the torque it carries is below the materiality scale
-  // of the angle (kMinTorqueShare of its RMS about the mean, as the motion fit's selection) cannot move
-  // the quasi-static motion by a material amount: what it changes in a simulation is not a strap.
-  const double angle_floor = kMinTorqueShare * s.q_rms[j];
-  if (e.name == "backlash" && !(v > 0 && v <= 0.1)) no = "dead band outside (0, 0.1] rad";
-  if (e.name == "series_compliance" && !(v > 0 && s.tau_C_max[j] / v <= 0.5 * range))
-    no = "strap deflection " + Num(v > 0 ? s.tau_C_max[j] / v : 0) + " rad beyond half the motion range";
-  else if (e.name == "series_compliance" && !(s.tau_C_rms[j] / v >= angle_floor))
-    no = "strap deflection " + Num(s.tau_C_rms[j] / v) + " rad RMS, below the angle's materiality " +
-         Num(angle_floor) + " rad";
-  else if (e.name == "series_compliance" && !(s.strap_dynamics[j] / v <= kStrapDynamics))
-    no = "strap resonance sqrt(k / J) at " + Num(std::sqrt(v / s.strap_dynamics[j])) +
-         " times the motion's frequency, expected above " + Num(1 / std::sqrt(kStrapDynamics)) +
-         " (the quasi-static strap model)";
-  if (e.name == "torque_ripple" && !(v <= 0.5 * s.tau_max[j])) no = "ripple beyond half the largest torque";
-  if (e.name == "sensor_offset" && !(std::abs(v) <= 0.5 * s.tau_max[j])) no = "offset beyond half the largest torque";
-  if (e.name == "sensor_gain" && !(v >= -0.25 && v <= 0.25)) no = "gain error outside -25 % .. +25 %";
-  if (e.name == "sensor_delay" && !(v > 0 && v <= 0.05)) no = "delay outside (0, 50] ms";
-  if (e.name == "passive_moment" && !(v > -1 && v <= kMaxPassiveScale - 1))
-    no = "passive moment " + Num(1 + v) + " times Riener & Edrich's, outside (0, " + Num(kMaxPassiveScale) + "]";
+  const std::string no = FitFamilyOf(d.effect.name).implausible(d.effect, s);
   if (why) *why = no;
   return no.empty();
 }
@@ -388,16 +327,9 @@ namespace {
 // Significant and plausible inside fit `f`?
 bool Admissible(const Candidate& c, const Fit& f, const PhysicalScale& s) {
   if (!f.ok) return false;
-  const double v = CoefOf(f, c.cols[0]), se = SeOf(f, c.cols[0]);
-  bool significant = std::abs(v) > kMinT * se;
-  if (c.name == "torque_ripple") {
-    const double b = CoefOf(f, c.cols[1]), sb = SeOf(f, c.cols[1]);
-    significant = std::hypot(v, b) > kMinT * std::max(se, sb);
-  }
-  if (c.name == "muscle_activity") {
-    significant = false;
-    for (int col : c.cols) significant |= std::abs(CoefOf(f, col)) > kMinT * SeOf(f, col);
-  }
+  const FitFamily& family = FitFamilyOf(c.name);
+  const bool significant = family.significant ? family.significant(c, f)
+                                              : std::abs(CoefOf(f, c.cols[0])) > kMinT * SeOf(f, c.cols[0]);
   return significant && Plausible(ToEffect(c, f), s);
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/fit_families.h"
 #include "diagnosis/diagnose_internal.h"
 #include "diagnosis/effects.h"
 #include "formats/measured_data.h"
@@ -75,12 +76,8 @@ void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std:
 }
 
 double RangeEdge(const Candidate& c, const PhysicalScale& s) {
-  const int j = c.joint;
-  if (c.name == "inertia_error") return s.M_jj[j];
-  if (c.name == "gravity_error") return 0.5 * s.distal_moment[j] + 0.05;
-  if (c.name == "coulomb_friction" || c.name == "sensor_offset") return 0.5 * s.tau_max[j];
-  if (c.name == "sensor_gain") return 0.25;
-  return 0;
+  const FitFamily& f = FitFamilyOf(c.name);
+  return f.range_edge ? f.range_edge(c.joint, s) : 0.0;
 }
 
 size_t RefineRows(const Rec& rc, size_t R) { return std::min<size_t>(rc.split, 6000 / R + 1); }
@@ -94,8 +91,7 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
   for (int c : chosen) D->effects.push_back(ToEffect(bank.candidates[c], chosen_fit));
   for (auto& de : D->effects) D->extended.effects.push_back(de.effect);
   for (size_t k = 0; k < D->effects.size(); ++k) {
-    const std::string& nm = D->effects[k].effect.name;
-    if (nm != "sensor_delay" && nm != "backlash" && nm != "series_compliance") continue;
+    if (!FitFamilyOf(D->effects[k].effect.name).refined_on_exact_form) continue;
     const size_t idx = params.effects.size() + k;
     const double v0 = D->extended.effects[idx].value;
     auto obj = [&](double v) {

@@ -6,6 +6,7 @@
 #include "formats/csv_table.h"
 #include "diagnosis/effects.h"
 #include "diagnosis/predict.h"
+#include "diagnosis/fit_families.h"
 #include "model/effect_families.h"
 #include "core/error.h"
 #include "core/rng.h"
@@ -14,24 +15,26 @@
 
 namespace exotwin {
 
+namespace {
+
+// The families the registry holds now that generate may hide (FitFamily::draw), in its order.
+std::vector<std::string> DrawnFamilies() {
+  std::vector<std::string> names;
+  for (const FitFamily& f : FitFamilies())
+    if (f.draw) names.push_back(f.family->name);
+  return names;
+}
+
+}  // namespace
+
 const std::vector<std::string>& AllEffectNames() {
-  static const std::vector<std::string> k = [] {
-    std::vector<std::string> names;
-    for (const EffectFamily& f : EffectFamilies())
-      if (f.drawn) names.push_back(f.name);
-    return names;
-  }();
+  static const std::vector<std::string> k = DrawnFamilies();
   return k;
 }
 
 namespace {
 
 const char* kEmgChannels[] = {"GMAX", "RF", "VM", "ST", "GAS"};
-constexpr double kJointLo[2] = {5 * kRadPerDeg, -70 * kRadPerDeg}, kJointHi[2] = {40 * kRadPerDeg, -5 * kRadPerDeg};
-// A one-joint device's angle range (HAL's convention, 0 hanging, + extension): the seated swing's
-// -0.3 .. +1.0 rad of the HAL-3 scenarios, widened a little.
-constexpr double kOneJointLo = -0.4, kOneJointHi = 1.2;
-
 struct Harmonic {
   double amp, omega, phase;
 };
@@ -39,46 +42,12 @@ struct Harmonic {
 }  // namespace
 
 Effect DrawEffect(Rng& rng, const std::string& name, int joint, bool one_joint) {
-  Effect e;
+  const EffectFamily* family = FindFamily(name);
+  if (!family || !FitFamilyOf(name).draw) throw InputError("generate: unknown effect '" + name + "'");
+  Effect e = FitFamilyOf(name).draw(rng, joint, one_joint);
   e.name = name;
   e.joint = joint == 0 ? "hip" : "knee";
-  if (name == "coulomb_friction") {
-    e.value = rng.Uniform(0.3, 1.5);
-  } else if (name == "viscous_friction") {
-    e.value = rng.Uniform(0.3, 2.0);
-  } else if (name == "inertia_error") {
-    e.value = rng.Sign() * rng.Uniform(0.05, 0.3);
-  } else if (name == "gravity_error") {
-    e.value = rng.Sign() * rng.Uniform(0.05, 0.3);
-    e.axis = rng.Uniform() < 0.5 ? "X" : "Y";
-  } else if (name == "joint_stiffness") {
-    e.value = rng.Uniform(3.0, 15.0);
-    e.fields["q0"] = one_joint ? rng.Uniform(kOneJointLo, kOneJointHi) : rng.Uniform(kJointLo[joint], kJointHi[joint]);
-  } else if (name == "backlash") {
-    e.value = rng.Uniform(0.3, 1.7) * kRadPerDeg;
-  } else if (name == "series_compliance") {
-    // The quasi-static strap model holds well below the strap's resonance sqrt(k / J_c): at the
-    // hip J_c is the whole leg's (~2.5 kg m^2 against ~0.4 at the knee), so for the same margin
-    // above the gait's frequencies the hip's straps are drawn stiffer (effects.h).
-    e.value = joint == 0 ? rng.Uniform(800.0, 3000.0) : rng.Uniform(150.0, 800.0);
-  } else if (name == "torque_ripple") {
-    e.value = rng.Uniform(0.2, 1.0);
-    e.fields["cycles_per_rad"] = rng.Uniform(2.0, 8.0);
-    e.fields["phase"] = rng.Uniform(-M_PI, M_PI);
-  } else if (name == "sensor_offset") {
-    e.value = rng.Sign() * rng.Uniform(0.2, 2.0);
-  } else if (name == "sensor_gain") {
-    e.value = rng.Sign() * rng.Uniform(0.02, 0.10);
-  } else if (name == "sensor_delay") {
-    e.value = rng.Uniform(0.005, 0.030);
-  } else if (name == "muscle_activity") {
-    e.value = 1.0;
-    const char* ch[2][2] = {{"GMAX", "RF"}, {"VM", "ST"}};
-    for (const char* c : ch[joint]) e.fields[std::string("w_") + c] = rng.Sign() * rng.Uniform(3.0, 10.0);
-  } else {
-    throw InputError("generate: unknown effect '" + name + "'");
-  }
-  e.unit = FamilyOf(e).unit;
+  e.unit = family->unit;
   return e;
 }
 
@@ -94,9 +63,10 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
   const bool one = params.one_joint.has_value();
   if (one && opt.joint == "hip")
     throw InputError("--joint: 'hip' for a one-joint model file, expected knee (its one joint)");
-  std::vector<std::string> pool = opt.allowed.empty() ? AllEffectNames() : opt.allowed;
+  const std::vector<std::string> drawn = DrawnFamilies();
+  std::vector<std::string> pool = opt.allowed.empty() ? drawn : opt.allowed;
   for (const auto& n : pool)
-    if (std::find(AllEffectNames().begin(), AllEffectNames().end(), n) == AllEffectNames().end())
+    if (std::find(drawn.begin(), drawn.end(), n) == drawn.end())
       throw InputError("--effect: unknown effect '" + n + "'");
   if (static_cast<int>(pool.size()) < opt.effects)
     throw InputError("--effects: " + std::to_string(opt.effects) + " distinct effects from " +
@@ -110,8 +80,8 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
   double centre[2], scale[2];
   for (int j = 0; j < 2; ++j) {
     // One joint: the hip held at 0 (the embedding, model/one_joint.h), the joint over its own range.
-    const double lo = one ? (j == 0 ? 0.0 : kOneJointLo) : kJointLo[j];
-    const double hi = one ? (j == 0 ? 0.0 : kOneJointHi) : kJointHi[j];
+    const double lo = one ? (j == 0 ? 0.0 : kGenerateOneJointLo) : kGenerateJointLo[j];
+    const double hi = one ? (j == 0 ? 0.0 : kGenerateOneJointHi) : kGenerateJointHi[j];
     centre[j] = 0.5 * (lo + hi);
     const double half = 0.5 * (hi - lo) * rng.Uniform(0.7, 1.0);
     double sum = 0;

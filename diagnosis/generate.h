@@ -7,6 +7,7 @@
 
 #include "formats/measured_data.h"
 #include "core/rng.h"
+#include "core/units.h"
 #include "model/lumped_params.h"
 
 namespace exotwin {
@@ -26,7 +27,15 @@ struct GeneratedData {
   double torque_noise = 0;  // sensor noise standard deviation, N m
 };
 
-// Names of the effect families generate may hide (EffectFamily::drawn), in DESIGN.md's table order.
+// generate's joint ranges (rad): the trajectory stays inside them, and so does a drawn stiffness's rest
+// angle; a one-joint device's (HAL's convention, 0 hanging, + extension): the seated swing's -0.3 ..
+// +1.0 rad of the HAL-3 scenarios, widened a little.
+constexpr double kGenerateJointLo[2] = {5 * kRadPerDeg, -70 * kRadPerDeg};
+constexpr double kGenerateJointHi[2] = {40 * kRadPerDeg, -5 * kRadPerDeg};
+constexpr double kGenerateOneJointLo = -0.4, kGenerateOneJointHi = 1.2;
+
+// Names of DESIGN.md's effect families generate may hide (those with FitFamily::draw), in its table
+// order (GenerateMeasured also draws from families added to the registry since).
 const std::vector<std::string>& AllEffectNames();
 
 // Draws one effect of `name` at `joint` (0 hip, 1 knee) with a magnitude in its realistic range:

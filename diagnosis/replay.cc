@@ -17,17 +17,8 @@ void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>
                                const std::vector<double> tau_S[2], std::vector<double> tau_R[2]) {
   for (int j = 0; j < 2; ++j) {
     std::vector<double> s = tau_S[j];
-    for (auto it = fx.sensor[j].rbegin(); it != fx.sensor[j].rend(); ++it) {
-      if (it->name == "sensor_offset") {
-        for (double& v : s) v -= it->value;
-      } else if (it->name == "sensor_gain") {
-        for (double& v : s) v /= 1.0 + it->value;
-      } else if (it->value != 0) {  // sensor_delay: the reading at t + delay is the torque at t
-        std::vector<double> tq(t.size());
-        for (size_t i = 0; i < t.size(); ++i) tq[i] = t[i] + it->value;
-        s = Interpolate(t, s, tq);
-      }
-    }
+    for (auto it = fx.sensor[j].rbegin(); it != fx.sensor[j].rend(); ++it)
+      FindFamily(it->name)->off_reading(it->value, t, &s);
     tau_R[j].resize(s.size());
     for (size_t i = 0; i < s.size(); ++i) tau_R[j][i] = -s[i];
   }

@@ -45,45 +45,82 @@ void Delay(const Effect& e, const std::vector<double>& t, std::vector<double>* t
   *tau_S = Interpolate(t, *tau_S, tq);
 }
 
+void OffsetOff(double v, const std::vector<double>&, std::vector<double>* tau_S) {
+  for (double& x : *tau_S) x -= v;
+}
+void GainOff(double v, const std::vector<double>&, std::vector<double>* tau_S) {
+  for (double& x : *tau_S) x /= 1.0 + v;
+}
+// The reading at t + delay is the torque at t.
+void DelayOff(double v, const std::vector<double>& t, std::vector<double>* tau_S) {
+  if (v == 0) return;
+  std::vector<double> tq(t.size());
+  for (size_t i = 0; i < t.size(); ++i) tq[i] = t[i] + v;
+  *tau_S = Interpolate(t, *tau_S, tq);
+}
+void OffsetAffine(double v, double*, double* b) { *b += v; }
+void GainAffine(double v, double* a, double* b) { *a *= 1 + v, *b *= 1 + v; }
+
 using S = EffectStage;
 using C = PlantCarrier;
 
-}  // namespace
-
-const std::vector<EffectFamily>& EffectFamilies() {
-  static const std::vector<EffectFamily> k = {
+std::deque<EffectFamily>& Registry() {
+  static std::deque<EffectFamily> k = {
       {"coulomb_friction", "N m", 0.0, 100.0, {}, S::kLink, C::kFrictionLoss, "",
-       "tau_R += value * sign(qd) (value > 0)", true, Coulomb},
-      {"viscous_friction", "N m s/rad", -100.0, 100.0, {}, S::kLink, C::kDamping, "", "tau_R += value * qd", true,
+       "tau_R += value * sign(qd) (value > 0)", Coulomb},
+      {"viscous_friction", "N m s/rad", -100.0, 100.0, {}, S::kLink, C::kDamping, "", "tau_R += value * qd",
        Viscous},
       {"inertia_error", "kg m^2", -10.0, 10.0, {}, S::kLink, C::kArmature, "",
-       "tau_R += value * qdd (extra inertia of that joint alone, like armature)", true, Inertia},
+       "tau_R += value * qdd (extra inertia of that joint alone, like armature)", Inertia},
       {"gravity_error", "kg m", -20.0, 20.0, {}, S::kLink, C::kAppliedForce, "",
-       "the lumped X or Y (field `axis`) of the segment distal to that joint is off by value", true, Gravity},
+       "the lumped X or Y (field `axis`) of the segment distal to that joint is off by value", Gravity},
       {"joint_stiffness", "N m/rad", -1000.0, 1000.0, {"q0"}, S::kLink, C::kSpring, "",
-       "tau_R += value * (q - q0) (field `q0`, rad)", true, Stiffness},
+       "tau_R += value * (q - q0) (field `q0`, rad)", Stiffness},
       // One internal hinge per joint: a dead band and a strap at one joint are one hinge too many.
       {"backlash", "rad", 0.0, 0.5, {}, S::kLink, C::kDeadBandHinge, "internal_hinge",
-       "the transmission has a dead band of total width value", true},
+       "the transmission has a dead band of total width value"},
       {"series_compliance", "N m/rad", 1.0, 1e6, {}, S::kLink, C::kStrapHinge, "internal_hinge",
-       "the link follows the exoskeleton through a spring of that stiffness (straps, cuffs)", true},
+       "the link follows the exoskeleton through a spring of that stiffness (straps, cuffs)"},
       {"torque_ripple", "N m", 0.0, 100.0, {"cycles_per_rad", "phase"}, S::kLink, C::kAppliedForce, "",
-       "tau_R += value * sin(2 pi cycles_per_rad q + phase) (fields `cycles_per_rad`, `phase`)", true, Ripple},
+       "tau_R += value * sin(2 pi cycles_per_rad q + phase) (fields `cycles_per_rad`, `phase`)", Ripple},
       {"passive_moment", "relative", -1.0, 10.0, {}, S::kLink, C::kSubjectForce, "",
        "the subject's passive moment is 1 + value times Riener & Edrich 1999's (HJ15 eq. 12 as rebuilt, "
        "`model/passive_torque.h`): tau_R += value * P_j(q), whatever passive model the twin subtracts "
-       "(optional field `cv`: see \"Realistic EXOwheel\")",
-       false, Passive},
-      {"sensor_offset", "N m", -100.0, 100.0, {}, S::kSensor, C::kReading, "", "tau_S += value", true, nullptr,
-       Offset},
+       "(optional field `cv`: see \"Realistic EXOwheel\")", Passive},
+      {"sensor_offset", "N m", -100.0, 100.0, {}, S::kSensor, C::kReading, "", "tau_S += value", nullptr,
+       Offset, OffsetOff, OffsetAffine},
       {"sensor_gain", "relative", -0.9, 10.0, {}, S::kSensor, C::kReading, "",
-       "tau_S *= 1 + value (0.05 = reads 5 % high)", true, nullptr, Gain},
+       "tau_S *= 1 + value (0.05 = reads 5 % high)", nullptr, Gain, GainOff, GainAffine},
       {"sensor_delay", "s", 0.0, 1.0, {}, S::kSensor, C::kReading, "", "tau_S(t) is the true reading at t - value",
-       true, nullptr, Delay},
+       nullptr, Delay, DelayOff},
       {"muscle_activity", "-", -1e6, 1e6, {}, S::kLink, C::kNotCarried, "",
-       "the subject was not relaxed: residual explained by EMG envelopes", true},
+       "the subject was not relaxed: residual explained by EMG envelopes"},
   };
   return k;
+}
+
+// DESIGN.md's families: the registry's size before anything is added.
+size_t BuiltInFamilies() {
+  static const size_t n = Registry().size();
+  return n;
+}
+
+}  // namespace
+
+const std::deque<EffectFamily>& EffectFamilies() { return Registry(); }
+
+void AddEffectFamily(const EffectFamily& f) {
+  if (!f.name || !*f.name || !f.unit || !*f.unit || !(f.lo < f.hi))
+    throw std::invalid_argument("effect family: expected a name, a unit and lo < hi");
+  if (FindFamily(f.name)) throw std::invalid_argument(std::string("effect family '") + f.name + "' exists");
+  BuiltInFamilies();  // counted before the first addition
+  Registry().push_back(f);
+}
+
+void RemoveAddedEffectFamily(const std::string& name) {
+  if (Registry().size() <= BuiltInFamilies() || name != Registry().back().name)
+    throw std::invalid_argument("effect family '" + name + "' is not the family added last");
+  Registry().pop_back();
 }
 
 const EffectFamily* FindFamily(const std::string& name) {

@@ -13,6 +13,7 @@
 // This is the model layer: the fit's behaviour of a family (its columns, physical ranges against the
 // records) sits in diagnosis/, found there by the family's name.
 #pragma once
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -55,16 +56,29 @@ struct EffectFamily {
   PlantCarrier carrier;
   const char* exclusive;            // families of one group exclude each other at one joint ("" none)
   const char* table;                // DESIGN.md's "what the rig does that the rigid twin does not"
-  bool drawn;                       // `generate` may hide it (DESIGN.md "Effects")
   // Torque (N m) the actuator needs in addition at both joints; nullptr where one sample's state
   // does not determine it.
   Eigen::Vector2d (*link_torque)(const Effect& e, const EffectState& s) = nullptr;
   // Applies a sensor family to its joint's reading tau_S (samples at times t); nullptr for link families.
   void (*on_reading)(const Effect& e, const std::vector<double>& t, std::vector<double>* tau_S) = nullptr;
+  // Its inverse: the reading before the effect from the reading after it (replay's actuator torque).
+  void (*off_reading)(double value, const std::vector<double>& t, std::vector<double>* tau_S) = nullptr;
+  // A sensor family that is affine in the torque: the reading a tau + b becomes a' tau + b'
+  // (a joint module's gain and offset); nullptr for the delay (whole samples of the module's skew).
+  void (*affine)(double value, double* a, double* b) = nullptr;
 };
 
-// Every family, in DESIGN.md's table order.
-const std::vector<EffectFamily>& EffectFamilies();
+// Every family: DESIGN.md's table in its order, then any added by AddEffectFamily. References stay
+// valid as families are added.
+const std::deque<EffectFamily>& EffectFamilies();
+
+// Adds a family to the registry (a device's own effect, a test's toy family): every stage then
+// iterates it. Call before any stage runs (the registry is not locked). Throws std::invalid_argument
+// for a name already taken, an empty name or unit, or lo >= hi.
+void AddEffectFamily(const EffectFamily& f);
+// Removes the family added last, which must be `name` (a test's toy family, when the test ends);
+// throws std::invalid_argument otherwise (DESIGN.md's families are never removed).
+void RemoveAddedEffectFamily(const std::string& name);
 
 // The family of `name`; nullptr for an unknown name.
 const EffectFamily* FindFamily(const std::string& name);

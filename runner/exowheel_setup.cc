@@ -159,14 +159,13 @@ hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j, const st
   // (tau + offset) (1 + gain) with offset = b / a + the sensor's own, gain = a - 1.
   double a = 1, b = 0;
   for (const SensorEffect& e : sensor) {
-    if (e.name == "sensor_offset") {
-      b += e.value;
-    } else if (e.name == "sensor_gain") {
-      a *= 1 + e.value, b *= 1 + e.value;
+    const EffectFamily* f = FindFamily(e.name);
+    if (f->affine) {
+      f->affine(e.value, &a, &b);
     } else {
       const double k = e.value / sample_s;
       if (std::abs(k - std::round(k)) > 1e-9)
-        throw InputError(source + ": sensor_delay " + std::to_string(e.value) + " s of the " +
+        throw InputError(source + ": " + e.name + " " + std::to_string(e.value) + " s of the " +
                          (j == 0 ? "hip" : "knee") + ": expected a whole number of the joint module's " +
                          std::to_string(sample_s) + " s samples");
       ms.torque_sensor_skew += static_cast<int>(std::lround(k));

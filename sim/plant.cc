@@ -466,7 +466,7 @@ void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t,
     const Eigen::Vector2d tau = ActuatorTorque(rigid, q, qd, qdd ? *qdd : Eigen::Vector2d::Zero());
     LegParams strapped = rigid;  // a strap carries the subject's passive moment too (CompliantPartTorque)
     for (const Effect& e : fx_.applied)
-      if (e.name == "passive_moment") strapped.effects.push_back(e);
+      if (FamilyOf(e).carrier == PlantCarrier::kSubjectForce) strapped.effects.push_back(e);
     for (int j = 0; j < 2; ++j) {
       if (in_q_[j] < 0) continue;
       d_->qpos[in_q_[j]] =
@@ -529,7 +529,7 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   if (!fx_.applied.empty()) applied += fx_.SubjectPassiveForce(q_follower);
   for (int j = 0; j < 2; ++j)
     if (in_v_[j] >= 0) d_->qfrc_applied[in_v_[j]] = applied[j];
-  if (!fx_.applied.empty()) applied += fx_.AppliedForce(q());
+  if (!fx_.applied.empty()) applied += fx_.AppliedForce(q(), qd());
   d_->qfrc_applied[hip_dof_] = applied[0];
   d_->qfrc_applied[knee_dof_] = applied[1];
   // Actuators are plain motors with gear 1: ctrl is the joint torque (clamped by ctrlrange).

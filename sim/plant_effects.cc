@@ -72,10 +72,10 @@ bool PlantEffects::has_internal_joints() const {
 
 bool PlantEffects::empty() const { return link_empty() && sensor[0].empty() && sensor[1].empty(); }
 
-Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q) const {
+Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q, const Eigen::Vector2d& qd) const {
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   EffectState s;
-  s.q = q, s.qd.setZero(), s.qdd.setZero(), s.g = g;
+  s.q = q, s.qd = qd, s.qdd.setZero(), s.g = g;
   for (const Effect& e : applied)
     if (FamilyOf(e).carrier == PlantCarrier::kAppliedForce) f -= FamilyOf(e).link_torque(e, s);
   return f;

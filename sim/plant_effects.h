@@ -76,15 +76,16 @@ struct PlantEffects {
   double backlash[2] = {0, 0};      // rad, total dead-band width (0: none)
   double compliance[2] = {0, 0};    // N m/rad, strap stiffness (0: none)
   bool compliant_human = false;     // the part behind a strap is the human limb (else the whole chain)
-  std::vector<Effect> applied;      // gravity_error, torque_ripple, passive_moment: qfrc_applied each step
+  std::vector<Effect> applied;      // kAppliedForce and kSubjectForce families: qfrc_applied each step
   std::vector<SensorEffect> sensor[2];
   double g = 9.81;                  // for gravity_error
   bool empty() const;
   bool link_empty() const;          // no effect on the link (only sensor effects, or none)
   bool has_internal_joints() const; // backlash or series_compliance: the MJCF gains hinges
-  // The generalized force (N m) of `applied` at q: minus the torques the actuator needs for them
-  // (gravity_error, torque_ripple; passive_moment is SubjectPassiveForce's).
-  Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q) const;
+  // The generalized force (N m) of `applied` at (q, qd): minus the torques the actuator needs for the
+  // families carried as an applied force (PlantCarrier::kAppliedForce), each by its own closed form;
+  // those carried at the human's angles (kSubjectForce) are SubjectPassiveForce's.
+  Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q, const Eigen::Vector2d& qd) const;
   // The generalized force (N m) of the passive_moment effects of `applied` at the human's angles
   // q_follower (behind a strap or dead band: q + the internal hinges' angles): where Riener & Edrich's
   // P^ acts, on the human's segments.

@@ -147,5 +147,29 @@ TEST(EffectFamilies, ClosedFormsAreTheTablesFormulas) {
   for (size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(tau[i], delayed[i], 1e-12) << i;
 }
 
+// A sensor family's inverse undoes it (replay's actuator torque from the reading), and the affine
+// ones compose into a joint module's gain and offset as the series form acts.
+TEST(EffectFamilies, SensorFormsInvertAndCompose) {
+  const std::vector<double> t = {0.0, 0.01, 0.02, 0.03, 0.04};
+  const std::vector<double> tau = {1.0, -2.0, 3.5, 0.25, -1.0};
+  for (const EffectFamily& f : EffectFamilies()) {
+    if (f.stage != EffectStage::kSensor) continue;
+    Effect e;
+    e.name = f.name, e.joint = "hip", e.value = f.unit == std::string("s") ? 0.01 : 0.2;
+    std::vector<double> x = tau;
+    f.on_reading(e, t, &x);
+    f.off_reading(e.value, t, &x);
+    // A delay of one sample shifts the record: the inverse restores all but the last sample (held).
+    const size_t n = f.affine ? t.size() : t.size() - 1;
+    for (size_t i = 1; i < n; ++i) EXPECT_NEAR(x[i], tau[i], 1e-12) << f.name << " " << i;
+    if (!f.affine) continue;
+    double a = 1, b = 0;
+    f.affine(e.value, &a, &b);
+    std::vector<double> y = tau;
+    f.on_reading(e, t, &y);
+    for (size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(y[i], a * tau[i] + b, 1e-12) << f.name;
+  }
+}
+
 }  // namespace
 }  // namespace exotwin

@@ -129,7 +129,7 @@ TEST(PlantEffects, PassiveMomentIsAFactorOnRienerEdrich) {
   LegParams p = RealRigModel();
   p.effects = {MakeEffect("passive_moment", "knee", 0.5)};
   EXPECT_NEAR(ToPlantEffects(p, "m.yaml").SubjectPassiveForce(q0)[1], -5.2, 0.03);
-  EXPECT_EQ(ToPlantEffects(p, "m.yaml").AppliedForce(q0)[1], 0.0);
+  EXPECT_EQ(ToPlantEffects(p, "m.yaml").AppliedForce(q0, Eigen::Vector2d::Zero())[1], 0.0);
   for (double v : {-1.0, 2.5}) {
     p.effects = {MakeEffect("passive_moment", "hip", v)};
     EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError) << v;
@@ -187,8 +187,8 @@ TEST(PlantEffects, AppliedForceIsEachAppliedFamilysClosedForm) {
       fx.applied = {e};
       for (double a : {-0.9, 0.2, 1.1}) {
         EffectState s;
-        s.q = {a, -0.5 * a}, s.qd.setZero(), s.qdd.setZero(), s.g = 9.81;
-        EXPECT_EQ(fx.AppliedForce(s.q), -f.link_torque(e, s)) << f.name << " " << joint;
+        s.q = {a, -0.5 * a}, s.qd = {0.3 * a, -a}, s.qdd.setZero(), s.g = 9.81;
+        EXPECT_EQ(fx.AppliedForce(s.q, s.qd), -f.link_torque(e, s)) << f.name << " " << joint;
       }
     }
   }
@@ -200,13 +200,13 @@ TEST(PlantEffects, AppliedForceIsEachAppliedFamilysClosedForm) {
   fx.g = 9.81;
   fx.applied = {r, g};
   const Eigen::Vector2d q(0.3, -0.6);
-  const Eigen::Vector2d f = fx.AppliedForce(q);
+  const Eigen::Vector2d f = fx.AppliedForce(q, Eigen::Vector2d(0.4, -0.2));
   EXPECT_NEAR(f[0], -9.81 * 0.2 * std::sin(0.3), 1e-14);
   EXPECT_NEAR(f[1], -0.4 * std::sin(2 * M_PI * 3.0 * -0.6 + 0.5), 1e-14);
   Effect unknown = r;
   unknown.name = "gear_friction";
   fx.applied = {unknown};
-  EXPECT_THROW(fx.AppliedForce(q), std::invalid_argument);
+  EXPECT_THROW(fx.AppliedForce(q, Eigen::Vector2d::Zero()), std::invalid_argument);
   LegParams p;
   p.effects = {unknown};
   EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError);
