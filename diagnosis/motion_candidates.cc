@@ -9,6 +9,7 @@
 #include "diagnosis/motion_fit.h"
 #include "diagnosis/motion_fit_internal.h"
 #include "formats/number_text.h"
+#include "model/effect_families.h"
 #include "model/passive_torque.h"
 
 namespace exotwin {
@@ -18,12 +19,15 @@ namespace {
 constexpr double kNoBacklash = 1e-5;    // rad: a narrower dead band is none (the hinge is not built)
 constexpr double kNoCompliance = 1e-7;  // rad/(N m): a stiffer strap is none
 
-// The effect of the model given that takes the place of candidate `name` at `joint` (the same effect;
-// a dead band or a strap for either: one internal hinge per joint), nullptr if none.
+// The effect of the model given that takes the place of candidate `name` at `joint` (the same effect,
+// or one of its exclusive group: a dead band or a strap for either, one internal hinge per joint),
+// nullptr if none.
 const Effect* CarriedByModel(const LegParams& params, const std::string& name, const std::string& joint) {
-  auto hinge = [](const std::string& n) { return n == "backlash" || n == "series_compliance"; };
+  const char* group = FindFamily(name) ? FindFamily(name)->exclusive : "";
   for (const Effect& e : params.effects)
-    if (e.joint == joint && (e.name == name || (hinge(name) && hinge(e.name)))) return &e;
+    if (e.joint == joint && (e.name == name || (*group && FindFamily(e.name) &&
+                                                std::string(group) == FindFamily(e.name)->exclusive)))
+      return &e;
   return nullptr;
 }
 
@@ -58,16 +62,23 @@ int CandidateOf(const MotionProblem& P, const Effect& fx) {
 void ExtendedTwin(const LegParams& params, Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
-    const bool sa = a.effect.name.rfind("sensor_", 0) == 0, sb = b.effect.name.rfind("sensor_", 0) == 0;
+    const bool sa = FamilyOf(a.effect).stage == EffectStage::kSensor, sb = FamilyOf(b.effect).stage == EffectStage::kSensor;
     return sa != sb ? !sa : a.explained_pct > b.explained_pct;
   });
   D.extended = params;
   for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  // The sensor effects in the order the rollouts applied them (offset, gain, delay).
+  // The sensor effects in the order the rollouts applied them (the registry's: offset, gain, delay),
+  // after the link effects.
   std::stable_sort(D.extended.effects.begin() + static_cast<long>(params.effects.size()), D.extended.effects.end(),
                    [](const Effect& a, const Effect& b) {
                      auto rank = [](const Effect& e) {
-                       return e.name == "sensor_offset" ? 1 : e.name == "sensor_gain" ? 2 : e.name == "sensor_delay" ? 3 : 0;
+                       if (FamilyOf(e).stage != EffectStage::kSensor) return 0;
+                       int k = 1;
+                       for (const EffectFamily& f : EffectFamilies()) {
+                         if (e.name == f.name) break;
+                         ++k;
+                       }
+                       return k;
                      };
                      return rank(a) < rank(b);
                    });
@@ -166,8 +177,9 @@ int MotionProblem::CandidateIndex(const std::string& name, const std::string& jo
 
 std::string MotionProblem::WhyNoCandidate(const Effect& e) const {
   if (CandidateIndex(e.name, e.joint, e.axis) >= 0) return "";
-  if (e.name == "muscle_activity") return "not carried by the forward plant";
-  if (e.name.rfind("sensor_", 0) == 0 && !reading_input_) return "the commands drive the plant: no torque reading to correct";
+  const EffectFamily* family = FindFamily(e.name);
+  if (family && family->carrier == PlantCarrier::kNotCarried) return "not carried by the forward plant";
+  if (family && family->stage == EffectStage::kSensor && !reading_input_) return "the commands drive the plant: no torque reading to correct";
   if (const Effect* g = CarriedByModel(params_, e.name, e.joint))
     return "the model given already carries a " + g->name + " at the " + g->joint + ": no candidate";
   if (e.name == "series_compliance" && e.joint == "hip" && params_.human)
@@ -179,9 +191,9 @@ std::string MotionProblem::WhyNoCandidate(const Effect& e) const {
 
 std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const {
   std::vector<Effect> link, sensor;
-  auto Make = [](const std::string& name, int j, double v, const std::string& unit) {
+  auto Make = [](const std::string& name, int j, double v) {
     Effect e;
-    e.name = name, e.joint = kJoint[j], e.value = v, e.unit = unit;
+    e.name = name, e.joint = kJoint[j], e.value = v, e.unit = FindFamily(name)->unit;
     return e;
   };
   for (int k = 0; k < parameters(); ++k) {
@@ -189,37 +201,37 @@ std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const
     const int j = joint_[k];
     const std::string& kind = kind_[k];
     if (v == 0) continue;
-    if (kind == "coulomb_friction" && v > 0) link.push_back(Make(kind, j, v, "N m"));
-    if (kind == "viscous_friction" && v > 0) link.push_back(Make(kind, j, v, "N m s/rad"));
-    if (kind == "inertia_error") link.push_back(Make(kind, j, v, "kg m^2"));
-    if (kind == "passive_moment") link.push_back(Make(kind, j, v, "relative"));
+    if (kind == "coulomb_friction" && v > 0) link.push_back(Make(kind, j, v));
+    if (kind == "viscous_friction" && v > 0) link.push_back(Make(kind, j, v));
+    if (kind == "inertia_error") link.push_back(Make(kind, j, v));
+    if (kind == "passive_moment") link.push_back(Make(kind, j, v));
     if (kind.rfind("gravity_error", 0) == 0) {
-      Effect e = Make("gravity_error", j, v, "kg m");
+      Effect e = Make("gravity_error", j, v);
       e.axis = kind.substr(14);
       link.push_back(e);
     }
     if (kind == "joint_stiffness" && v > 0) {  // its constant part k q0 is the offset parameter
-      Effect e = Make(kind, j, v, "N m/rad");
+      Effect e = Make(kind, j, v);
       e.fields["q0"] = 0;
       link.push_back(e);
     }
-    if (kind == "backlash" && v > kNoBacklash) link.push_back(Make(kind, j, v, "rad"));
-    if (kind == "series_compliance" && v > kNoCompliance) link.push_back(Make(kind, j, 1 / v, "N m/rad"));
+    if (kind == "backlash" && v > kNoBacklash) link.push_back(Make(kind, j, v));
+    if (kind == "series_compliance" && v > kNoCompliance) link.push_back(Make(kind, j, 1 / v));
     if (kind == "torque_ripple.sin") {
       const double b = theta[k + 1];
-      Effect e = Make("torque_ripple", j, std::hypot(v, b), "N m");
+      Effect e = Make("torque_ripple", j, std::hypot(v, b));
       e.fields["cycles_per_rad"] = ripple_f_[k];
       e.fields["phase"] = std::atan2(b, v);
       link.push_back(e);
     }
     // The input's constant torque: a sensor offset where the reading drives (tau_R = -(reading - offset)).
-    if (kind == "offset" && reading_input_) sensor.push_back(Make("sensor_offset", j, v, "N m"));
-    if (kind == "sensor_gain") sensor.push_back(Make(kind, j, v, "relative"));
-    if (kind == "sensor_delay" && v > 0) sensor.push_back(Make(kind, j, v, "s"));
+    if (kind == "offset" && reading_input_) sensor.push_back(Make("sensor_offset", j, v));
+    if (kind == "sensor_gain") sensor.push_back(Make(kind, j, v));
+    if (kind == "sensor_delay" && v > 0) sensor.push_back(Make(kind, j, v));
   }
   for (int k = 0; k < parameters(); ++k)  // a ripple whose sine part is 0
     if (kind_[k] == "torque_ripple.cos" && theta[k] != 0 && theta[k - 1] == 0) {
-      Effect e = Make("torque_ripple", joint_[k], std::abs(theta[k]), "N m");
+      Effect e = Make("torque_ripple", joint_[k], std::abs(theta[k]));
       e.fields["cycles_per_rad"] = ripple_f_[k];
       e.fields["phase"] = std::atan2(theta[k], 0.0);
       link.push_back(e);
