@@ -153,7 +153,7 @@ class MotionProblem {
   double lower(int k) const { return lo_[k]; }
   double upper(int k) const { return hi_[k]; }
   double step(int k) const { return step_[k]; }
-  const std::string& kind(int k) const { return kind_[static_cast<size_t>(k)]; }  // e.g. "backlash", "offset"
+  const std::string& kind(int k) const { return kind_[static_cast<size_t>(k)]; }  // a family's name, or "offset"
   // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
   int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
   // Why effect e (as the torque fit names it) is no candidate, "" when it is one: the plant cannot
@@ -226,7 +226,7 @@ class MotionProblem {
   std::vector<std::unique_ptr<Record>> rec_;
   std::vector<Candidate> candidates_;
   std::vector<double> lo_, hi_, step_;
-  std::vector<std::string> kind_;  // per parameter: what it is (e.g. "coulomb_friction", "offset")
+  std::vector<std::string> kind_;  // per parameter: what it is (a family's name, or "offset")
   std::vector<int> joint_;         // per parameter
   std::vector<double> ripple_f_;   // per parameter (torque_ripple)
   PhysicalScale scale_;

@@ -9,6 +9,7 @@
 #include "diagnosis/motion_fit.h"
 #include "diagnosis/motion_fit_internal.h"
 #include "dsp/statistics.h"
+#include "model/effect_families.h"
 
 namespace exotwin {
 namespace motion {
@@ -208,7 +209,8 @@ Refined Refine(const MotionProblem& P, const std::vector<int>& cols, const std::
   for (int round = 0; round < kMotionBandProbes; ++round) {
     std::vector<Eigen::VectorXd> probes;
     for (int k : cols) {
-      if (P.kind(k) != "backlash") continue;
+      const EffectFamily* f = FindFamily(P.kind(k));  // a dead band's parameter
+      if (!f || f->carrier != PlantCarrier::kDeadBandHinge) continue;
       const double size = std::max(R.theta[k], P.step(k));
       for (double f : {-0.5, -0.25, 0.25, 0.5}) {
         Eigen::VectorXd x = R.theta;
