@@ -39,7 +39,9 @@ fi
 
 # The independent MCAP / ROS 2 client of the bag tests (tests/mcap_client: Foxglove's @mcap/core and
 # ROS 2 serialization, pinned by its package-lock.json), from the npm registry.
-if command -v npm >/dev/null && [ ! -d tests/mcap_client/node_modules/@mcap/core ]; then
+# Installed again when its lock file is newer than what node_modules holds.
+if command -v npm >/dev/null && { [ ! -f tests/mcap_client/node_modules/.package-lock.json ] ||
+     [ tests/mcap_client/package-lock.json -nt tests/mcap_client/node_modules/.package-lock.json ]; }; then
   (cd tests/mcap_client && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
 fi
 
