@@ -226,32 +226,33 @@ int AddJointColumn(PendingColumns& p, const double w[2], int j, G g) {
 int AddLinearColumn(PendingColumns& p, const double w[2], int j, const Effect& unit, const EffectFamily& f,
                     const Kinematics& kin, double g) {
   ColumnBank& b = p.bank();
-  auto u = [&](size_t i) {
+  const int c = NewColumn(b);
+  const size_t n = b.filter ? b.n : b.sample.size();  // every sample for the filter, else the fit rows
+  std::vector<double> x[2] = {std::vector<double>(n), std::vector<double>(n)};
+  ForEachSample(b, n, [&](size_t k) {
+    const size_t i = b.filter ? k : b.sample[k];
     EffectState s;
     s.q = {kin.q[0][i], kin.q[1][i]}, s.qd = {kin.qd[0][i], kin.qd[1][i]}, s.qdd = {kin.qdd[0][i], kin.qdd[1][i]};
     s.g = g;
-    return Eigen::Vector2d(-f.link_torque(unit, s));
-  };
-  bool other_zero = true;  // the other joint's rows, on every sample
-  std::vector<double> x[2] = {std::vector<double>(b.n), std::vector<double>(b.n)};
-  ForEachSample(b, b.n, [&](size_t i) {
-    const Eigen::Vector2d v = u(i);
-    x[0][i] = v[0], x[1][i] = v[1];
+    const Eigen::Vector2d v = f.link_torque(unit, s);
+    x[0][k] = -v[0], x[1][k] = -v[1];
   });
-  for (double v : x[1 - j]) other_zero = other_zero && v == 0.0;
-  if (other_zero) {
-    std::vector<double>().swap(x[1 - j]);
-    const std::vector<double> own = std::move(x[j]);
-    return AddJointColumn(p, w, j, [&](size_t i) { return own[i]; });
-  }
-  const int c = NewColumn(b);
-  if (b.filter) {
-    for (int k = 0; k < 2; ++k)
-      p.Add(std::move(x[k]), [&b, w, c, k](const std::vector<double>& v) { PlaceJointRows(b, c, w, k, v); });
+  const bool other_zero = std::all_of(x[1 - j].begin(), x[1 - j].end(), [](double v) { return v == 0.0; });
+  if (!b.filter) {
+    const size_t m = b.sample.size();
+    for (size_t k = 0; k < m; ++k)
+      b.X(k, c) = w[0] * x[0][k], b.X(m + k, c) = w[1] * (other_zero && j == 0 ? 0.0 : x[1][k]);
+    if (other_zero && j == 1)
+      for (size_t k = 0; k < m; ++k) b.X(k, c) = w[0] * 0.0;
     return c;
   }
-  const size_t m = b.sample.size();
-  for (size_t k = 0; k < m; ++k) b.X(k, c) = w[0] * x[0][b.sample[k]], b.X(m + k, c) = w[1] * x[1][b.sample[k]];
+  if (other_zero) {
+    std::vector<double>().swap(x[1 - j]);
+    SetJointColumn(p, c, w, j, std::move(x[j]));
+    return c;
+  }
+  for (int k = 0; k < 2; ++k)
+    p.Add(std::move(x[k]), [&b, w, c, k](const std::vector<double>& v) { PlaceJointRows(b, c, w, k, v); });
   return c;
 }
 
