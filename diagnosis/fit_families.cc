@@ -172,6 +172,13 @@ Effect DrawMuscle(Rng& rng, int joint, bool) {
   return e;
 }
 
+// The motion fit's boxes (DESIGN.md's ranges) and secant steps (2 % of the box's scale).
+MotionBox CoulombBox(const MotionScale& s) { return {0, 0.5 * s.tau, 0.02 * s.tau}; }
+MotionBox ViscousBox(const MotionScale& s) { return {0, 100 * s.tau / s.qd_rms, 0.02 * s.tau / s.qd_rms}; }
+MotionBox InertiaBox(const MotionScale& s) { return {-0.45 * s.M, s.M, 0.02 * s.M}; }
+MotionBox GravityBox(const MotionScale& s) { return {-s.grav, s.grav, 0.02 * s.grav}; }
+MotionBox PassiveBox(const MotionScale&) { return {-0.95, kMaxPassiveScale - 1, 0.05}; }
+
 // Riener & Edrich's curves are a human leg's in HJ15's two-joint angles.
 bool TwoJointHuman(const LegParams& p) { return p.human && !p.one_joint; }
 
@@ -188,16 +195,16 @@ std::deque<FitFamily>& Registry() {
   static std::deque<FitFamily> k = [] {
     std::deque<FitFamily> v;
     FitFamily f = Row("coulomb_friction", CoulombRange, DrawCoulomb);
-    f.range_edge = HalfTorqueEdge, f.ceiling_sign = 1, f.linear_column = true;
+    f.range_edge = HalfTorqueEdge, f.ceiling_sign = 1, f.linear_column = true, f.motion_box = CoulombBox;
     v.push_back(f);
     f = Row("viscous_friction", ViscousRange, DrawViscous);
-    f.ceiling_sign = 1, f.linear_column = true;
+    f.ceiling_sign = 1, f.linear_column = true, f.motion_box = ViscousBox;
     v.push_back(f);
     f = Row("inertia_error", InertiaRange, DrawInertia);
-    f.range_edge = InertiaEdge, f.linear_column = true;
+    f.range_edge = InertiaEdge, f.linear_column = true, f.motion_box = InertiaBox;
     v.push_back(f);
     f = Row("gravity_error", GravityRange, DrawGravity);
-    f.range_edge = GravityEdge, f.linear_column = true, f.axes = {"X", "Y"};
+    f.range_edge = GravityEdge, f.linear_column = true, f.axes = {"X", "Y"}, f.motion_box = GravityBox;
     v.push_back(f);
     f = Row("joint_stiffness", StiffnessRange, DrawStiffness);
     f.to_effect = StiffnessEffect, f.ceiling_sign = 1;
@@ -212,7 +219,7 @@ std::deque<FitFamily>& Registry() {
     f.to_effect = RippleEffect, f.significant = RippleSignificant;
     v.push_back(f);
     f = Row("passive_moment", PassiveRange, nullptr);
-    f.linear_column = true, f.candidate_for = TwoJointHuman;
+    f.linear_column = true, f.candidate_for = TwoJointHuman, f.motion_box = PassiveBox;
     v.push_back(f);
     f = Row("sensor_offset", OffsetRange, DrawOffset);
     f.range_edge = HalfTorqueEdge;
@@ -254,9 +261,14 @@ void RemoveAddedFitFamily(const std::string& name) {
   Registry().pop_back();
 }
 
-const FitFamily& FitFamilyOf(const std::string& name) {
+const FitFamily* FindFitFamily(const std::string& name) {
   for (const FitFamily& f : FitFamilies())
-    if (name == f.family->name) return f;
+    if (name == f.family->name) return &f;
+  return nullptr;
+}
+
+const FitFamily& FitFamilyOf(const std::string& name) {
+  if (const FitFamily* f = FindFitFamily(name)) return *f;
   throw std::invalid_argument("no fit row for effect family '" + name + "'");
 }
 

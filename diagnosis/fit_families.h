@@ -22,6 +22,16 @@
 
 namespace exotwin {
 
+// The records' scales at one joint the motion fit's boxes are set from: the largest measured torque
+// (N m), the twin's mean diagonal inertia (kg m^2), the RMS velocity (rad/s) and DESIGN.md's gravity
+// edge (kg m).
+struct MotionScale {
+  double tau = 0, M = 0, qd_rms = 0, grav = 0;
+};
+struct MotionBox {
+  double lo = 0, hi = 0, step = 0;
+};
+
 struct FitFamily {
   const EffectFamily* family = nullptr;
   std::string (*implausible)(const Effect& e, const PhysicalScale& s) = nullptr;
@@ -37,6 +47,9 @@ struct FitFamily {
   std::vector<std::string> axes;
   // A candidate only for such models (nullptr: every model).
   bool (*candidate_for)(const LegParams& params) = nullptr;
+  // The motion fit's parameter of a family linear in its value: its box and secant step at a joint
+  // from the records' scales (MotionScale); nullptr: the family's own parameters (motion_candidates.cc).
+  MotionBox (*motion_box)(const MotionScale& s) = nullptr;
 };
 
 // Every family's fit row: DESIGN.md's families in the model registry's order, then those added.
@@ -51,5 +64,7 @@ void RemoveAddedFitFamily(const std::string& name);
 
 // The fit row of the family `name`; throws std::invalid_argument for a name of no family.
 const FitFamily& FitFamilyOf(const std::string& name);
+// The same, nullptr for a name of no family.
+const FitFamily* FindFitFamily(const std::string& name);
 
 }  // namespace exotwin

@@ -9,6 +9,7 @@
 #include "diagnosis/motion_fit.h"
 #include "diagnosis/motion_fit_internal.h"
 #include "formats/number_text.h"
+#include "diagnosis/fit_families.h"
 #include "model/effect_families.h"
 #include "model/passive_torque.h"
 
@@ -56,7 +57,8 @@ bool TorqueValues(const MotionProblem& P, const Effect& e, Eigen::VectorXd* thet
 }
 
 int CandidateOf(const MotionProblem& P, const Effect& fx) {
-  return P.CandidateIndex(fx.name, fx.joint, fx.name == "gravity_error" ? fx.axis : "");
+  const FitFamily* ff = FindFitFamily(fx.name);
+  return P.CandidateIndex(fx.name, fx.joint, ff && !ff->axes.empty() ? fx.axis : "");
 }
 
 void ExtendedTwin(const LegParams& params, Diagnosis* D_out) {
@@ -92,7 +94,7 @@ bool TorqueValuesOfSet(const MotionProblem& P, const std::vector<DiagnosedEffect
     for (const DiagnosedEffect& e : torque) {
       const Candidate& cand = cands[static_cast<size_t>(c)];
       if (e.effect.name == cand.name && e.effect.joint == kJoint[cand.joint] &&
-          (cand.name != "gravity_error" || e.effect.axis == cand.axis))
+          (cand.axis.empty() || e.effect.axis == cand.axis))
         has_torque = TorqueValues(P, e.effect, start_torque) || has_torque;
     }
   return has_torque;
@@ -134,19 +136,25 @@ void MotionProblem::AddCandidates(const std::vector<Kinematics>& kins, const std
       candidates_.push_back(c);
     };
     const int off = Add("offset", j, -0.5 * tau, 0.5 * tau, 0.02 * tau);
-    // Friction and inertia are summed by the plant (sim/plant_effects.h): candidates on top of the
-    // model's own (a one-joint device's R and C are its knee's frictions, model/one_joint.h).
-    Cand("coulomb_friction", {Add("coulomb_friction", j, 0, 0.5 * tau, 0.02 * tau)});
-    Cand("viscous_friction", {Add("viscous_friction", j, 0, 100 * tau / qd_rms, 0.02 * tau / qd_rms)});
-    Cand("inertia_error", {Add("inertia_error", j, -0.45 * M, M, 0.02 * M)});
-    if (!Has("gravity_error", j)) {
-      Cand("gravity_error", {Add("gravity_error.X", j, -grav, grav, 0.02 * grav)}, "X");
-      Cand("gravity_error", {Add("gravity_error.Y", j, -grav, grav, 0.02 * grav)}, "Y");
+    // The families linear in their value (FitFamily::motion_box). Friction and inertia are summed by
+    // the plant (sim/plant_effects.h: frictionloss, damping, armature): candidates on top of the model's
+    // own (a one-joint device's R and C are its knee's frictions, model/one_joint.h); any other family
+    // the model carries at the joint is no candidate.
+    const MotionScale ms{tau, M, qd_rms, grav};
+    for (const FitFamily& ff : FitFamilies()) {
+      if (!ff.motion_box || (ff.candidate_for && !ff.candidate_for(params))) continue;
+      const PlantCarrier carrier = ff.family->carrier;
+      const bool summed = carrier == PlantCarrier::kFrictionLoss || carrier == PlantCarrier::kDamping ||
+                          carrier == PlantCarrier::kArmature;
+      if (!summed && Has(ff.family->name, j)) continue;
+      const MotionBox box = ff.motion_box(ms);
+      for (const std::string& axis : ff.axes.empty() ? std::vector<std::string>{""} : ff.axes) {
+        const std::string kind = std::string(ff.family->name) + (axis.empty() ? "" : "." + axis);
+        Cand(ff.family->name, {Add(kind, j, box.lo, box.hi, box.step)}, axis);
+      }
     }
     if (!Has("joint_stiffness", j))
       Cand("joint_stiffness", {Add("joint_stiffness", j, 0, 100 * tau / qdev, 0.02 * tau / qdev), off});
-    if (params.human && !params.one_joint && !Has("passive_moment", j))
-      Cand("passive_moment", {Add("passive_moment", j, -0.95, kMaxPassiveScale - 1, 0.05)});
     if (!Has("backlash", j)) Cand("backlash", {Add("backlash", j, 0, 0.1, 0.005)});
     if (!Has("series_compliance", j) && !(j == 0 && params.human)) {
       const double tc = std::max(scale_.tau_C_max[j], 1e-3);
@@ -170,7 +178,7 @@ void MotionProblem::AddCandidates(const std::vector<Kinematics>& kins, const std
 int MotionProblem::CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis) const {
   for (size_t c = 0; c < candidates_.size(); ++c)
     if (candidates_[c].name == name && kJoint[candidates_[c].joint] == joint &&
-        (name != "gravity_error" || candidates_[c].axis == axis))
+        (candidates_[c].axis.empty() || candidates_[c].axis == axis))
       return static_cast<int>(c);
   return -1;
 }
@@ -201,14 +209,15 @@ std::vector<Effect> MotionProblem::EffectsOf(const Eigen::VectorXd& theta) const
     const int j = joint_[k];
     const std::string& kind = kind_[k];
     if (v == 0) continue;
-    if (kind == "coulomb_friction" && v > 0) link.push_back(Make(kind, j, v));
-    if (kind == "viscous_friction" && v > 0) link.push_back(Make(kind, j, v));
-    if (kind == "inertia_error") link.push_back(Make(kind, j, v));
-    if (kind == "passive_moment") link.push_back(Make(kind, j, v));
-    if (kind.rfind("gravity_error", 0) == 0) {
-      Effect e = Make("gravity_error", j, v);
-      e.axis = kind.substr(14);
-      link.push_back(e);
+    {  // a family linear in its value: name[.axis]; a box from 0 names positive values only
+      const size_t dot = kind.find('.');
+      const std::string name = kind.substr(0, dot);
+      const FitFamily* ff = FindFitFamily(name);
+      if (ff && ff->motion_box && (v > 0 || lo_[k] < 0)) {
+        Effect e = Make(name, j, v);
+        if (dot != std::string::npos) e.axis = kind.substr(dot + 1);
+        link.push_back(e);
+      }
     }
     if (kind == "joint_stiffness" && v > 0) {  // its constant part k q0 is the offset parameter
       Effect e = Make(kind, j, v);

@@ -30,6 +30,11 @@ Eigen::Vector2d DragTorque(const Effect& e, const EffectState& s) {
 std::string DragRange(const Effect& e, const PhysicalScale& s) {
   return e.value > 0 && e.value <= s.tau_max[EffectJoint(e)] ? "" : "drag outside (0, the largest torque]";
 }
+// The motion fit's box: a drag at most half the largest torque at the RMS velocity.
+MotionBox DragBox(const MotionScale& s) {
+  const double hi = 0.5 * s.tau / (s.qd_rms * s.qd_rms);
+  return {0, hi, 0.02 * hi};
+}
 Effect DrawDrag(Rng& rng, int, bool) {
   Effect e;
   e.value = rng.Uniform(2.0, 4.0);
@@ -44,7 +49,7 @@ struct ToyFamily {
     AddEffectFamily(f);
     FitFamily fit;
     fit.family = FindFamily(kToy), fit.implausible = DragRange, fit.draw = DrawDrag, fit.linear_column = true;
-    fit.ceiling_sign = 1;
+    fit.ceiling_sign = 1, fit.motion_box = DragBox;
     AddFitFamily(fit);
   }
   ~ToyFamily() {
@@ -99,6 +104,23 @@ TEST(ToyFamily, RunsThroughEveryStage) {
   EXPECT_GE(d.joints[1].gain_pct, 50);
   ASSERT_TRUE(d.simulation.done) << d.simulation.note;
   EXPECT_LT(d.simulation.split[1].rmse_after, d.simulation.split[1].rmse_before);
+  // The motion fit (the forward plant on the record's windows) names it too, from its box alone, and
+  // nothing else at the knee.
+  opt.fit = DiagnoseFit::kMotion;
+  const Diagnosis m = Diagnose(S1(), data.data, opt);
+  std::string named;
+  const DiagnosedEffect* drag = nullptr;
+  int at_knee = 0;
+  for (const auto& x : m.effects) {
+    named += " " + x.effect.name + "(" + x.effect.joint + ") = " + std::to_string(x.effect.value);
+    if (x.effect.name == kToy) drag = &x;
+    at_knee += x.effect.joint == "knee";
+  }
+  std::printf("motion fit named:%s (truth %g)\n", named.c_str(), truth.value);
+  ASSERT_NE(drag, nullptr) << named;
+  EXPECT_EQ(drag->effect.joint, "knee");
+  EXPECT_EQ(at_knee, 1) << named;
+  EXPECT_NEAR(drag->effect.value, truth.value, 0.15 * truth.value);
 }
 
 }  // namespace
