@@ -1,8 +1,9 @@
 // A family the registry was never given, added by one definition and one registration (this file):
 // a drive's quadratic (aerodynamic or churning) drag, tau_R += value * qd |qd|. Nothing else of the
 // code names it; it then runs through the model file (written and read), generate (hidden in a
-// record), predict (the closed form), the torque fit (named with its value) and the forward plant
-// (the extended twin's replay carries it as an applied force and gains on the held-out motion).
+// record), predict (the closed form), the torque fit (named with its value), the forward plant (the
+// extended twin's replay carries it as an applied force and gains on the held-out motion) and the
+// motion fit (named from its box alone).
 #include <gtest/gtest.h>
 
 #include <cmath>
