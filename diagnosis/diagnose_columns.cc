@@ -221,8 +221,8 @@ int AddJointColumn(PendingColumns& p, const double w[2], int j, G g) {
 }
 
 // Appends the column -f.link_torque(unit, state_i) (both joints' rows; `unit` at joint j with value
-// 1): the first-order column of a family linear in its value. A row series that is zero throughout (the
-// other joint of a one-joint form) is stored as AddJointColumn stores it.
+// 1): the first-order column of a family linear in its value. With the bank's filter, a row series
+// that is zero throughout (the other joint of a one-joint form) is not filtered (SetJointColumn).
 int AddLinearColumn(PendingColumns& p, const double w[2], int j, const Effect& unit, const EffectFamily& f,
                     const Kinematics& kin, double g) {
   ColumnBank& b = p.bank();
@@ -237,16 +237,11 @@ int AddLinearColumn(PendingColumns& p, const double w[2], int j, const Effect& u
     const Eigen::Vector2d v = f.link_torque(unit, s);
     x[0][k] = -v[0], x[1][k] = -v[1];
   });
-  const bool other_zero = std::all_of(x[1 - j].begin(), x[1 - j].end(), [](double v) { return v == 0.0; });
   if (!b.filter) {
-    const size_t m = b.sample.size();
-    for (size_t k = 0; k < m; ++k)
-      b.X(k, c) = w[0] * x[0][k], b.X(m + k, c) = w[1] * (other_zero && j == 0 ? 0.0 : x[1][k]);
-    if (other_zero && j == 1)
-      for (size_t k = 0; k < m; ++k) b.X(k, c) = w[0] * 0.0;
+    for (size_t k = 0; k < n; ++k) b.X(k, c) = w[0] * x[0][k], b.X(n + k, c) = w[1] * x[1][k];
     return c;
   }
-  if (other_zero) {
+  if (std::all_of(x[1 - j].begin(), x[1 - j].end(), [](double v) { return v == 0.0; })) {
     std::vector<double>().swap(x[1 - j]);
     SetJointColumn(p, c, w, j, std::move(x[j]));
     return c;

@@ -42,12 +42,12 @@ struct Harmonic {
 }  // namespace
 
 Effect DrawEffect(Rng& rng, const std::string& name, int joint, bool one_joint) {
-  const EffectFamily* family = FindFamily(name);
-  if (!family || !FitFamilyOf(name).draw) throw InputError("generate: unknown effect '" + name + "'");
-  Effect e = FitFamilyOf(name).draw(rng, joint, one_joint);
+  const FitFamily* family = FindFitFamily(name);
+  if (!family || !family->draw) throw InputError("generate: unknown effect '" + name + "'");
+  Effect e = family->draw(rng, joint, one_joint);
   e.name = name;
   e.joint = joint == 0 ? "hip" : "knee";
-  e.unit = family->unit;
+  e.unit = family->family->unit;
   return e;
 }
 

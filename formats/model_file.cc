@@ -42,7 +42,7 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
   const EffectFamily* spec = FindFamily(e.name);
   if (!spec)
     c.Fail(key + ".name", "unknown effect '" + e.name + "', expected one of: " +
-                              FamilyNames([](const EffectFamily&) { return true; }));
+                              FamilyNames());
   std::set<std::string> allowed = {"name", "joint", "value", "unit", "ci95", "explained_pct"};
   allowed.insert(spec->fields.begin(), spec->fields.end());
   if (e.name == "gravity_error") allowed.insert("axis");

@@ -138,7 +138,7 @@ const EffectFamily& FamilyOf(const Effect& e) {
 std::string FamilyNames(bool (*keep)(const EffectFamily&)) {
   std::string s;
   for (const EffectFamily& f : EffectFamilies())
-    if (keep(f)) s += (s.empty() ? "" : ", ") + std::string(f.name);
+    if (!keep || keep(f)) s += (s.empty() ? "" : ", ") + std::string(f.name);
   return s;
 }
 

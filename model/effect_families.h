@@ -87,8 +87,8 @@ const EffectFamily* FindFamily(const std::string& name);
 // refuses those first, with InputError).
 const EffectFamily& FamilyOf(const Effect& e);
 
-// The names of the families for which `keep` holds, joined by ", " (messages).
-std::string FamilyNames(bool (*keep)(const EffectFamily&));
+// The names of the families for which `keep` holds (nullptr: every family), joined by ", " (messages).
+std::string FamilyNames(bool (*keep)(const EffectFamily&) = nullptr);
 
 // Joint index of an effect ("hip" -> 0, "knee" -> 1).
 int EffectJoint(const Effect& e);

@@ -76,8 +76,10 @@ Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q, const Eigen
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   EffectState s;
   s.q = q, s.qd = qd, s.qdd.setZero(), s.g = g;
-  for (const Effect& e : applied)
-    if (FamilyOf(e).carrier == PlantCarrier::kAppliedForce) f -= FamilyOf(e).link_torque(e, s);
+  for (const Effect& e : applied) {
+    const EffectFamily& family = FamilyOf(e);
+    if (family.carrier == PlantCarrier::kAppliedForce) f -= family.link_torque(e, s);
+  }
   return f;
 }
 
@@ -108,7 +110,7 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
     const int j = e.joint == "hip" ? 0 : 1;
     const std::string where = source + ": effects[" + std::to_string(i) + "] (" + e.name + ", " + e.joint + ")";
     const EffectFamily* f = FindFamily(e.name);
-    if (!f) throw InputError(where + ": unknown effect; expected one of " + FamilyNames([](const EffectFamily&) { return true; }));
+    if (!f) throw InputError(where + ": unknown effect; expected one of " + FamilyNames());
     switch (f->carrier) {
       case PlantCarrier::kFrictionLoss:
         if (e.value < 0) throw InputError(where + ": a negative Coulomb friction cannot be a MuJoCo frictionloss");
