@@ -1,0 +1,69 @@
+// A term beyond DESIGN.md's effect table (DESIGN.md "Terms beyond the table"): `value * expr` added
+// to tau_R at its joint (stage link) or to the reading tau_S (stage sensor). This file is the grammar
+// and its evaluator; every command that reads a model file evaluates terms through it.
+//
+// Grammar (whitespace between tokens is free):
+//   expr    := sum
+//   sum     := product (('+' | '-') product)*
+//   product := unary (('*' | '/') unary)*
+//   unary   := '-' unary | power
+//   power   := atom ('^' number)?          -- the exponent is a number literal (e.g. 2, 0.5, -1)
+//   atom    := number | signal | func '(' expr ')' | '(' expr ')'
+//   signal  := q | qd | qdd | tau_R | q_hip | q_knee | qd_hip | qd_knee | t
+//   func    := sgn | abs | exp | sin | cos | tanh | pos
+// q, qd, qdd, tau_R are the term's own joint's; t is s from the record's or run's start. sgn is the
+// sign coulomb_friction's closed form uses (model/effect_families.cc: 0 at 0); pos(x) is 1 where
+// x > 0, else 0.
+#pragma once
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace exotwin {
+
+// The signals a term reads at one sample. tau_R: the rigid twin's actuator torque at the term's
+// joint where the motion is given (predict, diagnose), the actuator torque applied at that step in
+// the forward plant (replay, runs).
+struct TermSignals {
+  double q = 0, qd = 0, qdd = 0, tau_R = 0;  // the term's joint
+  double q_hip = 0, q_knee = 0, qd_hip = 0, qd_knee = 0;
+  double t = 0;
+};
+
+// A parse error: what was expected and the 0-based character position in the text.
+class TermExprError : public std::runtime_error {
+ public:
+  TermExprError(const std::string& what, size_t position);
+  size_t position() const { return position_; }
+
+ private:
+  size_t position_;
+};
+
+class TermExpr {
+ public:
+  // Parses `text` by the grammar above; throws TermExprError (position of the offending token)
+  // for anything outside it (an unknown signal or function, a missing parenthesis, a non-number
+  // exponent, trailing text, a non-finite number).
+  static TermExpr Parse(const std::string& text);
+
+  // The expression's value at one sample (may be non-finite for e.g. 1/0: the caller checks).
+  double Eval(const TermSignals& s) const;
+  // The text it was parsed from.
+  const std::string& text() const { return text_; }
+  // True when the expression reads the signal `name` (one of the grammar's signals).
+  bool Reads(const std::string& name) const;
+  // A friction-like term: expr = f * sgn(qd) with f not reading qd's sign (f reads no qd, or reads it
+  // only through abs). The forward plant carries such a term as a per-step friction bound
+  // |value * f| (dof_frictionloss) instead of an applied force. `f` receives the factor's expression.
+  bool FrictionLike(TermExpr* f = nullptr) const;
+
+  struct Node;  // the parse tree (term_expr.cc)
+
+ private:
+  std::string text_;
+  std::shared_ptr<const Node> root_;
+};
+
+}  // namespace exotwin
