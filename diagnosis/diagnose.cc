@@ -19,6 +19,7 @@
 
 #include "diagnosis/diagnose_columns.h"
 #include "diagnosis/diagnose_internal.h"
+#include "diagnosis/term_search.h"
 #include "diagnosis/diagnose_select.h"
 #include "diagnosis/diagnose_unexplained.h"
 #include "diagnosis/effects.h"
@@ -55,6 +56,8 @@ using torque_fit::ExtendAndRefine;
 using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
 using torque_fit::UseSecantDelayColumns;
+using torque_fit::SearchTerms;
+using torque_fit::TermSearchResult;
 
 // Autocorrelation length (in rows) of a residual of 2m rows (hip block, knee block): the longer.
 double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
@@ -110,6 +113,7 @@ Kinematics Slice(const Kinematics& kin, size_t a, size_t b) {
   }
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
   k.derivative_source = kin.derivative_source;
+  k.t_start = kin.t_start;
   return k;
 }
 
@@ -426,7 +430,8 @@ void FindAliases(const ColumnBank& bank, const Grams& g, const PhysicalScale& sc
 // records, each whole record predicted by the effects fitted on the others (D->left_out).
 void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const ColumnBank& bank,
                        const Grams& g, const std::vector<int>& chosen, const std::vector<double>& refine_ratio,
-                       const DiagnoseOptions& opt, Diagnosis* D_out) {
+                       const std::vector<std::vector<Effect>>& searched_left_out, const DiagnoseOptions& opt,
+                       Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   const size_t R = recs.size();
   // The extended twin's inverse dynamics on DiagnoseThreads plants (PredictTorque's ranges), one for a
@@ -485,13 +490,19 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
     cnt += static_cast<double>(n - rc.split);
     if (D.leave_one_out) {
       LegParams p = params;
-      const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
-      if (!cols.empty() && x.size() == 0)
-        throw InputError(rc.source + ": without this record the chosen effects are not identifiable");
-      for (size_t k = 0; k < chosen.size(); ++k) {
-        Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
-        e.value *= refine_ratio[k];
-        p.effects.push_back(e);
+      if (!searched_left_out.empty()) {  // the terms' search rewrote the model: its own refits
+        if (searched_left_out[r].empty())
+          throw InputError(rc.source + ": without this record the named effects and terms are not identifiable");
+        p.effects.insert(p.effects.end(), searched_left_out[r].begin(), searched_left_out[r].end());
+      } else {
+        const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
+        if (!cols.empty() && x.size() == 0)
+          throw InputError(rc.source + ": without this record the chosen effects are not identifiable");
+        for (size_t k = 0; k < chosen.size(); ++k) {
+          Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
+          e.value *= refine_ratio[k];
+          p.effects.push_back(e);
+        }
       }
       rs.left_out_effects = p.effects;
       Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
@@ -768,8 +779,10 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
+  const TermSearchResult searched = SearchTerms(params, recs, w, banks, scale, &D);
+  Lap("terms beyond the table");
 
-  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)
     for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r].ceiling[j], D.records[r].ceiling_null[j] = ceilings[r].null[j];

@@ -156,6 +156,7 @@ struct Diagnosis {
   std::vector<CandidateScore> scores;   // singles (best first) and the best pairs, for the report
   std::vector<std::string> collinear;   // nearly collinear candidate pairs on this record, in words
   std::vector<std::string> selection;   // the selection's steps, in words
+  std::vector<std::string> term_search; // the search for terms beyond the table, in words (term_search.h)
   std::vector<std::string> implausible; // candidates that fit alone but fall outside their range
   // Candidates these records cannot identify: fitted alone, even a value at the edge of their physical
   // range would not be significant (|t| < kMinT), e.g. an inertia on a slow, hand-guided record.
