@@ -9,8 +9,6 @@
 namespace exotwin {
 namespace {
 
-double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
-
 // value * f at the effect's joint, 0 at the other.
 Eigen::Vector2d AtJoint(const Effect& e, double f) {
   Eigen::Vector2d t = Eigen::Vector2d::Zero();
@@ -19,7 +17,7 @@ Eigen::Vector2d AtJoint(const Effect& e, double f) {
 }
 
 Eigen::Vector2d Coulomb(const Effect& e, const EffectState& s) {
-  return AtJoint(e, e.value * Sign(s.qd[EffectJoint(e)]));
+  return AtJoint(e, e.value * CoulombSign(s.qd[EffectJoint(e)]));
 }
 Eigen::Vector2d Viscous(const Effect& e, const EffectState& s) { return AtJoint(e, e.value * s.qd[EffectJoint(e)]); }
 Eigen::Vector2d Inertia(const Effect& e, const EffectState& s) { return AtJoint(e, e.value * s.qdd[EffectJoint(e)]); }

@@ -90,6 +90,9 @@ const EffectFamily& FamilyOf(const Effect& e);
 // The names of the families for which `keep` holds (nullptr: every family), joined by ", " (messages).
 std::string FamilyNames(bool (*keep)(const EffectFamily&) = nullptr);
 
+// The sign of coulomb_friction's closed form (and of a term's sgn): +-1, 0 at 0.
+inline double CoulombSign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
 // Joint index of an effect ("hip" -> 0, "knee" -> 1).
 int EffectJoint(const Effect& e);
 
