@@ -11,6 +11,9 @@
 //  - refined_on_exact_form: the fit's column is first order in the value (backlash, strap, delay):
 //    the value is refined on the exact form after the linear fit;
 //  - draw: generate's hidden effect at a joint with a realistic magnitude (nullptr: not drawn).
+// A family linear in its value needs no code of its own (linear_column, motion_box); the others' rows
+// hold their own code as hooks (add_columns, motion_candidates, ...), each family's rows and hooks in
+// its file (family_rows.h lists them), so a reader finds a family in one place by its name.
 #pragma once
 #include <deque>
 #include <functional>
@@ -78,7 +81,7 @@ struct FitFamily {
   // A candidate only for such models (nullptr: every model).
   bool (*candidate_for)(const LegParams& params) = nullptr;
   // The motion fit's parameter of a family linear in its value: its box and secant step at a joint
-  // from the records' scales (MotionScale); nullptr: the family's own parameters (motion_candidates.cc).
+  // from the records' scales (MotionScale); nullptr: the family's own (motion_candidates below) or none.
   MotionBox (*motion_box)(const MotionScale& s) = nullptr;
 
   // ---- a family with its own code (its file, diagnosis/family_*.cc) --------------------------------
