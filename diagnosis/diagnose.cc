@@ -55,7 +55,7 @@ using torque_fit::Rec;
 using torque_fit::ExtendAndRefine;
 using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
-using torque_fit::UseSecantDelayColumns;
+using torque_fit::UseSecantColumns;
 using torque_fit::SearchTerms;
 using torque_fit::TermSearchResult;
 
@@ -273,8 +273,8 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Re
   for (const ColumnBank& b : banks) raw.push_back(b.r);
   // Ripple frequency searched on what the other candidates leave and on the raw residual (a slow
   // ripple, ~1 cycle over the range, is otherwise absorbed by the stiffness/gravity columns).
-  AddRippleCandidates(banks, kins, e);
-  AddRippleCandidates(banks, kins, raw);
+  AddSearchedCandidates(banks, kins, e);
+  AddSearchedCandidates(banks, kins, raw);
   return banks;
 }
 
@@ -753,7 +753,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   std::vector<ColumnBank> banks = CandidateColumns(params, recs, w, opt);
   Lap("columns + ripple search");
   FilterMeasured(&recs);
-  UseSecantDelayColumns(recs, w, &banks);
+  UseSecantColumns(recs, w, &banks);
   if (params.one_joint) KeepJointCandidates(1, &banks);
   // The ceilings and the pooled Grams only read the banks: the two side by side.
   std::vector<CeilingScores> ceilings;

@@ -94,10 +94,10 @@ struct Rec {
   }
 };
 
-// Stage 3b: every sensor_delay column replaced by the secant (tau_S(t - d) - tau_S(t)) / d at the
-// single fit's delay d (s, pooled over records; kept when 1e-4 < d < 0.5), twice, so the
-// second-order term is not left for sensor_gain.
-void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io);
+// Stage 3b: every column of a family with a secant (FitFamily::secant_column: the delay's (tau_S(t - d)
+// - tau_S(t)) / d) replaced by it at the value d the single fit gives the column (pooled over
+// records), twice, so the second-order term is not left for another column (the gain's).
+void UseSecantColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io);
 
 // The largest magnitude DESIGN.md's physical range allows a one-parameter candidate (0: unbounded or
 // several parameters).

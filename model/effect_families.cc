@@ -7,6 +7,21 @@
 #include "model/passive_torque.h"
 
 namespace exotwin {
+
+const char* const kCoulombFriction = "coulomb_friction";
+const char* const kViscousFriction = "viscous_friction";
+const char* const kInertiaError = "inertia_error";
+const char* const kGravityError = "gravity_error";
+const char* const kJointStiffness = "joint_stiffness";
+const char* const kBacklash = "backlash";
+const char* const kSeriesCompliance = "series_compliance";
+const char* const kTorqueRipple = "torque_ripple";
+const char* const kPassiveMoment = "passive_moment";
+const char* const kSensorOffset = "sensor_offset";
+const char* const kSensorGain = "sensor_gain";
+const char* const kSensorDelay = "sensor_delay";
+const char* const kMuscleActivity = "muscle_activity";
+
 namespace {
 
 // value * f at the effect's joint, 0 at the other.
@@ -61,38 +76,42 @@ void GainAffine(double v, double* a, double* b) { *a *= 1 + v, *b *= 1 + v; }
 
 using S = EffectStage;
 using C = PlantCarrier;
+using K = EffectKey::Kind;
 
 std::deque<EffectFamily>& Registry() {
   static std::deque<EffectFamily> k = {
-      {"coulomb_friction", "N m", 0.0, 100.0, {}, S::kLink, C::kFrictionLoss, "",
+      {kCoulombFriction, "N m", 0.0, 100.0, {}, S::kLink, C::kFrictionLoss, "",
        "tau_R += value * sign(qd) (value > 0)", Coulomb},
-      {"viscous_friction", "N m s/rad", -100.0, 100.0, {}, S::kLink, C::kDamping, "", "tau_R += value * qd",
+      {kViscousFriction, "N m s/rad", -100.0, 100.0, {}, S::kLink, C::kDamping, "", "tau_R += value * qd",
        Viscous},
-      {"inertia_error", "kg m^2", -10.0, 10.0, {}, S::kLink, C::kArmature, "",
+      {kInertiaError, "kg m^2", -10.0, 10.0, {}, S::kLink, C::kArmature, "",
        "tau_R += value * qdd (extra inertia of that joint alone, like armature)", Inertia},
-      {"gravity_error", "kg m", -20.0, 20.0, {}, S::kLink, C::kAppliedForce, "",
-       "the lumped X or Y (field `axis`) of the segment distal to that joint is off by value", Gravity},
-      {"joint_stiffness", "N m/rad", -1000.0, 1000.0, {"q0"}, S::kLink, C::kSpring, "",
+      {kGravityError, "kg m", -20.0, 20.0, {}, S::kLink, C::kAppliedForce, "",
+       "the lumped X or Y (field `axis`) of the segment distal to that joint is off by value", Gravity, nullptr,
+       nullptr, nullptr, {{"axis", K::kAxis}}},
+      {kJointStiffness, "N m/rad", -1000.0, 1000.0, {"q0"}, S::kLink, C::kSpring, "",
        "tau_R += value * (q - q0) (field `q0`, rad)", Stiffness},
       // One internal hinge per joint: a dead band and a strap at one joint are one hinge too many.
-      {"backlash", "rad", 0.0, 0.5, {}, S::kLink, C::kDeadBandHinge, "internal_hinge",
+      {kBacklash, "rad", 0.0, 0.5, {}, S::kLink, C::kDeadBandHinge, "internal_hinge",
        "the transmission has a dead band of total width value"},
-      {"series_compliance", "N m/rad", 1.0, 1e6, {}, S::kLink, C::kStrapHinge, "internal_hinge",
+      {kSeriesCompliance, "N m/rad", 1.0, 1e6, {}, S::kLink, C::kStrapHinge, "internal_hinge",
        "the link follows the exoskeleton through a spring of that stiffness (straps, cuffs)"},
-      {"torque_ripple", "N m", 0.0, 100.0, {"cycles_per_rad", "phase"}, S::kLink, C::kAppliedForce, "",
+      {kTorqueRipple, "N m", 0.0, 100.0, {"cycles_per_rad", "phase"}, S::kLink, C::kAppliedForce, "",
        "tau_R += value * sin(2 pi cycles_per_rad q + phase) (fields `cycles_per_rad`, `phase`)", Ripple},
-      {"passive_moment", "relative", -1.0, 10.0, {}, S::kLink, C::kSubjectForce, "",
+      {kPassiveMoment, "relative", -1.0, 10.0, {}, S::kLink, C::kSubjectForce, "",
        "the subject's passive moment is 1 + value times Riener & Edrich 1999's (HJ15 eq. 12 as rebuilt, "
        "`model/passive_torque.h`): tau_R += value * P_j(q), whatever passive model the twin subtracts "
-       "(optional field `cv`: see \"Realistic EXOwheel\")", Passive},
-      {"sensor_offset", "N m", -100.0, 100.0, {}, S::kSensor, C::kReading, "", "tau_S += value", nullptr,
+       "(optional field `cv`: see \"Realistic EXOwheel\")", Passive, nullptr, nullptr, nullptr,
+       {{"cv", K::kOptionalField, 0.0, 2.0}}},  // cv: the inter-subject variation table5 draws from
+      {kSensorOffset, "N m", -100.0, 100.0, {}, S::kSensor, C::kReading, "", "tau_S += value", nullptr,
        Offset, OffsetOff, OffsetAffine},
-      {"sensor_gain", "relative", -0.9, 10.0, {}, S::kSensor, C::kReading, "",
+      {kSensorGain, "relative", -0.9, 10.0, {}, S::kSensor, C::kReading, "",
        "tau_S *= 1 + value (0.05 = reads 5 % high)", nullptr, Gain, GainOff, GainAffine},
-      {"sensor_delay", "s", 0.0, 1.0, {}, S::kSensor, C::kReading, "", "tau_S(t) is the true reading at t - value",
+      {kSensorDelay, "s", 0.0, 1.0, {}, S::kSensor, C::kReading, "", "tau_S(t) is the true reading at t - value",
        nullptr, Delay, DelayOff},
-      {"muscle_activity", "-", -1e6, 1e6, {}, S::kLink, C::kNotCarried, "",
-       "the subject was not relaxed: residual explained by EMG envelopes"},
+      {kMuscleActivity, "-", -1e6, 1e6, {}, S::kLink, C::kNotCarried, "",
+       "the subject was not relaxed: residual explained by EMG envelopes", nullptr, nullptr, nullptr, nullptr,
+       {{"weights", K::kWeights}, {"channels", K::kAccepted}}},
   };
   return k;
 }

@@ -47,6 +47,36 @@ struct EffectState {
   double g = 9.81;
 };
 
+// DESIGN.md's families by name, for code that constructs a named effect (a device's own friction, a
+// bench's hidden effect, an identification's result): each name spelled once, in the registry's row.
+extern const char* const kCoulombFriction;
+extern const char* const kViscousFriction;
+extern const char* const kInertiaError;
+extern const char* const kGravityError;
+extern const char* const kJointStiffness;
+extern const char* const kBacklash;
+extern const char* const kSeriesCompliance;
+extern const char* const kTorqueRipple;
+extern const char* const kPassiveMoment;
+extern const char* const kSensorOffset;
+extern const char* const kSensorGain;
+extern const char* const kSensorDelay;
+extern const char* const kMuscleActivity;
+
+// A model-file key of a family beyond name, joint, value, unit and its required `fields`; the reader
+// (formats/model_file.cc) reads it by kind, the writer writes the effect's axis, fields and weights.
+struct EffectKey {
+  enum class Kind {
+    kAxis,           // Effect::axis: X or Y (default X)
+    kOptionalField,  // a number in [lo, hi] into fields[key] where given
+    kWeights,        // a mapping EMG channel -> N m per V into fields["w_" + channel]
+    kAccepted,       // accepted and ignored (written by other tools)
+  };
+  const char* key;
+  Kind kind;
+  double lo = 0, hi = 0;
+};
+
 struct EffectFamily {
   const char* name;
   const char* unit;
@@ -66,6 +96,7 @@ struct EffectFamily {
   // A sensor family that is affine in the torque: the reading a tau + b becomes a' tau + b'
   // (a joint module's gain and offset); nullptr for the delay (whole samples of the module's skew).
   void (*affine)(double value, double* a, double* b) = nullptr;
+  std::vector<EffectKey> keys;  // its model-file keys beyond `fields`
 };
 
 // Every family: DESIGN.md's table in its order, then any added by AddEffectFamily. References stay
