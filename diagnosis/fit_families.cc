@@ -78,6 +78,9 @@ std::string DelayRange(const Effect& e, const PhysicalScale&) {
   return e.value > 0 && e.value <= 0.05 ? "" : "delay outside (0, 50] ms";
 }
 std::string AnyValue(const Effect&, const PhysicalScale&) { return ""; }
+std::string TermRange(const Effect& e, const PhysicalScale&) {
+  return std::isfinite(e.value) && e.value != 0 ? "" : "a term of value " + Num(e.value) + " (expected finite, non-zero)";
+}
 
 double InertiaEdge(int j, const PhysicalScale& s) { return s.M_jj[j]; }
 double GravityEdge(int j, const PhysicalScale& s) { return 0.5 * s.distal_moment[j] + 0.05; }
@@ -233,6 +236,9 @@ std::deque<FitFamily>& Registry() {
     f = Row("muscle_activity", AnyValue, DrawMuscle);
     f.to_effect = MuscleEffect, f.significant = AnyChannelSignificant;
     v.push_back(f);
+    // Terms beyond the table: proposed by the term search (diagnosis/term_search*), not a column of the
+    // table's fit, not drawn (generate --term hides one).
+    v.push_back(Row("term", TermRange, nullptr));
     return v;
   }();
   return k;

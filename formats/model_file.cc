@@ -8,6 +8,7 @@
 #include "core/yaml_fields.h"
 #include "model/effect_families.h"
 #include "model/one_joint.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 namespace {
@@ -34,6 +35,25 @@ LumpedParams ReadLumped(const YamlContext& c, const YAML::Node& n, const std::st
   return p;
 }
 
+// A term's expr (parsed: a parse error names the position in it) and stage (DESIGN.md "Terms beyond
+// the table").
+void ReadTerm(const YamlContext& c, const YAML::Node& n, const std::string& key, Effect* e) {
+  const std::string what = " (" + e->name + " at the " + e->joint + ")";
+  if (!n["expr"] || !n["expr"].IsScalar())
+    c.Fail(key + ".expr", "missing" + what + ", expected an expression of q, qd, qdd, tau_R, q_hip, q_knee, qd_hip, "
+           "qd_knee, t (DESIGN.md \"Terms beyond the table\")");
+  e->expr = n["expr"].Scalar();
+  try {
+    TermExpr::Parse(e->expr);
+  } catch (const TermExprError& x) {
+    c.Fail(key + ".expr", "\"" + e->expr + "\"" + what + ": " + x.what() + " of the expression");
+  }
+  if (n["stage"]) {
+    e->stage = n["stage"].IsScalar() ? n["stage"].Scalar() : "";
+    if (e->stage != "link" && e->stage != "sensor") c.Fail(key + ".stage", "expected link or sensor" + YamlLine(n["stage"]));
+  }
+}
+
 Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& key) {
   if (!n.IsMap()) c.Fail(key, "expected a mapping {name, joint, value, unit, ...}" + YamlLine(n));
   if (!n["name"] || !n["name"].IsScalar()) c.Fail(key + ".name", "missing, expected an effect name");
@@ -48,6 +68,7 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
   if (e.name == "gravity_error") allowed.insert("axis");
   if (e.name == "passive_moment") allowed.insert("cv");
   if (e.name == "muscle_activity") allowed.insert({"weights", "channels"});
+  if (spec->carries_expr) allowed.insert({"expr", "stage"});
   YamlCheckKeys(c, n, key, allowed);
   if (!n["joint"] || !n["joint"].IsScalar() ||
       (n["joint"].Scalar() != "hip" && n["joint"].Scalar() != "knee"))
@@ -78,6 +99,7 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
       e.fields["w_" + ch] = YamlNumber(c, kv.second, key + ".weights." + ch, -1e6, 1e6, "");
     }
   }
+  if (spec->carries_expr) ReadTerm(c, n, key, &e);
   return e;
 }
 
@@ -201,6 +223,8 @@ void WriteEffects(std::ostringstream& os, const std::vector<Effect>& effects) {
       os << "  - {name: " << e.name << ", joint: " << e.joint << ", value: " << Num(e.value)
          << ", unit: \"" << e.unit << "\"";
       if (!e.axis.empty()) os << ", axis: " << e.axis;
+      if (!e.expr.empty()) os << ", expr: \"" << e.expr << "\"";
+      if (!e.stage.empty()) os << ", stage: " << e.stage;
       std::string weights;
       for (const auto& f : e.fields) {
         if (f.first.rfind("w_", 0) == 0) weights += (weights.empty() ? "" : ", ") + f.first.substr(2) + ": " + Num(f.second);

@@ -29,8 +29,8 @@ LegParams EmbedOneJointModel(const OneJointModel& m, double g, const std::vector
   p.passive = PassiveModel::kNone;
   p.one_joint = m;
   p.one_joint->device_effects = 0;
-  if (m.R != 0) p.effects.push_back({"viscous_friction", "knee", m.R, "N m s/rad", {}, ""});
-  if (m.C != 0) p.effects.push_back({"coulomb_friction", "knee", m.C, "N m", {}, ""});
+  if (m.R != 0) p.effects.push_back({"viscous_friction", "knee", m.R, "N m s/rad", {}, "", "", ""});
+  if (m.C != 0) p.effects.push_back({"coulomb_friction", "knee", m.C, "N m", {}, "", "", ""});
   p.one_joint->device_effects = p.effects.size();
   p.effects.insert(p.effects.end(), effects.begin(), effects.end());
   return p;
