@@ -315,7 +315,7 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
     return coef[static_cast<Eigen::Index>(std::find(cols.begin(), cols.end(), c) - cols.begin())];
   };
   DiagnosedEffect d;
-  d.effect.name = "term";
+  d.effect.name = kTerm;
   d.effect.joint = kJointName[t.joint];
   d.effect.unit = "N m";
   double phi = 0, se = 0;

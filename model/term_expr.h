@@ -15,6 +15,7 @@
 // sign coulomb_friction's closed form uses (CoulombSign, model/effect_families.h: 0 at 0); pos(x) is
 // 1 where x > 0, else 0. A default-constructed TermExpr is the empty expression, which evaluates to 0.
 #pragma once
+#include <cstddef>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -78,5 +79,9 @@ class TermExpr {
   std::shared_ptr<const Program> program_;
   unsigned reads_ = 0;  // bit i: the expression reads the grammar's i-th signal
 };
+
+// The parsed expression of `text`, parsed once per text and kept (thread-safe; the reference stays
+// valid): the closed forms of model files' terms evaluate through it. Throws TermExprError as Parse.
+const TermExpr& CachedTermExpr(const std::string& text);
 
 }  // namespace exotwin
