@@ -200,5 +200,32 @@ TEST_F(PredictCli, NonUniformSamplingIsResampled) {
   EXPECT_EQ(p.rows(), 2000u);
 }
 
+// A term's expression outside the grammar: exit 2 naming the file, the effect and the position.
+TEST_F(PredictCli, BadTermExpressionNamesItsPosition) {
+  std::string model = kModel;
+  model.replace(model.find("effects: []"), std::string::npos,
+                "effects:\n  - {name: term, joint: knee, value: 0.5, expr: \"abs(tau_R) * sgn(qd\"}\n");
+  const auto r = Predict(model, GoodCsv());
+  ExpectBadInput(r, "m.yaml");
+  ExpectBadInput(r, "effects[0].expr");
+  ExpectBadInput(r, "expected ')' at position 19");
+}
+
+// A term in the model file reaches predict: "1.0*sgn(qd)" gives coulomb_friction 1.0's torque.
+TEST_F(PredictCli, TermSgnIsCoulomb) {
+  std::string coulomb = kModel, term = kModel;
+  coulomb.replace(coulomb.find("effects: []"), std::string::npos,
+                  "effects:\n  - {name: coulomb_friction, joint: knee, value: 1.0}\n");
+  term.replace(term.find("effects: []"), std::string::npos,
+               "effects:\n  - {name: term, joint: knee, value: 1.0, unit: \"N m\", expr: \"sgn(qd)\"}\n");
+  ASSERT_EQ(Predict(coulomb, GoodCsv()).exit_code, 0);
+  const CsvTable a = ReadCsv(dir_ + "/pred.csv");
+  ASSERT_EQ(Predict(term, GoodCsv()).exit_code, 0);
+  const CsvTable b = ReadCsv(dir_ + "/pred.csv");
+  ASSERT_EQ(a.rows(), b.rows());
+  for (size_t c = 0; c < a.names.size(); ++c)
+    for (size_t i = 0; i < a.rows(); ++i) ASSERT_NEAR(a.columns[c][i], b.columns[c][i], 1e-12) << a.names[c] << " " << i;
+}
+
 }  // namespace
 }  // namespace exotwin
