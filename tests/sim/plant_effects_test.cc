@@ -266,6 +266,16 @@ TEST(PlantEffects, TermsAreFrictionBoundsAppliedForcesOrReadings) {
     EXPECT_EQ(plant.model()->dof_frictionloss[hip], 0.0);
   }
 
+  // A negative bound (value f < 0: a friction pushing along the motion) is no frictionloss: the applied
+  // force -value f sgn(qd) instead.
+  LegParams along = RealRigModel();
+  along.effects = {TermEffect("hip", 0.3, "-2 * sgn(qd)")};
+  const std::unique_ptr<Plant> along_owned = FreePlant(along);
+  along_owned->Reset({0.3, -0.6}, {0.5, -1.0});
+  along_owned->Step({0.3, 0.0});
+  EXPECT_EQ(along_owned->model()->dof_frictionloss[Dof(*along_owned, "hip")], 0.0);
+  EXPECT_EQ(along_owned->data()->qfrc_applied[Dof(*along_owned, "hip")], 0.6);
+
   // An applied term 2 sin(q) at the hip: the force and the acceleration against the closed form.
   LegParams applied = RealRigModel();
   applied.effects = {p.effects[1]};
