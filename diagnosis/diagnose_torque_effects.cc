@@ -29,7 +29,8 @@ double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, 
     tr[j].assign(rc.tau_R[j].begin() + a, rc.tau_R[j].begin() + b);
   }
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
-  ApplyEffects(p, k, tr, ts, kin.t.empty() ? NAN : kin.t[0]);
+  k.t_start = kin.t_start;
+  ApplyEffects(p, k, tr, ts);
   double s = 0;
   const size_t lo = std::min<size_t>(200, (b - a) / 10);  // skip the edges (delay, filters)
   for (int j = 0; j < 2; ++j) {

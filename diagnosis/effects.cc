@@ -94,7 +94,7 @@ void AddRecordForm(const EffectFamily& f, const Effect& e, const LegParams& rigi
 }  // namespace
 
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
-                  std::vector<double> tau_S[2], double t_start) {
+                  std::vector<double> tau_S[2]) {
   const size_t n = kin.t.size();
   LegParams rigid = params;
   rigid.effects.clear();
@@ -106,7 +106,7 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
       break;
     }
   // Sample i's state; a term's t from the record's first sample.
-  const double t0 = std::isnan(t_start) ? (n ? kin.t[0] : 0.0) : t_start;
+  const double t0 = std::isnan(kin.t_start) ? (n ? kin.t[0] : 0.0) : kin.t_start;
   EffectState s;
   s.g = params.g;
   auto state_at = [&](size_t i) -> const EffectState& {

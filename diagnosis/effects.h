@@ -35,10 +35,10 @@ namespace exotwin {
 // the sensor reading tau_S = -tau_R and applies the sensor effects (offset, gain, delay). `params`
 // gives L1, g and the lumped parameters for the closed-form terms. tau_R[j] must have kin.t.size()
 // samples. Throws InputError for an effect it cannot apply (e.g. muscle_activity without the EMG
-// column of a weighted channel). `t_start`: the record's first time when kin is a window of it (a
-// term's t); NaN: kin.t[0].
+// column of a weighted channel). A term's t counts from kin.t_start (the record's first time, kept
+// by a window of it; NaN: kin.t[0]).
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
-                  std::vector<double> tau_S[2], double t_start = NAN);
+                  std::vector<double> tau_S[2]);
 
 // EMG envelope (V) of a measured column: dsp::ZeroPhaseEnvelope with a 2nd-order 20 Hz high-pass
 // (not the 20-450 Hz band-pass: a measured record may be sampled below 900 Hz) and the 4th-order 2 Hz

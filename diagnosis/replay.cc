@@ -247,7 +247,7 @@ void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>
   // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
   // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
   const Eigen::Vector2d qdd0 = Acceleration(r);
-  plant.SetTermTimeOrigin(t.front());  // a term's t: from the record's start
+  plant.SetTermTimeOrigin(std::isnan(s.t_start) ? t.front() : s.t_start);  // a term's t: from the record's start
   plant.Reset({(*angle0[0])[r], (*angle0[1])[r]}, StepVelocity(r), t[r], &qdd0);
   if (r < start) {
     // The measured joints follow the restart state's motion (linear between samples), each step

@@ -46,6 +46,7 @@
 //    start + horizon. A series quiet throughout has the every-horizon windows.
 //  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
 #pragma once
+#include <cmath>
 #include <array>
 #include <functional>
 #include <memory>
@@ -63,6 +64,7 @@ enum class ReplayInput { kTorque, kCommand };
 struct ReplaySeries {
   std::string source;
   std::vector<double> t;
+  double t_start = std::nan("");         // the record's first time (a term's t origin); NaN: t.front()
   std::vector<double> q[2];              // measured angle, rad (scored)
   // restart state: angle (rad; empty: the measured one, q), velocity (rad/s) and acceleration
   // (rad/s^2; empty: 0) derived at the cutoff
