@@ -397,6 +397,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     }
     const Grams g = MakeSearchGrams(S, model, extra, w, D->tau_eff);
     const Fit now = FitCols(g, cur);
+    double tt_all[2] = {0, 0};  // the measured torque's weighted sum of squares on every fit row
+    for (const SearchRec& s : S)
+      for (size_t k = 0; k < s.m; ++k)
+        for (int j = 0; j < 2; ++j) tt_all[j] += std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
     const double margin = kBicMargin + std::log(static_cast<double>(screened));
     int pick = -1;
     double best_gain = 0;
@@ -408,8 +412,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       const Fit f = FitCols(g, cols);
       if (!f.ok) continue;
       const double drop_te = now.sse_te_j[j] - f.sse_te_j[j];
+      // Material over the whole record, not only its held-out end: a term that fades (a drive warming
+      // up) is an effect where it acts.
       const bool held = drop_te >= kMinHeldoutGain * now.sse_te_j[j] &&
-                        drop_te >= kMinTorqueShare * kMinTorqueShare * g.tt_te[j];
+                        (now.sse_tr - f.sse_tr) + drop_te >= kMinTorqueShare * kMinTorqueShare * tt_all[j];
       const bool loo = R < 2 || now.sse_loo_j[j] - f.sse_loo_j[j] >= kMinHeldoutGain * now.sse_loo_j[j];
       const bool admissible = now.bic - f.bic > margin && held && loo && TermT(f, cand_cols[i]) > kMinT;
       D->term_search.push_back("step " + std::to_string(step + 1) + ": " +
@@ -461,7 +467,6 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       cur = Without(cur, {drop});
     }
   }
-  if (std::getenv("TERM_TRACE")) for (auto& l : D->term_search) std::fprintf(stderr, "%s\n", l.c_str());  // TEMP
   if (!out.changed) return out;
 
   // The final model: the kept table effects refitted, the terms; each one's held-out share.
