@@ -63,6 +63,22 @@ double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
 
 }  // namespace
 
+namespace torque_fit {
+
+void RigidTorque(const LegParams& params, const Kinematics& kin, int threads, std::vector<double> tau_R[2]) {
+  const size_t n = kin.t.size();
+  for (int j = 0; j < 2; ++j) tau_R[j].resize(n);
+  ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
+                                                 {kin.qdd[0][i], kin.qdd[1][i]});
+      tau_R[0][i] = tau[0], tau_R[1][i] = tau[1];
+    }
+  });
+}
+
+}  // namespace torque_fit
+
 // Held-out scores from the sums of squares before / after over `count` samples.
 JointScore ScoreOf(double sse_before, double sse_after, double count) {
   return {std::sqrt(sse_before / count), std::sqrt(sse_after / count),
@@ -189,20 +205,12 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
   if (filtered) rc.low.emplace(rc.kin.t, rc.hz, rc.source);
   for (int j = 0; j < 2; ++j) rc.raw[j] = meas[j]->data() + a;
   const Kinematics& kin = rc.kin;
-  const size_t n = kin.t.size();
   const double t_split = kin.t.front() + (1 - holdout_fraction) * (kin.t.back() - kin.t.front());
   rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
   // The twin: HJ15 eq. 5-7 + P(q) + the model's own effects, which equals predict's MuJoCo inverse
   // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
   // run (ScoreExtendedTwin) is predict itself.
-  for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
-  ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
-                                                 {kin.qdd[0][i], kin.qdd[1][i]});
-      rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
-    }
-  });
+  torque_fit::RigidTorque(params, kin, threads, rc.tau_R);
   if (params.effects.empty()) {
     ApplyEffects(params, kin, rc.tau_R, rc.tau_S);  // leaves rc.tau_R as it is
   } else {
@@ -770,6 +778,9 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("refinement");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);  // stage 6c
+  D.final_model = D.table_model;  // no search for terms beyond the table yet
+  Lap("completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)
     for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r].ceiling[j], D.records[r].ceiling_null[j] = ceilings[r].null[j];

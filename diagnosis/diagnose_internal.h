@@ -31,6 +31,10 @@ std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const 
 
 namespace torque_fit {
 
+// The rigid twin's actuator torque (HJ15 eq. 5-7 + P(q), model/leg_dynamics.h ActuatorTorque) on
+// every sample of kin, into tau_R[0..1] (resized), on `threads` threads.
+void RigidTorque(const LegParams& params, const Kinematics& kin, int threads, std::vector<double> tau_R[2]);
+
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
 struct Rec {
@@ -112,6 +116,19 @@ size_t RefineRows(const Rec& rc, size_t R);
 std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
                                     const ColumnBank& bank, const Grams& g, const Fit& f0,
                                     const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D);
+
+// Stage 6c (diagnose_completeness.cc): `model`'s assessment on the records against the model given
+// (`given`, whose rigid twin gives tau_R): the residual tests (completeness.h) of its filtered torque
+// residual on every record's held-out rows [split, n), decimated by CompletenessStep at the record's
+// cutoff, one segment per record, the material floor kMinTorqueShare of the measured torque's RMS on
+// those rows (the selection's); and its ceiling (JointCeiling), the black box trained on the model's
+// residual at most 12000 fit rows (the last quarter of every record's fit rows validating) and scored
+// on at most 8000 held-out rows. Both twins by the closed form (HJ15 + ApplyEffects, as stage 2),
+// which every effect (and term) ApplyEffects knows reaches. Needs each record's kin (with EMG for
+// muscle_activity) and raw. The table's model is the extended twin; after a search for terms, call
+// again with the final model.
+ModelAssessment AssessModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
+                            const DiagnoseOptions& opt);
 
 }  // namespace torque_fit
 }  // namespace exotwin
