@@ -154,6 +154,7 @@ struct TorqueOnlyEffect {
 struct JointCeiling {
   bool done = false;  // false: no rows, or the model given leaves no residual
   double named_pct = 0, black_box_pct = 0;
+  double given_rms = 0;  // the model given's held-out residual RMS on those rows, N m
   size_t train_rows = 0, heldout_rows = 0;
 };
 

@@ -136,6 +136,7 @@ ModelAssessment AssessModel(const LegParams& given, const LegParams& model, cons
     c.train_rows = fit_x.size(), c.heldout_rows = held_x.size();
     if (!(given_sse > 0)) continue;
     c.done = true;
+    c.given_rms = std::sqrt(given_sse / static_cast<double>(held_x.size()));
     c.named_pct = 100 * (1 - model_sse / given_sse);
     c.black_box_pct = 100 * (1 - bb_sse / given_sse);
   }

@@ -134,7 +134,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
     j["completeness"]["final"][names[k]] = verdict(d.final_model.completeness[k]);
     const JointCeiling& c = d.final_model.ceiling[k];
     j["ceiling"][names[k]] = {{"done", c.done}, {"named_pct", c.named_pct}, {"black_box_pct", c.black_box_pct},
-                              {"train_rows", c.train_rows}, {"heldout_rows", c.heldout_rows}};
+                              {"given_rms", c.given_rms}, {"train_rows", c.train_rows}, {"heldout_rows", c.heldout_rows}};
   }
   if (d.fit == DiagnoseFit::kMotion) {  // what the torque fit would have named, and what it alone names
     auto effect = [](const Effect& e) {
