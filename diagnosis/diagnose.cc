@@ -52,6 +52,7 @@ namespace {
 
 using torque_fit::Rec;
 using torque_fit::ExtendAndRefine;
+using torque_fit::PrepareRecord;
 using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
 using torque_fit::UseSecantDelayColumns;
@@ -169,11 +170,10 @@ CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const Meas
   return ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel, DiagnoseThreads(opt));
 }
 
-// Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
-// transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of its time,
-// the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual. With `owned`
-// (the record itself, which Diagnose may consume) its columns are moved, not copied: the record is
-// left empty.
+}  // namespace
+
+namespace torque_fit {
+
 void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
                    const CutoffChoice& cutoff, double holdout_fraction, int threads, Rec* out) {
   Rec& rc = *out;
@@ -219,6 +219,10 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
   }
   rc.Residuals(rc.resid);
 }
+
+}  // namespace torque_fit
+
+namespace {
 
 // Stage 3c: the measured torque filtered as the residual, into rc.meas (after the candidate columns,
 // whose temporaries are gone by then: a long record's peak memory).

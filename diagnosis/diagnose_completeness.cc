@@ -143,5 +143,14 @@ ModelAssessment AssessModel(const LegParams& given, const LegParams& model, cons
   return out;
 }
 
+ModelAssessment AssessModelOnRecords(const LegParams& given, const LegParams& model,
+                                     const std::vector<const MeasuredData*>& records, const CutoffChoice& cutoff,
+                                     const DiagnoseOptions& opt) {
+  std::vector<Rec> recs(records.size());  // in place: Rec::FilterFn captures its record
+  for (size_t r = 0; r < records.size(); ++r)
+    PrepareRecord(given, *records[r], nullptr, cutoff, opt.holdout_fraction, DiagnoseThreads(opt), &recs[r]);
+  return AssessModel(given, model, recs, opt);
+}
+
 }  // namespace torque_fit
 }  // namespace exotwin

@@ -117,6 +117,14 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
                                     const ColumnBank& bank, const Grams& g, const Fit& f0,
                                     const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D);
 
+// Stage 2 (diagnose.cc): one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase
+// filters' transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of
+// its time, the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual.
+// With `owned` (the record itself, which Diagnose may consume) its columns are moved, not copied: the
+// record is left empty.
+void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
+                   const CutoffChoice& cutoff, double holdout_fraction, int threads, Rec* out);
+
 // Stage 6c (diagnose_completeness.cc): `model`'s assessment on the records against the model given
 // (`given`, whose rigid twin gives tau_R): the residual tests (completeness.h) of its filtered torque
 // residual on every record's held-out rows [split, n), decimated by CompletenessStep at the record's
@@ -129,6 +137,11 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
 // again with the final model.
 ModelAssessment AssessModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
                             const DiagnoseOptions& opt);
+// The same on the records themselves (the motion fit's): each prepared as stage 2 does at `cutoff`
+// (the torque fit's) with the model given, then AssessModel.
+ModelAssessment AssessModelOnRecords(const LegParams& given, const LegParams& model,
+                                     const std::vector<const MeasuredData*>& records, const CutoffChoice& cutoff,
+                                     const DiagnoseOptions& opt);
 
 }  // namespace torque_fit
 }  // namespace exotwin

@@ -121,5 +121,25 @@ TEST(DiagnoseCompleteness, OffTableFormsAreIncomplete) {
     }
 }
 
+// The motion fit assesses its extended twin's torque residual alike: complete on a clean record,
+// incomplete where the load-dependent friction is hidden.
+TEST(DiagnoseCompleteness, MotionFitAssessesItsTwin) {
+  const LegParams base = S1();
+  DiagnoseOptions o;
+  o.fit = DiagnoseFit::kMotion;
+  GeneratedData g = Clean(6001, 30);
+  const Diagnosis clean = Diagnose(base, g.data, o);
+  EXPECT_TRUE(clean.table_model.completeness[0].complete && clean.table_model.completeness[1].complete);
+  Hide(base, {0, 1}, [](double, double qd, double tau, double) { return (0.3 + 0.06 * std::abs(tau)) * Sgn(qd); }, &g.data);
+  const Diagnosis d = Diagnose(base, g.data, o);
+  for (int j = 0; j < 2; ++j) {
+    std::printf("motion fit, load-dependent friction, %s: %s (failed:%s); ceiling named %.1f %%, black box %.1f %%\n",
+                j == 0 ? "hip" : "knee", d.table_model.completeness[j].complete ? "complete" : "incomplete",
+                Failed(d.table_model.completeness[j]).c_str(), d.table_model.ceiling[j].named_pct,
+                d.table_model.ceiling[j].black_box_pct);
+    EXPECT_FALSE(d.table_model.completeness[j].complete) << j;
+  }
+}
+
 }  // namespace
 }  // namespace exotwin
