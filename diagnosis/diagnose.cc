@@ -782,6 +782,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("refinement");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  Lap("extended twin");
   D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);  // stage 6c
   D.final_model = D.table_model;  // no search for terms beyond the table yet
   Lap("completeness + ceiling");
@@ -794,7 +795,6 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   });
   D.extended.effects.resize(params.effects.size());
   for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  Lap("extended twin");
   SimulateTwins(params, recs, opt, &D);
   D.kin = std::move(recs[0].kin);  // recs are done with: the plot series take the first record's kinematics
   D.split = recs[0].split;
