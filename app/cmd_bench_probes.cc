@@ -41,6 +41,7 @@
 #include "formats/model_file.h"
 #include "formats/measured_data.h"
 #include "formats/number_text.h"
+#include "model/effect_families.h"
 
 namespace exotwin {
 namespace {
@@ -339,7 +340,7 @@ GenerateOptions BenchFrictionRecord(double duration_s) {
   g.duration = duration_s;
   g.rate = 1000;
   g.effects = 1;
-  g.allowed = {"coulomb_friction"};
+  g.allowed = {kCoulombFriction};
   return g;
 }
 
@@ -377,8 +378,8 @@ json BenchReplay(const BenchConfig& c) {
     e.name = name, e.joint = joint, e.value = v;
     return e;
   };
-  p.effects = {fx_of("coulomb_friction", "hip", 0.155), fx_of("coulomb_friction", "knee", 0.147),
-               fx_of("inertia_error", "knee", 0.00275)};
+  p.effects = {fx_of(kCoulombFriction, "hip", 0.155), fx_of(kCoulombFriction, "knee", 0.147),
+               fx_of(kInertiaError, "knee", 0.00275)};
   PlantEffects fx;
   const std::unique_ptr<Plant> twin = MakeReplayPlant(p, "bench", "", &fx);
   Plant& plant = *twin;
@@ -424,7 +425,8 @@ json BenchMotionFit(const BenchConfig& c) {
   const double duration = c.quick ? 15.0 : 60.0;
   Scenario s = GaitScenario(duration);
   Effect dead_band;
-  dead_band.name = "backlash", dead_band.joint = "knee", dead_band.value = 0.02, dead_band.unit = "rad";
+  dead_band.name = kBacklash, dead_band.joint = "knee", dead_band.value = 0.02;
+  dead_band.unit = FindFamily(kBacklash)->unit;
   s.plant_effects = {dead_band};
   s.plant_effects_source = "bench: plant.effects";
   s.log_measured_csv = true;  // the record
@@ -467,7 +469,7 @@ json BenchDiagnosis(const BenchConfig& c) {
   return json{{"status", "ok"},
               {"data_s", g.duration},
               {"samples", data.data.size()},
-              {"hidden_effect", "coulomb_friction"},
+              {"hidden_effect", kCoulombFriction},
               {"diagnose_s", t},
               {"samples_per_s", data.data.size() / t},
               {"x_realtime", g.duration / t},

@@ -8,6 +8,7 @@
 #include "diagnosis/generate.h"
 #include "formats/model_file.h"
 #include "core/data_dir.h"
+#include "model/effect_families.h"
 
 namespace exotwin {
 namespace {
@@ -37,8 +38,8 @@ void Run(benchmark::State& state, const std::string& effect) {
 }
 
 void BM_Diagnose10min_Clean(benchmark::State& s) { Run(s, ""); }
-void BM_Diagnose10min_Coulomb(benchmark::State& s) { Run(s, "coulomb_friction"); }
-void BM_Diagnose10min_SeriesCompliance(benchmark::State& s) { Run(s, "series_compliance"); }
+void BM_Diagnose10min_Coulomb(benchmark::State& s) { Run(s, kCoulombFriction); }
+void BM_Diagnose10min_SeriesCompliance(benchmark::State& s) { Run(s, kSeriesCompliance); }
 BENCHMARK(BM_Diagnose10min_Clean)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_Diagnose10min_Coulomb)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_Diagnose10min_SeriesCompliance)->Unit(benchmark::kMillisecond)->Iterations(2);

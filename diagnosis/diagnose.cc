@@ -19,6 +19,7 @@
 
 #include "diagnosis/diagnose_columns.h"
 #include "diagnosis/diagnose_internal.h"
+#include "diagnosis/term_search.h"
 #include "diagnosis/diagnose_select.h"
 #include "diagnosis/diagnose_unexplained.h"
 #include "diagnosis/effects.h"
@@ -55,7 +56,9 @@ using torque_fit::ExtendAndRefine;
 using torque_fit::PrepareRecord;
 using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
-using torque_fit::UseSecantDelayColumns;
+using torque_fit::UseSecantColumns;
+using torque_fit::SearchTerms;
+using torque_fit::TermSearchResult;
 
 // Autocorrelation length (in rows) of a residual of 2m rows (hip block, knee block): the longer.
 double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
@@ -127,6 +130,7 @@ Kinematics Slice(const Kinematics& kin, size_t a, size_t b) {
   }
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
   k.derivative_source = kin.derivative_source;
+  k.t_start = kin.t_start;
   return k;
 }
 
@@ -281,8 +285,8 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Re
   for (const ColumnBank& b : banks) raw.push_back(b.r);
   // Ripple frequency searched on what the other candidates leave and on the raw residual (a slow
   // ripple, ~1 cycle over the range, is otherwise absorbed by the stiffness/gravity columns).
-  AddRippleCandidates(banks, kins, e);
-  AddRippleCandidates(banks, kins, raw);
+  AddSearchedCandidates(banks, kins, e);
+  AddSearchedCandidates(banks, kins, raw);
   return banks;
 }
 
@@ -438,7 +442,8 @@ void FindAliases(const ColumnBank& bank, const Grams& g, const PhysicalScale& sc
 // records, each whole record predicted by the effects fitted on the others (D->left_out).
 void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const ColumnBank& bank,
                        const Grams& g, const std::vector<int>& chosen, const std::vector<double>& refine_ratio,
-                       const DiagnoseOptions& opt, Diagnosis* D_out) {
+                       const std::vector<std::vector<Effect>>& searched_left_out, const DiagnoseOptions& opt,
+                       Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   const size_t R = recs.size();
   // The extended twin's inverse dynamics on DiagnoseThreads plants (PredictTorque's ranges), one for a
@@ -497,13 +502,19 @@ void ScoreExtendedTwin(const LegParams& params, std::vector<Rec>& recs, const Co
     cnt += static_cast<double>(n - rc.split);
     if (D.leave_one_out) {
       LegParams p = params;
-      const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
-      if (!cols.empty() && x.size() == 0)
-        throw InputError(rc.source + ": without this record the chosen effects are not identifiable");
-      for (size_t k = 0; k < chosen.size(); ++k) {
-        Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
-        e.value *= refine_ratio[k];
-        p.effects.push_back(e);
+      if (!searched_left_out.empty()) {  // the terms' search rewrote the model: its own refits
+        if (searched_left_out[r].empty())
+          throw InputError(rc.source + ": without this record the named effects and terms are not identifiable");
+        p.effects.insert(p.effects.end(), searched_left_out[r].begin(), searched_left_out[r].end());
+      } else {
+        const Eigen::VectorXd x = cols.empty() ? Eigen::VectorXd() : FitLeavingOut(g, cols, r);
+        if (!cols.empty() && x.size() == 0)
+          throw InputError(rc.source + ": without this record the chosen effects are not identifiable");
+        for (size_t k = 0; k < chosen.size(); ++k) {
+          Effect e = ToEffect(bank.candidates[chosen[k]], x, cols).effect;
+          e.value *= refine_ratio[k];
+          p.effects.push_back(e);
+        }
       }
       rs.left_out_effects = p.effects;
       Plant loo_plant(opt.mjcf.empty() ? ExowheelMjcfPath(p.human.has_value()) : opt.mjcf);
@@ -754,7 +765,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   std::vector<ColumnBank> banks = CandidateColumns(params, recs, w, opt);
   Lap("columns + ripple search");
   FilterMeasured(&recs);
-  UseSecantDelayColumns(recs, w, &banks);
+  UseSecantColumns(recs, w, &banks);
   if (params.one_joint) KeepJointCandidates(1, &banks);
   // The ceilings and the pooled Grams only read the banks: the two side by side.
   std::vector<CeilingScores> ceilings;
@@ -780,11 +791,16 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
+  const LegParams table_model = D.extended;  // the table's best model, before the search may rewrite it
+  const TermSearchResult searched = SearchTerms(params, recs, w, banks, scale, &D);
+  Lap("terms beyond the table");
 
-  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, opt, &D);
+  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
   Lap("extended twin");
-  D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);  // stage 6c
-  D.final_model = D.table_model;  // no search for terms beyond the table yet
+  // Stage 6c: the residual tests and ceiling of the table's best model and of the final one (after the
+  // search; the table's where it admitted no term).
+  D.table_model = torque_fit::AssessModel(params, table_model, recs, opt);
+  D.final_model = searched.changed ? torque_fit::AssessModel(params, D.extended, recs, opt) : D.table_model;
   Lap("completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)

@@ -175,6 +175,7 @@ struct Diagnosis {
   std::vector<CandidateScore> scores;   // singles (best first) and the best pairs, for the report
   std::vector<std::string> collinear;   // nearly collinear candidate pairs on this record, in words
   std::vector<std::string> selection;   // the selection's steps, in words
+  std::vector<std::string> term_search; // the search for terms beyond the table, in words (term_search.h)
   std::vector<std::string> implausible; // candidates that fit alone but fall outside their range
   // Candidates these records cannot identify: fitted alone, even a value at the edge of their physical
   // range would not be significant (|t| < kMinT), e.g. an inertia on a slow, hand-guided record.
@@ -194,8 +195,9 @@ struct Diagnosis {
   // The motion fit only: what the torque fit named (its values), and those the motion fit does not.
   std::vector<DiagnosedEffect> torque_named;
   std::vector<TorqueOnlyEffect> torque_only;
-  // The table's best model (the extended twin of the effects above) and the final model (after a
-  // search for terms beyond the table; the table's until there is one): their held-out residual tests
+  // The table's best model (the extended twin of the table's effects, before the search for terms) and
+  // the final model (D.extended, after the search; the table's where no term was admitted, and in the
+  // motion fit, which searches none): their held-out residual tests
   // (completeness.h) and ceiling. Both fits assess the torque residual of their extended twin on the
   // held-out part of every record (the last holdout_fraction of its time), filtered as the torque
   // fit's (parallel filtering at its cutoff).

@@ -35,6 +35,7 @@ struct ColumnBank {
   Eigen::VectorXd r;           // 2m weighted residual
   std::vector<Candidate> candidates;
   int used = 0;                // columns in use (X may be over-allocated while building)
+  int constant[2] = {-1, -1};  // each joint's constant column (1 on its rows, 0 on the other's, weighted)
   // The residual's low-pass (parallel filtering): every column is evaluated on all n samples and
   // filtered by it before its fit rows are taken. Empty: no filter.
   ColumnFilter filter;
@@ -42,7 +43,9 @@ struct ColumnBank {
   int threads = 1;             // threads evaluating a column on the n samples (the same bits on any count)
 };
 
-// Builds every candidate for both joints. tau_S: the twin's prediction (N m) on all samples (its rigid
+// Builds every candidate for both joints: per joint its constant column, the columns of the families
+// linear in their value, then those of the families with their own (FitFamily::add_columns), in the
+// registry's order. tau_S: the twin's prediction (N m) on all samples (its rigid
 // tau_R, ActuatorTorque, is evaluated where a column needs it); resid[j]: measured - predicted
 // tau_S, released (left empty) once the fit rows' values are taken; w[j]: row weights (1/N m);
 // split: first held-out sample; threads: ColumnBank::threads (0: every core).
@@ -55,10 +58,10 @@ ColumnBank BuildColumns(const LegParams& params, const Kinematics& kin, const st
 // filtered by bank.filter when set and weighted by w.
 void SetColumn(ColumnBank& b, int c, const double w[2], std::vector<double> v[2]);
 
-// Adds the torque_ripple candidates (sin/cos of 2 pi f q_j) to every bank (one per record of one
-// device, same columns), with f (1 .. 10 cycles/rad) found by grid + golden search on the train rows
-// of `targets` pooled (per bank 2m weighted rows, e.g. the residual of all other columns).
-void AddRippleCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
-                         const std::vector<Eigen::VectorXd>& targets);
+// Adds the candidates whose columns are searched on a target (FitFamily::add_searched_columns: the
+// ripple's frequency) to every bank (one per record of one device, the same columns), the search on the
+// train rows of `targets` pooled (per bank 2m weighted rows, e.g. the residual of all other columns).
+void AddSearchedCandidates(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
+                           const std::vector<Eigen::VectorXd>& targets);
 
 }  // namespace exotwin

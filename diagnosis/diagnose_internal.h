@@ -98,10 +98,10 @@ struct Rec {
   }
 };
 
-// Stage 3b: every sensor_delay column replaced by the secant (tau_S(t - d) - tau_S(t)) / d at the
-// single fit's delay d (s, pooled over records; kept when 1e-4 < d < 0.5), twice, so the
-// second-order term is not left for sensor_gain.
-void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io);
+// Stage 3b: every column of a family with a secant (FitFamily::secant_column: the delay's (tau_S(t - d)
+// - tau_S(t)) / d) replaced by it at the value d the single fit gives the column (pooled over
+// records), twice, so the second-order term is not left for another column (the gain's).
+void UseSecantColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io);
 
 // The largest magnitude DESIGN.md's physical range allows a one-parameter candidate (0: unbounded or
 // several parameters).
@@ -133,8 +133,8 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
 // residual at most 12000 fit rows (the last quarter of every record's fit rows validating) and scored
 // on at most 8000 held-out rows. Both twins by the closed form (HJ15 + ApplyEffects, as stage 2),
 // which every effect (and term) ApplyEffects knows reaches. Needs each record's kin (with EMG for
-// muscle_activity) and raw. The table's model is the extended twin; after a search for terms, call
-// again with the final model.
+// muscle_activity) and raw. Called for the table's best model and, where the search for terms
+// admitted one, for the final model.
 ModelAssessment AssessModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
                             const DiagnoseOptions& opt);
 // The same on the records themselves (the motion fit's): each prepared as stage 2 does at `cutoff`

@@ -32,6 +32,12 @@ std::string DiagnosisJson(const Diagnosis& d) {
     json x = {{"name", e.effect.name}, {"joint", e.effect.joint}, {"value", e.effect.value},
               {"unit", e.effect.unit}, {"ci95", {e.ci_lo, e.ci_hi}}, {"explained_pct", e.explained_pct}};
     if (!e.effect.axis.empty()) x["axis"] = e.effect.axis;
+    if (!e.effect.expr.empty()) {  // a term beyond the table (DESIGN.md "Terms beyond the table")
+      x["expr"] = e.effect.expr;
+      if (!e.effect.stage.empty()) x["stage"] = e.effect.stage;
+      x["formula"] = std::string(e.effect.stage == "sensor" ? "tau_S" : "tau_R") + "(" + e.effect.joint +
+                     ") += " + nlohmann::json(e.effect.value).dump() + " * " + e.effect.expr;
+    }
     for (const auto& f : e.effect.fields) {
       if (f.first.rfind("w_", 0) == 0) x["weights"][f.first.substr(2)] = f.second;
       else x[f.first] = f.second;
@@ -74,6 +80,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
                  {"heldout_rmse_knee", d.cutoff.heldout_rmse[1]}};
   if (!d.extended.one_joint) j["cutoff"]["heldout_rmse_hip"] = d.cutoff.heldout_rmse[0];
   j["selection"] = d.selection;
+  j["term_search"] = d.term_search;
   j["implausible"] = d.implausible;
   j["not_identifiable"] = d.not_identifiable;
   j["records"] = json::array();

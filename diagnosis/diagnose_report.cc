@@ -290,6 +290,17 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
   o << "<h2>Selection</h2><ol>";
   for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
   o << "</ol>";
+  if (!d.term_search.empty()) {
+    o << "<h2>Terms beyond the table</h2><ul>";
+    for (const auto& e : d.effects)
+      if (!e.effect.expr.empty())
+        o << "<li><b>" << HtmlEscape((e.effect.stage == "sensor" ? "tau_S(" : "tau_R(") + e.effect.joint + ") += " +
+                                     NumberText(e.effect.value) + " * " + e.effect.expr)
+          << "</b> (" << NumberText(e.explained_pct) << " % of the held-out residual)</li>";
+    o << "</ul><p>The search's steps:</p><ol>";
+    for (const auto& s : d.term_search) o << "<li>" << HtmlEscape(s) << "</li>";
+    o << "</ol>";
+  }
   if (!d.implausible.empty()) {
     o << "<p>Fitted alone but outside their physical range, so not named:</p><ul>";
     for (const auto& s : d.implausible) o << "<li>" << HtmlEscape(s) << "</li>";

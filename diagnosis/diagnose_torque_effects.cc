@@ -1,6 +1,5 @@
-// The torque fit's stages (diagnose.cc) that branch on effect names, moved here whole: the secant
-// delay columns (stage 3b), the range edge of a candidate, and the extension with its refinement
-// (stage 5).
+// The torque fit's stages (diagnose.cc) that ask the families' fit rows: the secant columns (stage
+// 3b), the range edge of a candidate, and the extension with its refinement (stage 5).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -44,11 +43,12 @@ double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, 
 
 }  // namespace
 
-void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io) {
+void UseSecantColumns(const std::vector<Rec>& recs, const double w[2], std::vector<ColumnBank>* banks_io) {
   std::vector<ColumnBank>& banks = *banks_io;
   for (int pass = 0; pass < 2; ++pass) {
     for (const auto& c : banks[0].candidates) {
-      if (c.name != "sensor_delay") continue;
+      const FitFamily& ff = FitFamilyOf(c.name);
+      if (!ff.secant_column) continue;
       const int j = c.joint;
       double xr = 0, xx = 0;
       for (const ColumnBank& b : banks) {
@@ -60,16 +60,11 @@ void UseSecantDelayColumns(const std::vector<Rec>& recs, const double w[2], std:
         }
       }
       const double d = xx > 0 ? xr / xx : 0;
-      if (!(d > 1e-4 && d < 0.5)) continue;
       for (size_t r = 0; r < recs.size(); ++r) {
         const Rec& rc = recs[r];
-        ColumnBank& b = banks[r];
-        std::vector<double> tq(rc.n());
-        for (size_t i = 0; i < rc.n(); ++i) tq[i] = rc.kin.t[i] - d;
-        const std::vector<double> shifted = Interpolate(rc.kin.t, rc.tau_S[j], tq);
         std::vector<double> v[2] = {std::vector<double>(rc.n(), 0.0), std::vector<double>(rc.n(), 0.0)};
-        for (size_t i = 0; i < rc.n(); ++i) v[j][i] = (shifted[i] - rc.tau_S[j][i]) / d;
-        SetColumn(b, c.cols[0], w, v);
+        if (!ff.secant_column(d, rc.kin, rc.tau_S[j], &v[j])) break;  // d not taken: no record changed
+        SetColumn(banks[r], c.cols[0], w, v);
       }
     }
   }

@@ -11,9 +11,16 @@
 //  - refined_on_exact_form: the fit's column is first order in the value (backlash, strap, delay):
 //    the value is refined on the exact form after the linear fit;
 //  - draw: generate's hidden effect at a joint with a realistic magnitude (nullptr: not drawn).
+// A family linear in its value needs no code of its own (linear_column, motion_box); the others' rows
+// hold their own code as hooks (add_columns, motion_candidates, ...), each family's rows and hooks in
+// its file (family_rows.h lists them), so a reader finds a family in one place by its name.
 #pragma once
 #include <deque>
+#include <functional>
 #include <string>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "core/rng.h"
 #include "diagnosis/diagnose_columns.h"
@@ -27,9 +34,35 @@ namespace exotwin {
 // edge (kg m).
 struct MotionScale {
   double tau = 0, M = 0, qd_rms = 0, grav = 0;
+  double q_rms = 0;  // rad, the angle's RMS about its mean
+  double range = 0;  // rad, the recorded angle's range
+  double tau_C = 0;  // N m, the largest torque the compliant part carries
 };
 struct MotionBox {
   double lo = 0, hi = 0, step = 0;
+};
+
+struct ColumnContext;  // diagnosis/column_tools.h
+class MotionProblem;   // diagnosis/motion_fit.h
+struct FitFamily;
+
+// What a family's motion-fit candidates (FitFamily::motion_candidates) see of the problem at joint j
+// (MotionProblem::AddCandidates).
+struct MotionJoint {
+  int j = 0;
+  const LegParams* params = nullptr;
+  MotionScale scale;
+  int constant = -1;           // the joint's constant input torque parameter (the stiffness's k q0)
+  bool reading_input = false;  // every record driven by its torque reading (the sensor families)
+  const std::vector<DiagnosedEffect>* torque_named = nullptr;  // the torque fit's effects
+  // A parameter of family f at j, its box and secant step; `kind` names it (MotionProblem::kind), f a
+  // frequency it carries (Candidate::ripple_f). Returns its index.
+  std::function<int(const FitFamily& f, const std::string& kind, MotionBox box, double freq)> add_parameter;
+  std::function<void(const FitFamily& f, std::vector<int> parameters)> add_candidate;
+  // The model given carries f, or a family of its exclusive group, at j: no candidate.
+  std::function<bool(const FitFamily& f)> carried;
+  // Parameter k's value stands for family f's effect (EffectsOf; the constant parameter's owner).
+  std::function<void(int k, const FitFamily& f)> own;
 };
 
 struct FitFamily {
@@ -48,8 +81,36 @@ struct FitFamily {
   // A candidate only for such models (nullptr: every model).
   bool (*candidate_for)(const LegParams& params) = nullptr;
   // The motion fit's parameter of a family linear in its value: its box and secant step at a joint
-  // from the records' scales (MotionScale); nullptr: the family's own parameters (motion_candidates.cc).
+  // from the records' scales (MotionScale); nullptr: the family's own (motion_candidates below) or none.
   MotionBox (*motion_box)(const MotionScale& s) = nullptr;
+
+  // ---- a family with its own code (its file, diagnosis/family_*.cc) --------------------------------
+  // The torque fit's candidates and columns at one joint where they are not its closed form at value 1
+  // (BuildColumns: after the linear families, in the registry's order).
+  void (*add_columns)(ColumnContext& ctx, const FitFamily& self) = nullptr;
+  // Candidates whose columns are searched on a target (AddSearchedCandidates: the ripple's frequency).
+  void (*add_searched_columns)(std::vector<ColumnBank>& banks, const std::vector<const Kinematics*>& kins,
+                               const std::vector<Eigen::VectorXd>& targets, const FitFamily& self) = nullptr;
+  // A column first order in the value, evaluated again as the secant at the value d the first-order
+  // column fits (the torque fit's stage 3b): *v the column's values at the candidate's joint on every
+  // sample of the record (kin; tau_S_j the twin's reading there); false where d is not taken.
+  bool (*secant_column)(double d, const Kinematics& kin, const std::vector<double>& tau_S_j,
+                        std::vector<double>* v) = nullptr;
+  // The motion fit's candidates at one joint (with motion_box: generic).
+  void (*motion_candidates)(MotionJoint& mj, const FitFamily& self) = nullptr;
+  // The effect parameter k of the family stands for at theta (theta[k] != 0; *e named, at its joint,
+  // with value theta[k]); false: none.
+  bool (*motion_effect)(const MotionProblem& P, int k, const Eigen::VectorXd& theta, Effect* e) = nullptr;
+  // The torque fit's effect as its motion candidate's parameter values (nullptr: the first parameter
+  // takes the value).
+  void (*torque_values)(const Effect& e, const Candidate& cand, Eigen::VectorXd* theta) = nullptr;
+  // Why the motion fit has no candidate for e, where the family knows ("" where it does not).
+  std::string (*no_motion_candidate)(const Effect& e, const LegParams& params) = nullptr;
+  // The motion fit's exchange of forms (a friction's: Coulomb for viscous and back): the family tried
+  // in its place, from the torque the value gives at the joint's RMS speed and its inverse.
+  const char* exchanged_with = nullptr;
+  double (*torque_at_speed)(double value, double qd_rms) = nullptr;
+  double (*value_at_speed)(double torque, double qd_rms) = nullptr;
 };
 
 // Every family's fit row: DESIGN.md's families in the model registry's order, then those added.

@@ -139,6 +139,8 @@ constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5)
 Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const MeasuredData*>& records,
                            const DiagnoseOptions& opt);
 
+struct FitFamily;  // diagnosis/fit_families.h
+
 // The simulated-motion problem of some records: the candidates as columns, rollouts, Jacobians.
 class MotionProblem {
  public:
@@ -154,6 +156,7 @@ class MotionProblem {
   double upper(int k) const { return hi_[k]; }
   double step(int k) const { return step_[k]; }
   const std::string& kind(int k) const { return kind_[static_cast<size_t>(k)]; }  // a family's name, or "offset"
+  double ripple_f(int k) const { return ripple_f_[static_cast<size_t>(k)]; }  // a frequency it carries (cycles/rad)
   // Index of the candidate (name, joint "hip"/"knee", axis for gravity_error), -1 if not a candidate.
   int CandidateIndex(const std::string& name, const std::string& joint, const std::string& axis = "") const;
   // Why effect e (as the torque fit names it) is no candidate, "" when it is one: the plant cannot
@@ -229,6 +232,7 @@ class MotionProblem {
   std::vector<std::string> kind_;  // per parameter: what it is (a family's name, or "offset")
   std::vector<int> joint_;         // per parameter
   std::vector<double> ripple_f_;   // per parameter (torque_ripple)
+  std::vector<const FitFamily*> owner_;  // per parameter: the family whose effect it stands for (EffectsOf)
   PhysicalScale scale_;
   double w_[2] = {1, 1};
   double qd_rms_[2] = {1, 1};

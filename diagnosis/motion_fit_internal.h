@@ -1,7 +1,7 @@
 // The motion fit's parts (motion_fit.h), shared by its files and by nothing else:
 //   motion_problem.cc     MotionProblem: the records, rollouts, Jacobians, weighted errors;
 //   motion_candidates.cc  the candidates, EffectsOf, TorqueValues, the friction's form, the effects'
-//                         order (the code that branches on effect names);
+//                         order (each family's part through its fit row, fit_families.h);
 //   motion_refine.cc      the numerics of steps 2-4: weighted residual and Jacobian, Refine, RefineOne,
 //                         LeftOutThetas;
 //   motion_rounds.cc      the phases of steps 2-5 (MotionFit::Rounds, ConfirmTorqueNamed);

@@ -15,6 +15,7 @@
 #include "formats/svg_chart.h"
 #include "core/error.h"
 #include "core/output_path.h"
+#include "model/effect_families.h"
 
 namespace exotwin {
 namespace {
@@ -54,7 +55,7 @@ nlohmann::json Effects(const EmgDiagnosis& d) {
                  {"ci95", {m.spec.a_shape - 1.96 * m.spec.a_shape_se, m.spec.a_shape + 1.96 * m.spec.a_shape_se}}});
   for (const EmgTerm& t : m.terms) {
     std::string name;
-    if (t.kind == TermKind::kPassive) name = "passive_moment";
+    if (t.kind == TermKind::kPassive) name = kPassiveMoment;
     if (t.kind == TermKind::kAlphaQ) name = "moment_arm_angle";
     if (t.kind == TermKind::kAlpha && t.proxy) name = "missing_channel";
     if (name.empty()) continue;

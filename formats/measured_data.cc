@@ -346,6 +346,7 @@ bool IsEmgChannel(const std::string& name) { return name.rfind("emg_", 0) == 0 &
 Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
   Kinematics k;
   k.t = data.t();
+  if (!k.t.empty()) k.t_start = k.t.front();
   k.q[0] = data.q_hip();
   k.q[1] = data.q_knee();
   for (size_t c = 0; c < data.table.names.size(); ++c)
@@ -363,6 +364,7 @@ Kinematics DeriveKinematics(const MeasuredData& data, double cutoff_hz) {
 Kinematics DeriveKinematics(MeasuredData&& data, double cutoff_hz) {
   Kinematics k;
   k.t = std::move(data.column_at(kColT));
+  if (!k.t.empty()) k.t_start = k.t.front();
   k.q[0] = std::move(data.column_at(kColQHip));
   k.q[1] = std::move(data.column_at(kColQKnee));
   CsvTable& tab = data.table;

@@ -8,6 +8,7 @@
 #include "core/yaml_fields.h"
 #include "model/effect_families.h"
 #include "model/one_joint.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 namespace {
@@ -34,6 +35,53 @@ LumpedParams ReadLumped(const YamlContext& c, const YAML::Node& n, const std::st
   return p;
 }
 
+// A family's key beyond its fields (EffectFamily::keys) into e.
+void ReadEffectKey(const YamlContext& c, const YAML::Node& n, const std::string& key, const EffectKey& k, Effect* e) {
+  const YAML::Node v = n[k.key];
+  const std::string where = key + "." + k.key;
+  switch (k.kind) {
+    case EffectKey::Kind::kAxis:
+      e->axis = v ? v.Scalar() : "X";
+      if (e->axis != "X" && e->axis != "Y") c.Fail(where, "expected X or Y");
+      break;
+    case EffectKey::Kind::kOptionalField:
+      if (v) e->fields[k.key] = YamlNumber(c, v, where, k.lo, k.hi, "");
+      break;
+    case EffectKey::Kind::kWeights:
+      if (!v) break;
+      if (!v.IsMap()) c.Fail(where, "expected a mapping channel: N m per V");
+      for (const auto& kv : v) {
+        const std::string ch = kv.first.IsScalar() ? kv.first.Scalar() : "";
+        const char* kIdent = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_";
+        if (ch.empty() || ch.find_first_not_of(kIdent) != std::string::npos)
+          c.Fail(where, "expected EMG channel names (letters, digits, '_') as keys" + YamlLine(kv.first));
+        e->fields["w_" + ch] = YamlNumber(c, kv.second, where + "." + ch, -1e6, 1e6, "");
+      }
+      break;
+    case EffectKey::Kind::kAccepted:
+      break;
+  }
+}
+
+// A term's expr (parsed: a parse error names the position in it) and stage (DESIGN.md "Terms beyond
+// the table").
+void ReadTerm(const YamlContext& c, const YAML::Node& n, const std::string& key, Effect* e) {
+  const std::string what = " (" + e->name + " at the " + e->joint + ")";
+  if (!n["expr"] || !n["expr"].IsScalar())
+    c.Fail(key + ".expr", "missing" + what + ", expected an expression of q, qd, qdd, tau_R, q_hip, q_knee, qd_hip, "
+           "qd_knee, t (DESIGN.md \"Terms beyond the table\")");
+  e->expr = n["expr"].Scalar();
+  try {
+    TermExpr::Parse(e->expr);
+  } catch (const TermExprError& x) {
+    c.Fail(key + ".expr", "\"" + e->expr + "\"" + what + ": " + x.what() + " of the expression");
+  }
+  if (n["stage"]) {
+    e->stage = n["stage"].IsScalar() ? n["stage"].Scalar() : "";
+    if (e->stage != "link" && e->stage != "sensor") c.Fail(key + ".stage", "expected link or sensor" + YamlLine(n["stage"]));
+  }
+}
+
 Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& key) {
   if (!n.IsMap()) c.Fail(key, "expected a mapping {name, joint, value, unit, ...}" + YamlLine(n));
   if (!n["name"] || !n["name"].IsScalar()) c.Fail(key + ".name", "missing, expected an effect name");
@@ -45,9 +93,8 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
                               FamilyNames());
   std::set<std::string> allowed = {"name", "joint", "value", "unit", "ci95", "explained_pct"};
   allowed.insert(spec->fields.begin(), spec->fields.end());
-  if (e.name == "gravity_error") allowed.insert("axis");
-  if (e.name == "passive_moment") allowed.insert("cv");
-  if (e.name == "muscle_activity") allowed.insert({"weights", "channels"});
+  for (const EffectKey& k : spec->keys) allowed.insert(k.key);
+  if (spec->carries_expr) allowed.insert({"expr", "stage"});
   YamlCheckKeys(c, n, key, allowed);
   if (!n["joint"] || !n["joint"].IsScalar() ||
       (n["joint"].Scalar() != "hip" && n["joint"].Scalar() != "knee"))
@@ -62,22 +109,8 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
     if (!n[f]) c.Fail(key + "." + f, "missing, required by " + e.name);
     e.fields[f] = YamlNumber(c, n[f], key + "." + f, -1e6, 1e6, "");
   }
-  if (e.name == "gravity_error") {
-    e.axis = n["axis"] ? n["axis"].Scalar() : "X";
-    if (e.axis != "X" && e.axis != "Y") c.Fail(key + ".axis", "expected X or Y");
-  }
-  // passive_moment's optional inter-subject coefficient of variation (table5 draws each subject's value).
-  if (e.name == "passive_moment" && n["cv"]) e.fields["cv"] = YamlNumber(c, n["cv"], key + ".cv", 0.0, 2.0, "");
-  if (e.name == "muscle_activity" && n["weights"]) {
-    if (!n["weights"].IsMap()) c.Fail(key + ".weights", "expected a mapping channel: N m per V");
-    for (const auto& kv : n["weights"]) {
-      const std::string ch = kv.first.IsScalar() ? kv.first.Scalar() : "";
-      const char* kIdent = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_";
-      if (ch.empty() || ch.find_first_not_of(kIdent) != std::string::npos)
-        c.Fail(key + ".weights", "expected EMG channel names (letters, digits, '_') as keys" + YamlLine(kv.first));
-      e.fields["w_" + ch] = YamlNumber(c, kv.second, key + ".weights." + ch, -1e6, 1e6, "");
-    }
-  }
+  for (const EffectKey& k : spec->keys) ReadEffectKey(c, n, key, k, &e);
+  if (spec->carries_expr) ReadTerm(c, n, key, &e);
   return e;
 }
 
@@ -201,6 +234,8 @@ void WriteEffects(std::ostringstream& os, const std::vector<Effect>& effects) {
       os << "  - {name: " << e.name << ", joint: " << e.joint << ", value: " << Num(e.value)
          << ", unit: \"" << e.unit << "\"";
       if (!e.axis.empty()) os << ", axis: " << e.axis;
+      if (!e.expr.empty()) os << ", expr: \"" << e.expr << "\"";
+      if (!e.stage.empty()) os << ", stage: " << e.stage;
       std::string weights;
       for (const auto& f : e.fields) {
         if (f.first.rfind("w_", 0) == 0) weights += (weights.empty() ? "" : ", ") + f.first.substr(2) + ": " + Num(f.second);

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/materiality.h"
 #include "core/units.h"
+#include "model/effect_families.h"
 #include "model/passive_torque.h"
 #include "model/regressors.h"
 #include "formats/number_text.h"
@@ -327,8 +328,8 @@ IdentificationResult IdentifyHuman(const IdentificationSamples& knee, const Iden
   if (fit.subject_passive) {
     const std::pair<const char*, const StepEstimate*> per_joint[2] = {{"hip", &s4}, {"knee", &s3}};
     for (const auto& [joint, st] : per_joint) {
-      r.params.effects.push_back({"passive_moment", joint, st->passive_factor - 1.0, "relative", {}, ""});
-      r.params.effects.push_back({"viscous_friction", joint, st->damping, "N m s/rad", {}, ""});
+      r.params.effects.push_back({kPassiveMoment, joint, st->passive_factor - 1.0, FindFamily(kPassiveMoment)->unit, {}, ""});
+      r.params.effects.push_back({kViscousFriction, joint, st->damping, FindFamily(kViscousFriction)->unit, {}, ""});
     }
   }
   r.steps = {s3, s4};

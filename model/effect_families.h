@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "model/lumped_params.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 
@@ -41,10 +42,45 @@ enum class PlantCarrier {
 enum class EffectStage { kLink, kSensor };
 
 // One sample's state for a closed form: angles, velocities, accelerations (rad, rad/s, rad/s^2; [0]
-// hip, [1] knee) and gravity (m/s^2).
+// hip, [1] knee) and gravity (m/s^2); for a term (model/term_expr.h) also the actuator torque tau_R
+// (N m: the rigid twin's where the motion is given, the one applied at that step in the forward plant)
+// and the time t (s from the record's or run's start).
 struct EffectState {
   Eigen::Vector2d q, qd, qdd;
   double g = 9.81;
+  Eigen::Vector2d tau_R = Eigen::Vector2d::Zero();
+  double t = 0;
+};
+
+// DESIGN.md's families by name, for code that constructs a named effect (a device's own friction, a
+// bench's hidden effect, an identification's result): each name spelled once, in the registry's row.
+extern const char* const kCoulombFriction;
+extern const char* const kViscousFriction;
+extern const char* const kInertiaError;
+extern const char* const kGravityError;
+extern const char* const kJointStiffness;
+extern const char* const kBacklash;
+extern const char* const kSeriesCompliance;
+extern const char* const kTorqueRipple;
+extern const char* const kPassiveMoment;
+extern const char* const kSensorOffset;
+extern const char* const kSensorGain;
+extern const char* const kSensorDelay;
+extern const char* const kMuscleActivity;
+extern const char* const kTerm;
+
+// A model-file key of a family beyond name, joint, value, unit and its required `fields`; the reader
+// (formats/model_file.cc) reads it by kind, the writer writes the effect's axis, fields and weights.
+struct EffectKey {
+  enum class Kind {
+    kAxis,           // Effect::axis: X or Y (default X)
+    kOptionalField,  // a number in [lo, hi] into fields[key] where given
+    kWeights,        // a mapping EMG channel -> N m per V into fields["w_" + channel]
+    kAccepted,       // accepted and ignored (written by other tools)
+  };
+  const char* key;
+  Kind kind;
+  double lo = 0, hi = 0;
 };
 
 struct EffectFamily {
@@ -66,6 +102,10 @@ struct EffectFamily {
   // A sensor family that is affine in the torque: the reading a tau + b becomes a' tau + b'
   // (a joint module's gain and offset); nullptr for the delay (whole samples of the module's skew).
   void (*affine)(double value, double* a, double* b) = nullptr;
+  std::vector<EffectKey> keys;  // its model-file keys beyond `fields`
+  // A term (DESIGN.md "Terms beyond the table"): each effect carries its own `expr` (model/term_expr.h)
+  // and may carry a `stage` (link or sensor); link_torque is value * expr at the joint.
+  bool carries_expr = false;
 };
 
 // Every family: DESIGN.md's table in its order, then any added by AddEffectFamily. References stay
@@ -89,6 +129,15 @@ const EffectFamily& FamilyOf(const Effect& e);
 
 // The names of the families for which `keep` holds (nullptr: every family), joined by ", " (messages).
 std::string FamilyNames(bool (*keep)(const EffectFamily&) = nullptr);
+
+// The sign of coulomb_friction's closed form (and of a term's sgn): +-1, 0 at 0.
+inline double CoulombSign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+// The stage an effect acts at: its own `stage` ("link" or "sensor", a term's) or its family's.
+EffectStage StageOf(const Effect& e);
+
+// A term's signals (model/term_expr.h) at its joint from one sample's state.
+TermSignals TermSignalsAt(const Effect& e, const EffectState& s);
 
 // Joint index of an effect ("hip" -> 0, "knee" -> 1).
 int EffectJoint(const Effect& e);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "model/effect_families.h"
+
 namespace exotwin {
 
 LumpedParams OneJointLumped(const OneJointLink& link, double g) {
@@ -29,8 +31,8 @@ LegParams EmbedOneJointModel(const OneJointModel& m, double g, const std::vector
   p.passive = PassiveModel::kNone;
   p.one_joint = m;
   p.one_joint->device_effects = 0;
-  if (m.R != 0) p.effects.push_back({"viscous_friction", "knee", m.R, "N m s/rad", {}, ""});
-  if (m.C != 0) p.effects.push_back({"coulomb_friction", "knee", m.C, "N m", {}, ""});
+  if (m.R != 0) p.effects.push_back({kViscousFriction, "knee", m.R, FindFamily(kViscousFriction)->unit, {}, ""});
+  if (m.C != 0) p.effects.push_back({kCoulombFriction, "knee", m.C, FindFamily(kCoulombFriction)->unit, {}, ""});
   p.one_joint->device_effects = p.effects.size();
   p.effects.insert(p.effects.end(), effects.begin(), effects.end());
   return p;

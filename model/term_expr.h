@@ -12,9 +12,10 @@
 //   signal  := q | qd | qdd | tau_R | q_hip | q_knee | qd_hip | qd_knee | t
 //   func    := sgn | abs | exp | sin | cos | tanh | pos
 // q, qd, qdd, tau_R are the term's own joint's; t is s from the record's or run's start. sgn is the
-// sign coulomb_friction's closed form uses (model/effect_families.cc: 0 at 0); pos(x) is 1 where
-// x > 0, else 0.
+// sign coulomb_friction's closed form uses (CoulombSign, model/effect_families.h: 0 at 0); pos(x) is
+// 1 where x > 0, else 0. A default-constructed TermExpr is the empty expression, which evaluates to 0.
 #pragma once
+#include <cstddef>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -50,6 +51,16 @@ class TermExpr {
 
   // The expression's value at one sample (may be non-finite for e.g. 1/0: the caller checks).
   double Eval(const TermSignals& s) const;
+  // Eval at every row: out[i] = Eval(rows[i]), the same bits, evaluated a block of rows per
+  // operation (the term search's many expressions on long records).
+  void EvalRows(const std::vector<TermSignals>& rows, double* out) const;
+  // The column form of EvalRows: n samples of each signal (a null column reads 0).
+  struct Columns {
+    const double *q = nullptr, *qd = nullptr, *qdd = nullptr, *tau_R = nullptr;
+    const double *q_hip = nullptr, *q_knee = nullptr, *qd_hip = nullptr, *qd_knee = nullptr;
+    const double* t = nullptr;
+  };
+  void EvalColumns(const Columns& c, size_t n, double* out) const;
   // The text it was parsed from.
   const std::string& text() const { return text_; }
   // True when the expression reads the signal `name` (one of the grammar's signals).
@@ -59,11 +70,18 @@ class TermExpr {
   // |value * f| (dof_frictionloss) instead of an applied force. `f` receives the factor's expression.
   bool FrictionLike(TermExpr* f = nullptr) const;
 
-  struct Node;  // the parse tree (term_expr.cc)
+  struct Node;     // the parse tree (term_expr.cc)
+  struct Program;  // the tree compiled to a flat postfix program (term_expr.cc)
 
  private:
   std::string text_;
   std::shared_ptr<const Node> root_;
+  std::shared_ptr<const Program> program_;
+  unsigned reads_ = 0;  // bit i: the expression reads the grammar's i-th signal
 };
+
+// The parsed expression of `text`, parsed once per text and kept (thread-safe; the reference stays
+// valid): the closed forms of model files' terms evaluate through it. Throws TermExprError as Parse.
+const TermExpr& CachedTermExpr(const std::string& text);
 
 }  // namespace exotwin

@@ -9,8 +9,10 @@
 #include <cmath>
 #include <string>
 
+#include "diagnosis/column_tools.h"
 #include "diagnosis/diagnose.h"
 #include "diagnosis/fit_families.h"
+#include "diagnosis/motion_fit.h"
 #include "diagnosis/generate.h"
 #include "diagnosis/effects.h"
 #include "formats/model_file.h"
@@ -41,16 +43,33 @@ Effect DrawDrag(Rng& rng, int, bool) {
   e.value = rng.Uniform(2.0, 4.0);
   return e;
 }
+// The same family through its own code, as a family not linear in its value has it (its file's
+// hooks): its torque-fit column built by itself (-qd |qd| at its joint), its motion-fit candidate and
+// the effect its parameter stands for.
+void DragColumns(ColumnContext& x, const FitFamily& self) {
+  const std::vector<double>& qd = x.kin.qd[x.j];
+  x.AddCandidate(self, {AddJointColumn(x.pending, x.w, x.j, [&](size_t i) { return -qd[i] * std::abs(qd[i]); })});
+}
+void DragMotion(MotionJoint& mj, const FitFamily& self) {
+  if (!mj.carried(self)) mj.add_candidate(self, {mj.add_parameter(self, self.family->name, DragBox(mj.scale), 0)});
+}
+bool DragOfValue(const MotionProblem&, int, const Eigen::VectorXd&, Effect* e) { return e->value > 0; }
+
 // Registered for one test (the registry is the process's: the other tests of this executable must not
-// see a candidate they were not written for).
+// see a candidate they were not written for). own_code: through the hooks above instead of the
+// generic paths (linear_column, motion_box).
 struct ToyFamily {
-  ToyFamily() {
+  explicit ToyFamily(bool own_code = false) {
     EffectFamily f{kToy, "N m s^2/rad^2", 0.0, 100.0, {}, EffectStage::kLink, PlantCarrier::kAppliedForce, "",
                    "tau_R += value * qd |qd|", DragTorque};
     AddEffectFamily(f);
     FitFamily fit;
-    fit.family = FindFamily(kToy), fit.implausible = DragRange, fit.draw = DrawDrag, fit.linear_column = true;
-    fit.ceiling_sign = 1, fit.motion_box = DragBox;
+    fit.family = FindFamily(kToy), fit.implausible = DragRange, fit.draw = DrawDrag, fit.ceiling_sign = 1;
+    if (own_code) {
+      fit.add_columns = DragColumns, fit.motion_candidates = DragMotion, fit.motion_effect = DragOfValue;
+    } else {
+      fit.linear_column = true, fit.motion_box = DragBox;
+    }
     AddFitFamily(fit);
   }
   ~ToyFamily() {
@@ -122,6 +141,50 @@ TEST(ToyFamily, RunsThroughEveryStage) {
   EXPECT_EQ(drag->effect.joint, "knee");
   EXPECT_EQ(at_knee, 1) << named;
   EXPECT_NEAR(drag->effect.value, truth.value, 0.15 * truth.value);
+}
+
+// A family's own hooks take the generic paths' place: the torque fit names it with the value the
+// generic column gives (the same column, at another place in the bank), and the motion fit's
+// candidate (its box from the hook) stands for the drag at the parameter's value.
+TEST(ToyFamily, OwnCodeAsHooksMatchesTheGenericPaths) {
+  GenerateOptions g;
+  g.seed = 4242, g.effects = 1, g.allowed = {kToy}, g.joint = "knee", g.duration = 30, g.rate = 500;
+  DiagnoseOptions opt;
+  opt.threads = 2;
+  GeneratedData data;
+  double generic = 0;
+  {
+    const ToyFamily toy;
+    data = GenerateMeasured(S1(), g);
+    const Diagnosis d = Diagnose(S1(), data.data, opt);
+    ASSERT_EQ(d.effects.size(), 1u);
+    generic = d.effects[0].effect.value;
+  }
+  const ToyFamily toy(true);
+  const Diagnosis d = Diagnose(S1(), data.data, opt);
+  ASSERT_EQ(d.effects.size(), 1u) << (d.effects.empty() ? "nothing" : d.effects[0].effect.name);
+  EXPECT_EQ(d.effects[0].effect.name, kToy);
+  EXPECT_EQ(d.effects[0].effect.joint, "knee");
+  EXPECT_NEAR(d.effects[0].effect.value, generic, 1e-9 * generic);
+  // The motion fit's candidate at each joint, in the box DragBox gives the knee's scales.
+  const MotionProblem P(S1(), {&data.data}, opt);
+  const int c = P.CandidateIndex(kToy, "knee");
+  ASSERT_GE(c, 0);
+  ASSERT_GE(P.CandidateIndex(kToy, "hip"), 0);
+  const int k = P.candidates()[static_cast<size_t>(c)].cols[0];
+  EXPECT_EQ(P.lower(k), 0.0);
+  const double qd = P.qd_rms(1);
+  EXPECT_NEAR(P.upper(k), 0.5 * std::max(P.scale().tau_max[1], 1e-3) / (qd * qd), 1e-12 * P.upper(k));
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(P.parameters());
+  theta[k] = 2.5;
+  const std::vector<Effect> fx = P.EffectsOf(theta);
+  ASSERT_EQ(fx.size(), 1u);
+  EXPECT_EQ(fx[0].name, kToy);
+  EXPECT_EQ(fx[0].joint, "knee");
+  EXPECT_EQ(fx[0].value, 2.5);
+  EXPECT_EQ(fx[0].unit, "N m s^2/rad^2");
+  theta[k] = -1;  // a drag below its box names nothing (DragOfValue)
+  EXPECT_TRUE(P.EffectsOf(theta).empty());
 }
 
 }  // namespace
