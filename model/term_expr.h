@@ -63,11 +63,14 @@ class TermExpr {
   void EvalColumns(const Columns& c, size_t n, double* out) const;
   // The text it was parsed from.
   const std::string& text() const { return text_; }
-  // True when the expression reads the signal `name` (one of the grammar's signals).
+  // True when the expression reads the signal `name` (one of the grammar's signals; another name
+  // throws std::invalid_argument).
   bool Reads(const std::string& name) const;
   // A friction-like term: expr = f * sgn(qd) with f not reading qd's sign (f reads no qd, or reads it
-  // only through abs). The forward plant carries such a term as a per-step friction bound
-  // |value * f| (dof_frictionloss) instead of an applied force. `f` receives the factor's expression.
+  // only through abs): sgn(qd) a factor of the product (through products, numerators and negations),
+  // or of every addend of a sum. The forward plant carries such a term as a per-step friction bound
+  // value * f (dof_frictionloss; sim/plant_effects.h) instead of an applied force. `f` receives the
+  // factor (the tree with sgn(qd) taken out, printed back as text): f * sgn(qd) is expr bit for bit.
   bool FrictionLike(TermExpr* f = nullptr) const;
 
   struct Node;     // the parse tree (term_expr.cc)
