@@ -339,14 +339,15 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
 }  // namespace
 
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
-                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale, Diagnosis* D) {
+                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale,
+                             const bool at_joint[2], Diagnosis* D) {
   TermSearchResult out;
   const size_t R = recs.size(), K = D->effects.size();
   std::vector<SearchRec> S;
   for (size_t r = 0; r < R; ++r) S.push_back(Prepare(params, recs[r], banks[r], w, *D));
   std::vector<int> joints;
   for (int j = 0; j < 2; ++j)
-    if (w[j] > 0 && !(params.one_joint && j == 0)) joints.push_back(j);
+    if (at_joint[j] && w[j] > 0 && !(params.one_joint && j == 0)) joints.push_back(j);
   // The model's columns per record: the table's K, then the terms'.
   std::vector<Eigen::MatrixXd> model(R);
   for (size_t r = 0; r < R; ++r) model[r] = S[r].C;
