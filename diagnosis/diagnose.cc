@@ -792,11 +792,12 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
-  // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete, the
-  // search for terms beyond the table at those joints.
+  // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete on the
+  // held-out rows or on the fit rows, the search for terms beyond the table at those joints.
   D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);
+  const std::array<JointCompleteness, 2> on_fit_rows = torque_fit::CompletenessOnFitRows(params, D.extended, recs, opt);
   bool incomplete[2];
-  for (int j = 0; j < 2; ++j) incomplete[j] = !D.table_model.completeness[j].complete;
+  for (int j = 0; j < 2; ++j) incomplete[j] = !D.table_model.completeness[j].complete || !on_fit_rows[j].complete;
   Lap("completeness + ceiling");
   const TermSearchResult searched =
       incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};

@@ -42,10 +42,11 @@ RecordResiduals ResidualsOf(const LegParams& given, const LegParams& model, cons
 }
 
 // Joint j's held-out rows [split, n) of a record every `step` rows, as a test segment.
-ResidualSegment SegmentOf(const Rec& rc, const RecordResiduals& res, int j, size_t step) {
+// Joint j's rows [a, b) of a record every `step` rows, as a test segment.
+ResidualSegment SegmentOf(const Rec& rc, const RecordResiduals& res, int j, size_t step, size_t a, size_t b) {
   ResidualSegment s;
   const Kinematics& kin = rc.kin;
-  for (size_t i = rc.split; i < rc.n(); i += step) {
+  for (size_t i = a; i < b; i += step) {
     s.e.push_back(res.model[j][i]);
     s.q.push_back(kin.q[j][i]), s.qd.push_back(kin.qd[j][i]), s.qdd.push_back(kin.qdd[j][i]);
     s.tau_R.push_back(res.tau_R[j][i]);
@@ -53,6 +54,11 @@ ResidualSegment SegmentOf(const Rec& rc, const RecordResiduals& res, int j, size
     s.t.push_back(kin.t[i] - kin.t.front());
   }
   return s;
+}
+
+// Joint j's held-out rows [split, n).
+ResidualSegment SegmentOf(const Rec& rc, const RecordResiduals& res, int j, size_t step) {
+  return SegmentOf(rc, res, j, step, rc.split, rc.n());
 }
 
 // The black box's inputs at row i (i >= 2 h): q, qd, qdd, tau_R of both joints, and q, qd, tau_R of
@@ -140,6 +146,30 @@ ModelAssessment AssessModel(const LegParams& given, const LegParams& model, cons
     c.named_pct = 100 * (1 - model_sse / given_sse);
     c.black_box_pct = 100 * (1 - bb_sse / given_sse);
   }
+  return out;
+}
+
+std::array<JointCompleteness, 2> CompletenessOnFitRows(const LegParams& given, const LegParams& model,
+                                                      const std::vector<Rec>& recs, const DiagnoseOptions& opt) {
+  std::array<JointCompleteness, 2> out;
+  const int j0 = given.one_joint ? 1 : 0;
+  std::vector<ResidualSegment> segs[2];
+  size_t step0 = 0;
+  double torque_ss[2] = {0, 0}, rows = 0;
+  for (const Rec& rc : recs) {
+    if (rc.split < 2) continue;
+    for (size_t i = 0; i < rc.split; ++i)
+      for (int j = 0; j < 2; ++j) torque_ss[j] += rc.raw[j][i] * rc.raw[j][i];
+    rows += static_cast<double>(rc.split);
+    const RecordResiduals res = ResidualsOf(given, model, rc, DiagnoseThreads(opt));
+    const double fs = static_cast<double>(rc.n() - 1) / (rc.kin.t.back() - rc.kin.t.front());
+    const size_t step = CompletenessStep(fs, rc.hz);
+    if (step0 == 0) step0 = step;
+    for (int j = j0; j < 2; ++j) segs[j].push_back(SegmentOf(rc, res, j, step, 0, rc.split));
+  }
+  for (int j = j0; j < 2; ++j)
+    out[j] = AssessCompleteness(segs[j], std::max<size_t>(step0, 1),
+                                kMinTorqueShare * std::sqrt(torque_ss[j] / std::max(rows, 1.0)));
   return out;
 }
 

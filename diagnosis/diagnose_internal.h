@@ -1,6 +1,7 @@
 // The torque fit's internal parts shared by its files (diagnose.cc, diagnose_ceiling.cc,
 // diagnose_torque_effects.cc).
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -137,6 +138,11 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
 // admitted one, for the final model.
 ModelAssessment AssessModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
                             const DiagnoseOptions& opt);
+// The residual tests of `model` on every record's fit rows [0, split) instead (AssessModel's otherwise):
+// what decides the search for terms beyond the table, so that an effect that fades before the
+// held-out end (a drive warming up) is seen where it acts.
+std::array<JointCompleteness, 2> CompletenessOnFitRows(const LegParams& given, const LegParams& model,
+                                                      const std::vector<Rec>& recs, const DiagnoseOptions& opt);
 // The same on the records themselves (the motion fit's): each prepared as stage 2 does at `cutoff`
 // (the torque fit's) with the model given, then AssessModel.
 ModelAssessment AssessModelOnRecords(const LegParams& given, const LegParams& model,
