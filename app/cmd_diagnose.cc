@@ -56,7 +56,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     std::string names;
     for (const std::string& m : o->measured) {
       MapReport report;
-      data.push_back(ReadMeasured(m, o->map, 20, &report));
+      data.push_back(ReadMeasured(m, o->map, 20, &report, [fit](const std::string& n) { return DiagnoseReadsColumn(n, fit); }));
       if (!o->map.empty()) std::fprintf(stderr, "diagnose: %s", report.Summary().c_str());
       CheckRecordFitsModel(params, o->params, data.back());
       if (params.human) CheckHumanJointRange(data.back());

@@ -133,6 +133,10 @@ enum class DiagnoseFit { kTorque, kMotion };
 const char* DiagnoseFitName(DiagnoseFit fit);
 // The fit a --fit option names; InputError "<where>: '<text>', expected torque or motion" otherwise.
 DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where);
+// The columns a diagnosis reads besides t, q_*, tau_* (formats/measured_data.h MeasuredColumns): the
+// recorded qd_*, qdd_* and emg_* columns, and with the motion fit cmd_* (the input where a joint's
+// reading is zero). A run's ref_* and state, and the torque fit's cmd_*, are not read.
+bool DiagnoseReadsColumn(const std::string& name, DiagnoseFit fit);
 
 // The motion fit: an effect the torque fit names that the motion fit does not (it does not lower the
 // held-out simulated error enough, or is not carried by the plant).
