@@ -261,6 +261,16 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
   return out;
 }
 
+// The table's link forms at the term's joint, as candidates: q (stiffness), qd (viscous friction),
+// sgn(qd) (Coulomb friction), qdd (inertia), tau_R (a gain).
+const std::vector<TermCandidate>& TableForms() {
+  using S = TermSignal;
+  static const std::vector<TermCandidate> k = {{{{TermFn::kId, S::kQ, 0}}}, {{{TermFn::kId, S::kQd, 0}}},
+                                               {{{TermFn::kSgn, S::kQd, 0}}}, {{{TermFn::kId, S::kQdd, 0}}},
+                                               {{{TermFn::kId, S::kTauR, 0}}}};
+  return k;
+}
+
 // A term in the model: its joint, candidate and columns in the banks.
 struct Term {
   int joint = 0;
@@ -428,6 +438,29 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       gain[i] = drop_te;
       best_gain = std::max(best_gain, drop_te);
     }
+    // The table's own forms at a joint compete first (simplest first): a term that one of them
+    // (Coulomb and viscous friction, inertia, stiffness, gain) explains within kParsimony of its
+    // held-out gain is that table effect's, which the table's selection judged, not a term.
+    for (size_t i = 0; i < top.size(); ++i) {
+      if (gain[i] <= 0) continue;
+      const int j = top[i].joint;
+      for (const TermCandidate& form : TableForms()) {
+        std::vector<Eigen::MatrixXd> col(R);
+        for (size_t r = 0; r < R; ++r) col[r] = ExactColumns(S[r], j, form, w);
+        const Grams gf = MakeSearchGrams(S, model, col, w, D->tau_eff);
+        std::vector<int> cols = cur;
+        cols.push_back(base);
+        const Fit ff = FitCols(gf, cols);
+        if (ff.ok && now.sse_te_j[j] - ff.sse_te_j[j] >= (1 - kParsimony) * gain[i]) {
+          D->term_search.push_back("not a term: " + CandidateExpr(top[i].c, kJointName[j]) + " (" + kJointName[j] +
+                                   ") is explained as well by the table's form " + CandidateExpr(form, kJointName[j]));
+          gain[i] = -1;
+          break;
+        }
+      }
+    }
+    best_gain = 0;
+    for (double v : gain) best_gain = std::max(best_gain, v);
     // The simplest admissible within kParsimony of the best's held-out gain.
     for (size_t i = 0; i < top.size(); ++i)
       if (gain[i] >= (1 - kParsimony) * best_gain && gain[i] > 0 &&
