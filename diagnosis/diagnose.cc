@@ -792,17 +792,21 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
-  const LegParams table_model = D.extended;  // the table's best model, before the search may rewrite it
-  const TermSearchResult searched = SearchTerms(params, recs, w, banks, scale, &D);
+  // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete, the
+  // search for terms beyond the table at those joints.
+  D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);
+  bool incomplete[2];
+  for (int j = 0; j < 2; ++j) incomplete[j] = !D.table_model.completeness[j].complete;
+  Lap("completeness + ceiling");
+  const TermSearchResult searched =
+      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};
   Lap("terms beyond the table");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
   Lap("extended twin");
-  // Stage 6c: the residual tests and ceiling of the table's best model and of the final one (after the
-  // search; the table's where it admitted no term).
-  D.table_model = torque_fit::AssessModel(params, table_model, recs, opt);
+  // Stage 6c: the final model's (the table's where the search admitted no term).
   D.final_model = searched.changed ? torque_fit::AssessModel(params, D.extended, recs, opt) : D.table_model;
-  Lap("completeness + ceiling");
+  Lap("final completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)
     for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r].ceiling[j], D.records[r].ceiling_null[j] = ceilings[r].null[j];

@@ -339,14 +339,15 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
 }  // namespace
 
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
-                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale, Diagnosis* D) {
+                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale,
+                             const bool at_joint[2], Diagnosis* D) {
   TermSearchResult out;
   const size_t R = recs.size(), K = D->effects.size();
   std::vector<SearchRec> S;
   for (size_t r = 0; r < R; ++r) S.push_back(Prepare(params, recs[r], banks[r], w, *D));
   std::vector<int> joints;
   for (int j = 0; j < 2; ++j)
-    if (w[j] > 0 && !(params.one_joint && j == 0)) joints.push_back(j);
+    if (at_joint[j] && w[j] > 0 && !(params.one_joint && j == 0)) joints.push_back(j);
   // The model's columns per record: the table's K, then the terms'.
   std::vector<Eigen::MatrixXd> model(R);
   for (size_t r = 0; r < R; ++r) model[r] = S[r].C;
@@ -397,6 +398,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     }
     const Grams g = MakeSearchGrams(S, model, extra, w, D->tau_eff);
     const Fit now = FitCols(g, cur);
+    double tt_all[2] = {0, 0};  // the measured torque's weighted sum of squares on every fit row
+    for (const SearchRec& s : S)
+      for (size_t k = 0; k < s.m; ++k)
+        for (int j = 0; j < 2; ++j) tt_all[j] += std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
     const double margin = kBicMargin + std::log(static_cast<double>(screened));
     int pick = -1;
     double best_gain = 0;
@@ -408,8 +413,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       const Fit f = FitCols(g, cols);
       if (!f.ok) continue;
       const double drop_te = now.sse_te_j[j] - f.sse_te_j[j];
+      // Material over the whole record, not only its held-out end: a term that fades (a drive warming
+      // up) is an effect where it acts.
       const bool held = drop_te >= kMinHeldoutGain * now.sse_te_j[j] &&
-                        drop_te >= kMinTorqueShare * kMinTorqueShare * g.tt_te[j];
+                        (now.sse_tr - f.sse_tr) + drop_te >= kMinTorqueShare * kMinTorqueShare * tt_all[j];
       const bool loo = R < 2 || now.sse_loo_j[j] - f.sse_loo_j[j] >= kMinHeldoutGain * now.sse_loo_j[j];
       const bool admissible = now.bic - f.bic > margin && held && loo && TermT(f, cand_cols[i]) > kMinT;
       D->term_search.push_back("step " + std::to_string(step + 1) + ": " +
@@ -461,7 +468,6 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       cur = Without(cur, {drop});
     }
   }
-  if (std::getenv("TERM_TRACE")) for (auto& l : D->term_search) std::fprintf(stderr, "%s\n", l.c_str());  // TEMP
   if (!out.changed) return out;
 
   // The final model: the kept table effects refitted, the terms; each one's held-out share.

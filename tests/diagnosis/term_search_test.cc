@@ -112,6 +112,11 @@ TEST(TermSearch, FormsOffTheTableAreNamedAndPredictedOnAnotherTrajectory) {
        [](double, double qd, double, double t) { return 1.5 * std::exp(-t / 12) * Sgn(qd); }},
       {"angle-modulated friction 1.0 (1 + 0.8 sin 3q) sgn(qd), knee", 1,
        [](double q, double qd, double, double) { return 1.0 * (1 + 0.8 * std::sin(3 * q)) * Sgn(qd); }},
+      {"Stribeck friction (0.4 + 0.8 exp(-(qd / 0.1)^2)) sgn(qd), knee", 1,
+       [](double, double qd, double, double) { return (0.4 + 0.8 * std::exp(-(qd / 0.1) * (qd / 0.1))) * Sgn(qd); }},
+      {"quadratic drag 0.8 qd |qd|, hip", 0, [](double, double qd, double, double) { return 0.8 * qd * std::abs(qd); }},
+      {"a torque sensor's square law -0.004 tau_R |tau_R|, hip", 0,
+       [](double, double, double tau, double) { return -0.004 * tau * std::abs(tau); }},
   };
   for (size_t c = 0; c < cases.size(); ++c) {
     const Case& cs = cases[c];
