@@ -1,5 +1,5 @@
-// Stage 6c of both fits (diagnose.h): a model's held-out residual tests (completeness.h) and its
-// black-box ceiling (black_box.h, JointCeiling).
+// Stages 5c (the table's best model) and 6c (the final one) of both fits (diagnose.h): a model's
+// held-out residual tests (completeness.h) and its black-box ceiling (black_box.h, JointCeiling).
 #include <algorithm>
 #include <array>
 #include <cmath>

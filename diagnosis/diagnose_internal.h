@@ -126,8 +126,8 @@ std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<R
 void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
                    const CutoffChoice& cutoff, double holdout_fraction, int threads, Rec* out);
 
-// Stage 6c (diagnose_completeness.cc): `model`'s assessment on the records against the model given
-// (`given`, whose rigid twin gives tau_R): the residual tests (completeness.h) of its filtered torque
+// Stages 5c and 6c (diagnose_completeness.cc): `model`'s assessment on the records against the model
+// given (`given`, whose rigid twin gives tau_R): the residual tests (completeness.h) of its filtered torque
 // residual on every record's held-out rows [split, n), decimated by CompletenessStep at the record's
 // cutoff, one segment per record, the material floor kMinTorqueShare of the measured torque's RMS on
 // those rows (the selection's); and its ceiling (JointCeiling), the black box trained on the model's

@@ -3,7 +3,8 @@
 // table is hidden in the record (added by hand to the reading, tau_S -= value * expr since tau_S =
 // -tau_R): a friction growing with the load, a Coulomb modulated by the angle, a friction fading as
 // the drive warms up. The black box's ceiling sees what the table's model leaves of the load-dependent
-// friction. The verdicts and ceilings are printed.
+// friction. The search for terms (term_search.h) then names the form: the final model is complete.
+// The verdicts and ceilings of the table's and the final model are printed.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -103,14 +104,23 @@ TEST(DiagnoseCompleteness, OffTableFormsAreIncomplete) {
       Hide(base, c.joints, c.form, &g.data);
       const Diagnosis d = Diagnose(base, g.data, TorqueOnly());
       std::string named;
-      for (const auto& e : d.effects) named += " " + e.effect.name + "(" + e.effect.joint + ")";
+      for (const auto& e : d.effects)
+        named += " " + e.effect.name + "(" + e.effect.joint + (e.effect.expr.empty() ? "" : ": " + e.effect.expr) + ")";
       for (int j : c.joints) {
         const JointCompleteness& v = d.table_model.completeness[j];
         const JointCeiling& ceil = d.table_model.ceiling[j];
-        std::printf("%s, seed %d, %s: %s (failed:%s), named%s; ceiling named %.1f %%, black box %.1f %%\n", c.what,
-                    static_cast<int>(seed), j == 0 ? "hip" : "knee", v.complete ? "complete" : "incomplete",
-                    Failed(v).c_str(), named.c_str(), ceil.named_pct, ceil.black_box_pct);
+        const JointCompleteness& vf = d.final_model.completeness[j];
+        const JointCeiling& cf = d.final_model.ceiling[j];
+        std::printf("%s, seed %d, %s: table %s (failed:%s), ceiling named %.1f %%, black box %.1f %%; named%s; "
+                    "final %s (failed:%s), ceiling named %.1f %%, black box %.1f %%\n",
+                    c.what, static_cast<int>(seed), j == 0 ? "hip" : "knee", v.complete ? "complete" : "incomplete",
+                    Failed(v).c_str(), ceil.named_pct, ceil.black_box_pct, named.c_str(),
+                    vf.complete ? "complete" : "incomplete", Failed(vf).c_str(), cf.named_pct, cf.black_box_pct);
         EXPECT_FALSE(v.complete) << c.what << " seed " << seed << " joint " << j;
+        // The search for terms names the form (or one that stands for it): the final model is
+        // complete and explains at least what the table's does.
+        EXPECT_TRUE(vf.complete) << c.what << " seed " << seed << " joint " << j;
+        EXPECT_GE(cf.named_pct, ceil.named_pct) << c.what;
         EXPECT_TRUE(ceil.done);
         // The black box adds to what the table's model explains (beyond noise) where the form is a
         // function of the state (not of time).
