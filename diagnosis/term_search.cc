@@ -493,7 +493,13 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
         const double loss = fk.bic - f.bic, tk = std::abs(CoefOf(f, c)) / std::max(1e-300, SeOf(f, c));
         DiagnosedEffect de = D->effects[static_cast<size_t>(c)];
         de.effect.value = CoefOf(f, c);
-        if ((loss < kBicMargin || tk < kMinT || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
+        // Redundant: it no longer earns the BIC margin or |t| and leaving it out costs its joint's
+        // held-out error less than kMinHeldoutGain (a term that only resembles it keeps it); or out
+        // of its range.
+        const int jc = EffectJoint(de.effect);
+        const bool held = fk.sse_te_j[jc] <= (1 + kMinHeldoutGain) * f.sse_te_j[jc];
+        const bool redundant = (loss < kBicMargin || tk < kMinT) && held;
+        if ((redundant || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
       }
       if (drop < 0) break;
       D->term_search.push_back("dropped " + D->effects[static_cast<size_t>(drop)].effect.name + " (" +
