@@ -13,6 +13,7 @@
 #include <string>
 
 #include "diagnosis/diagnose.h"
+#include "tests/diagnosis/hidden_effect_util.h"
 #include "diagnosis/generate.h"
 #include "formats/model_file.h"
 #include "model/leg_dynamics.h"
@@ -20,40 +21,12 @@
 namespace exotwin {
 namespace {
 
-LegParams S1() { return ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml"); }
-
-DiagnoseOptions TorqueOnly() {
-  DiagnoseOptions o;
-  o.simulate = false;
-  return o;
-}
-
-GeneratedData Clean(uint64_t seed, double duration) {
-  GenerateOptions g;
-  g.seed = seed;
-  g.effects = 0;
-  g.duration = duration;
-  g.rate = 500;
-  return GenerateMeasured(S1(), g);
-}
-
-// What the hidden form reads at one sample: the joint's angle, velocity, rigid actuator torque, time.
-using Form = std::function<double(double q, double qd, double tau_R, double t)>;
-
-double Sgn(double v) { return v > 0 ? 1.0 : v < 0 ? -1.0 : 0.0; }
-
-// The record with `form` added to tau_R at the joints in `joints` (the reading tau_S = -tau_R
-// lowered by it); the state from the record's own angles (DeriveKinematics), the rigid torque by the
-// closed form of the model.
-void Hide(const LegParams& p, const std::vector<int>& joints, const Form& form, MeasuredData* data) {
-  const Kinematics kin = DeriveKinematics(*data);
-  for (size_t i = 0; i < kin.t.size(); ++i) {
-    const Eigen::Vector2d tau = ActuatorTorque(p, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
-                                               {kin.qdd[0][i], kin.qdd[1][i]});
-    for (int j : joints)
-      data->column_at(j == 0 ? kColTauHip : kColTauKnee)[i] -= form(kin.q[j][i], kin.qd[j][i], tau[j], kin.t[i] - kin.t[0]);
-  }
-}
+using testing_hidden::CleanRecord;
+using testing_hidden::Form;
+using testing_hidden::Hide;
+using testing_hidden::S1;
+using testing_hidden::Sgn;
+using testing_hidden::TorqueOnly;
 
 std::string Failed(const JointCompleteness& c) {
   std::string s;
@@ -66,7 +39,7 @@ TEST(DiagnoseCompleteness, CleanRecordsAreComplete) {
   const LegParams base = S1();
   int complete = 0;
   for (uint64_t seed = 1; seed <= 20; ++seed) {
-    const GeneratedData g = Clean(4000 + seed, 30);
+    const GeneratedData g = CleanRecord(4000 + seed, 30);
     const Diagnosis d = Diagnose(base, g.data, TorqueOnly());
     const ModelAssessment& a = d.table_model;
     ASSERT_TRUE(a.completeness[0].assessed && a.completeness[1].assessed);
@@ -100,7 +73,7 @@ TEST(DiagnoseCompleteness, OffTableFormsAreIncomplete) {
   };
   for (const Case& c : cases)
     for (uint64_t seed = 1; seed <= 2; ++seed) {
-      GeneratedData g = Clean(5000 + seed, 30);
+      GeneratedData g = CleanRecord(5000 + seed, 30);
       Hide(base, c.joints, c.form, &g.data);
       const Diagnosis d = Diagnose(base, g.data, TorqueOnly());
       std::string named;
@@ -137,7 +110,7 @@ TEST(DiagnoseCompleteness, MotionFitAssessesItsTwin) {
   const LegParams base = S1();
   DiagnoseOptions o;
   o.fit = DiagnoseFit::kMotion;
-  GeneratedData g = Clean(6001, 30);
+  GeneratedData g = CleanRecord(6001, 30);
   const Diagnosis clean = Diagnose(base, g.data, o);
   EXPECT_TRUE(clean.table_model.completeness[0].complete && clean.table_model.completeness[1].complete);
   Hide(base, {0, 1}, [](double, double qd, double tau, double) { return (0.3 + 0.06 * std::abs(tau)) * Sgn(qd); }, &g.data);
