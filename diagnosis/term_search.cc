@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <cstdio>
-#include <cstdlib>
 
 #include <Eigen/Dense>
 
@@ -120,7 +119,6 @@ struct Screen {
   Eigen::VectorXd y;     // 2N: the target with the current model projected out
   Eigen::MatrixXd B[2];  // N x b: orthonormal basis of the table's forms at each joint (unweighted)
   size_t N = 0;
-  double n_eff = 1, sse = 0;
 };
 
 // The candidate's values on the screening rows of joint j (-expr, weighted, unfiltered).
@@ -168,7 +166,6 @@ Screen MakeScreen(const std::vector<SearchRec>& S, const Eigen::MatrixXd& Zrows,
     sc.Q = Eigen::MatrixXd::Zero(2 * N, 0);
   }
   sc.y = yrows - sc.Q * (sc.Q.transpose() * yrows);
-  sc.sse = sc.y.squaredNorm();
   // The table's forms at a joint: 1, q, qd, sgn(qd), qdd and tau_R (offset, stiffness, viscous and
   // Coulomb friction, inertia, gain): a term is a form the table does not have.
   for (int j = 0; j < 2; ++j) {
@@ -373,6 +370,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     for (size_t k = 0; k < S[r].mtr; k += stride) at.push_back({r, k});
   const Eigen::Index N = static_cast<Eigen::Index>(at.size());
 
+  double tt_all[2] = {0, 0};  // the measured torque's weighted sum of squares on every fit row
+  for (const SearchRec& s : S)
+    for (size_t k = 0; k < s.m; ++k)
+      for (int j = 0; j < 2; ++j) tt_all[j] += std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
   for (int step = 0; step < kMaxTerms; ++step) {
     // Screening against the current model.
     Eigen::MatrixXd Z(2 * N, static_cast<Eigen::Index>(cur.size()));
@@ -408,13 +409,8 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     }
     const Grams g = MakeSearchGrams(S, model, extra, w, D->tau_eff);
     const Fit now = FitCols(g, cur);
-    double tt_all[2] = {0, 0};  // the measured torque's weighted sum of squares on every fit row
-    for (const SearchRec& s : S)
-      for (size_t k = 0; k < s.m; ++k)
-        for (int j = 0; j < 2; ++j) tt_all[j] += std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
     const double margin = kBicMargin + std::log(static_cast<double>(screened));
     int pick = -1;
-    double best_gain = 0;
     std::vector<double> gain(top.size(), -1);
     for (size_t i = 0; i < top.size(); ++i) {
       const int j = top[i].joint;
@@ -436,30 +432,35 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
                                Num(TermT(f, cand_cols[i])) + (admissible ? ": admissible" : ""));
       if (!admissible) continue;
       gain[i] = drop_te;
-      best_gain = std::max(best_gain, drop_te);
     }
     // The table's own forms at a joint compete first (simplest first): a term that one of them
     // (Coulomb and viscous friction, inertia, stiffness, gain) explains within kParsimony of its
-    // held-out gain is that table effect's, which the table's selection judged, not a term.
+    // held-out gain is that table effect's, which the table's selection judged, not a term. The best
+    // form's held-out drop at a joint, once per step.
+    double form_drop[2] = {-1, -1};
+    std::string form_expr[2];
     for (size_t i = 0; i < top.size(); ++i) {
       if (gain[i] <= 0) continue;
       const int j = top[i].joint;
-      for (const TermCandidate& form : TableForms()) {
-        std::vector<Eigen::MatrixXd> col(R);
-        for (size_t r = 0; r < R; ++r) col[r] = ExactColumns(S[r], j, form, w);
-        const Grams gf = MakeSearchGrams(S, model, col, w, D->tau_eff);
-        std::vector<int> cols = cur;
-        cols.push_back(base);
-        const Fit ff = FitCols(gf, cols);
-        if (ff.ok && now.sse_te_j[j] - ff.sse_te_j[j] >= (1 - kParsimony) * gain[i]) {
-          D->term_search.push_back("not a term: " + CandidateExpr(top[i].c, kJointName[j]) + " (" + kJointName[j] +
-                                   ") is explained as well by the table's form " + CandidateExpr(form, kJointName[j]));
-          gain[i] = -1;
-          break;
+      if (form_drop[j] < 0) {
+        form_drop[j] = 0;
+        for (const TermCandidate& form : TableForms()) {
+          std::vector<Eigen::MatrixXd> col(R);
+          for (size_t r = 0; r < R; ++r) col[r] = ExactColumns(S[r], j, form, w);
+          std::vector<int> cols = cur;
+          cols.push_back(base);
+          const Fit ff = FitCols(MakeSearchGrams(S, model, col, w, D->tau_eff), cols);
+          if (ff.ok && now.sse_te_j[j] - ff.sse_te_j[j] > form_drop[j])
+            form_drop[j] = now.sse_te_j[j] - ff.sse_te_j[j], form_expr[j] = CandidateExpr(form, kJointName[j]);
         }
       }
+      if (form_drop[j] >= (1 - kParsimony) * gain[i]) {
+        D->term_search.push_back("not a term: " + CandidateExpr(top[i].c, kJointName[j]) + " (" + kJointName[j] +
+                                 ") is explained as well by the table's form " + form_expr[j]);
+        gain[i] = -1;
+      }
     }
-    best_gain = 0;
+    double best_gain = 0;
     for (double v : gain) best_gain = std::max(best_gain, v);
     // The simplest admissible within kParsimony of the best's held-out gain.
     for (size_t i = 0; i < top.size(); ++i)

@@ -115,6 +115,22 @@ TEST(TermSearch, CleanRecordsNameNoTerm) {
   }
 }
 
+// A table effect the table's own gates leave unnamed is not named as a term either: the table's forms
+// compete first (a hidden hip inertia error of seed 7 was once named as sgn(qdd) qdd^2).
+TEST(TermSearch, ATableEffectIsNotNamedAsATerm) {
+  const LegParams base = S1();
+  GenerateOptions g;
+  g.seed = 7;
+  g.allowed = {"inertia_error"};
+  g.duration = 30;
+  g.rate = 500;
+  const Diagnosis d = Diagnose(base, GenerateMeasured(base, g).data, TorqueOnly());
+  bool competed = false;
+  for (const auto& s : d.term_search) competed = competed || s.rfind("not a term:", 0) == 0;
+  EXPECT_TRUE(competed) << "the search ran and a table form took its best candidate";
+  for (const auto& e : d.effects) EXPECT_NE(e.effect.name, "term") << e.effect.expr;
+}
+
 // Every candidate's expression, parsed by the model file's grammar, evaluates to the library's value.
 TEST(TermLibrary, ExpressionsEvaluateAsTheColumns) {
   TermScales s;
