@@ -343,6 +343,40 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
   return d;
 }
 
+// Backward elimination: drops, one at a time, the table effect (columns below K of `cur`) that no
+// longer earns the BIC margin or |t| beside the terms and whose absence costs its joint's held-out
+// error less than kMinHeldoutGain, or that left its physical range.
+void DropRedundant(const std::vector<SearchRec>& S, const std::vector<Eigen::MatrixXd>& model, const double w[2],
+                   const PhysicalScale& scale, size_t K, Diagnosis* D, std::vector<int>* cur_out) {
+  std::vector<int>& cur = *cur_out;
+  const size_t R = S.size();
+  const std::vector<Eigen::MatrixXd> none(R, Eigen::MatrixXd(model[0].rows(), 0));
+  const Grams gm = MakeSearchGrams(S, model, none, w, D->tau_eff);
+  for (;;) {
+    const Fit f = FitCols(gm, cur);
+    int drop = -1;
+    double least = 1e300;
+    for (int c : cur) {
+      if (c >= static_cast<int>(K)) continue;
+      const Fit fk = FitCols(gm, Without(cur, {c}));
+      const double loss = fk.bic - f.bic, tk = std::abs(CoefOf(f, c)) / std::max(1e-300, SeOf(f, c));
+      DiagnosedEffect de = D->effects[static_cast<size_t>(c)];
+      de.effect.value = CoefOf(f, c);
+      // Redundant: it no longer earns the BIC margin or |t| and leaving it out costs its joint's
+      // held-out error less than kMinHeldoutGain (a term that only resembles it keeps it); or out
+      // of its range.
+      const int jc = EffectJoint(de.effect);
+      const bool held = fk.sse_te_j[jc] <= (1 + kMinHeldoutGain) * f.sse_te_j[jc];
+      const bool redundant = (loss < kBicMargin || tk < kMinT) && held;
+      if ((redundant || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
+    }
+    if (drop < 0) break;
+    D->term_search.push_back("dropped " + D->effects[static_cast<size_t>(drop)].effect.name + " (" +
+                             D->effects[static_cast<size_t>(drop)].effect.joint + "): redundant beside the terms");
+    cur = Without(cur, {drop});
+  }
+}
+
 }  // namespace
 
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
@@ -482,31 +516,7 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     terms.push_back(t);
     out.changed = true;
     // Backward elimination of the table's effects the term makes redundant.
-    const std::vector<Eigen::MatrixXd> none(R, Eigen::MatrixXd(model[0].rows(), 0));
-    const Grams gm = MakeSearchGrams(S, model, none, w, D->tau_eff);
-    for (;;) {
-      const Fit f = FitCols(gm, cur);
-      int drop = -1;
-      double least = 1e300;
-      for (int c : cur) {
-        if (c >= static_cast<int>(K)) continue;
-        const Fit fk = FitCols(gm, Without(cur, {c}));
-        const double loss = fk.bic - f.bic, tk = std::abs(CoefOf(f, c)) / std::max(1e-300, SeOf(f, c));
-        DiagnosedEffect de = D->effects[static_cast<size_t>(c)];
-        de.effect.value = CoefOf(f, c);
-        // Redundant: it no longer earns the BIC margin or |t| and leaving it out costs its joint's
-        // held-out error less than kMinHeldoutGain (a term that only resembles it keeps it); or out
-        // of its range.
-        const int jc = EffectJoint(de.effect);
-        const bool held = fk.sse_te_j[jc] <= (1 + kMinHeldoutGain) * f.sse_te_j[jc];
-        const bool redundant = (loss < kBicMargin || tk < kMinT) && held;
-        if ((redundant || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
-      }
-      if (drop < 0) break;
-      D->term_search.push_back("dropped " + D->effects[static_cast<size_t>(drop)].effect.name + " (" +
-                               D->effects[static_cast<size_t>(drop)].effect.joint + "): redundant beside the terms");
-      cur = Without(cur, {drop});
-    }
+    DropRedundant(S, model, w, scale, K, D, &cur);
   }
   if (!out.changed) return out;
 
