@@ -168,6 +168,19 @@ struct ModelAssessment {
   JointCeiling ceiling[2];
 };
 
+// A named term's component-plus-residual plot (the report's "residual against the term's signals"):
+// on the first record's fit rows (at most kTermPlotPoints of them, evenly strided), the final model's
+// residual plus the term's own fitted torque (partial), against the term's shape (its torque per unit
+// value, filtered as the residual: partial = value * shape where the term is right) and against each
+// signal the term reads (unfiltered). N m, the signals in their grammar units.
+struct TermPlot {
+  std::string joint, expr;
+  double value = 0;
+  std::vector<double> shape, partial;
+  std::vector<std::pair<std::string, std::vector<double>>> signals;
+};
+constexpr size_t kTermPlotPoints = 1500;
+
 struct Diagnosis {
   DiagnoseFit fit = DiagnoseFit::kTorque;
   std::vector<DiagnosedEffect> effects;
@@ -180,6 +193,7 @@ struct Diagnosis {
   std::vector<std::string> collinear;   // nearly collinear candidate pairs on this record, in words
   std::vector<std::string> selection;   // the selection's steps, in words
   std::vector<std::string> term_search; // the search for terms beyond the table, in words (term_search.h)
+  std::vector<TermPlot> term_plots;     // one per named term (term_search.h)
   std::vector<std::string> implausible; // candidates that fit alone but fall outside their range
   // Candidates these records cannot identify: fitted alone, even a value at the edge of their physical
   // range would not be significant (|t| < kMinT), e.g. an inertia on a slow, hand-guided record.

@@ -159,6 +159,29 @@ std::string CompletenessSection(const Diagnosis& d) {
 }
 
 // The motion fit's report (diagnosis/motion_fit.h).
+// Each named term's component-plus-residual plots (diagnose.h TermPlot): the residual plus the term's
+// own torque against its shape, with the line value * shape, and against each signal it reads.
+std::string TermPlotsHtml(const Diagnosis& d) {
+  std::ostringstream o;
+  for (const TermPlot& p : d.term_plots) {
+    o << "<p>" << HtmlEscape(p.joint) << ": the residual plus the term's own torque (points) lies on the "
+      << "term's line where its form is right; spread about the line is what the final model leaves.</p>";
+    SvgSeries pts{p.shape, p.partial, "#d62728", "residual + term (fit rows)", true}, line{{}, {}, "#1f77b4", "term"};
+    double lo = 0, hi = 0;
+    for (double x : p.shape) lo = std::min(lo, x), hi = std::max(hi, x);
+    line.x = {lo, hi}, line.y = {p.value * lo, p.value * hi};
+    o << SvgChart(p.joint + ": residual + " + NumberText(p.value) + " * " + p.expr, "term shape (" + p.expr + ", filtered)",
+                  "N m", {pts, line});
+    for (const auto& sig : p.signals) {
+      SvgSeries r{sig.second, p.partial, "#d62728", "residual + term", true},
+          t{sig.second, {}, "#1f77b4", "term", true};
+      for (double x : p.shape) t.y.push_back(p.value * x);
+      o << SvgChart(p.joint + ": residual + term against " + sig.first, sig.first, "N m", {r, t});
+    }
+  }
+  return o.str();
+}
+
 std::string MotionReportHtml(const Diagnosis& d, const std::string& params_path, const std::string& measured_path) {
   const char* jn[2] = {"hip", "knee"};
   const int j0 = d.extended.one_joint ? 1 : 0;
@@ -297,7 +320,9 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
         o << "<li><b>" << HtmlEscape((e.effect.stage == "sensor" ? "tau_S(" : "tau_R(") + e.effect.joint + ") += " +
                                      NumberText(e.effect.value) + " * " + e.effect.expr)
           << "</b> (" << NumberText(e.explained_pct) << " % of the held-out residual)</li>";
-    o << "</ul><p>The search's steps:</p><ol>";
+    o << "</ul>";
+    o << TermPlotsHtml(d);
+    o << "<p>The search's steps:</p><ol>";
     for (const auto& s : d.term_search) o << "<li>" << HtmlEscape(s) << "</li>";
     o << "</ol>";
   }

@@ -12,6 +12,7 @@
 #include "diagnosis/term_library.h"
 #include "model/effect_families.h"
 #include "model/leg_dynamics.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 namespace torque_fit {
@@ -377,6 +378,46 @@ void DropRedundant(const std::vector<SearchRec>& S, const std::vector<Eigen::Mat
   }
 }
 
+// The named terms' component-plus-residual plots on the first record's fit rows (diagnose.h TermPlot):
+// the residual of the final fit `f` on `model` plus each term's own fitted columns.
+std::vector<TermPlot> TermPlots(const SearchRec& s, const Eigen::MatrixXd& model, const Fit& f,
+                                const std::vector<Term>& terms, const std::vector<DiagnosedEffect>& effects,
+                                const double w[2]) {
+  static const char* kSignal[2] = {"q", "qd"};
+  std::vector<TermPlot> out;
+  Eigen::VectorXd fitted = Eigen::VectorXd::Zero(s.r0.size());
+  for (size_t c = 0; c < f.cols.size(); ++c) fitted += f.coef[static_cast<Eigen::Index>(c)] * model.col(f.cols[c]);
+  const Eigen::VectorXd resid = s.r0 - fitted;
+  const size_t stride = std::max<size_t>(1, (s.m + kTermPlotPoints - 1) / kTermPlotPoints);
+  size_t e = 0;
+  for (const Term& t : terms) {
+    while (e < effects.size() && effects[e].effect.name != kTerm) ++e;
+    const DiagnosedEffect& de = effects[e++];
+    TermPlot p;
+    p.joint = de.effect.joint, p.expr = de.effect.expr, p.value = de.effect.value;
+    Eigen::VectorXd own = Eigen::VectorXd::Zero(s.r0.size());
+    for (int c : t.cols) own += CoefOf(f, c) * model.col(c);
+    const TermExpr expr = TermExpr::Parse(de.effect.expr);
+    const int j = t.joint;
+    // The grammar's names of the row's signals at joint j (the other joint's by its own name).
+    const std::string names[7] = {"q", "qd", "qdd", "tau_R", j == 0 ? "q_knee" : "q_hip", j == 0 ? "qd_knee" : "qd_hip", "t"};
+    std::vector<int> read;
+    for (int i = 0; i < 7; ++i)
+      if (expr.Reads(names[i]) || (i < 2 && expr.Reads(std::string(kSignal[i]) + (j == 0 ? "_hip" : "_knee"))))
+        read.push_back(i);
+    for (int i : read) p.signals.push_back({names[i], {}});
+    for (size_t k = 0; k < s.m; k += stride) {
+      const Eigen::Index row = static_cast<Eigen::Index>(j * s.m + k);
+      p.partial.push_back((resid[row] + own[row]) / w[j]);
+      p.shape.push_back(de.effect.value != 0 ? own[row] / (w[j] * de.effect.value) : 0.0);
+      const TermRow r = RowAt(s, j, s.bank->sample[k]);
+      for (size_t q = 0; q < read.size(); ++q) p.signals[q].second.push_back(r.s[static_cast<size_t>(read[q])]);
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 }  // namespace
 
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
@@ -546,6 +587,7 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     return e;
   };
   D->effects = effects_at(f.coef, f.cols, &f);
+  D->term_plots = TermPlots(S[0], model[0], f, terms, D->effects, w);
   D->extended = params;
   for (const DiagnosedEffect& de : D->effects) D->extended.effects.push_back(de.effect);
   if (R >= 2)

@@ -193,6 +193,42 @@ TEST(TermSearch, ATableEffectIsNotNamedAsATerm) {
   for (const auto& e : d.effects) EXPECT_NE(e.effect.name, "term") << e.effect.expr;
 }
 
+// The report's plot of a named term (diagnose.h TermPlot): the residual plus the term's own torque lies
+// on the term's line. The least-squares slope of the points against the shape is the hidden form's
+// coefficient (0.06 per N m of |tau_R|) within 3 %, the points explain >= 95 % of their variance, and
+// the signals read are the expression's (tau_R and qd).
+TEST(TermSearch, ThePlotsPointsLieOnTheTermsLine) {
+  const LegParams base = S1();
+  GeneratedData rec = CleanRecord(960, 40);
+  Hide(base, {1}, [](double, double qd, double tau, double) { return (0.3 + 0.06 * std::abs(tau)) * Sgn(qd); },
+       &rec.data);
+  const Diagnosis d = Diagnose(base, rec.data, TorqueOnly());
+  ASSERT_EQ(d.term_plots.size(), 1u);
+  const TermPlot& p = d.term_plots[0];
+  EXPECT_EQ(p.joint, "knee");
+  ASSERT_EQ(p.shape.size(), p.partial.size());
+  EXPECT_GT(p.shape.size(), 500u);
+  EXPECT_LE(p.shape.size(), kTermPlotPoints);
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  const double n = static_cast<double>(p.shape.size());
+  for (size_t i = 0; i < p.shape.size(); ++i) {
+    const double x = p.shape[i], y = p.partial[i];
+    sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y;
+  }
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double r2 = std::pow(n * sxy - sx * sy, 2) / ((n * sxx - sx * sx) * (n * syy - sy * sy));
+  std::printf("term %s = %.4g: the points' slope %.4g, R^2 %.4f\n", p.expr.c_str(), p.value, slope, r2);
+  EXPECT_NEAR(slope, 0.06, 0.03 * 0.06);
+  EXPECT_NEAR(slope, p.value, 0.03 * std::abs(p.value));
+  EXPECT_GE(r2, 0.95);
+  std::vector<std::string> read;
+  for (const auto& sig : p.signals) {
+    read.push_back(sig.first);
+    EXPECT_EQ(sig.second.size(), p.shape.size());
+  }
+  EXPECT_EQ(read, (std::vector<std::string>{"qd", "tau_R"}));
+}
+
 // Every candidate's expression, parsed by the model file's grammar, evaluates to the library's value.
 TEST(TermLibrary, ExpressionsEvaluateAsTheColumns) {
   TermScales s;
