@@ -63,6 +63,7 @@ using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
 using torque_fit::UseSecantColumns;
 using torque_fit::SearchTerms;
+using torque_fit::CeilingLeavesStructure;
 using torque_fit::TermSearchResult;
 
 // Autocorrelation length (in rows) of a residual of 2m rows (hip block, knee block): the longer.
@@ -802,7 +803,19 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);
   const std::array<JointCompleteness, 2> on_fit_rows = torque_fit::CompletenessOnFitRows(params, D.extended, recs, opt);
   bool incomplete[2];
-  for (int j = 0; j < 2; ++j) incomplete[j] = !D.table_model.completeness[j].complete || !on_fit_rows[j].complete;
+  for (int j = 0; j < 2; ++j) {
+    const JointCompleteness& held = D.table_model.completeness[j];
+    const bool ceiling = CeilingLeavesStructure(D.table_model.ceiling[j], held.floor);
+    incomplete[j] = opt.search_terms && (!held.complete || !on_fit_rows[j].complete || ceiling);
+    if (incomplete[j])
+      D.term_search.push_back(std::string(j == 0 ? "hip" : "knee") + ": the table's best model is incomplete (" +
+                              (!held.complete ? "residual tests on the held-out rows; " : "") +
+                              (!on_fit_rows[j].complete ? "residual tests on the fit rows; " : "") +
+                              (ceiling ? "the black box lowers its held-out error by " +
+                                             NumberText(100 * (D.table_model.ceiling[j].black_box_pct - D.table_model.ceiling[j].named_pct) /
+                                                            std::max(1e-9, 100 - D.table_model.ceiling[j].named_pct), 3) + " %; " : "") +
+                              "searched)");
+  }
   Lap("completeness + ceiling");
   const TermSearchResult searched =
       incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};

@@ -149,6 +149,13 @@ ModelAssessment AssessModel(const LegParams& given, const LegParams& model, cons
   return out;
 }
 
+bool CeilingLeavesStructure(const JointCeiling& c, double floor) {
+  if (!c.done) return false;
+  const double removed = (c.black_box_pct - c.named_pct) / 100;  // of the model given's held-out SSE
+  const double left = 1 - c.named_pct / 100;                      // what the named model leaves of it
+  return removed >= kMinHeldoutGain * left && c.given_rms * std::sqrt(std::max(0.0, removed)) >= floor;
+}
+
 std::array<JointCompleteness, 2> CompletenessOnFitRows(const LegParams& given, const LegParams& model,
                                                       const std::vector<Rec>& recs, const DiagnoseOptions& opt) {
   std::array<JointCompleteness, 2> out;

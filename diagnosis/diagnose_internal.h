@@ -143,6 +143,13 @@ ModelAssessment AssessModel(const LegParams& given, const LegParams& model, cons
 // held-out end (a drive warming up) is seen where it acts.
 std::array<JointCompleteness, 2> CompletenessOnFitRows(const LegParams& given, const LegParams& model,
                                                       const std::vector<Rec>& recs, const DiagnoseOptions& opt);
+// Whether the ceiling `c` says the named model leaves structure at a joint by the gates a table
+// effect passes (diagnose_select.h): the black box trained on its residual lowers its held-out sum of
+// squares by at least kMinHeldoutGain, and the part it removes is material (its RMS at least `floor`,
+// the completeness tests' material floor). Decides the search beside the residual tests: it needs no
+// minimum of decimated rows (a short held-out part, a low cutoff) and sees any function of the states,
+// tau_R and their short history.
+bool CeilingLeavesStructure(const JointCeiling& c, double floor);
 // The same on the records themselves (the motion fit's): each prepared as stage 2 does at `cutoff`
 // (the torque fit's) with the model given, then AssessModel.
 ModelAssessment AssessModelOnRecords(const LegParams& given, const LegParams& model,

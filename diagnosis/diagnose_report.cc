@@ -171,12 +171,12 @@ std::string TermPlotsHtml(const Diagnosis& d) {
     for (double x : p.shape) lo = std::min(lo, x), hi = std::max(hi, x);
     line.x = {lo, hi}, line.y = {p.value * lo, p.value * hi};
     o << SvgChart(p.joint + ": residual + " + NumberText(p.value) + " * " + p.expr, "term shape (" + p.expr + ", filtered)",
-                  "N m", {pts, line});
+                  "tau_S residual + term (N m)", {pts, line});
     for (const auto& sig : p.signals) {
       SvgSeries r{sig.second, p.partial, "#d62728", "residual + term", true},
           t{sig.second, {}, "#1f77b4", "term", true};
       for (double x : p.shape) t.y.push_back(p.value * x);
-      o << SvgChart(p.joint + ": residual + term against " + sig.first, sig.first, "N m", {r, t});
+      o << SvgChart(p.joint + ": residual + term against " + sig.first, sig.first, "tau_S residual + term (N m)", {r, t});
     }
   }
   return o.str();

@@ -56,6 +56,7 @@ Diagnosis TorqueFitOf(const LegParams& params, const std::vector<const MeasuredD
   DiagnoseOptions topt = opt;
   topt.fit = DiagnoseFit::kTorque;
   topt.simulate = false;
+  topt.search_terms = false;  // the motion fit searches no terms: its start and floor are the table's model
   Diagnosis T = Diagnose(params, records, topt);
   return T;
 }

@@ -261,11 +261,21 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
 
 // The table's link forms at the term's joint, as candidates: q (stiffness), qd (viscous friction),
 // sgn(qd) (Coulomb friction), qdd (inertia), tau_R (a gain).
-const std::vector<TermCandidate>& TableForms() {
+// The table's forms that compete with a term at its joint: a stiffness (q), viscous and Coulomb
+// friction (qd, sgn(qd)), an inertia error (qdd) and a sensor gain (tau_R). `passive`: the table names
+// the form only with a positive coefficient (a restoring or dissipative torque, which the actuator's
+// tau_R grows by); at the other sign it is no table effect, so it takes no term's place.
+struct TableForm {
+  TermCandidate c;
+  bool passive = false;
+};
+const std::vector<TableForm>& TableForms() {
   using S = TermSignal;
-  static const std::vector<TermCandidate> k = {{{{TermFn::kId, S::kQ, 0}}}, {{{TermFn::kId, S::kQd, 0}}},
-                                               {{{TermFn::kSgn, S::kQd, 0}}}, {{{TermFn::kId, S::kQdd, 0}}},
-                                               {{{TermFn::kId, S::kTauR, 0}}}};
+  static const std::vector<TableForm> k = {{{{{TermFn::kId, S::kQ, 0}}}, true},
+                                           {{{{TermFn::kId, S::kQd, 0}}}, true},
+                                           {{{{TermFn::kSgn, S::kQd, 0}}}, true},
+                                           {{{{TermFn::kId, S::kQdd, 0}}}, false},
+                                           {{{{TermFn::kId, S::kTauR, 0}}}, false}};
   return k;
 }
 
@@ -346,9 +356,11 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
 
 // Backward elimination: drops, one at a time, the table effect (columns below K of `cur`) that no
 // longer earns the BIC margin or |t| beside the terms and whose absence costs its joint's held-out
-// error less than kMinHeldoutGain, or that left its physical range.
+// error less than the selection's gates (kMinHeldoutGain of it or the material floor; tt_te: the
+// measured torque's weighted sum of squares on the held-out rows), or that left its physical range.
 void DropRedundant(const std::vector<SearchRec>& S, const std::vector<Eigen::MatrixXd>& model, const double w[2],
-                   const PhysicalScale& scale, size_t K, Diagnosis* D, std::vector<int>* cur_out) {
+                   const PhysicalScale& scale, size_t K, const double tt_te[2], Diagnosis* D,
+                   std::vector<int>* cur_out) {
   std::vector<int>& cur = *cur_out;
   const size_t R = S.size();
   const std::vector<Eigen::MatrixXd> none(R, Eigen::MatrixXd(model[0].rows(), 0));
@@ -364,10 +376,12 @@ void DropRedundant(const std::vector<SearchRec>& S, const std::vector<Eigen::Mat
       DiagnosedEffect de = D->effects[static_cast<size_t>(c)];
       de.effect.value = CoefOf(f, c);
       // Redundant: it no longer earns the BIC margin or |t| and leaving it out costs its joint's
-      // held-out error less than kMinHeldoutGain (a term that only resembles it keeps it); or out
-      // of its range.
+      // held-out error less than the selection's gates ask of an effect, kMinHeldoutGain of it or
+      // the material floor (kMinTorqueShare of the measured torque's RMS, squared, on those rows): a
+      // term that only resembles it keeps it; or out of its range.
       const int jc = EffectJoint(de.effect);
-      const bool held = fk.sse_te_j[jc] <= (1 + kMinHeldoutGain) * f.sse_te_j[jc];
+      const double cost = fk.sse_te_j[jc] - f.sse_te_j[jc];
+      const bool held = cost < kMinHeldoutGain * f.sse_te_j[jc] || cost < kMinTorqueShare * kMinTorqueShare * tt_te[jc];
       const bool redundant = (loss < kBicMargin || tk < kMinT) && held;
       if ((redundant || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
     }
@@ -445,10 +459,15 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     for (size_t k = 0; k < S[r].mtr; k += stride) at.push_back({r, k});
   const Eigen::Index N = static_cast<Eigen::Index>(at.size());
 
-  double tt_all[2] = {0, 0};  // the measured torque's weighted sum of squares on every fit row
+  // The measured torque's weighted sum of squares on every fit row, and on the held-out rows.
+  double tt_all[2] = {0, 0}, tt_te[2] = {0, 0};
   for (const SearchRec& s : S)
     for (size_t k = 0; k < s.m; ++k)
-      for (int j = 0; j < 2; ++j) tt_all[j] += std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
+      for (int j = 0; j < 2; ++j) {
+        const double v = std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
+        tt_all[j] += v;
+        if (!s.bank->train[k]) tt_te[j] += v;
+      }
   for (int step = 0; step < kMaxTerms; ++step) {
     // Screening against the current model.
     Eigen::MatrixXd Z(2 * N, static_cast<Eigen::Index>(cur.size()));
@@ -519,14 +538,14 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       const int j = top[i].joint;
       if (form_drop[j] < 0) {
         form_drop[j] = 0;
-        for (const TermCandidate& form : TableForms()) {
+        for (const TableForm& form : TableForms()) {
           std::vector<Eigen::MatrixXd> col(R);
-          for (size_t r = 0; r < R; ++r) col[r] = ExactColumns(S[r], j, form, w);
+          for (size_t r = 0; r < R; ++r) col[r] = ExactColumns(S[r], j, form.c, w);
           std::vector<int> cols = cur;
           cols.push_back(base);
           const Fit ff = FitCols(MakeSearchGrams(S, model, col, w, D->tau_eff), cols);
-          if (ff.ok && now.sse_te_j[j] - ff.sse_te_j[j] > form_drop[j])
-            form_drop[j] = now.sse_te_j[j] - ff.sse_te_j[j], form_expr[j] = CandidateExpr(form, kJointName[j]);
+          if (ff.ok && (!form.passive || CoefOf(ff, base) > 0) && now.sse_te_j[j] - ff.sse_te_j[j] > form_drop[j])
+            form_drop[j] = now.sse_te_j[j] - ff.sse_te_j[j], form_expr[j] = CandidateExpr(form.c, kJointName[j]);
         }
       }
       if (form_drop[j] >= (1 - kParsimony) * gain[i]) {
@@ -557,7 +576,7 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     terms.push_back(t);
     out.changed = true;
     // Backward elimination of the table's effects the term makes redundant.
-    DropRedundant(S, model, w, scale, K, D, &cur);
+    DropRedundant(S, model, w, scale, K, tt_te, D, &cur);
   }
   if (!out.changed) return out;
 
