@@ -25,6 +25,7 @@
 #include "diagnosis/effects.h"
 #include "diagnosis/generate.h"
 #include "diagnosis/motion_fit.h"
+#include "diagnosis/fit_families.h"
 #include "formats/number_text.h"
 #include "diagnosis/predict.h"
 #include "dsp/statistics.h"
@@ -821,6 +822,12 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
       incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};
   Lap("terms beyond the table");
 
+  // Each final effect's equivalent reading (FitFamily::equivalent), among its aliases.
+  for (DiagnosedEffect& de : D.effects) {
+    EffectAlias a;
+    const FitFamily& f = FitFamilyOf(de.effect.name);
+    if (f.equivalent && f.equivalent(de, D.effects, &a)) de.aliases.insert(de.aliases.begin(), a);
+  }
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
   Lap("extended twin");
   // Stage 6c: the final model's (the table's where the search admitted no term).

@@ -18,7 +18,7 @@ std::string AliasText(const EffectAlias& a) {
   std::string s;
   for (const Effect& e : a.effects)
     s += (s.empty() ? "" : " + ") + e.name + (e.axis.empty() ? "" : "." + e.axis) + " (" + e.joint + ") = " +
-         NumberText(e.value, 4) + " " + e.unit;
+         NumberText(e.value, 4) + " " + e.unit + (e.expr.empty() ? "" : " * " + e.expr);
   return s + " (reaches " + NumberText(a.reach_pct, 4) + " % of its fit, leaves it " + NumberText(a.left_pct, 2) + " %)" +
          (a.plausible ? "" : " [outside its range]");
 }
@@ -48,6 +48,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
       for (const Effect& f : a.effects) {
         json jf = {{"name", f.name}, {"joint", f.joint}, {"value", f.value}, {"unit", f.unit}};
         if (!f.axis.empty()) jf["axis"] = f.axis;
+        if (!f.expr.empty()) jf["expr"] = f.expr, jf["stage"] = f.stage;
         ja["effects"].push_back(jf);
       }
       x["aliases"].push_back(ja);

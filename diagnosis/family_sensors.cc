@@ -85,6 +85,24 @@ void DelayMotion(MotionJoint& mj, const FitFamily& self) {
     mj.add_candidate(self, {mj.add_parameter(self, self.family->name, {0, 0.05, 0.002}, 0)});
 }
 
+// A sensor offset o beside a Coulomb friction c at the same joint: the reading tau_S = -tau_R + o
+// while the joint moves is that of a friction (c - o) sgn(qd) + ... with no offset only at rest, i.e.
+// a direction-dependent friction c - o one way (qd > 0) and c + o the other: the link term
+// -o * abs(sgn(qd)) (abs(sgn(qd)) = 1 wherever qd != 0) in the offset's place, exactly. Only a record
+// that holds the joint still under a known torque tells the two apart.
+bool OffsetAsFrictionAsymmetry(const DiagnosedEffect& e, const std::vector<DiagnosedEffect>& named, EffectAlias* a) {
+  const auto coulomb = std::find_if(named.begin(), named.end(), [&](const DiagnosedEffect& d) {
+    return d.effect.name == kCoulombFriction && d.effect.joint == e.effect.joint;
+  });
+  if (coulomb == named.end()) return false;
+  Effect t;
+  t.name = kTerm, t.joint = e.effect.joint, t.unit = "N m", t.value = -e.effect.value;
+  t.expr = "abs(sgn(qd))", t.stage = "link";
+  a->effects = {t};
+  a->reach_pct = 100, a->left_pct = 0, a->plausible = true;
+  return true;
+}
+
 bool AnyValue(const MotionProblem&, int, const Eigen::VectorXd&, Effect*) { return true; }
 bool PositiveValue(const MotionProblem&, int, const Eigen::VectorXd&, Effect* e) { return e->value > 0; }
 
@@ -94,6 +112,7 @@ FitFamily SensorOffsetRow() {
   FitFamily f = FitRow("sensor_offset", OffsetRange, DrawOffset);
   f.range_edge = HalfTorqueEdge;
   f.add_columns = OffsetColumns, f.motion_candidates = OffsetMotion, f.motion_effect = AnyValue;
+  f.equivalent = OffsetAsFrictionAsymmetry;
   return f;
 }
 

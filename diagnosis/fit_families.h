@@ -111,6 +111,10 @@ struct FitFamily {
   const char* exchanged_with = nullptr;
   double (*torque_at_speed)(double value, double qd_rms) = nullptr;
   double (*value_at_speed)(double torque, double qd_rms) = nullptr;
+  // A reading of the named effect e that the data of a moving joint cannot tell apart from it, given
+  // the other named effects (e.g. a sensor offset beside a Coulomb friction: a direction-dependent
+  // friction), as an alias whose effects stand in e's place; false: none.
+  bool (*equivalent)(const DiagnosedEffect& e, const std::vector<DiagnosedEffect>& named, EffectAlias* a) = nullptr;
 };
 
 // Every family's fit row: DESIGN.md's families in the model registry's order, then those added.
