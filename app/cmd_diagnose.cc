@@ -56,7 +56,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     std::string names;
     for (const std::string& m : o->measured) {
       MapReport report;
-      data.push_back(ReadMeasured(m, o->map, 20, &report));
+      data.push_back(ReadMeasured(m, o->map, 20, &report, [fit](const std::string& n) { return DiagnoseReadsColumn(n, fit); }));
       if (!o->map.empty()) std::fprintf(stderr, "diagnose: %s", report.Summary().c_str());
       CheckRecordFitsModel(params, o->params, data.back());
       if (params.human) CheckHumanJointRange(data.back());
@@ -100,6 +100,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
         for (size_t k = 0; k < S.torque_fit_not_carried.size(); ++k)
           line += (k == 0 ? " (not carried: " : ", ") + S.torque_fit_not_carried[k] + (k + 1 == S.torque_fit_not_carried.size() ? ")" : "");
         std::printf("%s\n", line.c_str());
+        if (!S.torque_fit_why.empty()) std::printf("diagnose: %s\n", S.torque_fit_why.c_str());
       }
       std::printf("diagnose: report %s/report.html\n", o->out.c_str());
       return 0;

@@ -49,6 +49,11 @@ DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where) 
   if (text == "motion") return DiagnoseFit::kMotion;
   throw InputError(where + ": '" + text + "', expected torque or motion");
 }
+
+bool DiagnoseReadsColumn(const std::string& name, DiagnoseFit fit) {
+  if (name.rfind("qd_", 0) == 0 || name.rfind("qdd_", 0) == 0 || name.rfind("emg_", 0) == 0) return IsMeasuredColumn(name);
+  return fit == DiagnoseFit::kMotion && IsMeasuredColumn(name) && name.rfind("cmd_", 0) == 0;
+}
 namespace {
 
 using torque_fit::Rec;

@@ -120,6 +120,9 @@ struct SimulationScores {
   bool torque_fit_done = false;
   JointScore torque_fit_split[2], torque_fit_left_out[2];
   std::vector<std::string> torque_fit_not_carried;
+  // A motion fit whose extended twin still replays the held-out rows worse than the torque fit's twin
+  // (above kTorqueTwinTolerance times its RMS error at a joint, motion_fit.h): why, in words; else empty.
+  std::string torque_fit_why;
   // First record's held-out part: time, measured angle, rigid and extended twin's simulated angle
   // (NaN between windows).
   std::vector<double> t, measured[2], rigid[2], extended[2];
@@ -132,6 +135,10 @@ enum class DiagnoseFit { kTorque, kMotion };
 const char* DiagnoseFitName(DiagnoseFit fit);
 // The fit a --fit option names; InputError "<where>: '<text>', expected torque or motion" otherwise.
 DiagnoseFit ParseDiagnoseFit(const std::string& text, const std::string& where);
+// The columns a diagnosis reads besides t, q_*, tau_* (formats/measured_data.h MeasuredColumns): the
+// recorded qd_*, qdd_* and emg_* columns, and with the motion fit cmd_* (the input where a joint's
+// reading is zero). A run's ref_* and state, and the torque fit's cmd_*, are not read.
+bool DiagnoseReadsColumn(const std::string& name, DiagnoseFit fit);
 
 // The motion fit: an effect the torque fit names that the motion fit does not (it does not lower the
 // held-out simulated error enough, or is not carried by the plant).

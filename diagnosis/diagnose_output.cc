@@ -121,6 +121,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
       for (int k = k0; k < 2; ++k) t["joints"][names[k]] = sim(S.torque_fit_split[k]);
       if (d.leave_one_out)
         for (int k = k0; k < 2; ++k) t["left_out"][names[k]] = sim(S.torque_fit_left_out[k]);
+      if (!S.torque_fit_why.empty()) t["why_worse"] = S.torque_fit_why;
       js["torque_fit"] = t;
     }
   }

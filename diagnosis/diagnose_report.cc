@@ -102,6 +102,7 @@ std::string SimulationTable(const Diagnosis& d) {
                                        }()) + ")")
                           : std::string())
     << ".</p>";
+  if (!S.torque_fit_why.empty()) o << "<p>" << HtmlEscape(S.torque_fit_why) << ".</p>";
   return o.str();
 }
 

@@ -133,6 +133,122 @@ void MotionFit::HeldOutGate() {
   Charge(kGate);
 }
 
+void MotionFit::TorqueTwinFloor() {
+  // 6b. The torque fit's twin (its effects at its values, those the plant carries) against the current
+  // set on the held-out parts, unweighted RMS per joint: the final comparison (ScoreTorqueFitTwin).
+  std::vector<Effect> named;
+  std::vector<int> tset;  // their candidates
+  for (const DiagnosedEffect& d : T.effects) {
+    named.push_back(d.effect);
+    Eigen::VectorXd probe = zero;
+    const int c = CandidateOf(P, d.effect);
+    if (c >= 0 && TorqueValues(P, d.effect, &probe) && std::find(tset.begin(), tset.end(), c) == tset.end())
+      tset.push_back(c);
+  }
+  if (tset.empty()) return;
+  const Eigen::VectorXd tx = TorqueTwinTheta(named, nullptr);
+  const MotionProblem::Rollout tro = P.Simulate(tx, Part::kHeldOut);
+  double now[2], tq[2];
+  HeldOutRms(at, now);
+  if (!tro.ok) return;
+  HeldOutRms(tro, tq);
+  const int j0 = params.one_joint ? 1 : 0;
+  auto Within = [&](const double rms[2]) {
+    for (int j = j0; j < 2; ++j)
+      if (!(rms[j] <= kTorqueTwinTolerance * tq[j])) return false;
+    return true;
+  };
+  auto Deg = [&](const double rms[2]) {
+    std::string o;
+    for (int j = j0; j < 2; ++j)
+      o += std::string(j == j0 ? "" : ", ") + kJoint[j] + " " + NumberText(rms[j] * 180 / M_PI, 4);
+    return o + " deg";
+  };
+  if (Within(now)) return;
+  const std::string head = "the torque fit's twin (" + Labels(P, tset) + ") replays the held-out rows at " + Deg(tq) +
+                           ", " + Labels(P, chosen) + " at " + Deg(now) + " (more than " +
+                           NumberText(kTorqueTwinTolerance) + "x at a joint): ";
+  // The options: the torque fit's effects refined on the fit part from its values; the current set
+  // with those of them that conflict with none of it, refined from the current values and theirs; the
+  // torque fit's effects at its values (its twin itself, within the tolerance by construction).
+  struct Option {
+    std::string what;
+    std::vector<int> set;
+    Eigen::VectorXd theta;
+    bool keep = false;
+  };
+  std::vector<Option> options;
+  {
+    const Refined ra = Refine(P, ColumnsOf(cand_bank, tset), {tx}, kMotionLmIterations, false);
+    if (std::isfinite(ra.cost)) options.push_back({"its effects refined on the fit part", tset, ra.theta});
+    std::vector<int> uset = chosen;
+    Eigen::VectorXd ux = theta;
+    for (int c : tset) {
+      const bool clash = std::any_of(uset.begin(), uset.end(), [&](int s) {
+        return s == c || Conflicts(cands[static_cast<size_t>(s)], cands[static_cast<size_t>(c)]);
+      });
+      if (clash) continue;
+      uset.push_back(c);
+      for (int k : cands[static_cast<size_t>(c)].cols) ux[k] = tx[k];
+    }
+    if (uset.size() > chosen.size() && !chosen.empty()) {
+      const Refined rb = Refine(P, ColumnsOf(cand_bank, uset), {ux}, kMotionLmIterations, false);
+      if (std::isfinite(rb.cost)) options.push_back({"its effects added to the set, refined", uset, rb.theta});
+    }
+    options.push_back({"its effects at its values", tset, tx, true});
+  }
+  std::vector<Eigen::VectorXd> xs;
+  for (const Option& o : options) xs.push_back(o.theta);
+  const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(xs, Part::kBoth);
+  int best = -1;
+  double best_bic = INFINITY;
+  for (size_t k = 0; k < options.size(); ++k) {
+    if (!ro[k].ok) {
+      D.selection.push_back(head + options[k].what + ": the plant cannot simulate them");
+      continue;
+    }
+    double rms[2];
+    HeldOutRms(ro[k], rms);
+    const double bic = ExactBic(Cost(P, ro[k], Part::kFit), ParameterCount(options[k].set));
+    const bool within = Within(rms);
+    D.selection.push_back(head + options[k].what + " (" + Labels(P, options[k].set) + "): held-out " + Deg(rms) +
+                          ", exact fit-part BIC " + NumberText(bic, 4) + (within ? "" : ", still worse"));
+    if (within && bic < best_bic) best_bic = bic, best = static_cast<int>(k);
+  }
+  if (best < 0) {
+    floor_note = "the torque fit's effects, refined or at its values, could not be simulated on the records";
+    return;
+  }
+  const Option& o = options[static_cast<size_t>(best)];
+  D.selection.push_back("taken: " + o.what + " (" + Labels(P, o.set) + "), the lowest exact fit-part BIC within " +
+                        NumberText(kTorqueTwinTolerance) + "x the torque fit's twin");
+  chosen = o.set, theta = o.theta, at = ro[static_cast<size_t>(best)];
+  keep_values = o.keep, have_last = false;
+  floor_note = "the torque fit's twin, " + o.what + ", was taken in place of the motion fit's set" +
+               (o.keep ? std::string("; the held-out gate removed what gained too little there")
+                       : std::string("; its values moved when refined under the extended twin's own misfit"));
+  // The held-out gate on this set, read against the torque fit's twin: an effect that gains less than
+  // kMinHeldoutGain at its joint goes only where the set without it still replays within the tolerance.
+  for (std::string why; !chosen.empty();) {
+    const int drop = WeakestEffect(&why);
+    if (drop < 0) break;
+    Eigen::VectorXd x = theta;
+    for (int k : cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])].cols) x[k] = 0;
+    MotionProblem::Rollout rx = P.Simulate(x, Part::kBoth);
+    double rms[2] = {INFINITY, INFINITY};
+    if (rx.ok) HeldOutRms(rx, rms);
+    if (!Within(rms)) {
+      D.selection.push_back("kept against the " + why + ": without it the twin replays the held-out rows at " + Deg(rms) +
+                            ", beyond " + NumberText(kTorqueTwinTolerance) + "x the torque fit's twin");
+      break;
+    }
+    D.selection.push_back(why + " (the rest still within " + NumberText(kTorqueTwinTolerance) + "x the torque fit's twin)");
+    chosen.erase(chosen.begin() + drop);
+    theta = x, at = std::move(rx);
+  }
+  Charge(kGate);
+}
+
 int MotionFit::OutOfRange(std::string* why) const {
   int drop = -1;
   for (size_t k = 0; k < chosen.size() && drop < 0; ++k) {
@@ -237,7 +353,14 @@ void MotionFit::Intervals() {
   }
   D.tau_eff = ResidualAutocorrelation(P, at, window_rows);
   if (!chosen.empty()) {
-    if (!have_last) last = Refine(P, cols, {theta});  // with the new weights (from theta, its band probes)
+    if (keep_values) {  // step 6b kept the torque fit's values: the Jacobian at them, not moved
+      last.theta = theta;
+      last.cost = Cost(P, at, Part::kFit);
+      last.J = WeightedFitJacobian(P, theta, at, cols);
+      last.e = WeightedResidual(P, at, PartRows(P, Part::kFit));
+    } else if (!have_last) {
+      last = Refine(P, cols, {theta});  // with the new weights (from theta, its band probes)
+    }
     theta = last.theta;
     at = P.Simulate(theta, Part::kBoth);
     Fit f;
@@ -393,26 +516,15 @@ void MotionFit::ScoreTorqueFitTwin() {
   // record left out its values fitted without that record, as the plant carries them.
   SimulationScores& S = D.simulation;
   if (S.done) {
-    auto ThetaOf = [&](const std::vector<Effect>& fx, std::vector<std::string>* not_carried) {
-      Eigen::VectorXd x = zero;
-      for (const Effect& e : fx) {
-        if (TorqueValues(P, e, &x)) continue;
-        const std::string label = e.name + " (" + e.joint + ")";
-        if (not_carried && std::find(not_carried->begin(), not_carried->end(), label) == not_carried->end())
-          not_carried->push_back(label);
-      }
-      for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
-      return x;
-    };
     std::vector<Effect> named;
     for (const DiagnosedEffect& d : T.effects) named.push_back(d.effect);
-    const Eigen::VectorXd t_theta = ThetaOf(named, &S.torque_fit_not_carried);
+    const Eigen::VectorXd t_theta = TorqueTwinTheta(named, &S.torque_fit_not_carried);
     const MotionProblem::Rollout t_ro = P.Simulate(t_theta, Part::kHeldOut);
     std::vector<Eigen::VectorXd> t_loo;
     if (loo)
       for (size_t r = 0; r < P.records(); ++r) {
         const std::vector<Effect>& fx = T.records[r].left_out_effects;
-        t_loo.push_back(ThetaOf(std::vector<Effect>(fx.begin() + static_cast<long>(std::min(params.effects.size(), fx.size())), fx.end()),
+        t_loo.push_back(TorqueTwinTheta(std::vector<Effect>(fx.begin() + static_cast<long>(std::min(params.effects.size(), fx.size())), fx.end()),
                                 &S.torque_fit_not_carried));
       }
     const std::vector<MotionProblem::Rollout> t_loo_ro = P.SimulateEachRecord(t_loo);
@@ -437,8 +549,39 @@ void MotionFit::ScoreTorqueFitTwin() {
         if (loo) S.torque_fit_left_out[j] = Score(ltb[j], lta[j], ltc);
       }
       S.torque_fit_done = true;
+      std::string worse;
+      for (int j = params.one_joint ? 1 : 0; j < 2; ++j)
+        if (S.split[j].rmse_after > kTorqueTwinTolerance * S.torque_fit_split[j].rmse_after)
+          worse += std::string(worse.empty() ? "" : ", ") + "the " + kJoint[j] + " " +
+                   NumberText(S.split[j].rmse_after * 180 / M_PI, 4) + " deg against " +
+                   NumberText(S.torque_fit_split[j].rmse_after * 180 / M_PI, 4);
+      if (!worse.empty())
+        S.torque_fit_why = "the motion fit's twin replays the held-out rows worse than the torque fit's twin (" + worse +
+                           "): " + (floor_note.empty() ? "the torque fit's effects were not put to the plant" : floor_note);
     }
   }
+}
+
+Eigen::VectorXd MotionFit::TorqueTwinTheta(const std::vector<Effect>& fx, std::vector<std::string>* not_carried) const {
+  Eigen::VectorXd x = zero;
+  for (const Effect& e : fx) {
+    if (TorqueValues(P, e, &x)) continue;
+    const std::string label = e.name + " (" + e.joint + ")";
+    if (not_carried && std::find(not_carried->begin(), not_carried->end(), label) == not_carried->end())
+      not_carried->push_back(label);
+  }
+  for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
+  return x;
+}
+
+void MotionFit::HeldOutRms(const MotionProblem::Rollout& ro, double rms[2]) const {
+  double sse[2] = {0, 0}, count = 0;
+  for (size_t r = 0; r < P.records(); ++r) {
+    double a[2], c;
+    P.RecordSse(ro, r, Part::kHeldOut, a, &c);
+    sse[0] += a[0], sse[1] += a[1], count += c;
+  }
+  for (int j = 0; j < 2; ++j) rms[j] = std::sqrt(sse[j] / std::max(count, 1.0));
 }
 
 void MotionFit::FindUnexplained() {
@@ -506,6 +649,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   fit.Rounds();
   fit.ConfirmTorqueNamed();
   fit.HeldOutGate();
+  fit.TorqueTwinFloor();
   fit.Intervals();
   fit.ScoreTwins();
   fit.ListTorqueOnly();

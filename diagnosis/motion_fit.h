@@ -131,6 +131,9 @@ constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per r
 constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
 constexpr int kMotionBandProbes = 3;  // rounds of a dead band's probes after a refinement at most (step 4)
 constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5)
+// The motion fit's extended twin replays the held-out rows at most this times the RMS error of the
+// torque fit's twin at each joint, else the torque fit's effects are put in its place (step 6b).
+constexpr double kTorqueTwinTolerance = 1.05;
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a

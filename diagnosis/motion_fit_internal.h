@@ -129,6 +129,11 @@ class MotionFit {
   void ConfirmTorqueNamed();
   // Step 6: ranges and the exact held-out gate; leaves `at` the extended twin's rollout (both parts).
   void HeldOutGate();
+  // Step 6b: where the torque fit's twin replays the held-out rows better than kTorqueTwinTolerance
+  // times the current set's RMS error at a joint, the torque fit's effects in its place (refined on
+  // the fit part, added to the set, or at the torque fit's values), the gate then read against that
+  // twin.
+  void TorqueTwinFloor();
   // Step 7: the weights of the extended twin's misfit, the values refined under them, the 95 %
   // intervals, D.effects and D.extended.
   void Intervals();
@@ -190,6 +195,11 @@ class MotionFit {
                                                    const std::vector<MotionProblem::Rollout>& ro);
   // The first record's held-out part as plotted: time, measured, given and extended twin's angle.
   void PlottedSeries();
+  // The parameters standing for the effects `fx` at their values, inside the box (the model given's
+  // elsewhere); the effects the plant cannot carry appended to *not_carried (when given) once each.
+  Eigen::VectorXd TorqueTwinTheta(const std::vector<Effect>& fx, std::vector<std::string>* not_carried) const;
+  // Unweighted RMS simulated-angle error per joint of a rollout on the held-out parts, pooled (rad).
+  void HeldOutRms(const MotionProblem::Rollout& ro, double rms[2]) const;
 
  public:
   // The state between the phases.
@@ -226,6 +236,8 @@ class MotionFit {
   Refined last;                      // the last refinement of the chosen set
   bool have_last = false;            // `last` is at theta under the current weights
   std::vector<int> cols;             // the final set's parameters (Intervals)
+  bool keep_values = false;          // step 6b kept the torque fit's values: Intervals does not move them
+  std::string floor_note;            // step 6b's outcome in words (SimulationScores::torque_fit_why)
 };
 
 }  // namespace motion

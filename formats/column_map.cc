@@ -263,13 +263,13 @@ MeasuredData ApplyColumnMap(const ColumnMap& map, const CsvTable& in, const std:
 }
 
 MeasuredData ReadMeasured(const std::string& csv_path, const std::string& map_path, size_t min_samples,
-                          MapReport* report) {
+                          MapReport* report, const MeasuredColumns& keep) {
   const bool bag = IsBagPath(csv_path);
   if (bag && map_path.empty())
     throw InputError(csv_path + ": a ROS 2 bag needs a column map (--map MAP.yaml) naming the topics' fields, "
                                 "e.g. t: {from: /exo/joint_states.header.stamp}, q_hip: {from: "
                                 "\"/exo/joint_states.position[hip]\"} (DESIGN.md \"ROS 2 bags (MCAP) in and out\")");
-  if (map_path.empty()) return ReadMeasuredCsv(csv_path, min_samples);
+  if (map_path.empty()) return ReadMeasuredCsv(csv_path, min_samples, keep);
   const ColumnMap map = ReadColumnMap(map_path);
   return ApplyColumnMap(map, bag ? BagTable(csv_path, map) : ReadCsv(csv_path), csv_path, report, min_samples);
 }

@@ -68,8 +68,8 @@ MeasuredData ApplyColumnMap(const ColumnMap& map, const CsvTable& in, const std:
 // Reads a --measured file: in the schema when `map_path` is empty (ReadMeasuredCsv), else a foreign
 // CSV through the map at `map_path`, or a ROS 2 bag (IsBagPath: an .mcap file or a rosbag2 folder;
 // formats/bag_table.h) through it; a bag without a map is bad input. `report` (optional) receives
-// what the map did.
+// what the map did. `keep`: the columns the caller reads (ReadMeasuredCsv's; a schema CSV's only).
 MeasuredData ReadMeasured(const std::string& csv_path, const std::string& map_path, size_t min_samples = 20,
-                          MapReport* report = nullptr);
+                          MapReport* report = nullptr, const MeasuredColumns& keep = {});
 
 }  // namespace exotwin

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
@@ -242,7 +243,9 @@ namespace {
 constexpr size_t kSplitBytes = size_t{1} << 20;  // a piece read in two halves at once from this size on
 }  // namespace
 
-CsvTable ReadCsv(const std::string& path) {
+CsvTable ReadCsv(const std::string& path) { return ReadCsv(path, CsvColumnFilter{}); }
+
+CsvTable ReadCsv(const std::string& path, const CsvColumnFilter& filter) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a CSV file");
   TextFileChunks in(path, "", "a text CSV file");
@@ -262,29 +265,57 @@ CsvTable ReadCsv(const std::string& path) {
   // the one reported (the file's first), as when read in one go.
   std::vector<std::vector<double>> later_columns;
   std::vector<int> later_lines;
-  // Every row `r` reads, into columns and lines.
-  auto ReadRows = [](CsvReader& r, double* values, std::vector<std::vector<double>>& columns,
-                     std::vector<int>& lines) {
+  std::vector<size_t> kept;     // file index of each kept column
+  std::vector<size_t> dropped;  // file index of each dropped column (t.dropped's order)
+  // Every row `r` reads, into columns and lines; a dropped column's first value failing the check
+  // into bad[k] (row within this call, value) when none before.
+  using Bad = std::vector<std::pair<size_t, double>>;
+  auto ReadRows = [&](CsvReader& r, double* values, std::vector<std::vector<double>>& columns, std::vector<int>& lines,
+                      Bad& bad) {
+    const size_t start = lines.size();
     while (r.NextNumbers(values)) {
-      for (size_t i = 0; i < columns.size(); ++i) columns[i].push_back(values[i]);
+      for (size_t i = 0; i < kept.size(); ++i) columns[i].push_back(values[kept[i]]);
+      if (filter.check)
+        for (size_t k = 0; k < dropped.size(); ++k)
+          if (bad[k].first == SIZE_MAX && !filter.check(t.dropped[k].name, values[dropped[k]]))
+            bad[k] = {lines.size() - start, values[dropped[k]]};
       lines.push_back(r.line());
     }
+  };
+  // The first failing rows of a piece read from table row `offset` on, into t.dropped.
+  auto NoteBad = [&](const Bad& bad, size_t offset) {
+    for (size_t k = 0; k < bad.size(); ++k)
+      if (bad[k].first != SIZE_MAX && t.dropped[k].bad_row == SIZE_MAX)
+        t.dropped[k].bad_row = offset + bad[k].first, t.dropped[k].bad_value = bad[k].second;
   };
   auto parse = [&](const char* b, const char* e) {
     if (!reader) reader.emplace(b, e, path);
     else reader->Continue(b, e);
     if (t.names.empty()) {
       if (!reader->ReadHeader()) return;
-      t.names = reader->names();
+      const std::vector<std::string>& all = reader->names();
+      for (size_t i = 0; i < all.size(); ++i) {
+        if (!filter.keep || filter.keep(all[i])) {
+          kept.push_back(i);
+          t.names.push_back(all[i]);
+        } else {
+          dropped.push_back(i);
+          t.dropped.push_back({all[i], t.names.size(), SIZE_MAX, 0.0});
+        }
+      }
       t.columns.assign(t.names.size(), {});
-      row.resize(t.names.size());
+      row.resize(all.size());
+      if (t.names.empty()) throw InputError(path + ": every column left out by the reader's filter");
     }
+    Bad bad(dropped.size(), {SIZE_MAX, 0.0}), later_bad = bad;
+    const size_t rows_before = t.rows();
     const char* half = b + (e - b) / 2;
     const char* nl = static_cast<size_t>(e - b) >= kSplitBytes && t.rows() > 0
                          ? static_cast<const char*>(std::memchr(half, '\n', static_cast<size_t>(e - half)))
                          : nullptr;
     if (!nl || nl + 1 >= e) {
-      ReadRows(*reader, row.data(), t.columns, t.line_of_row);
+      ReadRows(*reader, row.data(), t.columns, t.line_of_row, bad);
+      NoteBad(bad, rows_before);
     } else {
       const char* m = nl + 1;  // the second half's first line
       CsvReader later = *reader;
@@ -292,18 +323,20 @@ CsvTable ReadCsv(const std::string& path) {
       reader->Continue(b, m);
       later_columns.assign(t.names.size(), {});
       later_lines.clear();
-      std::vector<double> later_row(t.names.size());
+      std::vector<double> later_row(row.size());
       std::exception_ptr error[2];
       ParallelFor(2, 2, [&](size_t k) {
         try {
-          if (k == 0) ReadRows(*reader, row.data(), t.columns, t.line_of_row);
-          else ReadRows(later, later_row.data(), later_columns, later_lines);
+          if (k == 0) ReadRows(*reader, row.data(), t.columns, t.line_of_row, bad);
+          else ReadRows(later, later_row.data(), later_columns, later_lines, later_bad);
         } catch (...) {
           error[k] = std::current_exception();
         }
       });
       for (const std::exception_ptr& x : error)
         if (x) std::rethrow_exception(x);
+      NoteBad(bad, rows_before);
+      NoteBad(later_bad, t.rows());
       for (size_t i = 0; i < t.columns.size(); ++i)
         t.columns[i].insert(t.columns[i].end(), later_columns[i].begin(), later_columns[i].end());
       t.line_of_row.insert(t.line_of_row.end(), later_lines.begin(), later_lines.end());

@@ -2,6 +2,7 @@
 // header row of column names, then one record per line. Every CSV exotwin reads goes through
 // CsvReader: measured data and column maps' inputs (ReadCsv), sweep tables (runner/sweep_table.cc).
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -85,6 +86,16 @@ struct CsvTable {
   std::vector<std::vector<double>> columns;  // columns[i] belongs to names[i]
   std::vector<int> line_of_row;              // 1-based file line of each data row
   int dropped_cut_line = 0;  // line number of a cut last line dropped from a streamed file, else 0
+  // Columns ReadCsv read (every field a number) but did not keep (CsvColumnFilter::keep false), in
+  // file order: `before` kept columns precede it in the file; the first row whose value failed the
+  // filter's check (rows() if none) and that value.
+  struct Dropped {
+    std::string name;
+    size_t before = 0;
+    size_t bad_row = 0;
+    double bad_value = 0;
+  };
+  std::vector<Dropped> dropped;
 
   size_t rows() const { return columns.empty() ? 0 : columns[0].size(); }
   // Index of a column, -1 if absent.
@@ -98,6 +109,17 @@ struct CsvTable {
 // unterminated last line is a row cut by a killed run: it is dropped, with a warning on stderr, and
 // its line number kept in dropped_cut_line.
 CsvTable ReadCsv(const std::string& path);
+
+// Which columns a reader keeps: a long record's columns that no stage reads cost memory as they are
+// read. keep(name) false: the column is read (every field must be a number) but not stored; then
+// check(name, value), when set, tests each of its values as read, the first failing row noted in
+// CsvTable::dropped (so that a validation of the table sees what it would have seen).
+struct CsvColumnFilter {
+  std::function<bool(const std::string& name)> keep;
+  std::function<bool(const std::string& name, double value)> check;
+};
+// ReadCsv keeping the columns `filter` keeps (all when filter.keep is empty).
+CsvTable ReadCsv(const std::string& path, const CsvColumnFilter& filter);
 
 // Appends the shortest text of v that reads back to the same double (std::to_chars: no locale, no
 // printf cost; "1e-05" where %.17g writes "1.0000000000000001e-05").

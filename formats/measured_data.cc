@@ -67,8 +67,11 @@ std::string Where(const std::string& source, const CsvTable& t, size_t row, cons
 }  // namespace
 
 bool IsOneJointTable(const CsvTable& table) {
-  for (const char* hip : {"q_hip", "tau_hip", "qd_hip", "qdd_hip", "cmd_hip"})
+  for (const char* hip : {"q_hip", "tau_hip", "qd_hip", "qdd_hip", "cmd_hip"}) {
     if (table.Find(hip) >= 0) return false;
+    for (const CsvTable::Dropped& d : table.dropped)
+      if (d.name == hip) return false;
+  }
   return table.Find("q_knee") >= 0 && table.Find("tau_knee") >= 0;
 }
 
@@ -92,6 +95,18 @@ CsvTable TableAsRecorded(const MeasuredData& data) {
   return out;
 }
 
+namespace {
+
+// The bound on the values of schema column n (DESIGN.md "What the CSV reader accepts") and its unit.
+double ValueLimit(const std::string& n, std::string* unit) {
+  if (n == "q_hip" || n == "q_knee") return *unit = "rad", kMaxRecordedAngle;
+  if (n == "tau_hip" || n == "tau_knee" || n.rfind("cmd_", 0) == 0) return *unit = "N m", 1000;
+  if (n.rfind("emg_", 0) == 0) return *unit = "V", 100;
+  return unit->clear(), 1e6;
+}
+
+}  // namespace
+
 MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t min_samples) {
   MeasuredData d;
   d.source = source;
@@ -103,23 +118,31 @@ MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t
   if (t.rows() < min_samples)
     throw InputError(source + ": " + std::to_string(t.rows()) + " samples, expected at least " +
                      std::to_string(min_samples));
+  auto Check = [&](const std::string& n, size_t r, double v) {
+    std::string unit;
+    const double limit = ValueLimit(n, &unit);
+    if (!std::isfinite(v))
+      throw InputError(Where(source, t, r, n) + "value is not finite, expected a finite number");
+    if (std::abs(v) > limit)
+      throw InputError(Where(source, t, r, n) + "value " + NumberText(v) + " out of range, expected |x| <= " +
+                       std::to_string(limit) + " " + unit);
+  };
+  // In file order: the columns the reader left out (their first failing value, CsvTable::dropped)
+  // among those it kept.
+  size_t next_dropped = 0;
+  auto CheckDropped = [&](size_t before) {
+    for (; next_dropped < t.dropped.size() && t.dropped[next_dropped].before <= before; ++next_dropped) {
+      const CsvTable::Dropped& x = t.dropped[next_dropped];
+      if (IsMeasuredColumn(x.name) && x.bad_row < t.rows()) Check(x.name, x.bad_row, x.bad_value);
+    }
+  };
   for (size_t c = 0; c < t.names.size(); ++c) {
+    CheckDropped(c);
     const std::string& n = t.names[c];
     if (!IsMeasuredColumn(n)) continue;
-    double limit = 1e6;
-    std::string unit;
-    if (n == "q_hip" || n == "q_knee") { limit = kMaxRecordedAngle; unit = "rad"; }
-    if (n == "tau_hip" || n == "tau_knee" || n.rfind("cmd_", 0) == 0) { limit = 1000; unit = "N m"; }
-    if (n.rfind("emg_", 0) == 0) { limit = 100; unit = "V"; }
-    for (size_t r = 0; r < t.rows(); ++r) {
-      const double v = t.columns[c][r];
-      if (!std::isfinite(v))
-        throw InputError(Where(source, t, r, n) + "value is not finite, expected a finite number");
-      if (std::abs(v) > limit)
-        throw InputError(Where(source, t, r, n) + "value " + NumberText(v) + " out of range, expected |x| <= " +
-                         std::to_string(limit) + " " + unit);
-    }
+    for (size_t r = 0; r < t.rows(); ++r) Check(n, r, t.columns[c][r]);
   }
+  CheckDropped(t.names.size());
   const auto& tc = t.columns[t.Find("t")];
   for (size_t r = 1; r < tc.size(); ++r)
     if (!(tc[r] > tc[r - 1]))
@@ -185,6 +208,19 @@ double MedianStep(const std::vector<double>& t) {
 
 MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples) {
   return MeasuredFromTable(ReadCsv(path), path, min_samples);
+}
+
+MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples, const MeasuredColumns& keep) {
+  if (!keep) return ReadMeasuredCsv(path, min_samples);
+  CsvColumnFilter f;
+  f.keep = [&](const std::string& n) {
+    return n == "t" || n == "q_hip" || n == "q_knee" || n == "tau_hip" || n == "tau_knee" || keep(n);
+  };
+  f.check = [](const std::string& n, double v) {
+    std::string unit;
+    return !IsMeasuredColumn(n) || (std::isfinite(v) && std::abs(v) <= ValueLimit(n, &unit));
+  };
+  return MeasuredFromTable(ReadCsv(path, f), path, min_samples);
 }
 
 void CheckHumanJointRange(const MeasuredData& data) {

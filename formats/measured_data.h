@@ -87,6 +87,12 @@ MeasuredData MeasuredFromTable(CsvTable table, const std::string& source, size_t
 
 // Reads a measured-data CSV and validates it as MeasuredFromTable does.
 MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples = 20);
+// The columns a caller reads besides t, q_*, tau_* (which are always kept); empty: every column.
+using MeasuredColumns = std::function<bool(const std::string& name)>;
+// The same, storing only the columns `keep` names (a long record's columns no stage of the caller
+// reads, e.g. a run's ref_*, state: memory). The columns left out are still read as numbers and a
+// schema column's values validated: the same errors as ReadMeasuredCsv(path, min_samples).
+MeasuredData ReadMeasuredCsv(const std::string& path, size_t min_samples, const MeasuredColumns& keep);
 
 // The check for records of a human wearing the device (predict / identify / diagnose with a
 // `human:` block): |q_hip|, |q_knee| <= kMaxHumanJointAngle. Throws InputError naming the file,

@@ -6,12 +6,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <string>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/rng.h"
 #include "dsp/butterworth.h"
+#include "formats/number_text.h"
+#include "tests/temp_dir.h"
 
 namespace exotwin {
 namespace {
@@ -213,6 +218,109 @@ TEST(MedianStep, IsTheMiddleOfTheSortedSteps) {
     EXPECT_EQ(MedianStep(t), Reference(t));
   }
   EXPECT_THROW(MedianStep({0.0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace exotwin
+
+namespace exotwin {
+namespace {
+
+// A record as `run` writes it, with the columns a caller may leave out between the required ones:
+// t, q_hip, cmd_hip, q_knee, tau_hip, ref_hip, tau_knee, state, emg_VM; n rows at 1 kHz (over 1 MB of
+// text: the reader reads a piece in two halves at once). `set`: (column, row, text) put in place.
+using Cell = std::tuple<std::string, size_t, std::string>;
+std::string WriteRunLike(const testing::ScopedTempDir& tmp, const std::string& name, size_t n,
+                         const std::vector<Cell>& set = {}) {
+  const std::vector<std::string> names = {"t", "q_hip", "cmd_hip", "q_knee", "tau_hip", "ref_hip", "tau_knee", "state", "emg_VM"};
+  std::string text = "# exotwin stream: complete rows end with a newline\n";
+  for (size_t c = 0; c < names.size(); ++c) text += (c ? "," : "") + names[c];
+  text += "\n";
+  Rng rng(7);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t c = 0; c < names.size(); ++c) {
+      std::string v = c == 0 ? std::to_string(1e-3 * static_cast<double>(i + 1)) : NumberText(rng.Uniform(-1, 1), 17);
+      for (const Cell& x : set)
+        if (std::get<0>(x) == names[c] && std::get<1>(x) == i) v = std::get<2>(x);
+      text += (c ? "," : "") + v;
+    }
+    text += "\n";
+  }
+  const std::string path = tmp.File(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+MeasuredColumns KeepEmg() {
+  return [](const std::string& n) { return n.rfind("emg_", 0) == 0; };
+}
+
+// The error text of reading `path` (unfiltered or with `keep`), "" when it reads.
+std::string ReadError(const std::string& path, const MeasuredColumns& keep) {
+  try {
+    if (keep) ReadMeasuredCsv(path, 20, keep);
+    else ReadMeasuredCsv(path, 20);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ReadMeasuredColumns, KeepsTheColumnsAskedForWithTheSameValuesAndLines) {
+  const testing::ScopedTempDir tmp("measured_keep");
+  const std::string path = WriteRunLike(tmp, "run.csv", 30000);
+  const MeasuredData all = ReadMeasuredCsv(path);
+  const MeasuredData some = ReadMeasuredCsv(path, 20, KeepEmg());
+  ASSERT_EQ(all.size(), 30000u);
+  EXPECT_EQ(some.table.names, (std::vector<std::string>{"t", "q_hip", "q_knee", "tau_hip", "tau_knee", "emg_VM"}));
+  for (const std::string& n : some.table.names) EXPECT_EQ(*some.Column(n), *all.Column(n)) << n;  // bit for bit
+  EXPECT_EQ(some.table.line_of_row, all.table.line_of_row);
+  ASSERT_EQ(some.table.dropped.size(), 3u);
+  EXPECT_EQ(some.table.dropped[0].name, "cmd_hip");
+  EXPECT_EQ(some.table.dropped[0].before, 2u);  // after t, q_hip
+  EXPECT_EQ(some.table.dropped[2].name, "state");
+  EXPECT_EQ(some.table.dropped[2].before, 5u);
+  EXPECT_FALSE(some.one_joint);
+}
+
+TEST(ReadMeasuredColumns, AColumnLeftOutIsValidatedAsIfKept) {
+  const testing::ScopedTempDir tmp("measured_keep_bad");
+  // A schema column left out (cmd_hip, |x| <= 1000 N m, finite) in the first and in the second half of
+  // the file; a column outside the schema (ref_hip) may hold anything numeric, kept or not.
+  for (const size_t row : {size_t{17}, size_t{24000}}) {
+    for (const std::string bad : {"2000", "nan"}) {
+      const std::string path = WriteRunLike(tmp, "bad.csv", 30000, {{"cmd_hip", row, bad}});
+      const std::string want = ReadError(path, {});
+      EXPECT_NE(want.find(":" + std::to_string(row + 3) + ": column 'cmd_hip'"), std::string::npos) << want;
+      EXPECT_EQ(ReadError(path, KeepEmg()), want);
+    }
+  }
+  const std::string odd = WriteRunLike(tmp, "ref.csv", 3000, {{"ref_hip", 5, "inf"}});
+  EXPECT_EQ(ReadError(odd, {}), "");
+  EXPECT_EQ(ReadError(odd, KeepEmg()), "");
+  // Two bad values: the first column in file order is reported, left out or not (cmd_hip before
+  // q_knee, whose bad value comes first in the rows).
+  {
+    const std::string path = WriteRunLike(tmp, "two.csv", 3000, {{"cmd_hip", 2000, "1e9"}, {"q_knee", 0, "nan"}});
+    const std::string want = ReadError(path, {});
+    EXPECT_NE(want.find("column 'cmd_hip'"), std::string::npos) << want;
+    EXPECT_EQ(ReadError(path, KeepEmg()), want);
+  }
+  // A number-less field in a column left out is still an error of the CSV.
+  const std::string word = WriteRunLike(tmp, "word.csv", 3000, {{"state", 9, "x"}});
+  EXPECT_FALSE(ReadError(word, KeepEmg()).empty());
+  EXPECT_EQ(ReadError(word, KeepEmg()), ReadError(word, {}));
+}
+
+TEST(ReadMeasuredColumns, AHipColumnLeftOutStillMakesTheTableTwoJoint) {
+  const testing::ScopedTempDir tmp("measured_keep_hip");
+  const std::string path = tmp.File("knee.csv");
+  std::string text = "t,q_knee,tau_knee,cmd_hip\n";
+  for (int i = 0; i < 50; ++i) text += std::to_string(1e-3 * (i + 1)) + ",0.1,0.2,0.3\n";
+  std::ofstream(path) << text;
+  const std::string want = ReadError(path, {});
+  EXPECT_NE(want, "");  // a hip column without q_hip: not a one-joint record
+  EXPECT_EQ(ReadError(path, KeepEmg()), want);
 }
 
 }  // namespace
