@@ -6,6 +6,7 @@
 #include "formats/csv_table.h"
 #include "diagnosis/generate.h"
 #include "formats/model_file.h"
+#include "core/error.h"
 #include "app/commands.h"
 
 namespace exotwin {
@@ -18,7 +19,8 @@ CommandRunner RegisterGenerate(CLI::App& app) {
     int effects = 1;
     double duration = 60.0, rate = 1000.0;
     bool clean = false;
-    std::vector<std::string> allowed;
+    std::vector<std::string> allowed, terms, stages;
+    std::vector<double> values;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
@@ -33,12 +35,33 @@ CommandRunner RegisterGenerate(CLI::App& app) {
   sub->add_option("--rate", o->rate, "sample rate, Hz (default 1000)");
   sub->add_option("--truth", o->truth, "write the truth (model + hidden effects) to this YAML");
   sub->add_flag("--clean", o->clean, "no hidden effect (same as --effects 0)");
-  return [sub, o]() -> int {
+  sub->add_option("--term", o->terms,
+                  "hide a term beyond the table: value * EXPR at --joint (repeatable, one --value each; "
+                  "alone, no drawn effect unless --effects is given)");
+  sub->add_option("--value", o->values, "the value of each --term (N m), in their order");
+  sub->add_option("--stage", o->stages, "link (default) or sensor, for each --term in their order");
+  auto* effects_option = sub->get_option("--effects");
+  return [sub, o, effects_option]() -> int {
     if (!*sub) return -1;
     const LegParams params = ReadModelFile(o->params);
     GenerateOptions g;
     g.seed = o->seed;
-    g.effects = o->clean ? 0 : o->effects;
+    g.effects = o->clean || (!o->terms.empty() && effects_option->count() == 0) ? 0 : o->effects;
+    if (o->values.size() != o->terms.size())
+      throw InputError("--term: " + std::to_string(o->terms.size()) + " terms and " + std::to_string(o->values.size()) +
+                       " --value, expected one --value per --term");
+    if (!o->stages.empty() && o->stages.size() != o->terms.size())
+      throw InputError("--stage: " + std::to_string(o->stages.size()) + " for " + std::to_string(o->terms.size()) +
+                       " terms, expected none or one per --term");
+    if (!o->terms.empty() && o->joint.empty() && !params.one_joint)
+      throw InputError("--term: expected --joint hip or knee (the terms' joint)");
+    for (size_t k = 0; k < o->terms.size(); ++k) {
+      Effect e;
+      e.name = "term", e.unit = "N m", e.expr = o->terms[k], e.value = o->values[k];
+      e.joint = o->joint.empty() ? "knee" : o->joint;
+      e.stage = o->stages.empty() || o->stages[k] == "link" ? "" : o->stages[k];
+      g.terms.push_back(e);
+    }
     g.allowed = o->allowed;
     g.joint = o->joint;
     g.duration = o->duration;

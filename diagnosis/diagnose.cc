@@ -576,6 +576,7 @@ void SimulateTwins(const LegParams& params, std::vector<Rec>& recs, const Diagno
     ReplaySeries series;
     series.source = rc.source;
     series.t = std::move(rc.kin.t);
+    series.t_start = rc.kin.t_start;
     for (int j = 0; j < 2; ++j) series.q[j] = std::move(rc.kin.q[j]);
     struct GiveBack {
       ReplaySeries& s;

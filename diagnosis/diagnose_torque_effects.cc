@@ -29,6 +29,7 @@ double ExactSse(const LegParams& p, const Rec& rc, const double w[2], size_t a, 
     tr[j].assign(rc.tau_R[j].begin() + a, rc.tau_R[j].begin() + b);
   }
   for (const auto& ch : kin.emg) k.emg[ch.first].assign(ch.second.begin() + a, ch.second.begin() + b);
+  k.t_start = kin.t_start;
   ApplyEffects(p, k, tr, ts);
   double s = 0;
   const size_t lo = std::min<size_t>(200, (b - a) / 10);  // skip the edges (delay, filters)

@@ -98,24 +98,32 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
   const size_t n = kin.t.size();
   LegParams rigid = params;
   rigid.effects.clear();
-  std::vector<double> tau_rigid[2];  // the rigid torque, for the forms that depend on it (the dead band)
+  // The rigid torque, for the forms that depend on it (the dead band; a term's tau_R).
+  std::vector<double> tau_rigid[2];
   for (const Effect& e : params.effects)
-    if (FamilyOf(e).carrier == PlantCarrier::kDeadBandHinge) {
+    if (FamilyOf(e).carrier == PlantCarrier::kDeadBandHinge || FamilyOf(e).carries_expr) {
       tau_rigid[0] = tau_R[0], tau_rigid[1] = tau_R[1];
       break;
     }
+  // Sample i's state; a term's t from the record's first sample.
+  const double t0 = std::isnan(kin.t_start) ? (n ? kin.t[0] : 0.0) : kin.t_start;
+  EffectState s;
+  s.g = params.g;
+  auto state_at = [&](size_t i) -> const EffectState& {
+    s.q = At(kin.q, i), s.qd = At(kin.qd, i), s.qdd = At(kin.qdd, i);
+    if (!tau_rigid[0].empty()) s.tau_R = At(tau_rigid, i);
+    s.t = kin.t[i] - t0;
+    return s;
+  };
   for (const Effect& e : params.effects) {
     const EffectFamily& f = FamilyOf(e);
-    if (f.stage != EffectStage::kLink) continue;
+    if (StageOf(e) != EffectStage::kLink) continue;
     if (!f.link_torque) {
       AddRecordForm(f, e, rigid, kin, tau_rigid, tau_R);
       continue;
     }
-    EffectState s;
-    s.g = params.g;
     for (size_t i = 0; i < n; ++i) {
-      s.q = At(kin.q, i), s.qd = At(kin.qd, i), s.qdd = At(kin.qdd, i);
-      const Eigen::Vector2d d = f.link_torque(e, s);
+      const Eigen::Vector2d d = f.link_torque(e, state_at(i));
       tau_R[0][i] += d[0];
       tau_R[1][i] += d[1];
     }
@@ -124,9 +132,17 @@ void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<do
     tau_S[j].resize(n);
     for (size_t i = 0; i < n; ++i) tau_S[j][i] = -tau_R[j][i];
   }
+  // The sensor effects in the order listed: a family's form on the reading, or a sample's closed
+  // form (a sensor-stage term) added to it.
   for (const Effect& e : params.effects) {
     const EffectFamily& f = FamilyOf(e);
-    if (f.stage == EffectStage::kSensor) f.on_reading(e, kin.t, &tau_S[EffectJoint(e)]);
+    if (StageOf(e) != EffectStage::kSensor) continue;
+    const int j = EffectJoint(e);
+    if (f.on_reading) {
+      f.on_reading(e, kin.t, &tau_S[j]);
+      continue;
+    }
+    for (size_t i = 0; i < n; ++i) tau_S[j][i] += f.link_torque(e, state_at(i))[j];
   }
 }
 

@@ -16,7 +16,11 @@
 //  - muscle_activity: tau_R += value * sum_ch w_ch env_ch(t), env = EmgEnvelope of column emg_<ch>
 //    (fields "w_<ch>", N m per V); value is a dimensionless scale (1 as written by diagnose).
 //  - sensor_offset, sensor_gain, sensor_delay act on tau_S = -tau_R, in the order listed.
+//  - term (DESIGN.md "Terms beyond the table"): value * expr added to tau_R at its joint (stage link) or
+//    to tau_S in the sensor effects' order (stage sensor); expr's tau_R is the rigid torque given (before
+//    any effect), its t the time from the record's start.
 #pragma once
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -31,7 +35,8 @@ namespace exotwin {
 // the sensor reading tau_S = -tau_R and applies the sensor effects (offset, gain, delay). `params`
 // gives L1, g and the lumped parameters for the closed-form terms. tau_R[j] must have kin.t.size()
 // samples. Throws InputError for an effect it cannot apply (e.g. muscle_activity without the EMG
-// column of a weighted channel).
+// column of a weighted channel). A term's t counts from kin.t_start (the record's first time, kept
+// by a window of it; NaN: kin.t[0]).
 void ApplyEffects(const LegParams& params, const Kinematics& kin, std::vector<double> tau_R[2],
                   std::vector<double> tau_S[2]);
 

@@ -35,6 +35,10 @@ std::string PassiveRange(const Effect& e, const PhysicalScale&) {
              ? ""
              : "passive moment " + Num(1 + v) + " times Riener & Edrich's, outside (0, " + Num(kMaxPassiveScale) + "]";
 }
+std::string TermRange(const Effect& e, const PhysicalScale&) {
+  return std::isfinite(e.value) && e.value != 0 ? "" : "a term of value " + Num(e.value) + " (expected finite, non-zero)";
+}
+
 double InertiaEdge(int j, const PhysicalScale& s) { return s.M_jj[j]; }
 double GravityEdge(int j, const PhysicalScale& s) { return 0.5 * s.distal_moment[j] + 0.05; }
 
@@ -96,6 +100,9 @@ std::deque<FitFamily>& Registry() {
     v.push_back(SensorGainRow());
     v.push_back(SensorDelayRow());
     v.push_back(MuscleActivityRow());
+    // Terms beyond the table: proposed by the term search (diagnosis/term_search*), not a column of the
+    // table's fit, not drawn (generate --term hides one).
+    v.push_back(FitRow(kTerm, TermRange, nullptr));
     return v;
   }();
   return k;

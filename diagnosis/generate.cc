@@ -8,6 +8,7 @@
 #include "diagnosis/predict.h"
 #include "diagnosis/fit_families.h"
 #include "model/effect_families.h"
+#include "model/term_expr.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/units.h"
@@ -72,6 +73,19 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
     throw InputError("--effects: " + std::to_string(opt.effects) + " distinct effects from " +
                      std::to_string(pool.size()) + " allowed names");
 
+  for (const Effect& e : opt.terms) {
+    const std::string what = "--term \"" + e.expr + "\"";
+    try {
+      TermExpr::Parse(e.expr);
+    } catch (const TermExprError& x) {
+      throw InputError(what + ": " + x.what() + " of the expression");
+    }
+    if (e.joint != "knee" && (one || e.joint != "hip"))
+      throw InputError(what + ": joint '" + e.joint + "', expected " + (one ? "knee (the one-joint model's)" : "hip or knee"));
+    if (!std::isfinite(e.value)) throw InputError(what + ": --value not finite");
+    if (!e.stage.empty() && e.stage != "link" && e.stage != "sensor")
+      throw InputError(what + ": --stage '" + e.stage + "', expected link or sensor");
+  }
   NormalRng<NormalBoxMuller<BoxMullerU1::kOneMinusUniform>> rng(opt.seed);
   GeneratedData g;
   g.truth = params;
@@ -101,6 +115,7 @@ GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& o
     const int joint = one ? 1 : opt.joint.empty() ? rng.Index(2) : (opt.joint == "hip" ? 0 : 1);
     g.truth.effects.push_back(DrawEffect(rng, name, joint, one));
   }
+  for (const Effect& e : opt.terms) g.truth.effects.push_back(e);
   // EMG activations: 0.02 + a (0.5 + 0.5 sin(w t + p))^2 V, a in 0.05-0.3 V, w in 0.1-0.8 Hz.
   struct Act { double a, w, p; } act[5];
   for (auto& a : act) a = {rng.Uniform(0.05, 0.3), 2 * M_PI * rng.Uniform(0.1, 0.8), rng.Uniform(-M_PI, M_PI)};

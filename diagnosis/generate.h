@@ -19,6 +19,10 @@ struct GenerateOptions {
   std::string joint;                    // "hip" / "knee" forces the joint; empty = drawn
   double duration = 60.0;               // s, > 2
   double rate = 1000.0;                 // Hz, 100 .. 10000
+  // Terms beyond the table hidden besides the drawn effects (generate --term; DESIGN.md "Terms beyond
+  // the table"): name "term", joint, value, expr and stage as a model file's. They draw nothing from the
+  // seed (the same seed gives the same trajectory and noise with or without them).
+  std::vector<Effect> terms;
 };
 
 struct GeneratedData {
@@ -51,7 +55,9 @@ Effect DrawEffect(Rng& rng, const std::string& name, int joint, bool one_joint =
 // -0.4 .. 1.2 rad, every effect at it, a one-joint record); EMG on GMAX, RF, VM, ST, GAS (white noise modulated by slow random activations);
 // truth torque by the MuJoCo twin (analytic derivatives) plus ApplyEffects; encoder quantization
 // 2^19 counts/rev; torque sensor noise 0.02-0.04 N m (drawn) and 0.005 N m resolution.
-// Throws InputError for options out of range or params without a realization.
+// Throws InputError for options out of range or params without a realization, and for a term whose
+// expr is outside the grammar (naming --term, the position in it), whose joint is not hip or knee (knee
+// in a one-joint model), whose value is not finite or whose stage is not link, sensor or empty.
 GeneratedData GenerateMeasured(const LegParams& params, const GenerateOptions& opt);
 
 // Writes the generated record as a measured-data CSV (comments name the seed, not the truth).

@@ -52,7 +52,7 @@ int CandidateOf(const MotionProblem& P, const Effect& fx) {
 void ExtendedTwin(const LegParams& params, Diagnosis* D_out) {
   Diagnosis& D = *D_out;
   std::stable_sort(D.effects.begin(), D.effects.end(), [](const DiagnosedEffect& a, const DiagnosedEffect& b) {
-    const bool sa = FamilyOf(a.effect).stage == EffectStage::kSensor, sb = FamilyOf(b.effect).stage == EffectStage::kSensor;
+    const bool sa = StageOf(a.effect) == EffectStage::kSensor, sb = StageOf(b.effect) == EffectStage::kSensor;
     return sa != sb ? !sa : a.explained_pct > b.explained_pct;
   });
   D.extended = params;
@@ -62,7 +62,7 @@ void ExtendedTwin(const LegParams& params, Diagnosis* D_out) {
   std::stable_sort(D.extended.effects.begin() + static_cast<long>(params.effects.size()), D.extended.effects.end(),
                    [](const Effect& a, const Effect& b) {
                      auto rank = [](const Effect& e) {
-                       if (FamilyOf(e).stage != EffectStage::kSensor) return 0;
+                       if (StageOf(e) != EffectStage::kSensor) return 0;
                        int k = 1;
                        for (const EffectFamily& f : EffectFamilies()) {
                          if (e.name == f.name) break;

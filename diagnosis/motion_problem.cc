@@ -150,7 +150,7 @@ MotionProblem::MotionProblem(const LegParams& params, const std::vector<const Me
   for (auto& rp : rec_) {
     Record& R = *rp;
     ReplaySeries s = R.series;
-    if (R.by_reading) ActuatorTorqueFromReading(base_fx, s.t, R.reading, s.tau_R);
+    if (R.by_reading) ActuatorTorqueFromReading(base_fx, s.t, R.reading, s.tau_R, &s);
     else s.tau_R[0] = R.cmd[0], s.tau_R[1] = R.cmd[1];
     const ReplayRecord a = Replay(*plant, s, H, 0, R.split);
     const ReplayRecord b = Replay(*plant, s, H, R.split, R.n);
@@ -323,7 +323,7 @@ MotionProblem::Rollout MotionProblem::Run(const Eigen::VectorXd& theta, Part par
     }
     ReplaySeries s = R.series;
     if (R.by_reading) {
-      ActuatorTorqueFromReading(fx, s.t, R.reading, s.tau_R);
+      ActuatorTorqueFromReading(fx, s.t, R.reading, s.tau_R, &s);
     } else {
       s.tau_R[0] = R.cmd[0], s.tau_R[1] = R.cmd[1];
       for (int k = 0; k < parameters(); ++k)

@@ -13,14 +13,71 @@
 
 namespace exotwin {
 
-void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>& t,
-                               const std::vector<double> tau_S[2], std::vector<double> tau_R[2]) {
-  for (int j = 0; j < 2; ++j) {
-    std::vector<double> s = tau_S[j];
-    for (auto it = fx.sensor[j].rbegin(); it != fx.sensor[j].rend(); ++it)
+namespace {
+
+// The reading before joint j's sensor effects: tau_S with them undone in reverse order; a term's
+// value * expr taken off at the actuator torque `tau` (null: no term).
+std::vector<double> ReadingBeforeSensor(const PlantEffects& fx, int j, const std::vector<double>& t,
+                                        const std::vector<double>& tau_S, const std::vector<double>* tau,
+                                        const ReplaySeries* motion) {
+  std::vector<double> s = tau_S;
+  for (auto it = fx.sensor[j].rbegin(); it != fx.sensor[j].rend(); ++it) {
+    if (it->expr.empty()) {
       FindFamily(it->name)->off_reading(it->value, t, &s);
+      continue;
+    }
+    if (!tau) continue;
+    const TermExpr& expr = CachedTermExpr(it->expr);
+    const bool moves = expr.Reads("q") || expr.Reads("qd") || expr.Reads("qdd") || expr.Reads("q_hip") ||
+                       expr.Reads("q_knee") || expr.Reads("qd_hip") || expr.Reads("qd_knee");
+    if (moves && !motion)
+      throw InputError("sensor term \"" + it->expr + "\": reads the motion, which this reading's inversion is not given");
+    std::vector<TermSignals> rows(s.size());
+    for (size_t i = 0; i < s.size(); ++i) {
+      TermSignals& x = rows[i];
+      x.tau_R = (*tau)[i], x.t = t[i] - t[0];
+      if (!moves) continue;
+      auto at = [&](const std::vector<double>& v) { return v.empty() ? 0.0 : v[i]; };
+      x.q_hip = motion->q[0][i], x.q_knee = motion->q[1][i];
+      x.qd_hip = at(motion->qd0[0]), x.qd_knee = at(motion->qd0[1]);
+      x.q = j == 0 ? x.q_hip : x.q_knee, x.qd = j == 0 ? x.qd_hip : x.qd_knee, x.qdd = at(motion->qdd0[j]);
+    }
+    std::vector<double> v(s.size());
+    expr.EvalRows(rows, v.data());
+    for (size_t i = 0; i < s.size(); ++i) s[i] -= it->value * v[i];
+  }
+  return s;
+}
+
+}  // namespace
+
+void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>& t,
+                               const std::vector<double> tau_S[2], std::vector<double> tau_R[2],
+                               const ReplaySeries* motion) {
+  for (int j = 0; j < 2; ++j) {
+    std::vector<double> s = ReadingBeforeSensor(fx, j, t, tau_S[j], nullptr, motion);
     tau_R[j].resize(s.size());
     for (size_t i = 0; i < s.size(); ++i) tau_R[j][i] = -s[i];
+    bool terms = false;
+    for (const SensorEffect& e : fx.sensor[j]) terms |= !e.expr.empty();
+    if (!terms) continue;
+    // tau_R = -(reading with the effects undone at tau_R): a fixed point, a contraction where
+    // |value d expr / d tau_R| < 1.
+    for (int k = 0;; ++k) {
+      s = ReadingBeforeSensor(fx, j, t, tau_S[j], &tau_R[j], motion);
+      double change = 0, scale = 1;
+      for (size_t i = 0; i < s.size(); ++i) {
+        change = std::max(change, std::abs(-s[i] - tau_R[j][i]));
+        scale = std::max(scale, std::abs(s[i]));
+        tau_R[j][i] = -s[i];
+      }
+      if (change <= 1e-10 * scale) break;
+      if (k + 1 == kTermInverseIterations || !std::isfinite(change))
+        throw InputError("the " + std::string(j == 0 ? "hip" : "knee") + "'s sensor terms: the actuator torque from the "
+                         "reading did not converge in " + std::to_string(kTermInverseIterations) +
+                         " fixed-point steps (last change " + std::to_string(change) +
+                         " N m): not invertible where |value d expr / d tau_R| >= 1");
+    }
   }
 }
 
@@ -70,7 +127,7 @@ ReplaySeries ReplaySeriesOf(const std::string& source, const std::vector<double>
 
 void CompleteReplaySeries(const std::vector<double> tau_S[2], const PlantEffects& fx, double cutoff_hz, ReplaySeries* s) {
   SetRestartState(cutoff_hz, s);
-  ActuatorTorqueFromReading(fx, s->t, tau_S, s->tau_R);
+  ActuatorTorqueFromReading(fx, s->t, tau_S, s->tau_R, s);
 }
 
 ReplaySeries ReplaySeriesOf(const MeasuredData& data, const PlantEffects& fx, ReplayInput input, double cutoff_hz) {
@@ -190,6 +247,7 @@ void ReplayWindow(Plant& plant, const ReplaySeries& s, const std::vector<double>
   // The restart state's acceleration: a dead band's flank is the one the rigid torque of that motion
   // presses (what the gear transmits in contact), a strap's deflection the one carrying it.
   const Eigen::Vector2d qdd0 = Acceleration(r);
+  plant.SetTermTimeOrigin(std::isnan(s.t_start) ? t.front() : s.t_start);  // a term's t: from the record's start
   plant.Reset({(*angle0[0])[r], (*angle0[1])[r]}, StepVelocity(r), t[r], &qdd0);
   if (r < start) {
     // The measured joints follow the restart state's motion (linear between samples), each step

@@ -46,6 +46,7 @@
 //    start + horizon. A series quiet throughout has the every-horizon windows.
 //  - the simulated angle at a sample time is interpolated linearly between the bracketing steps.
 #pragma once
+#include <cmath>
 #include <array>
 #include <functional>
 #include <memory>
@@ -63,6 +64,7 @@ enum class ReplayInput { kTorque, kCommand };
 struct ReplaySeries {
   std::string source;
   std::vector<double> t;
+  double t_start = std::nan("");         // the record's first time (a term's t origin); NaN: t.front()
   std::vector<double> q[2];              // measured angle, rad (scored)
   // restart state: angle (rad; empty: the measured one, q), velocity (rad/s) and acceleration
   // (rad/s^2; empty: 0) derived at the cutoff
@@ -94,9 +96,16 @@ constexpr double kReplayQuietShortest = 0.1;
 
 // tau_R on t from a measured reading tau_S with the sensor effects of fx inverted, in reverse order
 // of the model file (tau_S = (reading - offset) / (1 + gain); a delayed reading is read value s later,
-// held at the record's end): the torque the actuator applied.
+// held at the record's end): the torque the actuator applied. A sensor-stage term (tau_S += value *
+// expr, expr's tau_R the actuator torque) is inverted with the others by fixed-point iteration on
+// tau_R over the whole series (at most kTermInverseIterations, to 1e-10 N m relative); its motion
+// signals (q, qd, qdd, ...) are `motion`'s measured angle and restart state (t from t's first sample).
+// Throws InputError for a term whose iteration does not converge (|value d expr / d tau_R| >= 1: not
+// invertible) or that reads the motion where `motion` is null.
+constexpr int kTermInverseIterations = 100;
 void ActuatorTorqueFromReading(const PlantEffects& fx, const std::vector<double>& t,
-                               const std::vector<double> tau_S[2], std::vector<double> tau_R[2]);
+                               const std::vector<double> tau_S[2], std::vector<double> tau_R[2],
+                               const ReplaySeries* motion = nullptr);
 
 // The series of a record: t, q (measured), restart state at cutoff_hz, and the input (kTorque: from
 // tau_hip/tau_knee through ActuatorTorqueFromReading; kCommand: cmd_hip/cmd_knee, cmd_knee alone for a

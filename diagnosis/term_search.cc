@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <cstdio>
+#include <cstdlib>
 
 #include <Eigen/Dense>
 
@@ -33,10 +35,12 @@ struct SearchRec {
   Eigen::MatrixXd C;    // 2m x K
 };
 
+double RecordStart(const Kinematics& k) { return std::isnan(k.t_start) ? k.t.front() : k.t_start; }
+
 TermRow RowAt(const SearchRec& s, int j, size_t i) {
   const Kinematics& k = s.rc->kin;
   const int o = 1 - j;
-  return {{k.q[j][i], k.qd[j][i], k.qdd[j][i], s.tauR[j][i], k.q[o][i], k.qd[o][i], k.t[i] - k.t_start}};
+  return {{k.q[j][i], k.qd[j][i], k.qdd[j][i], s.tauR[j][i], k.q[o][i], k.qd[o][i], k.t[i] - RecordStart(k)}};
 }
 
 // The reading of the twin `p` on every sample from the rigid torque.
@@ -207,7 +211,7 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, qd2 = 0, cnt = 0;
     for (const SearchRec& s : S) {
       const Kinematics& k = s.rc->kin;
-      ts.duration = std::max(ts.duration, k.t.back() - k.t_start);
+      ts.duration = std::max(ts.duration, k.t.back() - RecordStart(k));
       for (size_t i = 0; i < k.t.size(); i += 10) {
         for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], k.q[a][i]), hi[a] = std::max(hi[a], k.q[a][i]);
         qd2 += k.qd[j][i] * k.qd[j][i], cnt += 1;
@@ -315,7 +319,7 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
     return coef[static_cast<Eigen::Index>(std::find(cols.begin(), cols.end(), c) - cols.begin())];
   };
   DiagnosedEffect d;
-  d.effect.name = "term";
+  d.effect.name = kTerm;
   d.effect.joint = kJointName[t.joint];
   d.effect.unit = "N m";
   double phi = 0, se = 0;
@@ -410,8 +414,8 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       const bool admissible = now.bic - f.bic > margin && held && loo && TermT(f, cand_cols[i]) > kMinT;
       D->term_search.push_back("step " + std::to_string(step + 1) + ": " +
                                CandidateExpr(top[i].c, kJointName[j]) + " (" + kJointName[j] + "): BIC " +
-                               Num(f.bic - now.bic) + " (needed < -" + Num(margin) + "), held-out -" +
-                               Num(100 * drop_te / std::max(1e-300, now.sse_te_j[j])) + " %, |t| " +
+                               Num(f.bic - now.bic) + " (needed < -" + Num(margin) + "), held-out error " +
+                               Num(-100 * drop_te / std::max(1e-300, now.sse_te_j[j])) + " %, |t| " +
                                Num(TermT(f, cand_cols[i])) + (admissible ? ": admissible" : ""));
       if (!admissible) continue;
       gain[i] = drop_te;
@@ -457,6 +461,7 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       cur = Without(cur, {drop});
     }
   }
+  if (std::getenv("TERM_TRACE")) for (auto& l : D->term_search) std::fprintf(stderr, "%s\n", l.c_str());  // TEMP
   if (!out.changed) return out;
 
   // The final model: the kept table effects refitted, the terms; each one's held-out share.

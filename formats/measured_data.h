@@ -102,7 +102,8 @@ void CheckHumanJointRange(const MeasuredData& data);
 // Joint kinematics on the measured time base.
 struct Kinematics {
   std::vector<double> t;
-  double t_start = 0;  // the record's first time (s, before any trim or slice): a term's t counts from it
+  // The record's first time (s, before any trim or window): a term's t counts from it; NaN: t.front().
+  double t_start = std::nan("");
   std::vector<double> q[2], qd[2], qdd[2];  // [0] hip, [1] knee; rad, rad/s, rad/s^2
   bool resampled = false;                    // the input was non-uniform and went through a grid
   std::string derivative_source;             // "measured columns" or "butterworth 20 Hz"

@@ -8,6 +8,7 @@
 #include "core/yaml_fields.h"
 #include "model/effect_families.h"
 #include "model/one_joint.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 namespace {
@@ -62,6 +63,25 @@ void ReadEffectKey(const YamlContext& c, const YAML::Node& n, const std::string&
   }
 }
 
+// A term's expr (parsed: a parse error names the position in it) and stage (DESIGN.md "Terms beyond
+// the table").
+void ReadTerm(const YamlContext& c, const YAML::Node& n, const std::string& key, Effect* e) {
+  const std::string what = " (" + e->name + " at the " + e->joint + ")";
+  if (!n["expr"] || !n["expr"].IsScalar())
+    c.Fail(key + ".expr", "missing" + what + ", expected an expression of q, qd, qdd, tau_R, q_hip, q_knee, qd_hip, "
+           "qd_knee, t (DESIGN.md \"Terms beyond the table\")");
+  e->expr = n["expr"].Scalar();
+  try {
+    TermExpr::Parse(e->expr);
+  } catch (const TermExprError& x) {
+    c.Fail(key + ".expr", "\"" + e->expr + "\"" + what + ": " + x.what() + " of the expression");
+  }
+  if (n["stage"]) {
+    e->stage = n["stage"].IsScalar() ? n["stage"].Scalar() : "";
+    if (e->stage != "link" && e->stage != "sensor") c.Fail(key + ".stage", "expected link or sensor" + YamlLine(n["stage"]));
+  }
+}
+
 Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& key) {
   if (!n.IsMap()) c.Fail(key, "expected a mapping {name, joint, value, unit, ...}" + YamlLine(n));
   if (!n["name"] || !n["name"].IsScalar()) c.Fail(key + ".name", "missing, expected an effect name");
@@ -74,6 +94,7 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
   std::set<std::string> allowed = {"name", "joint", "value", "unit", "ci95", "explained_pct"};
   allowed.insert(spec->fields.begin(), spec->fields.end());
   for (const EffectKey& k : spec->keys) allowed.insert(k.key);
+  if (spec->carries_expr) allowed.insert({"expr", "stage"});
   YamlCheckKeys(c, n, key, allowed);
   if (!n["joint"] || !n["joint"].IsScalar() ||
       (n["joint"].Scalar() != "hip" && n["joint"].Scalar() != "knee"))
@@ -89,6 +110,7 @@ Effect ReadEffect(const YamlContext& c, const YAML::Node& n, const std::string& 
     e.fields[f] = YamlNumber(c, n[f], key + "." + f, -1e6, 1e6, "");
   }
   for (const EffectKey& k : spec->keys) ReadEffectKey(c, n, key, k, &e);
+  if (spec->carries_expr) ReadTerm(c, n, key, &e);
   return e;
 }
 
@@ -212,6 +234,8 @@ void WriteEffects(std::ostringstream& os, const std::vector<Effect>& effects) {
       os << "  - {name: " << e.name << ", joint: " << e.joint << ", value: " << Num(e.value)
          << ", unit: \"" << e.unit << "\"";
       if (!e.axis.empty()) os << ", axis: " << e.axis;
+      if (!e.expr.empty()) os << ", expr: \"" << e.expr << "\"";
+      if (!e.stage.empty()) os << ", stage: " << e.stage;
       std::string weights;
       for (const auto& f : e.fields) {
         if (f.first.rfind("w_", 0) == 0) weights += (weights.empty() ? "" : ", ") + f.first.substr(2) + ": " + Num(f.second);

@@ -21,6 +21,7 @@ const char* const kSensorOffset = "sensor_offset";
 const char* const kSensorGain = "sensor_gain";
 const char* const kSensorDelay = "sensor_delay";
 const char* const kMuscleActivity = "muscle_activity";
+const char* const kTerm = "term";
 
 namespace {
 
@@ -44,6 +45,11 @@ Eigen::Vector2d Ripple(const Effect& e, const EffectState& s) {
   return AtJoint(e, TorqueRippleTorque(e, s.q[EffectJoint(e)]));
 }
 Eigen::Vector2d Passive(const Effect& e, const EffectState& s) { return AtJoint(e, PassiveMomentTorque(e, s.q)); }
+// DESIGN.md "Terms beyond the table": value * expr at the joint (added to tau_R, or to tau_S at the
+// sensor stage).
+Eigen::Vector2d Term(const Effect& e, const EffectState& s) {
+  return AtJoint(e, e.value * CachedTermExpr(e.expr).Eval(TermSignalsAt(e, s)));
+}
 
 // DESIGN.md: tau_S += offset, tau_S *= 1 + gain, tau_S(t) = true reading at t - delay.
 void Offset(const Effect& e, const std::vector<double>&, std::vector<double>* tau_S) {
@@ -112,6 +118,9 @@ std::deque<EffectFamily>& Registry() {
       {kMuscleActivity, "-", -1e6, 1e6, {}, S::kLink, C::kNotCarried, "",
        "the subject was not relaxed: residual explained by EMG envelopes", nullptr, nullptr, nullptr, nullptr,
        {{"weights", K::kWeights}, {"channels", K::kAccepted}}},
+      {kTerm, "N m", -1e6, 1e6, {}, S::kLink, C::kAppliedForce, "",
+       "tau_R += value * expr (field `expr`, \"Terms beyond the table\"); with `stage: sensor`, tau_S += value * "
+       "expr", Term, nullptr, nullptr, nullptr, {}, true},
   };
   return k;
 }
@@ -160,6 +169,20 @@ std::string FamilyNames(bool (*keep)(const EffectFamily&)) {
 }
 
 int EffectJoint(const Effect& e) { return e.joint == "hip" ? 0 : 1; }
+
+EffectStage StageOf(const Effect& e) {
+  if (e.stage.empty()) return FamilyOf(e).stage;
+  return e.stage == "sensor" ? EffectStage::kSensor : EffectStage::kLink;
+}
+
+TermSignals TermSignalsAt(const Effect& e, const EffectState& s) {
+  const int j = EffectJoint(e);
+  TermSignals x;
+  x.q = s.q[j], x.qd = s.qd[j], x.qdd = s.qdd[j], x.tau_R = s.tau_R[j];
+  x.q_hip = s.q[0], x.q_knee = s.q[1], x.qd_hip = s.qd[0], x.qd_knee = s.qd[1];
+  x.t = s.t;
+  return x;
+}
 
 Eigen::Vector2d GravityErrorTorque(const Effect& e, double g, const Eigen::Vector2d& q) {
   const int j = EffectJoint(e);

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "model/lumped_params.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 
@@ -41,10 +42,14 @@ enum class PlantCarrier {
 enum class EffectStage { kLink, kSensor };
 
 // One sample's state for a closed form: angles, velocities, accelerations (rad, rad/s, rad/s^2; [0]
-// hip, [1] knee) and gravity (m/s^2).
+// hip, [1] knee) and gravity (m/s^2); for a term (model/term_expr.h) also the actuator torque tau_R
+// (N m: the rigid twin's where the motion is given, the one applied at that step in the forward plant)
+// and the time t (s from the record's or run's start).
 struct EffectState {
   Eigen::Vector2d q, qd, qdd;
   double g = 9.81;
+  Eigen::Vector2d tau_R = Eigen::Vector2d::Zero();
+  double t = 0;
 };
 
 // DESIGN.md's families by name, for code that constructs a named effect (a device's own friction, a
@@ -62,6 +67,7 @@ extern const char* const kSensorOffset;
 extern const char* const kSensorGain;
 extern const char* const kSensorDelay;
 extern const char* const kMuscleActivity;
+extern const char* const kTerm;
 
 // A model-file key of a family beyond name, joint, value, unit and its required `fields`; the reader
 // (formats/model_file.cc) reads it by kind, the writer writes the effect's axis, fields and weights.
@@ -97,6 +103,9 @@ struct EffectFamily {
   // (a joint module's gain and offset); nullptr for the delay (whole samples of the module's skew).
   void (*affine)(double value, double* a, double* b) = nullptr;
   std::vector<EffectKey> keys;  // its model-file keys beyond `fields`
+  // A term (DESIGN.md "Terms beyond the table"): each effect carries its own `expr` (model/term_expr.h)
+  // and may carry a `stage` (link or sensor); link_torque is value * expr at the joint.
+  bool carries_expr = false;
 };
 
 // Every family: DESIGN.md's table in its order, then any added by AddEffectFamily. References stay
@@ -123,6 +132,12 @@ std::string FamilyNames(bool (*keep)(const EffectFamily&) = nullptr);
 
 // The sign of coulomb_friction's closed form (and of a term's sgn): +-1, 0 at 0.
 inline double CoulombSign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+// The stage an effect acts at: its own `stage` ("link" or "sensor", a term's) or its family's.
+EffectStage StageOf(const Effect& e);
+
+// A term's signals (model/term_expr.h) at its joint from one sample's state.
+TermSignals TermSignalsAt(const Effect& e, const EffectState& s);
 
 // Joint index of an effect ("hip" -> 0, "knee" -> 1).
 int EffectJoint(const Effect& e);

@@ -35,8 +35,8 @@ struct Effect {
   std::string unit;
   std::map<std::string, double> fields;  // q0, cycles_per_rad, phase, ...
   std::string axis;                      // gravity_error only: "X" or "Y"
-  std::string expr{};                    // term only: model/term_expr.h's grammar
-  std::string stage{};                   // term only: "link" (default, "") or "sensor"
+  std::string expr{};                    // term only: value * expr (model/term_expr.h's grammar)
+  std::string stage{};                   // "" (the family's), "link" or "sensor" (term only)
 };
 
 // A one-joint device (DESIGN.md "One-joint devices"): HAL-3's knee model of Lee & Sankai, HKS05

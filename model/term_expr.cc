@@ -4,6 +4,8 @@
 #include <charconv>
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 
 #include "model/effect_families.h"
@@ -531,6 +533,15 @@ bool TermExpr::Reads(const std::string& name) const {
   const int i = SignalIndex(name);
   if (i < 0) throw std::invalid_argument("TermExpr::Reads: '" + name + "' is not a signal of the grammar");
   return (reads_ >> i) & 1u;
+}
+
+const TermExpr& CachedTermExpr(const std::string& text) {
+  static std::mutex mutex;
+  static std::map<std::string, std::unique_ptr<const TermExpr>> parsed;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = parsed.find(text);
+  if (it == parsed.end()) it = parsed.emplace(text, std::make_unique<const TermExpr>(TermExpr::Parse(text))).first;
+  return *it->second;
 }
 
 bool TermExpr::FrictionLike(TermExpr* f) const {

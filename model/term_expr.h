@@ -15,6 +15,7 @@
 // sign coulomb_friction's closed form uses (CoulombSign, model/effect_families.h: 0 at 0); pos(x) is
 // 1 where x > 0, else 0. A default-constructed TermExpr is the empty expression, which evaluates to 0.
 #pragma once
+#include <cstddef>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -62,11 +63,14 @@ class TermExpr {
   void EvalColumns(const Columns& c, size_t n, double* out) const;
   // The text it was parsed from.
   const std::string& text() const { return text_; }
-  // True when the expression reads the signal `name` (one of the grammar's signals).
+  // True when the expression reads the signal `name` (one of the grammar's signals; another name
+  // throws std::invalid_argument).
   bool Reads(const std::string& name) const;
   // A friction-like term: expr = f * sgn(qd) with f not reading qd's sign (f reads no qd, or reads it
-  // only through abs). The forward plant carries such a term as a per-step friction bound
-  // |value * f| (dof_frictionloss) instead of an applied force. `f` receives the factor's expression.
+  // only through abs): sgn(qd) a factor of the product (through products, numerators and negations),
+  // or of every addend of a sum. The forward plant carries such a term as a per-step friction bound
+  // value * f (dof_frictionloss; sim/plant_effects.h) instead of an applied force. `f` receives the
+  // factor (the tree with sgn(qd) taken out, printed back as text): f * sgn(qd) is expr bit for bit.
   bool FrictionLike(TermExpr* f = nullptr) const;
 
   struct Node;     // the parse tree (term_expr.cc)
@@ -78,5 +82,9 @@ class TermExpr {
   std::shared_ptr<const Program> program_;
   unsigned reads_ = 0;  // bit i: the expression reads the grammar's i-th signal
 };
+
+// The parsed expression of `text`, parsed once per text and kept (thread-safe; the reference stays
+// valid): the closed forms of model files' terms evaluate through it. Throws TermExprError as Parse.
+const TermExpr& CachedTermExpr(const std::string& text);
 
 }  // namespace exotwin

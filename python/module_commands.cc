@@ -111,6 +111,8 @@ py::dict ReadModel(const std::string& path) {
     x["unit"] = e.unit;
     for (const auto& kv : e.fields) x[py::str(kv.first)] = kv.second;
     if (!e.axis.empty()) x["axis"] = e.axis;
+    if (!e.expr.empty()) x["expr"] = e.expr;  // a term's (DESIGN.md "Terms beyond the table")
+    if (!e.stage.empty()) x["stage"] = e.stage;
     effects.append(x);
   }
   d["effects"] = effects;

@@ -159,6 +159,10 @@ hwsim::JointModuleSpec JointModuleSpecOf(const HardwareSpec& hw, int j, const st
   // (tau + offset) (1 + gain) with offset = b / a + the sensor's own, gain = a - 1.
   double a = 1, b = 0;
   for (const SensorEffect& e : sensor) {
+    if (!e.expr.empty())
+      throw InputError(source + ": a sensor-stage term (\"" + e.expr + "\") at the " + (j == 0 ? "hip" : "knee") +
+                       ": a scenario's joint modules apply the affine sensor effects and the delay only; carried at "
+                       "the link stage, or in replay");
     const EffectFamily* f = FindFamily(e.name);
     if (f->affine) {
       f->affine(e.value, &a, &b);

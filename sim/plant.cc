@@ -410,7 +410,8 @@ void Plant::CarryEffects(const PlantEffects& fx) {
       m_->dof_frictionloss[dof] = base_frictionloss_[j] + fx.frictionloss[j];
       // The frictionloss constraint's time constant: the shortest MuJoCo integrates safely (2 steps),
       // so that its stiction zone around qd = 0 is as narrow as the step allows.
-      m_->dof_solref[mjNREF * dof] = fx.frictionloss[j] > 0 ? 2 * m_->opt.timestep : base_solref_[j];
+      m_->dof_solref[mjNREF * dof] =
+          fx.frictionloss[j] > 0 || fx.has_friction_term(j) ? 2 * m_->opt.timestep : base_solref_[j];
       m_->dof_damping[dof] = base_damping_[j] + fx.damping[j];
       m_->dof_armature[dof] = base_armature_[j] + fx.armature[j] + (j == 0 && hip_held_ ? kHeldHipArmature : 0.0);
       if (fx.stiffness[j] != 0) {
@@ -456,6 +457,7 @@ void Plant::HoldHip() {
 void Plant::Reset(const Eigen::Vector2d& q, const Eigen::Vector2d& qd, double t, const Eigen::Vector2d* qdd) {
   ClearMujocoWarning();
   mj_resetData(m_, d_);
+  last_qdd_.setZero();
   for (int j = 0; j < 2; ++j) {
     d_->qpos[q_adr_[j]] = q[j];
     d_->qvel[j == 0 ? hip_dof_ : knee_dof_] = qd[j];
@@ -529,7 +531,18 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   if (!fx_.applied.empty()) applied += fx_.SubjectPassiveForce(q_follower);
   for (int j = 0; j < 2; ++j)
     if (in_v_[j] >= 0) d_->qfrc_applied[in_v_[j]] = applied[j];
-  if (!fx_.applied.empty()) applied += fx_.AppliedForce(q(), qd());
+  if (!fx_.applied.empty()) applied += fx_.AppliedForce(q(), qd(), last_qdd_, tau_R, d_->time - term_t0_);
+  if (!fx_.friction_terms.empty()) {
+    // Friction-like terms: this step's friction bound at the state and the applied actuator torque.
+    EffectState s;
+    s.q = q(), s.qd = qd(), s.qdd = last_qdd_, s.g = fx_.g, s.tau_R = tau_R, s.t = d_->time - term_t0_;
+    double bound[2];
+    Eigen::Vector2d force;
+    fx_.FrictionTermBounds(s, bound, &force);
+    m_->dof_frictionloss[hip_dof_] = base_frictionloss_[0] + fx_.frictionloss[0] + bound[0];
+    m_->dof_frictionloss[knee_dof_] = base_frictionloss_[1] + fx_.frictionloss[1] + bound[1];
+    applied += force;
+  }
   d_->qfrc_applied[hip_dof_] = applied[0];
   d_->qfrc_applied[knee_dof_] = applied[1];
   // Actuators are plain motors with gear 1: ctrl is the joint torque (clamped by ctrlrange).
@@ -538,6 +551,7 @@ void Plant::Step(const Eigen::Vector2d& tau_R, const Eigen::Vector2d& tau_ext) {
   ClearMujocoWarning();
   mj_step(m_, d_);
   if (hip_held_) d_->qpos[m_->jnt_qposadr[hip_jnt_]] = 0, d_->qvel[hip_dof_] = 0;
+  last_qdd_ = qdd();
   CheckDivergence("step");
 }
 

@@ -114,6 +114,9 @@ class Plant {
   Eigen::Vector2d q() const;
   Eigen::Vector2d qd() const;
   Eigen::Vector2d qdd() const;  // acceleration of the last step
+  // The time (s) a term's t counts from (DESIGN.md "Terms beyond the table": the record's or run's
+  // start); 0 unless set.
+  void SetTermTimeOrigin(double t0) { term_t0_ = t0; }
   double time() const;
   double timestep() const;
 
@@ -136,6 +139,8 @@ class Plant {
   int hip_dof_ = -1, knee_dof_ = -1;
   LegParams params_;
   PlantEffects fx_;
+  double term_t0_ = 0;
+  Eigen::Vector2d last_qdd_ = Eigen::Vector2d::Zero();  // a term's qdd: the last step's acceleration (0 after a reset)
   // The MJCF's own per-dof values, which CarryEffects adds to.
   double base_frictionloss_[2] = {0, 0}, base_damping_[2] = {0, 0}, base_armature_[2] = {0, 0};
   double base_stiffness_[2] = {0, 0}, base_springref_[2] = {0, 0}, base_solref_[2] = {0, 0};

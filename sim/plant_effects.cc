@@ -56,7 +56,7 @@ bool PlantEffects::link_empty() const {
     if (frictionloss[j] != 0 || damping[j] != 0 || armature[j] != 0 || stiffness[j] != 0 || backlash[j] != 0 ||
         compliance[j] != 0)
       return false;
-  return applied.empty();
+  return applied.empty() && friction_terms.empty();
 }
 
 Eigen::Vector2d PlantEffects::SubjectPassiveForce(const Eigen::Vector2d& q_follower) const {
@@ -72,10 +72,11 @@ bool PlantEffects::has_internal_joints() const {
 
 bool PlantEffects::empty() const { return link_empty() && sensor[0].empty() && sensor[1].empty(); }
 
-Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q, const Eigen::Vector2d& qd) const {
+Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                                           const Eigen::Vector2d& qdd, const Eigen::Vector2d& tau_R, double t) const {
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   EffectState s;
-  s.q = q, s.qd = qd, s.qdd.setZero(), s.g = g;
+  s.q = q, s.qd = qd, s.qdd = qdd, s.g = g, s.tau_R = tau_R, s.t = t;
   for (const Effect& e : applied) {
     const EffectFamily& family = FamilyOf(e);
     if (family.carrier == PlantCarrier::kAppliedForce) f -= family.link_torque(e, s);
@@ -83,7 +84,45 @@ Eigen::Vector2d PlantEffects::AppliedForce(const Eigen::Vector2d& q, const Eigen
   return f;
 }
 
+void PlantEffects::FrictionTermBounds(const EffectState& s, double bound[2], Eigen::Vector2d* force) const {
+  bound[0] = bound[1] = 0;
+  force->setZero();
+  Effect at;  // the term's joint for its signals
+  for (const FrictionTerm& ft : friction_terms) {
+    at.joint = ft.joint == 0 ? "hip" : "knee";
+    const double b = ft.value * ft.f.Eval(TermSignalsAt(at, s));
+    if (b >= 0) bound[ft.joint] += b;
+    else (*force)[ft.joint] -= b * CoulombSign(s.qd[ft.joint]);
+  }
+}
+
+bool PlantEffects::has_friction_term(int j) const {
+  for (const FrictionTerm& ft : friction_terms)
+    if (ft.joint == j) return true;
+  return false;
+}
+
 namespace {
+
+// A term (DESIGN.md "Terms beyond the table"): at the sensor stage where the reading is formed; at the
+// link a friction bound (friction-like) or an applied force.
+void AddTerm(const Effect& e, int j, const std::string& where, PlantEffects* fx) {
+  TermExpr expr;
+  try {
+    expr = TermExpr::Parse(e.expr);
+  } catch (const TermExprError& x) {
+    throw InputError(where + ": expr \"" + e.expr + "\": " + x.what() + " of the expression");
+  }
+  if (!std::isfinite(e.value)) throw InputError(where + ": value not finite");
+  if (StageOf(e) == EffectStage::kSensor) {
+    fx->sensor[j].push_back({e.name, e.value, e.expr});
+    return;
+  }
+  FrictionTerm ft;
+  ft.joint = j, ft.value = e.value;
+  if (expr.FrictionLike(&ft.f)) fx->friction_terms.push_back(ft);
+  else fx->applied.push_back(e);
+}
 
 // Smallest eigenvalue of M(th2) + diag(armature) over th2 in [-pi, pi) (360 points; M is periodic
 // in th2, HJ15 eq. 5).
@@ -111,6 +150,10 @@ PlantEffects ToPlantEffects(const LegParams& params, const std::string& source) 
     const std::string where = source + ": effects[" + std::to_string(i) + "] (" + e.name + ", " + e.joint + ")";
     const EffectFamily* f = FindFamily(e.name);
     if (!f) throw InputError(where + ": unknown effect; expected one of " + FamilyNames());
+    if (f->carries_expr) {
+      AddTerm(e, j, where, &fx);
+      continue;
+    }
     switch (f->carrier) {
       case PlantCarrier::kFrictionLoss:
         if (e.value < 0) throw InputError(where + ": a negative Coulomb friction cannot be a MuJoCo frictionloss");

@@ -32,6 +32,11 @@
 //    limit constraints); the whole chain is behind it and the motor side is a rotor body.
 //    series_compliance: a relative hinge with stiffness value, springref 0: behind it the human limb
 //    (a model with a human, at the knee) or the whole chain (no human, behind a rotor body).
+//  - term (DESIGN.md "Terms beyond the table"): at the link stage an applied generalized force
+//    -value * expr each step from the state and the actuator torque applied at that step; a
+//    friction-like one (expr = f sgn(qd), TermExpr::FrictionLike) instead that step's friction bound
+//    dof_frictionloss += value * f (an applied force where value * f < 0: no bound pushes along the
+//    motion). At the sensor stage it acts where the reading is formed (SensorEffect::expr).
 //  - muscle_activity: not carried (the subject's EMG is an input of the record, not a property of the
 //    plant): ToPlantEffects refuses it (InputError).
 #pragma once
@@ -42,15 +47,25 @@
 
 #include "model/effect_families.h"  // the families' closed forms (GravityErrorTorque, ...)
 #include "model/lumped_params.h"
+#include "model/term_expr.h"
 
 namespace exotwin {
 
 // Torque-sensor effects of one joint, in the order the model file lists them (DESIGN.md: tau_S +=
 // offset, tau_S *= 1 + gain, tau_S(t) = true reading at t - delay).
 struct SensorEffect {
-  std::string name;  // sensor_offset | sensor_gain | sensor_delay
+  std::string name;  // sensor_offset | sensor_gain | sensor_delay | term
   double value = 0;
-  bool operator==(const SensorEffect& o) const { return name == o.name && value == o.value; }
+  std::string expr;  // a sensor-stage term's: tau_S += value * expr
+  bool operator==(const SensorEffect& o) const { return name == o.name && value == o.value && expr == o.expr; }
+};
+
+// A friction-like link term at a joint: the friction bound value * f each step (f the factor of
+// expr = f sgn(qd)).
+struct FrictionTerm {
+  int joint = 0;
+  double value = 0;
+  TermExpr f;
 };
 
 // Transition width of the backlash flank selection s(tau) = tanh(tau / width), N m (the inverse form:
@@ -77,6 +92,7 @@ struct PlantEffects {
   double compliance[2] = {0, 0};    // N m/rad, strap stiffness (0: none)
   bool compliant_human = false;     // the part behind a strap is the human limb (else the whole chain)
   std::vector<Effect> applied;      // kAppliedForce and kSubjectForce families: qfrc_applied each step
+  std::vector<FrictionTerm> friction_terms;  // friction-like link terms: frictionloss each step
   std::vector<SensorEffect> sensor[2];
   double g = 9.81;                  // for gravity_error
   bool empty() const;
@@ -84,15 +100,23 @@ struct PlantEffects {
   bool has_internal_joints() const; // backlash or series_compliance: the MJCF gains hinges
   // The generalized force (N m) of `applied` at (q, qd): minus the torques the actuator needs for the
   // families carried as an applied force (PlantCarrier::kAppliedForce), each by its own closed form;
-  // those carried at the human's angles (kSubjectForce) are SubjectPassiveForce's.
-  Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q, const Eigen::Vector2d& qd) const;
+  // those carried at the human's angles (kSubjectForce) are SubjectPassiveForce's. A term also reads
+  // qdd, the actuator torque tau_R and the time t (s from the run's or record's start).
+  Eigen::Vector2d AppliedForce(const Eigen::Vector2d& q, const Eigen::Vector2d& qd,
+                               const Eigen::Vector2d& qdd = Eigen::Vector2d::Zero(),
+                               const Eigen::Vector2d& tau_R = Eigen::Vector2d::Zero(), double t = 0) const;
+  // The friction-like terms at state s: bound[j] (N m) to add to joint j's frictionloss, and the
+  // applied force (N m) of those whose bound value * f is negative (-value * f sgn(qd)).
+  void FrictionTermBounds(const EffectState& s, double bound[2], Eigen::Vector2d* force) const;
+  bool has_friction_term(int j) const;
   // The generalized force (N m) of the passive_moment effects of `applied` at the human's angles
   // q_follower (behind a strap or dead band: q + the internal hinges' angles): where Riener & Edrich's
   // P^ acts, on the human's segments.
   Eigen::Vector2d SubjectPassiveForce(const Eigen::Vector2d& q_follower) const;
 };
 
-// Sorts `params.effects` into the plant's form. Throws InputError naming `source`, the effect
+// Sorts `params.effects` into the plant's form (a term by its stage and TermExpr::FrictionLike).
+// Throws InputError naming `source`, the effect
 // (effects[i], its name and joint) and why, for an effect the plant cannot carry (muscle_activity;
 // series_compliance at the hip of a model with a human; a second backlash or compliance at one joint;
 // a backlash outside 0 .. 0.1 rad or a stiffness <= 0) and for a negative inertia_error that leaves M + diag(armature)

@@ -258,10 +258,12 @@ def read_model(path):
 
 
 def generate(params, seed, out=None, effects=None, effect=None, joint=None, duration=None, rate=None,
-             clean=False):
+             clean=False, term=None, value=None, stage=None):
     """`exotwin generate`: a synthetic record of the twin with hidden effects. Returns {"measured":
     {column: array}, "truth": the model with the hidden effects (read_model), "path": the CSV (None
-    without out)}. out: the CSV to write (None: a temporary file)."""
+    without out)}. out: the CSV to write (None: a temporary file). term, value, stage: terms beyond the
+    table hidden at `joint` (DESIGN.md "Terms beyond the table"): an expression or a list of them, with
+    their values (N m) and stages (link or sensor) in the same order."""
     with _Out(None, "generate") as tmp:
         csv_path = _path(out, "out") if out is not None else os.path.join(tmp, "measured.csv")
         truth = os.path.join(tmp, "truth.yaml")
@@ -269,7 +271,10 @@ def generate(params, seed, out=None, effects=None, effect=None, joint=None, dura
                                     ("--out", csv_path), ("--effects", effects),
                                     ("--effect", [effect] if isinstance(effect, str) else effect),
                                     ("--joint", joint), ("--duration", duration), ("--rate", rate),
-                                    ("--truth", truth), ("--clean", bool(clean))]))
+                                    ("--truth", truth), ("--clean", bool(clean)),
+                                    ("--term", [term] if isinstance(term, str) else term),
+                                    ("--value", [value] if isinstance(value, (int, float)) else value),
+                                    ("--stage", [stage] if isinstance(stage, str) else stage)]))
         return {"measured": read_measured(csv_path), "truth": read_model(truth),
                 "path": csv_path if out is not None else None}
 

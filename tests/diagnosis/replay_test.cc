@@ -200,6 +200,50 @@ TEST(ReplaySensor, InvertsOffsetGainAndDelayOfTheReading) {
   }
 }
 
+Effect TermEffect(const char* joint, double value, const char* expr, const char* stage = "") {
+  Effect e = MakeEffect("term", joint, value);
+  e.expr = expr, e.stage = stage;
+  return e;
+}
+
+// Sensor-stage terms inverted with the other sensor effects (fixed point on tau_R): a load-dependent
+// reading error, one reading the motion, after a gain; a term whose iteration cannot contract
+// (|value d expr / d tau_R| >= 1) is refused.
+TEST(ReplaySensor, InvertsSensorTerms) {
+  LegParams p = RealRigModel();
+  p.effects = {MakeEffect("sensor_gain", "hip", 0.05), TermEffect("hip", -0.02, "tau_R * abs(tau_R)", "sensor"),
+               TermEffect("knee", 0.3, "sin(q) * tau_R + t", "sensor"), MakeEffect("sensor_offset", "knee", 0.1)};
+  ReplaySeries motion;
+  Kinematics kin;
+  std::vector<double> tau_R[2], tau_S[2];
+  for (int i = 0; i < 2000; ++i) {
+    const double t = 1e-3 * i;
+    kin.t.push_back(t);
+    for (int j = 0; j < 2; ++j) {
+      kin.q[j].push_back(0.4 * std::sin(1.3 * t + j)), kin.qd[j].push_back(0), kin.qdd[j].push_back(0);
+      motion.q[j].push_back(kin.q[j].back());
+    }
+    tau_R[0].push_back(Drive(t)[0]);
+    tau_R[1].push_back(Drive(t)[1]);
+  }
+  motion.t = kin.t;
+  std::vector<double> applied[2] = {tau_R[0], tau_R[1]};
+  ApplyEffects(p, kin, tau_R, tau_S);
+  std::vector<double> back[2];
+  ActuatorTorqueFromReading(ToPlantEffects(p, "test"), kin.t, tau_S, back, &motion);
+  for (int j = 0; j < 2; ++j)
+    for (size_t i = 0; i < kin.t.size(); ++i) ASSERT_NEAR(back[j][i], applied[j][i], 1e-9) << j << " " << i;
+  // The motion is needed where a term reads it.
+  EXPECT_THROW(ActuatorTorqueFromReading(ToPlantEffects(p, "test"), kin.t, tau_S, back), InputError);
+  p.effects = {TermEffect("knee", 2.0, "tau_R", "sensor")};
+  try {
+    ActuatorTorqueFromReading(ToPlantEffects(p, "test"), kin.t, tau_S, back);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not invertible"), std::string::npos) << e.what();
+  }
+}
+
 // A record the forward plant made, replayed by the same twin from its exact state: the simulated
 // angles are the record's (the input is interpolated mid-step, as the record's was applied: error
 // O(dt^2 u'') per step); the rigid twin drifts away from it.
@@ -567,6 +611,24 @@ TEST(Replay, AOneJointRecordIsReplayedByItsTruthTwin) {
   EXPECT_EQ(truth.score.Rmse(0), 0.0);
   EXPECT_LT(truth.score.Rmse(1), 0.01);           // rad
   EXPECT_LT(truth.score.Rmse(1), 0.25 * rigid.score.Rmse(1));
+}
+
+// A term "sgn(qd)" is carried as coulomb_friction is (the same frictionloss each step): replaying a
+// record the Coulomb twin made, the two twins give the same angles.
+TEST(Replay, ATermSgnReplaysAsCoulombFriction) {
+  LegParams coulomb = RealRigModel(), term = RealRigModel();
+  coulomb.effects = {MakeEffect("coulomb_friction", "knee", 0.145), MakeEffect("coulomb_friction", "hip", 0.13)};
+  term.effects = {TermEffect("knee", 0.145, "1.0 * sgn(qd)"), TermEffect("hip", 0.13, "sgn(qd)")};
+  const ForwardRun r = Simulate(coulomb, 2.0);
+  ReplaySeries s = ExactRecord(r);
+  for (int j = 0; j < 2; ++j) s.q0[j] = r.kin.q[j], s.qd0[j] = r.kin.qd[j];
+  const ReplayRecord a = Replay(*MakeReplayPlant(coulomb, "coulomb", ""), s, 0.5);
+  const ReplayRecord b = Replay(*MakeReplayPlant(term, "term", ""), s, 0.5);
+  ASSERT_EQ(a.score.windows, b.score.windows);
+  for (int j = 0; j < 2; ++j)
+    for (size_t i = 0; i < a.sim[j].size(); ++i)
+      if (!std::isnan(a.sim[j][i])) ASSERT_NEAR(b.sim[j][i], a.sim[j][i], 1e-12) << j << " " << i;
+  EXPECT_LT(a.score.Rmse(1), 1e-3);  // the twin that made it
 }
 
 }  // namespace

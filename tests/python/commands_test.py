@@ -174,3 +174,30 @@ def test_identify_is_the_programs(tmp):
     assert m == ref and m["human"] is None
     assert m["exo"]["J1"] == pytest.approx(3.01, rel=0.05)  # the scenarios' exoskeleton (Table 3 mean)
     assert (tmp / "py.yaml").read_text() == (tmp / "cli.yaml").read_text()
+
+
+def test_terms_are_read_written_and_hidden(tmp):
+    """A model file's terms (DESIGN.md "Terms beyond the table"): expr and stage in read_model's effects
+    and in its yaml; generate hides one, the same record as the program's generate --term."""
+    params = exotwin.data_path("examples/S1.yaml")
+    g = exotwin.generate(params, seed=5, out=tmp / "rec.csv", joint="knee", duration=4,
+                         term=["abs(tau_R) * sgn(qd)", "tau_R * abs(tau_R)"], value=[0.06, -0.0016],
+                         stage=["link", "sensor"])
+    effects = g["truth"]["effects"]
+    assert [e["name"] for e in effects] == ["term", "term"]
+    assert effects[0]["expr"] == "abs(tau_R) * sgn(qd)" and "stage" not in effects[0]
+    assert effects[1]["expr"] == "tau_R * abs(tau_R)" and effects[1]["stage"] == "sensor"
+    assert effects[1]["value"] == -0.0016 and effects[0]["joint"] == "knee"
+    cli("generate", "--params", params, "--seed", 5, "--out", tmp / "cli.csv", "--joint", "knee", "--duration", 4,
+        "--term", "abs(tau_R) * sgn(qd)", "--value", 0.06, "--term", "tau_R * abs(tau_R)", "--value", -0.0016,
+        "--stage", "link", "--stage", "sensor")
+    ref = read_csv(tmp / "cli.csv")
+    for name in ref:
+        assert same_bits(g["measured"][name], ref[name]), name
+    # The yaml written back reads as the same model.
+    (tmp / "again.yaml").write_text(g["truth"]["yaml"])
+    again = exotwin.read_model(tmp / "again.yaml")
+    assert again["effects"] == effects
+    # A bad expression: the program's exit 2 text, naming the position.
+    with pytest.raises(Exception, match="position 17"):
+        exotwin.generate(params, seed=5, joint="knee", duration=4, term="abs(tau_R) * sgn(qdx)", value=1.0)

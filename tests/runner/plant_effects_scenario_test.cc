@@ -83,6 +83,32 @@ TEST(PlantScenario, TheBlockIsReadOrRefusedNamingTheKey) {
                    "s.yaml: plant.effects: effects[0] (muscle_activity, knee)");
 }
 
+// Terms in a run's plant (DESIGN.md "Terms beyond the table"): "sgn(qd)" and a ripple's formula as
+// terms give the run of coulomb_friction and torque_ripple bit for bit (the same carriers); a
+// load-dependent friction changes the run; a sensor-stage term is refused naming the effect.
+TEST(PlantScenario, TermsInTheRunsPlant) {
+  const testing::ScopedTempDir tmp("plant_terms");
+  auto run = [&](const std::string& effects, const std::string& dir) {
+    Scenario s = ParseScenarioYaml(GaitWith("plant: {effects: " + effects + "}"), kSrc + "/scenarios/gait_2kmh.yaml");
+    s.protocol.duration = 3;
+    RunOptions o;
+    o.out_dir = tmp.path() + "/" + dir;
+    RunScenario(s, o);
+    return ReadMeasuredCsv(o.out_dir + "/measured.csv");
+  };
+  const MeasuredData table = run("[{name: coulomb_friction, joint: knee, value: 0.5}, {name: torque_ripple, joint: hip, "
+                                 "value: 0.4, cycles_per_rad: 3, phase: 0.2}]", "table");
+  const MeasuredData terms = run("[{name: term, joint: knee, value: 0.5, expr: \"sgn(qd)\"}, {name: term, joint: hip, "
+                                 "value: 0.4, expr: \"sin(2 * 3.141592653589793 * 3 * q + 0.2)\"}]", "terms");
+  const MeasuredData load = run("[{name: term, joint: knee, value: 0.05, expr: \"abs(tau_R) * sgn(qd)\"}]", "load");
+  EXPECT_EQ(terms.q_knee(), table.q_knee());
+  EXPECT_EQ(terms.tau_knee(), table.tau_knee());
+  EXPECT_EQ(terms.q_hip(), table.q_hip());
+  EXPECT_NE(load.tau_knee(), table.tau_knee());
+  ExpectRunRefused("[{name: term, joint: knee, value: 0.01, expr: \"tau_R\", stage: sensor}]", tmp.path() + "/sensor",
+                   "a sensor-stage term (\"tau_R\") at the knee");
+}
+
 // 20 s of the shipped gait (as tests/runner/runner_test.cc) on the rigid plant and on a plant whose
 // knee carries 2 N m of Coulomb friction; diagnose with the rigid subject model (examples/S1.yaml,
 // the S1 preset's parameters) names the friction within 15 % (measured: 2.000 N m on 60 s) and

@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 
 #include <Eigen/Dense>
+#include <mujoco/mujoco.h>
 
 #include "core/error.h"
 #include "tests/real_rig_model.h"
@@ -180,7 +182,7 @@ TEST(PlantEffects, AppliedForceIsEachAppliedFamilysClosedForm) {
     if (f.carrier != PlantCarrier::kAppliedForce) continue;
     for (const char* joint : {"hip", "knee"}) {
       Effect e;
-      e.name = f.name, e.joint = joint, e.value = 0.3, e.axis = "Y";
+      e.name = f.name, e.joint = joint, e.value = 0.3, e.axis = "Y", e.expr = "q_hip - 0.5 * qd";  // expr: a term's
       for (const std::string& field : f.fields) e.fields[field] = 0.7;
       PlantEffects fx;
       fx.g = 9.81;
@@ -210,6 +212,119 @@ TEST(PlantEffects, AppliedForceIsEachAppliedFamilysClosedForm) {
   LegParams p;
   p.effects = {unknown};
   EXPECT_THROW(ToPlantEffects(p, "m.yaml"), InputError);
+}
+
+Effect TermEffect(const char* joint, double value, const char* expr, const char* stage = "") {
+  Effect e = MakeEffect("term", joint, value);
+  e.expr = expr, e.stage = stage;
+  return e;
+}
+
+// The shipped two-link plant carrying p's effects, its joints and torque free.
+std::unique_ptr<Plant> FreePlant(const LegParams& p) {
+  auto plant = std::make_unique<Plant>(ExowheelMjcfPath(false));
+  plant->SetParams(p);
+  plant->CarryEffects(ToPlantEffects(p, "test"));
+  plant->FreeJointsAndTorque();
+  return plant;
+}
+
+int Dof(const Plant& plant, const char* joint) {
+  return plant.model()->jnt_dofadr[mj_name2id(plant.model(), mjOBJ_JOINT, joint)];
+}
+
+// Terms in the forward plant (DESIGN.md "Terms beyond the table"): sorted by stage and friction
+// likeness; a friction-like term is that step's frictionloss |value f| from the actuator torque of the
+// step; an applied term is minus its closed form at the step's state (qdd the last step's, t from the
+// origin set), and the acceleration is the closed form's with it.
+TEST(PlantEffects, TermsAreFrictionBoundsAppliedForcesOrReadings) {
+  LegParams p = RealRigModel();
+  p.effects = {TermEffect("knee", 0.05, "abs(tau_R) * sgn(qd)"), TermEffect("hip", 2.0, "sin(q)"),
+               TermEffect("knee", -0.01, "tau_R", "sensor")};
+  const PlantEffects fx = ToPlantEffects(p, "test");
+  ASSERT_EQ(fx.friction_terms.size(), 1u);
+  EXPECT_EQ(fx.friction_terms[0].joint, 1);
+  EXPECT_EQ(fx.friction_terms[0].f.text(), "abs(tau_R)");
+  ASSERT_EQ(fx.applied.size(), 1u);
+  EXPECT_EQ(fx.applied[0].expr, "sin(q)");
+  ASSERT_EQ(fx.sensor[1].size(), 1u);
+  EXPECT_EQ(fx.sensor[1][0].expr, "tau_R");
+  EXPECT_FALSE(fx.link_empty());
+
+  // The friction bound each step: |0.05 tau_R,knee| of the torque applied at that step.
+  LegParams friction = RealRigModel();
+  friction.effects = {p.effects[0]};
+  const std::unique_ptr<Plant> plant_owned = FreePlant(friction);
+  Plant& plant = *plant_owned;
+  const int knee = Dof(plant, "knee"), hip = Dof(plant, "hip");
+  const double base = plant.model()->dof_frictionloss[knee];
+  EXPECT_EQ(plant.model()->dof_solref[mjNREF * knee], 2 * plant.timestep());
+  plant.Reset({0.3, -0.6}, {0.5, -1.0});
+  for (double tau : {-4.0, 6.0, 0.0, 2.5}) {
+    plant.Step({0.3, tau});
+    EXPECT_EQ(plant.model()->dof_frictionloss[knee], base + std::abs(0.05 * tau)) << tau;
+    EXPECT_EQ(plant.model()->dof_frictionloss[hip], 0.0);
+  }
+
+  // A negative bound (value f < 0: a friction pushing along the motion) is no frictionloss: the applied
+  // force -value f sgn(qd) instead.
+  LegParams along = RealRigModel();
+  along.effects = {TermEffect("hip", 0.3, "-2 * sgn(qd)")};
+  const std::unique_ptr<Plant> along_owned = FreePlant(along);
+  along_owned->Reset({0.3, -0.6}, {0.5, -1.0});
+  along_owned->Step({0.3, 0.0});
+  EXPECT_EQ(along_owned->model()->dof_frictionloss[Dof(*along_owned, "hip")], 0.0);
+  EXPECT_EQ(along_owned->data()->qfrc_applied[Dof(*along_owned, "hip")], 0.6);
+
+  // An applied term 2 sin(q) at the hip: the force and the acceleration against the closed form.
+  LegParams applied = RealRigModel();
+  applied.effects = {p.effects[1]};
+  const Eigen::Vector2d q(0.7, -1.1), qd(1.5, -2.0), tau(0.4, -0.3);
+  const std::unique_ptr<Plant> a_owned = FreePlant(applied);
+  Plant& a = *a_owned;
+  a.Reset(q, qd);
+  a.Step(tau);
+  EXPECT_EQ(a.data()->qfrc_applied[Dof(a, "hip")], -2.0 * std::sin(q[0]));
+  EXPECT_EQ(a.data()->qfrc_applied[Dof(a, "knee")], 0.0);
+  const Eigen::Vector2d closed = ClosedFormAcceleration(RealRigModel(), q, qd, tau - Eigen::Vector2d(2.0 * std::sin(q[0]), 0));
+  EXPECT_NEAR((a.qdd() - closed).norm(), 0.0, 1e-9 * closed.norm());
+
+  // qdd the last step's (0 after a reset), tau_R the step's torque, t from the origin set.
+  LegParams reads = RealRigModel();
+  reads.effects = {TermEffect("knee", 0.5, "qdd + 0.1 * tau_R + t")};
+  const std::unique_ptr<Plant> b_owned = FreePlant(reads);
+  Plant& b = *b_owned;
+  b.SetTermTimeOrigin(1.5);
+  b.Reset(q, qd, 2.0);
+  b.Step(tau);
+  EXPECT_DOUBLE_EQ(b.data()->qfrc_applied[Dof(b, "knee")], -0.5 * (0.0 + 0.1 * tau[1] + 0.5));
+  const double qdd1 = b.qdd()[1], t1 = b.time();
+  b.Step(2 * tau);
+  EXPECT_DOUBLE_EQ(b.data()->qfrc_applied[Dof(b, "knee")], -0.5 * (qdd1 + 0.1 * 2 * tau[1] + (t1 - 1.5)));
+
+  // A bad expression: the source, the effect and the position.
+  LegParams bad = RealRigModel();
+  bad.effects = {TermEffect("knee", 1.0, "sgn(qd) * (1 + q")};
+  try {
+    ToPlantEffects(bad, "m.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("m.yaml: effects[0] (term, knee)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("position 16"), std::string::npos) << e.what();
+  }
+}
+
+// A term-free plant steps exactly as before terms existed: its frictionloss is the carried one.
+TEST(PlantEffects, ATermFreePlantKeepsItsFrictionloss) {
+  LegParams p = RealRigModel();
+  p.effects = {MakeEffect("coulomb_friction", "knee", 0.12)};
+  Plant plant(ExowheelMjcfPath(false));
+  plant.SetParams(p);
+  plant.CarryEffects(ToPlantEffects(p, "test"));
+  const double fl = plant.model()->dof_frictionloss[Dof(plant, "knee")];
+  plant.Reset({0.3, -0.6}, {0.5, -1.0});
+  plant.Step({0.3, -4.0});
+  EXPECT_EQ(plant.model()->dof_frictionloss[Dof(plant, "knee")], fl);
 }
 
 }  // namespace
