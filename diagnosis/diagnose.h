@@ -29,6 +29,7 @@
 //  6. structure left in the held-out residual (low-passed rms well above the noise) is reported as
 //     unexplained with its dominant frequency and its correlation with angle, velocity, accel, time.
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,10 @@ struct DiagnosedEffect {
   // (diagnose.cc FindAliases); those in range first, singles before pairs, then the most reaching;
   // at most kMaxAliases.
   std::vector<EffectAlias> aliases;
+  // The motion fit: the value's spread across resamples of the fit rows (motion_fit.h step 7):
+  // spread_sd the standard deviation over kSpreadBootstraps block bootstraps, spread_lo / spread_hi
+  // the least and largest value with each fifth of the fit rows left out in turn. NaN: not resampled.
+  double spread_sd = NAN, spread_lo = NAN, spread_hi = NAN;
 };
 
 constexpr double kAliasLeft = 0.01;  // an alias leaves the named effect at most 1 % of its drop of the fit error

@@ -31,6 +31,8 @@ std::string DiagnosisJson(const Diagnosis& d) {
   for (const auto& e : d.effects) {
     json x = {{"name", e.effect.name}, {"joint", e.effect.joint}, {"value", e.effect.value},
               {"unit", e.effect.unit}, {"ci95", {e.ci_lo, e.ci_hi}}, {"explained_pct", e.explained_pct}};
+    if (std::isfinite(e.spread_sd))
+      x["spread"] = {{"sd", e.spread_sd}, {"segments_left_out", {e.spread_lo, e.spread_hi}}};
     if (!e.effect.axis.empty()) x["axis"] = e.effect.axis;
     if (!e.effect.expr.empty()) {  // a term beyond the table (DESIGN.md "Terms beyond the table")
       x["expr"] = e.effect.expr;

@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "diagnosis/diagnose_internal.h"
 #include "diagnosis/diagnose_unexplained.h"
 #include "diagnosis/motion_fit_internal.h"
@@ -378,8 +379,88 @@ void MotionFit::Intervals() {
       de.explained_pct = explained[k];
       D.effects.push_back(de);
     }
+    Spread();
   }
   ExtendedTwin(params, &D);
+}
+
+void MotionFit::Spread() {
+  const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
+  const Eigen::Index p = static_cast<Eigen::Index>(cols.size());
+  if (p == 0 || last.J.rows() != static_cast<Eigen::Index>(idx.size()) || last.e.size() != last.J.rows()) return;
+  // Each fit row's block (a window's rows of one record, both joints alike) and fifth of its record.
+  const size_t block_rows = static_cast<size_t>(std::max(1.0, std::round(window_rows)));
+  std::vector<size_t> block(idx.size()), fifth(idx.size());
+  size_t blocks = 0;
+  {
+    Eigen::Index off = 0;
+    size_t rec = 0, base = 0;
+    for (size_t i = 0; i < idx.size(); ++i) {
+      while (idx[i] >= off + P.measured(rec).size()) {
+        base += (P.fit_rows(rec) + block_rows - 1) / block_rows;
+        off += P.measured(rec).size(), ++rec;
+      }
+      const size_t m = P.rows(rec).size(), k = static_cast<size_t>(idx[i] - off) % m;
+      block[i] = base + k / block_rows;
+      fifth[i] = std::min<size_t>(4, 5 * k / std::max<size_t>(P.fit_rows(rec), 1));
+      blocks = std::max(blocks, block[i] + 1);
+    }
+  }
+  std::vector<Eigen::MatrixXd> A(blocks, Eigen::MatrixXd::Zero(p, p)), As(5, Eigen::MatrixXd::Zero(p, p));
+  std::vector<Eigen::VectorXd> g(blocks, Eigen::VectorXd::Zero(p)), gs(5, Eigen::VectorXd::Zero(p));
+  for (size_t i = 0; i < idx.size(); ++i) {
+    const Eigen::Index r = static_cast<Eigen::Index>(i);
+    A[block[i]].noalias() += last.J.row(r).transpose() * last.J.row(r);
+    g[block[i]].noalias() += last.J.row(r).transpose() * last.e[r];
+    As[fifth[i]].noalias() += last.J.row(r).transpose() * last.J.row(r);
+    gs[fifth[i]].noalias() += last.J.row(r).transpose() * last.e[r];
+  }
+  Eigen::MatrixXd At = Eigen::MatrixXd::Zero(p, p);
+  Eigen::VectorXd gt = Eigen::VectorXd::Zero(p);
+  for (int s = 0; s < 5; ++s) At += As[static_cast<size_t>(s)], gt += gs[static_cast<size_t>(s)];
+  // The effects' values at theta + the step of (A, g); false where the step is not defined.
+  auto Values = [&](const Eigen::MatrixXd& Ar, const Eigen::VectorXd& gr, std::vector<double>* v) {
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(Ar);
+    const Eigen::VectorXd d = ldlt.solve(gr);
+    if (ldlt.info() != Eigen::Success || !d.allFinite()) return false;
+    Eigen::VectorXd x = theta;
+    for (Eigen::Index c = 0; c < p; ++c) {
+      const int k = cols[static_cast<size_t>(c)];
+      x[k] = std::clamp(theta[k] + d[c], P.lower(k), P.upper(k));
+    }
+    v->clear();
+    for (int ch : chosen) {
+      const Candidate& cand = cands[static_cast<size_t>(ch)];
+      Eigen::VectorXd coef(static_cast<Eigen::Index>(cand.cols.size()));
+      for (size_t i = 0; i < cand.cols.size(); ++i) coef[static_cast<Eigen::Index>(i)] = x[cand.cols[i]];
+      v->push_back(ToEffect(cand, coef, cand.cols).effect.value);
+    }
+    return true;
+  };
+  const size_t n = chosen.size();
+  std::vector<double> sum(n, 0), sum2(n, 0), lo(n, INFINITY), hi(n, -INFINITY), v;
+  int draws = 0;
+  Rng rng(kSpreadSeed);
+  for (int b = 0; b < kSpreadBootstraps; ++b) {
+    Eigen::MatrixXd Ar = Eigen::MatrixXd::Zero(p, p);
+    Eigen::VectorXd gr = Eigen::VectorXd::Zero(p);
+    for (size_t k = 0; k < blocks; ++k) {
+      const size_t pick = static_cast<size_t>(rng.Index(static_cast<int>(blocks)));
+      Ar += A[pick], gr += g[pick];
+    }
+    if (!Values(Ar, gr, &v)) continue;
+    ++draws;
+    for (size_t k = 0; k < n; ++k) sum[k] += v[k], sum2[k] += v[k] * v[k];
+  }
+  for (int s = 0; s < 5; ++s)
+    if (Values(At - As[static_cast<size_t>(s)], gt - gs[static_cast<size_t>(s)], &v))
+      for (size_t k = 0; k < n; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  if (draws < 2) return;
+  for (size_t k = 0; k < n && k < D.effects.size(); ++k) {
+    const double mean = sum[k] / draws;
+    D.effects[k].spread_sd = std::sqrt(std::max(0.0, (sum2[k] - draws * mean * mean) / (draws - 1)));
+    if (std::isfinite(lo[k])) D.effects[k].spread_lo = lo[k], D.effects[k].spread_hi = hi[k];
+  }
 }
 
 void MotionFit::ScoreTwins() {

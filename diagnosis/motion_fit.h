@@ -113,6 +113,7 @@
 // report's header).
 #pragma once
 #include <array>
+#include <cstdint>
 #include <atomic>
 #include <memory>
 #include <string>
@@ -134,6 +135,9 @@ constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5)
 // The motion fit's extended twin replays the held-out rows at most this times the RMS error of the
 // torque fit's twin at each joint, else the torque fit's effects are put in its place (step 6b).
 constexpr double kTorqueTwinTolerance = 1.05;
+// Step 7's resamples of the fit rows: block bootstraps (blocks of a window's rows) and their seed.
+constexpr int kSpreadBootstraps = 200;
+constexpr uint64_t kSpreadSeed = 64;
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a

@@ -137,6 +137,11 @@ class MotionFit {
   // Step 7: the weights of the extended twin's misfit, the values refined under them, the 95 %
   // intervals, D.effects and D.extended.
   void Intervals();
+  // Step 7's spread: each named effect's value one Gauss-Newton step from theta (the final Jacobian
+  // and residual, `last`) on resampled fit rows, a block bootstrap over blocks of a window's rows
+  // (kSpreadBootstraps draws, kSpreadSeed) and each fifth of every record's fit rows left out in turn;
+  // into D.effects' spread_sd, spread_lo, spread_hi.
+  void Spread();
   // The given vs the extended twin on the held-out parts and on every whole record left out
   // (D.records, D.joints, D.left_out, D.simulation), the plotted series.
   void ScoreTwins();

@@ -6,6 +6,7 @@
 // Skipped (with a message) when shared/data is not beside the project.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +15,7 @@
 
 #include "formats/column_map.h"
 #include "diagnosis/diagnose.h"
+#include "diagnosis/motion_fit.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "diagnosis/replay.h"
@@ -181,7 +183,7 @@ TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfS
   const LegParams model = RigModel();
   DiagnoseOptions opt;
   opt.fit = DiagnoseFit::kMotion;
-  int both = 0;
+  int both = 0, floor_taken = 0;
   for (const MeasuredData& r : ReadRig()) {
     const Diagnosis d = Diagnose(model, {&r}, opt);
     std::printf("%s\n", r.source.c_str());
@@ -193,11 +195,23 @@ TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfS
         EXPECT_LT(e->value, 0.3) << r.source;
       }
     ASSERT_TRUE(d.simulation.done) << r.source << ": " << d.simulation.note;
+    ASSERT_TRUE(d.simulation.torque_fit_done) << r.source;
     for (int j = 0; j < 2; ++j) {
       EXPECT_LT(d.simulation.split[j].rmse_after, d.simulation.split[j].rmse_before) << r.source << " joint " << j;
+      // Never worse than the torque fit's twin on the same rows (motion_fit.h step 6b), or it says why.
+      std::printf("  %s: held-out %.3f (motion) / %.3f (torque fit's twin) deg\n", j == 0 ? "hip" : "knee",
+                  d.simulation.split[j].rmse_after * 180 / M_PI, d.simulation.torque_fit_split[j].rmse_after * 180 / M_PI);
+      EXPECT_LE(d.simulation.split[j].rmse_after, kTorqueTwinTolerance * d.simulation.torque_fit_split[j].rmse_after)
+          << r.source << " joint " << j << ": " << d.simulation.torque_fit_why;
     }
+    EXPECT_EQ(d.simulation.torque_fit_why.empty(),
+              d.simulation.split[0].rmse_after <= kTorqueTwinTolerance * d.simulation.torque_fit_split[0].rmse_after &&
+                  d.simulation.split[1].rmse_after <= kTorqueTwinTolerance * d.simulation.torque_fit_split[1].rmse_after);
+    floor_taken += std::any_of(d.selection.begin(), d.selection.end(),
+                               [](const std::string& s) { return s.rfind("taken: its effects", 0) == 0; });
   }
   EXPECT_GE(both, 6);
+  std::printf("the torque fit's twin taken as the floor on %d of 7 records\n", floor_taken);
 }
 
 // The motion fit of several records keeps an effect that moves the records left out, not only the
