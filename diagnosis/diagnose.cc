@@ -58,6 +58,7 @@ namespace {
 
 using torque_fit::Rec;
 using torque_fit::ExtendAndRefine;
+using torque_fit::PrepareRecord;
 using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
 using torque_fit::UseSecantColumns;
@@ -70,6 +71,22 @@ double AutocorrLength(const Eigen::VectorXd& e, size_t m) {
 }
 
 }  // namespace
+
+namespace torque_fit {
+
+void RigidTorque(const LegParams& params, const Kinematics& kin, int threads, std::vector<double> tau_R[2]) {
+  const size_t n = kin.t.size();
+  for (int j = 0; j < 2; ++j) tau_R[j].resize(n);
+  ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
+                                                 {kin.qdd[0][i], kin.qdd[1][i]});
+      tau_R[0][i] = tau[0], tau_R[1][i] = tau[1];
+    }
+  });
+}
+
+}  // namespace torque_fit
 
 // Held-out scores from the sums of squares before / after over `count` samples.
 JointScore ScoreOf(double sse_before, double sse_after, double count) {
@@ -162,11 +179,10 @@ CutoffChoice ResolveCutoff(const LegParams& params, const std::vector<const Meas
   return ChooseCutoff(records, params.L1, params.g, CutoffUse::kParallel, DiagnoseThreads(opt));
 }
 
-// Stage 2: one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase filters'
-// transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of its time,
-// the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual. With `owned`
-// (the record itself, which Diagnose may consume) its columns are moved, not copied: the record is
-// left empty.
+}  // namespace
+
+namespace torque_fit {
+
 void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
                    const CutoffChoice& cutoff, double holdout_fraction, int threads, Rec* out) {
   Rec& rc = *out;
@@ -198,20 +214,12 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
   if (filtered) rc.low.emplace(rc.kin.t, rc.hz, rc.source);
   for (int j = 0; j < 2; ++j) rc.raw[j] = meas[j]->data() + a;
   const Kinematics& kin = rc.kin;
-  const size_t n = kin.t.size();
   const double t_split = kin.t.front() + (1 - holdout_fraction) * (kin.t.back() - kin.t.front());
   rc.split = static_cast<size_t>(std::lower_bound(kin.t.begin(), kin.t.end(), t_split) - kin.t.begin());
   // The twin: HJ15 eq. 5-7 + P(q) + the model's own effects, which equals predict's MuJoCo inverse
   // dynamics to round-off (tests/integration) at a tenth of the cost; the extended twin's held-out
   // run (ScoreExtendedTwin) is predict itself.
-  for (int j = 0; j < 2; ++j) rc.tau_R[j].resize(n);
-  ParallelForRanges(n, threads, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      const Eigen::Vector2d tau = ActuatorTorque(params, {kin.q[0][i], kin.q[1][i]}, {kin.qd[0][i], kin.qd[1][i]},
-                                                 {kin.qdd[0][i], kin.qdd[1][i]});
-      rc.tau_R[0][i] = tau[0], rc.tau_R[1][i] = tau[1];
-    }
-  });
+  torque_fit::RigidTorque(params, kin, threads, rc.tau_R);
   if (params.effects.empty()) {
     ApplyEffects(params, kin, rc.tau_R, rc.tau_S);  // leaves rc.tau_R as it is
   } else {
@@ -220,6 +228,10 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
   }
   rc.Residuals(rc.resid);
 }
+
+}  // namespace torque_fit
+
+namespace {
 
 // Stage 3c: the measured torque filtered as the residual, into rc.meas (after the candidate columns,
 // whose temporaries are gone by then: a long record's peak memory).
@@ -785,10 +797,22 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
-  const TermSearchResult searched = SearchTerms(params, recs, w, banks, scale, &D);
+  // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete on the
+  // held-out rows or on the fit rows, the search for terms beyond the table at those joints.
+  D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);
+  const std::array<JointCompleteness, 2> on_fit_rows = torque_fit::CompletenessOnFitRows(params, D.extended, recs, opt);
+  bool incomplete[2];
+  for (int j = 0; j < 2; ++j) incomplete[j] = !D.table_model.completeness[j].complete || !on_fit_rows[j].complete;
+  Lap("completeness + ceiling");
+  const TermSearchResult searched =
+      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};
   Lap("terms beyond the table");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
+  Lap("extended twin");
+  // Stage 6c: the final model's (the table's where the search admitted no term).
+  D.final_model = searched.changed ? torque_fit::AssessModel(params, D.extended, recs, opt) : D.table_model;
+  Lap("final completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)
     for (int j = 0; j < 2; ++j) D.records[r].ceiling[j] = ceilings[r].ceiling[j], D.records[r].ceiling_null[j] = ceilings[r].null[j];
@@ -798,7 +822,6 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   });
   D.extended.effects.resize(params.effects.size());
   for (const auto& de : D.effects) D.extended.effects.push_back(de.effect);
-  Lap("extended twin");
   SimulateTwins(params, recs, opt, &D);
   D.kin = std::move(recs[0].kin);  // recs are done with: the plot series take the first record's kinematics
   D.split = recs[0].split;

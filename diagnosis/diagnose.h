@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/completeness.h"
 #include "diagnosis/derivative_cutoff.h"
 #include "diagnosis/replay.h"
 #include "formats/measured_data.h"
@@ -157,6 +158,24 @@ struct TorqueOnlyEffect {
                                            // at that value to the motion fit's effects, % (< 0: lower)
 };
 
+// A model's black-box ceiling at one joint (DESIGN.md "Terms beyond the table": `ceiling`), on the
+// held-out rows (a subsample, the same rows for both): named_pct = 100 (1 - SSE(model) / SSE(given)),
+// the share of the model given's held-out residual sum of squares the model removes; black_box_pct
+// the same for the model plus a black box (black_box.h) trained on the model's residual on the fit
+// rows, with the states q, qd, qdd, tau_R of both joints and their values 50 and 100 ms back as inputs.
+struct JointCeiling {
+  bool done = false;  // false: no rows, or the model given leaves no residual
+  double named_pct = 0, black_box_pct = 0;
+  double given_rms = 0;  // the model given's held-out residual RMS on those rows, N m
+  size_t train_rows = 0, heldout_rows = 0;
+};
+
+// One model's residual tests and ceiling at both joints (a one-joint device: the hip's left unassessed).
+struct ModelAssessment {
+  JointCompleteness completeness[2];
+  JointCeiling ceiling[2];
+};
+
 struct Diagnosis {
   DiagnoseFit fit = DiagnoseFit::kTorque;
   std::vector<DiagnosedEffect> effects;
@@ -188,6 +207,13 @@ struct Diagnosis {
   // The motion fit only: what the torque fit named (its values), and those the motion fit does not.
   std::vector<DiagnosedEffect> torque_named;
   std::vector<TorqueOnlyEffect> torque_only;
+  // The table's best model (the extended twin of the table's effects, before the search for terms) and
+  // the final model (D.extended, after the search; the table's where no term was admitted, and in the
+  // motion fit, which searches none): their held-out residual tests
+  // (completeness.h) and ceiling. Both fits assess the torque residual of their extended twin on the
+  // held-out part of every record (the last holdout_fraction of its time), filtered as the torque
+  // fit's (parallel filtering at its cutoff).
+  ModelAssessment table_model, final_model;
 };
 
 struct DiagnoseOptions {

@@ -1,6 +1,7 @@
 // The torque fit's internal parts shared by its files (diagnose.cc, diagnose_ceiling.cc,
 // diagnose_torque_effects.cc).
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,10 @@ struct CeilingScores {
 std::vector<CeilingScores> Ceilings(const std::vector<ColumnBank>& banks, const double w[2]);
 
 namespace torque_fit {
+
+// The rigid twin's actuator torque (HJ15 eq. 5-7 + P(q), model/leg_dynamics.h ActuatorTorque) on
+// every sample of kin, into tau_R[0..1] (resized), on `threads` threads.
+void RigidTorque(const LegParams& params, const Kinematics& kin, int threads, std::vector<double> tau_R[2]);
 
 // One record prepared at the chosen cutoff: trimmed kinematics, the measured torque filtered alike,
 // the twin's prediction and the residual.
@@ -112,6 +117,37 @@ size_t RefineRows(const Rec& rc, size_t R);
 std::vector<double> ExtendAndRefine(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
                                     const ColumnBank& bank, const Grams& g, const Fit& f0,
                                     const std::vector<int>& chosen, const Fit& chosen_fit, Diagnosis* D);
+
+// Stage 2 (diagnose.cc): one record at the chosen cutoff into *rc: kinematics trimmed of the zero-phase
+// filters' transients, measured torque filtered alike, the held-out split at 1 - holdout_fraction of
+// its time, the twin's torque (HJ15 eq. 5-7 + P + the model's effects) and the filtered residual.
+// With `owned` (the record itself, which Diagnose may consume) its columns are moved, not copied: the
+// record is left empty.
+void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredData* owned,
+                   const CutoffChoice& cutoff, double holdout_fraction, int threads, Rec* out);
+
+// Stages 5c and 6c (diagnose_completeness.cc): `model`'s assessment on the records against the model
+// given (`given`, whose rigid twin gives tau_R): the residual tests (completeness.h) of its filtered torque
+// residual on every record's held-out rows [split, n), decimated by CompletenessStep at the record's
+// cutoff, one segment per record, the material floor kMinTorqueShare of the measured torque's RMS on
+// those rows (the selection's); and its ceiling (JointCeiling), the black box trained on the model's
+// residual at most 12000 fit rows (the last quarter of every record's fit rows validating) and scored
+// on at most 8000 held-out rows. Both twins by the closed form (HJ15 + ApplyEffects, as stage 2),
+// which every effect (and term) ApplyEffects knows reaches. Needs each record's kin (with EMG for
+// muscle_activity) and raw. Called for the table's best model and, where the search for terms
+// admitted one, for the final model.
+ModelAssessment AssessModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
+                            const DiagnoseOptions& opt);
+// The residual tests of `model` on every record's fit rows [0, split) instead (AssessModel's otherwise):
+// what decides the search for terms beyond the table, so that an effect that fades before the
+// held-out end (a drive warming up) is seen where it acts.
+std::array<JointCompleteness, 2> CompletenessOnFitRows(const LegParams& given, const LegParams& model,
+                                                      const std::vector<Rec>& recs, const DiagnoseOptions& opt);
+// The same on the records themselves (the motion fit's): each prepared as stage 2 does at `cutoff`
+// (the torque fit's) with the model given, then AssessModel.
+ModelAssessment AssessModelOnRecords(const LegParams& given, const LegParams& model,
+                                     const std::vector<const MeasuredData*>& records, const CutoffChoice& cutoff,
+                                     const DiagnoseOptions& opt);
 
 }  // namespace torque_fit
 }  // namespace exotwin

@@ -128,6 +128,24 @@ std::string DiagnosisJson(const Diagnosis& d) {
     }
   }
   j["simulation"] = js;
+  // DESIGN.md "Terms beyond the table": the residual tests of the table's and the final model, and the
+  // final model's ceiling.
+  auto verdict = [](const JointCompleteness& c) {
+    json x = {{"complete", c.complete}, {"assessed", c.assessed}, {"rows", c.rows}, {"step_rows", c.step},
+              {"alpha", c.alpha}, {"material_floor", c.floor}, {"rms", c.rms},
+              {"tests", json::object()}};
+    for (const CompletenessTest& t : c.tests)
+      x["tests"][t.name] = {{"statistic", t.statistic}, {"threshold", t.threshold}, {"p_value", t.p_value},
+                             {"size", t.size}, {"pass", t.pass}};
+    return x;
+  };
+  for (int k = k0; k < 2; ++k) {
+    j["completeness"]["table"][names[k]] = verdict(d.table_model.completeness[k]);
+    j["completeness"]["final"][names[k]] = verdict(d.final_model.completeness[k]);
+    const JointCeiling& c = d.final_model.ceiling[k];
+    j["ceiling"][names[k]] = {{"done", c.done}, {"named_pct", c.named_pct}, {"black_box_pct", c.black_box_pct},
+                              {"given_rms", c.given_rms}, {"train_rows", c.train_rows}, {"heldout_rows", c.heldout_rows}};
+  }
   if (d.fit == DiagnoseFit::kMotion) {  // what the torque fit would have named, and what it alone names
     auto effect = [](const Effect& e) {
       json x = {{"name", e.name}, {"joint", e.joint}, {"value", e.value}, {"unit", e.unit}};

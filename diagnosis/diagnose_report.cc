@@ -106,6 +106,59 @@ std::string SimulationTable(const Diagnosis& d) {
   return o.str();
 }
 
+// "named X % of what is explainable": the named model's held-out share of the model given's residual
+// sum of squares against the larger of it and the black box's (named + black box); words where
+// neither removes anything; the RMS of what the black box adds, against the material floor.
+std::string CeilingText(const JointCeiling& c, double floor) {
+  if (!c.done) return "not assessed";
+  std::string s = "the named model removes " + NumberText(c.named_pct, 3) + " % of the model given's held-out residual "
+                  "sum of squares, with a black box beside it " + NumberText(c.black_box_pct, 3) + " %";
+  const double explainable = std::max(c.named_pct, c.black_box_pct);
+  if (!(explainable > 0)) return s + ": nothing explainable beyond the noise";
+  const double added = c.given_rms * std::sqrt(std::max(0.0, c.black_box_pct - c.named_pct) / 100);
+  return s + ": named " + NumberText(100 * std::max(0.0, c.named_pct) / explainable, 3) +
+         " % of what is explainable (the black box adds " + NumberText(added, 2) + " N m RMS, " +
+         (added < floor ? "below" : "above") + " the material floor)";
+}
+
+// The completeness verdicts (table's and final model) and the final model's residual tests and ceiling.
+std::string CompletenessSection(const Diagnosis& d) {
+  const char* jn[2] = {"hip", "knee"};
+  const int j0 = d.extended.one_joint ? 1 : 0;
+  auto verdict = [](const JointCompleteness& c) {
+    return std::string(!c.assessed ? "not assessed (held-out part too short)" : c.complete ? "complete" : "<b>incomplete</b>");
+  };
+  std::ostringstream o;
+  o << "<h2>Completeness and ceiling</h2><p>Residual tests of the held-out torque residual (whiteness: Ljung-Box; "
+       "cross-correlation with the states; the nonlinear correlation tests of Billings &amp; Voon 1986), on rows "
+       "decimated where the filtered noise is near-independent, each test Bonferroni over its lags and the tests "
+       "(family-wise " << NumberText(100 * kCompletenessAlpha) << " %); structure below the material floor passes.</p><ul>";
+  for (int j = j0; j < 2; ++j) {
+    const JointCompleteness &t = d.table_model.completeness[j], &f = d.final_model.completeness[j];
+    o << "<li><b>" << jn[j] << "</b>: the table's model " << verdict(t) << ", the final model " << verdict(f) << " ("
+      << f.rows << " rows, every " << f.step << " samples; floor " << NumberText(f.floor, 3) << " N m, residual RMS "
+      << NumberText(f.rms, 3) << " N m); " << HtmlEscape(CeilingText(d.final_model.ceiling[j], f.floor)) << ".</li>";
+  }
+  o << "</ul><table><tr><th>test (final model)</th>";
+  for (int j = j0; j < 2; ++j) o << "<th>" << jn[j] << ": statistic / threshold (p, size N m)</th>";
+  o << "</tr>";
+  const std::vector<CompletenessTest>& names = d.final_model.completeness[1].tests;
+  for (size_t k = 0; k < names.size(); ++k) {
+    o << "<tr><td>" << names[k].name << "</td>";
+    for (int j = j0; j < 2; ++j) {
+      o << "<td>";
+      for (const CompletenessTest& t : d.final_model.completeness[j].tests)
+        if (t.name == names[k].name)
+          o << (t.pass ? "" : "<b>") << NumberText(t.statistic, 3) << " / " << NumberText(t.threshold, 3) << " (p "
+            << NumberText(t.p_value, 2) << ", " << NumberText(t.size, 2) << ")" << (t.pass ? "" : " fails</b>");
+      o << "</td>";
+    }
+    o << "</tr>";
+  }
+  o << "</table>";
+  return o.str();
+}
+
 // The motion fit's report (diagnosis/motion_fit.h).
 std::string MotionReportHtml(const Diagnosis& d, const std::string& params_path, const std::string& measured_path) {
   const char* jn[2] = {"hip", "knee"};
@@ -158,6 +211,7 @@ std::string MotionReportHtml(const Diagnosis& d, const std::string& params_path,
       << SvgChart("measured vs fitted simulated angle (held-out, four windows of " + NumberText(S.horizon_s) + " s)",
                   "t (s)", "angle (deg)", {sm, sr, se});
   }
+  o << CompletenessSection(d);
   o << "<h2>Selection</h2><ol>";
   for (const auto& s : d.selection) o << "<li>" << HtmlEscape(s) << "</li>";
   o << "</ol></body></html>\n";
@@ -266,6 +320,7 @@ std::string DiagnosisReportHtml(const Diagnosis& d, const std::string& params_pa
       << NumberText(u.dominant_hz, 3) << " Hz; correlation with angle " << NumberText(u.corr_q, 2) << ", velocity "
       << NumberText(u.corr_qd, 2) << ", acceleration " << NumberText(u.corr_qdd, 2) << ", time " << NumberText(u.corr_t, 2)
       << " &mdash; " << HtmlEscape(u.hint) << ".</p>";
+  o << CompletenessSection(d);
   o << "<h2>Candidates</h2><table><tr><th>candidate</th><th>&Delta;BIC</th><th>held-out gain</th>"
        "<th>chosen</th></tr>";
   for (const auto& s : d.scores)

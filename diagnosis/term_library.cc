@@ -136,7 +136,12 @@ std::vector<TermCandidate> TermLibrary(const TermScales& s, bool other_joint) {
       if (HasInner(f.fn) || f.sig != S::kQd || f.fn == TermFn::kSquare) lib.push_back({{f, carrier}});
   for (size_t a = 0; a < basic.size(); ++a)
     for (size_t b = a + 1; b < basic.size(); ++b) {
-      if (basic[a].sig == basic[b].sig) continue;  // one signal's functions multiply into one function
+      // One signal's functions multiply into one of them, but for x^2 sgn(x) (= x abs(x), odd) and
+      // x pos(x) (one-sided, a ramp).
+      if (basic[a].sig == basic[b].sig &&
+          !(basic[a].fn == TermFn::kSgn && basic[b].fn == TermFn::kSquare) &&
+          !(basic[a].fn == TermFn::kId && basic[b].fn == TermFn::kPos))
+        continue;
       const bool carrier = [&] {
         for (const TermFactor& f : {basic[a], basic[b]})
           if (f.sig == S::kQd && (f.fn == TermFn::kSgn || f.fn == TermFn::kId)) return true;

@@ -9,7 +9,7 @@
 //   exp(-(qd / v)^2), tanh(qd / v)                      (v, rad/s: a velocity scale)
 //   sin(k * x + phi) for x an angle                     (k, rad^-1; phi fitted linearly with cos)
 // Terms: every factor alone, every factor times sgn(qd) or qd (a friction's or a damping's carrier),
-// and every product of two factors without inner parameter.
+// and every product of two factors without inner parameter (of two signals, or x^2 sgn(x) and x pos(x)).
 #pragma once
 #include <string>
 #include <vector>

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <cstdio>
-#include <cstdlib>
 
 #include <Eigen/Dense>
 
@@ -120,7 +119,6 @@ struct Screen {
   Eigen::VectorXd y;     // 2N: the target with the current model projected out
   Eigen::MatrixXd B[2];  // N x b: orthonormal basis of the table's forms at each joint (unweighted)
   size_t N = 0;
-  double n_eff = 1, sse = 0;
 };
 
 // The candidate's values on the screening rows of joint j (-expr, weighted, unfiltered).
@@ -168,7 +166,6 @@ Screen MakeScreen(const std::vector<SearchRec>& S, const Eigen::MatrixXd& Zrows,
     sc.Q = Eigen::MatrixXd::Zero(2 * N, 0);
   }
   sc.y = yrows - sc.Q * (sc.Q.transpose() * yrows);
-  sc.sse = sc.y.squaredNorm();
   // The table's forms at a joint: 1, q, qd, sgn(qd), qdd and tau_R (offset, stiffness, viscous and
   // Coulomb friction, inertia, gain): a term is a form the table does not have.
   for (int j = 0; j < 2; ++j) {
@@ -261,6 +258,16 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
   return out;
 }
 
+// The table's link forms at the term's joint, as candidates: q (stiffness), qd (viscous friction),
+// sgn(qd) (Coulomb friction), qdd (inertia), tau_R (a gain).
+const std::vector<TermCandidate>& TableForms() {
+  using S = TermSignal;
+  static const std::vector<TermCandidate> k = {{{{TermFn::kId, S::kQ, 0}}}, {{{TermFn::kId, S::kQd, 0}}},
+                                               {{{TermFn::kSgn, S::kQd, 0}}}, {{{TermFn::kId, S::kQdd, 0}}},
+                                               {{{TermFn::kId, S::kTauR, 0}}}};
+  return k;
+}
+
 // A term in the model: its joint, candidate and columns in the banks.
 struct Term {
   int joint = 0;
@@ -336,17 +343,52 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
   return d;
 }
 
+// Backward elimination: drops, one at a time, the table effect (columns below K of `cur`) that no
+// longer earns the BIC margin or |t| beside the terms and whose absence costs its joint's held-out
+// error less than kMinHeldoutGain, or that left its physical range.
+void DropRedundant(const std::vector<SearchRec>& S, const std::vector<Eigen::MatrixXd>& model, const double w[2],
+                   const PhysicalScale& scale, size_t K, Diagnosis* D, std::vector<int>* cur_out) {
+  std::vector<int>& cur = *cur_out;
+  const size_t R = S.size();
+  const std::vector<Eigen::MatrixXd> none(R, Eigen::MatrixXd(model[0].rows(), 0));
+  const Grams gm = MakeSearchGrams(S, model, none, w, D->tau_eff);
+  for (;;) {
+    const Fit f = FitCols(gm, cur);
+    int drop = -1;
+    double least = 1e300;
+    for (int c : cur) {
+      if (c >= static_cast<int>(K)) continue;
+      const Fit fk = FitCols(gm, Without(cur, {c}));
+      const double loss = fk.bic - f.bic, tk = std::abs(CoefOf(f, c)) / std::max(1e-300, SeOf(f, c));
+      DiagnosedEffect de = D->effects[static_cast<size_t>(c)];
+      de.effect.value = CoefOf(f, c);
+      // Redundant: it no longer earns the BIC margin or |t| and leaving it out costs its joint's
+      // held-out error less than kMinHeldoutGain (a term that only resembles it keeps it); or out
+      // of its range.
+      const int jc = EffectJoint(de.effect);
+      const bool held = fk.sse_te_j[jc] <= (1 + kMinHeldoutGain) * f.sse_te_j[jc];
+      const bool redundant = (loss < kBicMargin || tk < kMinT) && held;
+      if ((redundant || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
+    }
+    if (drop < 0) break;
+    D->term_search.push_back("dropped " + D->effects[static_cast<size_t>(drop)].effect.name + " (" +
+                             D->effects[static_cast<size_t>(drop)].effect.joint + "): redundant beside the terms");
+    cur = Without(cur, {drop});
+  }
+}
+
 }  // namespace
 
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
-                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale, Diagnosis* D) {
+                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale,
+                             const bool at_joint[2], Diagnosis* D) {
   TermSearchResult out;
   const size_t R = recs.size(), K = D->effects.size();
   std::vector<SearchRec> S;
   for (size_t r = 0; r < R; ++r) S.push_back(Prepare(params, recs[r], banks[r], w, *D));
   std::vector<int> joints;
   for (int j = 0; j < 2; ++j)
-    if (w[j] > 0 && !(params.one_joint && j == 0)) joints.push_back(j);
+    if (at_joint[j] && w[j] > 0 && !(params.one_joint && j == 0)) joints.push_back(j);
   // The model's columns per record: the table's K, then the terms'.
   std::vector<Eigen::MatrixXd> model(R);
   for (size_t r = 0; r < R; ++r) model[r] = S[r].C;
@@ -362,6 +404,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     for (size_t k = 0; k < S[r].mtr; k += stride) at.push_back({r, k});
   const Eigen::Index N = static_cast<Eigen::Index>(at.size());
 
+  double tt_all[2] = {0, 0};  // the measured torque's weighted sum of squares on every fit row
+  for (const SearchRec& s : S)
+    for (size_t k = 0; k < s.m; ++k)
+      for (int j = 0; j < 2; ++j) tt_all[j] += std::pow(w[j] * s.rc->meas[j][s.bank->sample[k]], 2);
   for (int step = 0; step < kMaxTerms; ++step) {
     // Screening against the current model.
     Eigen::MatrixXd Z(2 * N, static_cast<Eigen::Index>(cur.size()));
@@ -399,7 +445,6 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     const Fit now = FitCols(g, cur);
     const double margin = kBicMargin + std::log(static_cast<double>(screened));
     int pick = -1;
-    double best_gain = 0;
     std::vector<double> gain(top.size(), -1);
     for (size_t i = 0; i < top.size(); ++i) {
       const int j = top[i].joint;
@@ -408,8 +453,10 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       const Fit f = FitCols(g, cols);
       if (!f.ok) continue;
       const double drop_te = now.sse_te_j[j] - f.sse_te_j[j];
+      // Material over the whole record, not only its held-out end: a term that fades (a drive warming
+      // up) is an effect where it acts.
       const bool held = drop_te >= kMinHeldoutGain * now.sse_te_j[j] &&
-                        drop_te >= kMinTorqueShare * kMinTorqueShare * g.tt_te[j];
+                        (now.sse_tr - f.sse_tr) + drop_te >= kMinTorqueShare * kMinTorqueShare * tt_all[j];
       const bool loo = R < 2 || now.sse_loo_j[j] - f.sse_loo_j[j] >= kMinHeldoutGain * now.sse_loo_j[j];
       const bool admissible = now.bic - f.bic > margin && held && loo && TermT(f, cand_cols[i]) > kMinT;
       D->term_search.push_back("step " + std::to_string(step + 1) + ": " +
@@ -419,8 +466,36 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
                                Num(TermT(f, cand_cols[i])) + (admissible ? ": admissible" : ""));
       if (!admissible) continue;
       gain[i] = drop_te;
-      best_gain = std::max(best_gain, drop_te);
     }
+    // The table's own forms at a joint compete first (simplest first): a term that one of them
+    // (Coulomb and viscous friction, inertia, stiffness, gain) explains within kParsimony of its
+    // held-out gain is that table effect's, which the table's selection judged, not a term. The best
+    // form's held-out drop at a joint, once per step.
+    double form_drop[2] = {-1, -1};
+    std::string form_expr[2];
+    for (size_t i = 0; i < top.size(); ++i) {
+      if (gain[i] <= 0) continue;
+      const int j = top[i].joint;
+      if (form_drop[j] < 0) {
+        form_drop[j] = 0;
+        for (const TermCandidate& form : TableForms()) {
+          std::vector<Eigen::MatrixXd> col(R);
+          for (size_t r = 0; r < R; ++r) col[r] = ExactColumns(S[r], j, form, w);
+          std::vector<int> cols = cur;
+          cols.push_back(base);
+          const Fit ff = FitCols(MakeSearchGrams(S, model, col, w, D->tau_eff), cols);
+          if (ff.ok && now.sse_te_j[j] - ff.sse_te_j[j] > form_drop[j])
+            form_drop[j] = now.sse_te_j[j] - ff.sse_te_j[j], form_expr[j] = CandidateExpr(form, kJointName[j]);
+        }
+      }
+      if (form_drop[j] >= (1 - kParsimony) * gain[i]) {
+        D->term_search.push_back("not a term: " + CandidateExpr(top[i].c, kJointName[j]) + " (" + kJointName[j] +
+                                 ") is explained as well by the table's form " + form_expr[j]);
+        gain[i] = -1;
+      }
+    }
+    double best_gain = 0;
+    for (double v : gain) best_gain = std::max(best_gain, v);
     // The simplest admissible within kParsimony of the best's held-out gain.
     for (size_t i = 0; i < top.size(); ++i)
       if (gain[i] >= (1 - kParsimony) * best_gain && gain[i] > 0 &&
@@ -441,27 +516,8 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
     terms.push_back(t);
     out.changed = true;
     // Backward elimination of the table's effects the term makes redundant.
-    const std::vector<Eigen::MatrixXd> none(R, Eigen::MatrixXd(model[0].rows(), 0));
-    const Grams gm = MakeSearchGrams(S, model, none, w, D->tau_eff);
-    for (;;) {
-      const Fit f = FitCols(gm, cur);
-      int drop = -1;
-      double least = 1e300;
-      for (int c : cur) {
-        if (c >= static_cast<int>(K)) continue;
-        const Fit fk = FitCols(gm, Without(cur, {c}));
-        const double loss = fk.bic - f.bic, tk = std::abs(CoefOf(f, c)) / std::max(1e-300, SeOf(f, c));
-        DiagnosedEffect de = D->effects[static_cast<size_t>(c)];
-        de.effect.value = CoefOf(f, c);
-        if ((loss < kBicMargin || tk < kMinT || !Plausible(de, scale)) && loss < least) least = loss, drop = c;
-      }
-      if (drop < 0) break;
-      D->term_search.push_back("dropped " + D->effects[static_cast<size_t>(drop)].effect.name + " (" +
-                               D->effects[static_cast<size_t>(drop)].effect.joint + "): redundant beside the terms");
-      cur = Without(cur, {drop});
-    }
+    DropRedundant(S, model, w, scale, K, D, &cur);
   }
-  if (std::getenv("TERM_TRACE")) for (auto& l : D->term_search) std::fprintf(stderr, "%s\n", l.c_str());  // TEMP
   if (!out.changed) return out;
 
   // The final model: the kept table effects refitted, the terms; each one's held-out share.

@@ -39,12 +39,14 @@ struct TermSearchResult {
   std::vector<std::vector<Effect>> left_out;     // per record: the final effects fitted without it
 };
 
-// Runs the search on the records' fit rows (banks[r].sample, .train; their X may be released),
+// Runs the search at the joints `at_joint` (those whose table model is incomplete, completeness.h)
+// on the records' fit rows (banks[r].sample, .train; their X may be released),
 // with D->effects and D->extended the table's best model (stage 5). Where a term is admitted,
 // rewrites D->effects (the kept table effects refitted, the terms) and D->extended, and appends its
 // steps in words to D->term_search.
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
-                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale, Diagnosis* D);
+                             const std::vector<ColumnBank>& banks, const PhysicalScale& scale,
+                             const bool at_joint[2], Diagnosis* D);
 
 }  // namespace torque_fit
 }  // namespace exotwin

@@ -74,6 +74,8 @@ SWEEPS="$SWEEPS|cli\.regress_suite_test|DiagnoseHiddenEffect\.PairsAreFound|Diag
 SWEEPS="$SWEEPS|OneJointHiddenEffect\.EverySingleEffectIsNamedAtItsValue|HalRunner\.ViscousSweepTroughOverOperators"
 SWEEPS="$SWEEPS|Excitation\.DesignImprovesCriterionWithinLimits|PlantScenario\.EffectsCarriedByTheForwardPlantAreNamed"
 SWEEPS="$SWEEPS|DiagnoseOtherChain\.FindsEffectsOnAChainThatIsNotTheLeg"
+SWEEPS="$SWEEPS|DiagnoseCompleteness\.CleanRecordsAreComplete|DiagnoseCompleteness\.OffTableFormsAreIncomplete"
+SWEEPS="$SWEEPS|DiagnoseCompleteness\.MotionFitAssessesItsTwin|TermSearch\.CleanRecordsNameNoTerm"
 EXCLUDE="^install\.|^($SWEEPS)\$"
 # The command-line mutation fuzz (tests/cli/fuzz_cli_test.sh): a third of the Release suite's 330
 # mutations here (the same seed), ~30 s -> ~10 s of this suite's CPU.

@@ -23,15 +23,8 @@ using testing_hidden::EnvInt;
 using testing_hidden::Find;
 using testing_hidden::ValueError;
 
-// The torque analysis alone: these tests check what is named, not the forward simulation (step 6b,
-// tested on the real rig and in replay_test.cc).
-DiagnoseOptions TorqueOnly() {
-  DiagnoseOptions o;
-  o.simulate = false;
-  return o;
-}
-
-LegParams S1() { return ReadModelFile(std::string(EXOTWIN_SOURCE_DIR) + "/examples/S1.yaml"); }
+using testing_hidden::S1;
+using testing_hidden::TorqueOnly;
 
 struct Row {
   int runs = 0, found = 0, exact = 0, ok = 0;

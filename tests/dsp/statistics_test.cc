@@ -75,5 +75,61 @@ TEST(Statistics, PercentileBySelectionIsThePercentileOfTheSortedValues) {
   EXPECT_TRUE(std::isnan(PercentileInPlace(empty, 0.5)));
 }
 
+// The normal quantile against tabulated values (Abramowitz & Stegun 26.2) and as Phi's inverse.
+TEST(Statistics, NormalQuantileAgainstTables) {
+  EXPECT_NEAR(NormalQuantile(0.975), 1.959963985, 1e-9);
+  EXPECT_NEAR(NormalQuantile(0.995), 2.575829304, 1e-9);
+  EXPECT_NEAR(NormalQuantile(0.5), 0.0, 1e-12);
+  EXPECT_NEAR(NormalQuantile(1 - 1e-6), 4.753424309, 1e-8);
+  EXPECT_NEAR(NormalQuantile(0.01), -2.326347874, 1e-9);
+  for (double z : {-6.0, -2.5, -0.3, 0.7, 3.1, 7.5})
+    EXPECT_NEAR(NormalSurvival(NormalQuantile(NormalSurvival(-z))), NormalSurvival(z), 1e-12 + 1e-9 * NormalSurvival(z)) << z;
+  EXPECT_NEAR(NormalSurvival(1.959963985), 0.025, 1e-10);
+}
+
+// The chi-square tail against its closed forms (2 dof: exp(-x/2); 1 dof: erfc(sqrt(x/2)); 4 dof:
+// (1 + x/2) exp(-x/2)) and tabulated upper quantiles (NIST/SEMATECH e-Handbook 1.3.6.7.4).
+TEST(Statistics, ChiSquareAgainstClosedFormsAndTables) {
+  for (double x : {0.01, 0.5, 1.0, 3.0, 10.0, 40.0}) {
+    EXPECT_NEAR(ChiSquareSurvival(x, 2), std::exp(-x / 2), 1e-14) << x;
+    EXPECT_NEAR(ChiSquareSurvival(x, 1), std::erfc(std::sqrt(x / 2)), 1e-13) << x;
+    EXPECT_NEAR(ChiSquareSurvival(x, 4), (1 + x / 2) * std::exp(-x / 2), 1e-13) << x;
+  }
+  EXPECT_EQ(ChiSquareSurvival(0, 3), 1.0);
+  EXPECT_NEAR(ChiSquareUpperQuantile(0.05, 1), 3.841, 1e-3);
+  EXPECT_NEAR(ChiSquareUpperQuantile(0.01, 10), 23.209, 1e-3);
+  EXPECT_NEAR(ChiSquareUpperQuantile(0.01, 20), 37.566, 1e-3);
+  EXPECT_NEAR(ChiSquareUpperQuantile(0.001, 50), 86.661, 1e-3);
+  EXPECT_NEAR(ChiSquareUpperQuantile(0.05, 100), 124.342, 1e-3);
+}
+
+// Ljung-Box Q of seeded white Gaussian noise follows chi2(m): over 2000 series its mean is m (sd of
+// the mean sqrt(2 m / 2000)) and it exceeds the 5 % quantile in 5 % of them (binomial sd 0.5 %);
+// an AR(1) series with phi = 0.3 is rejected.
+TEST(Statistics, LjungBoxOfWhiteNoiseIsChiSquare) {
+  const size_t n = 400, m = 10;
+  NormalRng<NormalBoxMuller<BoxMullerU1::kOneMinusUniform>> rng(11);
+  const double q95 = ChiSquareUpperQuantile(0.05, m);
+  double sum = 0;
+  int over = 0;
+  const int S = 2000;
+  std::vector<double> x(n);
+  for (int s = 0; s < S; ++s) {
+    for (double& v : x) v = rng.Normal();
+    const double q = LjungBoxQ(x.data(), n, m);
+    sum += q;
+    over += q > q95;
+  }
+  EXPECT_NEAR(sum / S, static_cast<double>(m), 4 * std::sqrt(2.0 * m / S) + 0.2);
+  EXPECT_NEAR(over / static_cast<double>(S), 0.05, 0.015);
+  double v = 0;
+  for (double& s : x) s = v = 0.3 * v + rng.Normal();
+  EXPECT_GT(LjungBoxQ(x.data(), n, m), ChiSquareUpperQuantile(1e-6, m));
+  // The sample autocorrelation of a line of period 4 (1, 0, -1, 0, ...): r(2) near -1.
+  std::vector<double> p;
+  for (int i = 0; i < 400; ++i) p.push_back(std::cos(M_PI * i / 2));
+  EXPECT_NEAR(SampleAutocorrelation(p.data(), p.size(), 2)[1], -1.0, 0.01);
+}
+
 }  // namespace
 }  // namespace exotwin
