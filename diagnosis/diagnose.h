@@ -154,8 +154,11 @@ struct TorqueOnlyEffect {
   std::string why;                         // when not simulated: the forward plant cannot carry it
                                            // (muscle_activity), the model given already carries one
                                            // (no candidate), no sensor to correct, or its rollout failed
-  double heldout_change_pct[2] = {0, 0};   // held-out simulated-angle SSE change per joint when added
-                                           // at that value to the motion fit's effects, % (< 0: lower)
+  // The held-out simulated-angle RMS error's change per joint (unweighted, the final comparison's
+  // measure), % (< 0: lower): added at that value to the motion fit's effects; and its share in the
+  // torque fit's twin, that twin against the twin without it (NaN: not simulated).
+  double heldout_change_pct[2] = {0, 0};
+  double in_torque_twin_pct[2] = {NAN, NAN};
 };
 
 // A model's black-box ceiling at one joint (DESIGN.md "Terms beyond the table": `ceiling`), on the

@@ -164,7 +164,10 @@ std::string DiagnosisJson(const Diagnosis& d) {
       x["simulated"] = t.simulated;
       if (!t.simulated) x["why"] = t.why;
       if (t.simulated)
-        for (int k = k0; k < 2; ++k) x["heldout_change_pct"][names[k]] = t.heldout_change_pct[k];
+        for (int k = k0; k < 2; ++k) {
+          x["heldout_change_pct"][names[k]] = t.heldout_change_pct[k];
+          if (std::isfinite(t.in_torque_twin_pct[k])) x["in_torque_twin_pct"][names[k]] = t.in_torque_twin_pct[k];
+        }
       j["torque_only"].push_back(x);
     }
   }

@@ -169,34 +169,53 @@ void MotionFit::TorqueTwinFloor() {
   const std::string head = "the torque fit's twin (" + Labels(P, tset) + ") replays the held-out rows at " + Deg(tq) +
                            ", " + Labels(P, chosen) + " at " + Deg(now) + " (more than " +
                            NumberText(kTorqueTwinTolerance) + "x at a joint): ";
-  // The options: the torque fit's effects refined on the fit part from its values; the current set
-  // with those of them that conflict with none of it, refined from the current values and theirs; the
-  // torque fit's effects at its values (its twin itself, within the tolerance by construction).
+  // The options, each starting from the torque fit's effects at its values: refined on the fit part;
+  // held at its values with the motion fit's effects that conflict with none of them added, those
+  // refined alone; the current set with the torque fit's effects that conflict with none of it added,
+  // all refined; at its values (its twin itself, within the tolerance by construction). `held`: the
+  // parameters left at the torque fit's values.
   struct Option {
     std::string what;
     std::vector<int> set;
     Eigen::VectorXd theta;
-    bool keep = false;
+    std::vector<int> held;
+  };
+  const std::vector<int> tcols = ColumnsOf(cand_bank, tset);
+  auto Clash = [&](const std::vector<int>& set, int c) {
+    return std::any_of(set.begin(), set.end(), [&](int s) {
+      return s == c || Conflicts(cands[static_cast<size_t>(s)], cands[static_cast<size_t>(c)]);
+    });
+  };
+  // Set `a` at values xa with the effects of set `b` that conflict with none of it added at values xb.
+  auto Union = [&](const std::vector<int>& a, const Eigen::VectorXd& xa, const std::vector<int>& b,
+                   const Eigen::VectorXd& xb, Eigen::VectorXd* x) {
+    std::vector<int> u = a;
+    *x = xa;
+    for (int c : b) {
+      if (Clash(u, c)) continue;
+      u.push_back(c);
+      for (int k : cands[static_cast<size_t>(c)].cols) (*x)[k] = xb[k];
+    }
+    return u;
   };
   std::vector<Option> options;
   {
-    const Refined ra = Refine(P, ColumnsOf(cand_bank, tset), {tx}, kMotionLmIterations, false);
-    if (std::isfinite(ra.cost)) options.push_back({"its effects refined on the fit part", tset, ra.theta});
-    std::vector<int> uset = chosen;
-    Eigen::VectorXd ux = theta;
-    for (int c : tset) {
-      const bool clash = std::any_of(uset.begin(), uset.end(), [&](int s) {
-        return s == c || Conflicts(cands[static_cast<size_t>(s)], cands[static_cast<size_t>(c)]);
-      });
-      if (clash) continue;
-      uset.push_back(c);
-      for (int k : cands[static_cast<size_t>(c)].cols) ux[k] = tx[k];
+    const Refined ra = Refine(P, tcols, {tx}, kMotionLmIterations, false);
+    if (std::isfinite(ra.cost)) options.push_back({"its effects refined on the fit part", tset, ra.theta, {}});
+    Eigen::VectorXd dx, ux;
+    const std::vector<int> dset = Union(tset, tx, chosen, theta, &dx);
+    if (dset.size() > tset.size()) {
+      const std::vector<int> added(dset.begin() + static_cast<long>(tset.size()), dset.end());
+      const Refined rd = Refine(P, ColumnsOf(cand_bank, added), {dx}, kMotionLmIterations, false);
+      if (std::isfinite(rd.cost))
+        options.push_back({"its effects at its values, the motion fit's others added and refined", dset, rd.theta, tcols});
     }
+    const std::vector<int> uset = Union(chosen, theta, tset, tx, &ux);
     if (uset.size() > chosen.size() && !chosen.empty()) {
       const Refined rb = Refine(P, ColumnsOf(cand_bank, uset), {ux}, kMotionLmIterations, false);
-      if (std::isfinite(rb.cost)) options.push_back({"its effects added to the set, refined", uset, rb.theta});
+      if (std::isfinite(rb.cost)) options.push_back({"its effects added to the set, refined", uset, rb.theta, {}});
     }
-    options.push_back({"its effects at its values", tset, tx, true});
+    options.push_back({"its effects at its values", tset, tx, tcols});
   }
   std::vector<Eigen::VectorXd> xs;
   for (const Option& o : options) xs.push_back(o.theta);
@@ -224,17 +243,20 @@ void MotionFit::TorqueTwinFloor() {
   D.selection.push_back("taken: " + o.what + " (" + Labels(P, o.set) + "), the lowest exact fit-part BIC within " +
                         NumberText(kTorqueTwinTolerance) + "x the torque fit's twin");
   chosen = o.set, theta = o.theta, at = ro[static_cast<size_t>(best)];
-  keep_values = o.keep, have_last = false;
+  held = o.held, have_last = false;
   floor_note = "the torque fit's twin, " + o.what + ", was taken in place of the motion fit's set" +
-               (o.keep ? std::string("; the held-out gate removed what gained too little there")
-                       : std::string("; its values moved when refined under the extended twin's own misfit"));
+               (held.empty() ? std::string("; its values moved when refined under the extended twin's own misfit")
+                             : std::string("; the held-out gate removed what gained too little there"));
   // The held-out gate on this set, read against the torque fit's twin: an effect that gains less than
   // kMinHeldoutGain at its joint goes only where the set without it still replays within the tolerance.
   for (std::string why; !chosen.empty();) {
     const int drop = WeakestEffect(&why);
     if (drop < 0) break;
     Eigen::VectorXd x = theta;
-    for (int k : cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])].cols) x[k] = 0;
+    for (int k : cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])].cols) {
+      x[k] = 0;
+      held.erase(std::remove(held.begin(), held.end(), k), held.end());
+    }
     MotionProblem::Rollout rx = P.Simulate(x, Part::kBoth);
     double rms[2] = {INFINITY, INFINITY};
     if (rx.ok) HeldOutRms(rx, rms);
@@ -354,7 +376,14 @@ void MotionFit::Intervals() {
   }
   D.tau_eff = ResidualAutocorrelation(P, at, window_rows);
   if (!chosen.empty()) {
-    if (keep_values) {  // step 6b kept the torque fit's values: the Jacobian at them, not moved
+    if (!held.empty()) {  // step 6b held the torque fit's values: the rest refined, the Jacobian at all
+      std::vector<int> free;
+      for (int k : cols)
+        if (std::find(held.begin(), held.end(), k) == held.end()) free.push_back(k);
+      if (!free.empty()) {
+        const Refined rf = Refine(P, free, {theta}, kMotionLmIterations, false);
+        if (std::isfinite(rf.cost)) theta = rf.theta, at = P.Simulate(theta, Part::kBoth);
+      }
       last.theta = theta;
       last.cost = Cost(P, at, Part::kFit);
       last.J = WeightedFitJacobian(P, theta, at, cols);
@@ -386,8 +415,19 @@ void MotionFit::Intervals() {
 
 void MotionFit::Spread() {
   const std::vector<Eigen::Index> idx = PartRows(P, Part::kFit);
-  const Eigen::Index p = static_cast<Eigen::Index>(cols.size());
-  if (p == 0 || last.J.rows() != static_cast<Eigen::Index>(idx.size()) || last.e.size() != last.J.rows()) return;
+  // The fit that produced the values: the parameters the motion objective moved (not those step 6b
+  // held at the torque fit's values), their columns of the final Jacobian.
+  std::vector<int> fcols;
+  std::vector<Eigen::Index> fpos;
+  for (size_t c = 0; c < cols.size(); ++c)
+    if (std::find(held.begin(), held.end(), cols[c]) == held.end())
+      fcols.push_back(cols[c]), fpos.push_back(static_cast<Eigen::Index>(c));
+  const Eigen::Index p = static_cast<Eigen::Index>(fcols.size());
+  if (p == 0 || last.J.rows() != static_cast<Eigen::Index>(idx.size()) || last.e.size() != last.J.rows() ||
+      last.J.cols() != static_cast<Eigen::Index>(cols.size()))
+    return;
+  Eigen::MatrixXd Jf(last.J.rows(), p);
+  for (Eigen::Index c = 0; c < p; ++c) Jf.col(c) = last.J.col(fpos[static_cast<size_t>(c)]);
   // Each fit row's block (a window's rows of one record, both joints alike) and fifth of its record.
   const size_t block_rows = static_cast<size_t>(std::max(1.0, std::round(window_rows)));
   std::vector<size_t> block(idx.size()), fifth(idx.size());
@@ -410,10 +450,10 @@ void MotionFit::Spread() {
   std::vector<Eigen::VectorXd> g(blocks, Eigen::VectorXd::Zero(p)), gs(5, Eigen::VectorXd::Zero(p));
   for (size_t i = 0; i < idx.size(); ++i) {
     const Eigen::Index r = static_cast<Eigen::Index>(i);
-    A[block[i]].noalias() += last.J.row(r).transpose() * last.J.row(r);
-    g[block[i]].noalias() += last.J.row(r).transpose() * last.e[r];
-    As[fifth[i]].noalias() += last.J.row(r).transpose() * last.J.row(r);
-    gs[fifth[i]].noalias() += last.J.row(r).transpose() * last.e[r];
+    A[block[i]].noalias() += Jf.row(r).transpose() * Jf.row(r);
+    g[block[i]].noalias() += Jf.row(r).transpose() * last.e[r];
+    As[fifth[i]].noalias() += Jf.row(r).transpose() * Jf.row(r);
+    gs[fifth[i]].noalias() += Jf.row(r).transpose() * last.e[r];
   }
   Eigen::MatrixXd At = Eigen::MatrixXd::Zero(p, p);
   Eigen::VectorXd gt = Eigen::VectorXd::Zero(p);
@@ -425,7 +465,7 @@ void MotionFit::Spread() {
     if (ldlt.info() != Eigen::Success || !d.allFinite()) return false;
     Eigen::VectorXd x = theta;
     for (Eigen::Index c = 0; c < p; ++c) {
-      const int k = cols[static_cast<size_t>(c)];
+      const int k = fcols[static_cast<size_t>(c)];
       x[k] = std::clamp(theta[k] + d[c], P.lower(k), P.upper(k));
     }
     v->clear();
@@ -457,6 +497,9 @@ void MotionFit::Spread() {
       for (size_t k = 0; k < n; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
   if (draws < 2) return;
   for (size_t k = 0; k < n && k < D.effects.size(); ++k) {
+    const std::vector<int>& kc = cands[static_cast<size_t>(chosen[k])].cols;
+    if (std::all_of(kc.begin(), kc.end(), [&](int c) { return std::find(held.begin(), held.end(), c) != held.end(); }))
+      continue;  // the torque fit's value: not resampled here
     const double mean = sum[k] / draws;
     D.effects[k].spread_sd = std::sqrt(std::max(0.0, (sum2[k] - draws * mean * mean) / (draws - 1)));
     if (std::isfinite(lo[k])) D.effects[k].spread_lo = lo[k], D.effects[k].spread_hi = hi[k];
@@ -555,15 +598,19 @@ void MotionFit::PlottedSeries() {
 }
 
 void MotionFit::ListTorqueOnly() {
-  // Torque only: what the torque fit names and the motion fit does not.
-  std::vector<Eigen::VectorXd> tthetas;
+  // Torque only: what the torque fit names and the motion fit does not, judged as the final comparison
+  // judges twins (unweighted held-out RMS simulated-angle error per joint): added at the torque fit's
+  // value to the motion fit's effects, and taken out of the torque fit's twin.
+  std::vector<Effect> named;
+  for (const DiagnosedEffect& d : T.effects) named.push_back(d.effect);
+  std::vector<Eigen::VectorXd> tthetas = {TorqueTwinTheta(named, nullptr)};
   std::vector<size_t> tidx;
   for (size_t k = 0; k < T.effects.size(); ++k) {
     const Effect& e = T.effects[k].effect;
-    bool named = false;
+    bool is_named = false;
     for (const auto& de : D.effects)
-      named = named || (de.effect.name == e.name && de.effect.joint == e.joint && de.effect.axis == e.axis);
-    if (named) continue;
+      is_named = is_named || (de.effect.name == e.name && de.effect.joint == e.joint && de.effect.axis == e.axis);
+    if (is_named) continue;
     TorqueOnlyEffect to;
     to.effect = e;
     Eigen::VectorXd x = theta;
@@ -571,24 +618,33 @@ void MotionFit::ListTorqueOnly() {
     if (!to.simulated) to.why = P.WhyNoCandidate(e);
     if (to.simulated) {
       for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
+      std::vector<Effect> rest = named;
+      rest.erase(rest.begin() + static_cast<long>(k));
       tthetas.push_back(x);
+      tthetas.push_back(TorqueTwinTheta(rest, nullptr));
       tidx.push_back(D.torque_only.size());
     }
     D.torque_only.push_back(to);
   }
+  if (tidx.empty()) return;
   const std::vector<MotionProblem::Rollout> tro = P.SimulateAll(tthetas, Part::kHeldOut);
-  double base_te[2];
-  P.Sse(at, Part::kHeldOut, base_te);
-  for (size_t k = 0; k < tro.size(); ++k) {
+  double base[2], twin[2];
+  HeldOutRms(at, base);
+  HeldOutRms(tro[0], twin);
+  for (size_t k = 0; k < tidx.size(); ++k) {
     TorqueOnlyEffect& to = D.torque_only[tidx[k]];
-    if (!tro[k].ok) {
+    const MotionProblem::Rollout &added = tro[1 + 2 * k], &without = tro[2 + 2 * k];
+    if (!added.ok) {
       to.simulated = false;
       to.why = "its rollout failed (the plant refused the values or diverged)";
       continue;
     }
-    double s[2];
-    P.Sse(tro[k], Part::kHeldOut, s);
-    for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base_te[j] > 0 ? 100 * (s[j] / base_te[j] - 1) : 0.0;
+    double s[2], w[2];
+    HeldOutRms(added, s);
+    for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base[j] > 0 ? 100 * (s[j] / base[j] - 1) : 0.0;
+    if (!tro[0].ok || !without.ok) continue;
+    HeldOutRms(without, w);
+    for (int j = 0; j < 2; ++j) to.in_torque_twin_pct[j] = w[j] > 0 ? 100 * (twin[j] / w[j] - 1) : 0.0;
   }
 }
 

@@ -241,7 +241,8 @@ class MotionFit {
   Refined last;                      // the last refinement of the chosen set
   bool have_last = false;            // `last` is at theta under the current weights
   std::vector<int> cols;             // the final set's parameters (Intervals)
-  bool keep_values = false;          // step 6b kept the torque fit's values: Intervals does not move them
+  std::vector<int> held;             // step 6b's parameters held at the torque fit's values (Intervals
+                                     // does not move them; Spread does not resample them)
   std::string floor_note;            // step 6b's outcome in words (SimulationScores::torque_fit_why)
 };
 
