@@ -149,6 +149,8 @@ namespace exotwin {
 // predict / diagnose of a generated 1 kHz record (600 s, ~75 MB of CSV; quick: 20 s) run as child
 // processes, against reading the same file once with strtod per field: ratio (wall time) first,
 // then the times, the child's peak memory (ru_maxrss) and that of `exotwin --help` (start-up alone).
+// diagnose_long adds the same row on the record `run` writes for the shipped gait scenario at that
+// length (15 columns: cmd_*, ref_*, state and EMG besides the required ones; `run_record` in its JSON).
 nlohmann::ordered_json BenchPredictLong(const BenchConfig& c);
 nlohmann::ordered_json BenchDiagnoseLong(const BenchConfig& c);
 

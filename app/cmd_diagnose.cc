@@ -76,7 +76,11 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
         std::printf("diagnose: torque only: %s (%s) = %g %s%s\n", t.effect.name.c_str(), t.effect.joint.c_str(),
                     t.effect.value, t.effect.unit.c_str(),
                     t.simulated ? (": held-out simulated error " + NumberText(t.heldout_change_pct[0], 3) + " % hip, " +
-                                   NumberText(t.heldout_change_pct[1], 3) + " % knee when added").c_str()
+                                   NumberText(t.heldout_change_pct[1], 3) + " % knee when added" +
+                                   (std::isfinite(t.in_torque_twin_pct[0] + t.in_torque_twin_pct[1])
+                                        ? ", " + NumberText(t.in_torque_twin_pct[0], 3) + " % hip, " +
+                                              NumberText(t.in_torque_twin_pct[1], 3) + " % knee in the torque fit's twin"
+                                        : std::string())).c_str()
                                 : (" (" + t.why + ")").c_str());
       const int j0 = params.one_joint ? 1 : 0;
       for (int j = j0; j < 2; ++j)
@@ -100,6 +104,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
         for (size_t k = 0; k < S.torque_fit_not_carried.size(); ++k)
           line += (k == 0 ? " (not carried: " : ", ") + S.torque_fit_not_carried[k] + (k + 1 == S.torque_fit_not_carried.size() ? ")" : "");
         std::printf("%s\n", line.c_str());
+        if (!S.torque_fit_why.empty()) std::printf("diagnose: %s\n", S.torque_fit_why.c_str());
       }
       std::printf("diagnose: report %s/report.html\n", o->out.c_str());
       return 0;

@@ -29,6 +29,7 @@
 //  6. structure left in the held-out residual (low-passed rms well above the noise) is reported as
 //     unexplained with its dominant frequency and its correlation with angle, velocity, accel, time.
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,10 @@ struct DiagnosedEffect {
   // (diagnose.cc FindAliases); those in range first, singles before pairs, then the most reaching;
   // at most kMaxAliases.
   std::vector<EffectAlias> aliases;
+  // The motion fit: the value's spread across resamples of the fit rows (motion_fit.h step 7):
+  // spread_sd the standard deviation over kSpreadBootstraps block bootstraps, spread_lo / spread_hi
+  // the least and largest value with each fifth of the fit rows left out in turn. NaN: not resampled.
+  double spread_sd = NAN, spread_lo = NAN, spread_hi = NAN;
 };
 
 constexpr double kAliasLeft = 0.01;  // an alias leaves the named effect at most 1 % of its drop of the fit error
@@ -121,6 +126,9 @@ struct SimulationScores {
   bool torque_fit_done = false;
   JointScore torque_fit_split[2], torque_fit_left_out[2];
   std::vector<std::string> torque_fit_not_carried;
+  // A motion fit whose extended twin still replays the held-out rows worse than the torque fit's twin
+  // (above kTorqueTwinTolerance times its RMS error at a joint, motion_fit.h): why, in words; else empty.
+  std::string torque_fit_why;
   // First record's held-out part: time, measured angle, rigid and extended twin's simulated angle
   // (NaN between windows).
   std::vector<double> t, measured[2], rigid[2], extended[2];
@@ -146,8 +154,11 @@ struct TorqueOnlyEffect {
   std::string why;                         // when not simulated: the forward plant cannot carry it
                                            // (muscle_activity), the model given already carries one
                                            // (no candidate), no sensor to correct, or its rollout failed
-  double heldout_change_pct[2] = {0, 0};   // held-out simulated-angle SSE change per joint when added
-                                           // at that value to the motion fit's effects, % (< 0: lower)
+  // The held-out simulated-angle RMS error's change per joint (unweighted, the final comparison's
+  // measure), % (< 0: lower): added at that value to the motion fit's effects; and its share in the
+  // torque fit's twin, that twin against the twin without it (NaN: not simulated).
+  double heldout_change_pct[2] = {0, 0};
+  double in_torque_twin_pct[2] = {NAN, NAN};
 };
 
 // A model's black-box ceiling at one joint (DESIGN.md "Terms beyond the table": `ceiling`), on the

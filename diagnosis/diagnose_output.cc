@@ -31,6 +31,8 @@ std::string DiagnosisJson(const Diagnosis& d) {
   for (const auto& e : d.effects) {
     json x = {{"name", e.effect.name}, {"joint", e.effect.joint}, {"value", e.effect.value},
               {"unit", e.effect.unit}, {"ci95", {e.ci_lo, e.ci_hi}}, {"explained_pct", e.explained_pct}};
+    if (std::isfinite(e.spread_sd))
+      x["spread"] = {{"sd", e.spread_sd}, {"segments_left_out", {e.spread_lo, e.spread_hi}}};
     if (!e.effect.axis.empty()) x["axis"] = e.effect.axis;
     if (!e.effect.expr.empty()) {  // a term beyond the table (DESIGN.md "Terms beyond the table")
       x["expr"] = e.effect.expr;
@@ -122,6 +124,7 @@ std::string DiagnosisJson(const Diagnosis& d) {
       for (int k = k0; k < 2; ++k) t["joints"][names[k]] = sim(S.torque_fit_split[k]);
       if (d.leave_one_out)
         for (int k = k0; k < 2; ++k) t["left_out"][names[k]] = sim(S.torque_fit_left_out[k]);
+      if (!S.torque_fit_why.empty()) t["why_worse"] = S.torque_fit_why;
       js["torque_fit"] = t;
     }
   }
@@ -162,7 +165,10 @@ std::string DiagnosisJson(const Diagnosis& d) {
       x["simulated"] = t.simulated;
       if (!t.simulated) x["why"] = t.why;
       if (t.simulated)
-        for (int k = k0; k < 2; ++k) x["heldout_change_pct"][names[k]] = t.heldout_change_pct[k];
+        for (int k = k0; k < 2; ++k) {
+          x["heldout_change_pct"][names[k]] = t.heldout_change_pct[k];
+          if (std::isfinite(t.in_torque_twin_pct[k])) x["in_torque_twin_pct"][names[k]] = t.in_torque_twin_pct[k];
+        }
       j["torque_only"].push_back(x);
     }
   }

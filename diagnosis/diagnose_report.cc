@@ -102,6 +102,7 @@ std::string SimulationTable(const Diagnosis& d) {
                                        }()) + ")")
                           : std::string())
     << ".</p>";
+  if (!S.torque_fit_why.empty()) o << "<p>" << HtmlEscape(S.torque_fit_why) << ".</p>";
   return o.str();
 }
 
@@ -209,7 +210,12 @@ std::string MotionReportHtml(const Diagnosis& d, const std::string& params_path,
         if (t.effect.name == e.effect.name && t.effect.joint == e.effect.joint && t.effect.axis == e.effect.axis)
           verdict = t.simulated ? "torque only: added at this value, the held-out simulated error changes by " +
                                       NumberText(t.heldout_change_pct[0], 3) + " % (hip), " +
-                                      NumberText(t.heldout_change_pct[1], 3) + " % (knee)"
+                                      NumberText(t.heldout_change_pct[1], 3) + " % (knee)" +
+                                      (std::isfinite(t.in_torque_twin_pct[0] + t.in_torque_twin_pct[1])
+                                           ? "; in the torque fit's twin it changes it by " +
+                                                 NumberText(t.in_torque_twin_pct[0], 3) + " % (hip), " +
+                                                 NumberText(t.in_torque_twin_pct[1], 3) + " % (knee)"
+                                           : std::string())
                                 : "torque only: " + t.why;
       o << "<tr><td>" << e.effect.name << (e.effect.axis.empty() ? "" : "." + e.effect.axis) << "</td><td>"
         << e.effect.joint << "</td><td>" << NumberText(e.effect.value, 4) << " " << HtmlEscape(e.effect.unit)

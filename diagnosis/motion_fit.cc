@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "diagnosis/diagnose_internal.h"
 #include "diagnosis/diagnose_unexplained.h"
 #include "diagnosis/motion_fit_internal.h"
@@ -134,6 +135,144 @@ void MotionFit::HeldOutGate() {
   Charge(kGate);
 }
 
+void MotionFit::TorqueTwinFloor() {
+  // 6b. The torque fit's twin (its effects at its values, those the plant carries) against the current
+  // set on the held-out parts, unweighted RMS per joint: the final comparison (ScoreTorqueFitTwin).
+  std::vector<Effect> named;
+  std::vector<int> tset;  // their candidates
+  for (const DiagnosedEffect& d : T.effects) {
+    named.push_back(d.effect);
+    Eigen::VectorXd probe = zero;
+    const int c = CandidateOf(P, d.effect);
+    if (c >= 0 && TorqueValues(P, d.effect, &probe) && std::find(tset.begin(), tset.end(), c) == tset.end())
+      tset.push_back(c);
+  }
+  if (tset.empty()) return;
+  const Eigen::VectorXd tx = TorqueTwinTheta(named, nullptr);
+  const MotionProblem::Rollout tro = P.Simulate(tx, Part::kHeldOut);
+  double now[2], tq[2];
+  HeldOutRms(at, now);
+  if (!tro.ok) return;
+  HeldOutRms(tro, tq);
+  const int j0 = params.one_joint ? 1 : 0;
+  auto Within = [&](const double rms[2]) {
+    for (int j = j0; j < 2; ++j)
+      if (!(rms[j] <= kTorqueTwinTolerance * tq[j])) return false;
+    return true;
+  };
+  auto Deg = [&](const double rms[2]) {
+    std::string o;
+    for (int j = j0; j < 2; ++j)
+      o += std::string(j == j0 ? "" : ", ") + kJoint[j] + " " + NumberText(rms[j] * 180 / M_PI, 4);
+    return o + " deg";
+  };
+  if (Within(now)) return;
+  const std::string head = "the torque fit's twin (" + Labels(P, tset) + ") replays the held-out rows at " + Deg(tq) +
+                           ", " + Labels(P, chosen) + " at " + Deg(now) + " (more than " +
+                           NumberText(kTorqueTwinTolerance) + "x at a joint): ";
+  // The options, each starting from the torque fit's effects at its values: refined on the fit part;
+  // held at its values with the motion fit's effects that conflict with none of them added, those
+  // refined alone; the current set with the torque fit's effects that conflict with none of it added,
+  // all refined; at its values (its twin itself, within the tolerance by construction). `held`: the
+  // parameters left at the torque fit's values.
+  struct Option {
+    std::string what;
+    std::vector<int> set;
+    Eigen::VectorXd theta;
+    std::vector<int> held;
+  };
+  const std::vector<int> tcols = ColumnsOf(cand_bank, tset);
+  auto Clash = [&](const std::vector<int>& set, int c) {
+    return std::any_of(set.begin(), set.end(), [&](int s) {
+      return s == c || Conflicts(cands[static_cast<size_t>(s)], cands[static_cast<size_t>(c)]);
+    });
+  };
+  // Set `a` at values xa with the effects of set `b` that conflict with none of it added at values xb.
+  auto Union = [&](const std::vector<int>& a, const Eigen::VectorXd& xa, const std::vector<int>& b,
+                   const Eigen::VectorXd& xb, Eigen::VectorXd* x) {
+    std::vector<int> u = a;
+    *x = xa;
+    for (int c : b) {
+      if (Clash(u, c)) continue;
+      u.push_back(c);
+      for (int k : cands[static_cast<size_t>(c)].cols) (*x)[k] = xb[k];
+    }
+    return u;
+  };
+  std::vector<Option> options;
+  {
+    const Refined ra = Refine(P, tcols, {tx}, kMotionLmIterations, false);
+    if (std::isfinite(ra.cost)) options.push_back({"its effects refined on the fit part", tset, ra.theta, {}});
+    Eigen::VectorXd dx, ux;
+    const std::vector<int> dset = Union(tset, tx, chosen, theta, &dx);
+    if (dset.size() > tset.size()) {
+      const std::vector<int> added(dset.begin() + static_cast<long>(tset.size()), dset.end());
+      const Refined rd = Refine(P, ColumnsOf(cand_bank, added), {dx}, kMotionLmIterations, false);
+      if (std::isfinite(rd.cost))
+        options.push_back({"its effects at its values, the motion fit's others added and refined", dset, rd.theta, tcols});
+    }
+    const std::vector<int> uset = Union(chosen, theta, tset, tx, &ux);
+    if (uset.size() > chosen.size() && !chosen.empty()) {
+      const Refined rb = Refine(P, ColumnsOf(cand_bank, uset), {ux}, kMotionLmIterations, false);
+      if (std::isfinite(rb.cost)) options.push_back({"its effects added to the set, refined", uset, rb.theta, {}});
+    }
+    options.push_back({"its effects at its values", tset, tx, tcols});
+  }
+  std::vector<Eigen::VectorXd> xs;
+  for (const Option& o : options) xs.push_back(o.theta);
+  const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(xs, Part::kBoth);
+  int best = -1;
+  double best_bic = INFINITY;
+  for (size_t k = 0; k < options.size(); ++k) {
+    if (!ro[k].ok) {
+      D.selection.push_back(head + options[k].what + ": the plant cannot simulate them");
+      continue;
+    }
+    double rms[2];
+    HeldOutRms(ro[k], rms);
+    const double bic = ExactBic(Cost(P, ro[k], Part::kFit), ParameterCount(options[k].set));
+    const bool within = Within(rms);
+    D.selection.push_back(head + options[k].what + " (" + Labels(P, options[k].set) + "): held-out " + Deg(rms) +
+                          ", exact fit-part BIC " + NumberText(bic, 4) + (within ? "" : ", still worse"));
+    if (within && bic < best_bic) best_bic = bic, best = static_cast<int>(k);
+  }
+  if (best < 0) {
+    floor_note = "the torque fit's effects, refined or at its values, could not be simulated on the records";
+    return;
+  }
+  const Option& o = options[static_cast<size_t>(best)];
+  D.selection.push_back("taken: " + o.what + " (" + Labels(P, o.set) + "), the lowest exact fit-part BIC within " +
+                        NumberText(kTorqueTwinTolerance) + "x the torque fit's twin");
+  chosen = o.set, theta = o.theta, at = ro[static_cast<size_t>(best)];
+  held = o.held, have_last = false;
+  floor_note = "the torque fit's twin, " + o.what + ", was taken in place of the motion fit's set" +
+               (held.empty() ? std::string("; its values moved when refined under the extended twin's own misfit")
+                             : std::string("; the held-out gate removed what gained too little there"));
+  // The held-out gate on this set, read against the torque fit's twin: an effect that gains less than
+  // kMinHeldoutGain at its joint goes only where the set without it still replays within the tolerance.
+  for (std::string why; !chosen.empty();) {
+    const int drop = WeakestEffect(&why);
+    if (drop < 0) break;
+    Eigen::VectorXd x = theta;
+    for (int k : cands[static_cast<size_t>(chosen[static_cast<size_t>(drop)])].cols) {
+      x[k] = 0;
+      held.erase(std::remove(held.begin(), held.end(), k), held.end());
+    }
+    MotionProblem::Rollout rx = P.Simulate(x, Part::kBoth);
+    double rms[2] = {INFINITY, INFINITY};
+    if (rx.ok) HeldOutRms(rx, rms);
+    if (!Within(rms)) {
+      D.selection.push_back("kept against the " + why + ": without it the twin replays the held-out rows at " + Deg(rms) +
+                            ", beyond " + NumberText(kTorqueTwinTolerance) + "x the torque fit's twin");
+      break;
+    }
+    D.selection.push_back(why + " (the rest still within " + NumberText(kTorqueTwinTolerance) + "x the torque fit's twin)");
+    chosen.erase(chosen.begin() + drop);
+    theta = x, at = std::move(rx);
+  }
+  Charge(kGate);
+}
+
 int MotionFit::OutOfRange(std::string* why) const {
   int drop = -1;
   for (size_t k = 0; k < chosen.size() && drop < 0; ++k) {
@@ -238,7 +377,21 @@ void MotionFit::Intervals() {
   }
   D.tau_eff = ResidualAutocorrelation(P, at, window_rows);
   if (!chosen.empty()) {
-    if (!have_last) last = Refine(P, cols, {theta});  // with the new weights (from theta, its band probes)
+    if (!held.empty()) {  // step 6b held the torque fit's values: the rest refined, the Jacobian at all
+      std::vector<int> free;
+      for (int k : cols)
+        if (std::find(held.begin(), held.end(), k) == held.end()) free.push_back(k);
+      if (!free.empty()) {
+        const Refined rf = Refine(P, free, {theta}, kMotionLmIterations, false);
+        if (std::isfinite(rf.cost)) theta = rf.theta, at = P.Simulate(theta, Part::kBoth);
+      }
+      last.theta = theta;
+      last.cost = Cost(P, at, Part::kFit);
+      last.J = WeightedFitJacobian(P, theta, at, cols);
+      last.e = WeightedResidual(P, at, PartRows(P, Part::kFit));
+    } else if (!have_last) {
+      last = Refine(P, cols, {theta});  // with the new weights (from theta, its band probes)
+    }
     theta = last.theta;
     at = P.Simulate(theta, Part::kBoth);
     Fit f;
@@ -256,6 +409,8 @@ void MotionFit::Intervals() {
       de.explained_pct = explained[k];
       D.effects.push_back(de);
     }
+    Spread();
+    TorqueFitSpread();
   }
   ExtendedTwin(params, &D);
 }
@@ -352,15 +507,19 @@ void MotionFit::PlottedSeries() {
 }
 
 void MotionFit::ListTorqueOnly() {
-  // Torque only: what the torque fit names and the motion fit does not.
-  std::vector<Eigen::VectorXd> tthetas;
+  // Torque only: what the torque fit names and the motion fit does not, judged as the final comparison
+  // judges twins (unweighted held-out RMS simulated-angle error per joint): added at the torque fit's
+  // value to the motion fit's effects, and taken out of the torque fit's twin.
+  std::vector<Effect> named;
+  for (const DiagnosedEffect& d : T.effects) named.push_back(d.effect);
+  std::vector<Eigen::VectorXd> tthetas = {TorqueTwinTheta(named, nullptr)};
   std::vector<size_t> tidx;
   for (size_t k = 0; k < T.effects.size(); ++k) {
     const Effect& e = T.effects[k].effect;
-    bool named = false;
+    bool is_named = false;
     for (const auto& de : D.effects)
-      named = named || (de.effect.name == e.name && de.effect.joint == e.joint && de.effect.axis == e.axis);
-    if (named) continue;
+      is_named = is_named || (de.effect.name == e.name && de.effect.joint == e.joint && de.effect.axis == e.axis);
+    if (is_named) continue;
     TorqueOnlyEffect to;
     to.effect = e;
     Eigen::VectorXd x = theta;
@@ -368,24 +527,33 @@ void MotionFit::ListTorqueOnly() {
     if (!to.simulated) to.why = P.WhyNoCandidate(e);
     if (to.simulated) {
       for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
+      std::vector<Effect> rest = named;
+      rest.erase(rest.begin() + static_cast<long>(k));
       tthetas.push_back(x);
+      tthetas.push_back(TorqueTwinTheta(rest, nullptr));
       tidx.push_back(D.torque_only.size());
     }
     D.torque_only.push_back(to);
   }
+  if (tidx.empty()) return;
   const std::vector<MotionProblem::Rollout> tro = P.SimulateAll(tthetas, Part::kHeldOut);
-  double base_te[2];
-  P.Sse(at, Part::kHeldOut, base_te);
-  for (size_t k = 0; k < tro.size(); ++k) {
+  double base[2], twin[2];
+  HeldOutRms(at, base);
+  HeldOutRms(tro[0], twin);
+  for (size_t k = 0; k < tidx.size(); ++k) {
     TorqueOnlyEffect& to = D.torque_only[tidx[k]];
-    if (!tro[k].ok) {
+    const MotionProblem::Rollout &added = tro[1 + 2 * k], &without = tro[2 + 2 * k];
+    if (!added.ok) {
       to.simulated = false;
       to.why = "its rollout failed (the plant refused the values or diverged)";
       continue;
     }
-    double s[2];
-    P.Sse(tro[k], Part::kHeldOut, s);
-    for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base_te[j] > 0 ? 100 * (s[j] / base_te[j] - 1) : 0.0;
+    double s[2], w[2];
+    HeldOutRms(added, s);
+    for (int j = 0; j < 2; ++j) to.heldout_change_pct[j] = base[j] > 0 ? 100 * (s[j] / base[j] - 1) : 0.0;
+    if (!tro[0].ok || !without.ok) continue;
+    HeldOutRms(without, w);
+    for (int j = 0; j < 2; ++j) to.in_torque_twin_pct[j] = w[j] > 0 ? 100 * (twin[j] / w[j] - 1) : 0.0;
   }
 }
 
@@ -394,26 +562,15 @@ void MotionFit::ScoreTorqueFitTwin() {
   // record left out its values fitted without that record, as the plant carries them.
   SimulationScores& S = D.simulation;
   if (S.done) {
-    auto ThetaOf = [&](const std::vector<Effect>& fx, std::vector<std::string>* not_carried) {
-      Eigen::VectorXd x = zero;
-      for (const Effect& e : fx) {
-        if (TorqueValues(P, e, &x)) continue;
-        const std::string label = e.name + " (" + e.joint + ")";
-        if (not_carried && std::find(not_carried->begin(), not_carried->end(), label) == not_carried->end())
-          not_carried->push_back(label);
-      }
-      for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
-      return x;
-    };
     std::vector<Effect> named;
     for (const DiagnosedEffect& d : T.effects) named.push_back(d.effect);
-    const Eigen::VectorXd t_theta = ThetaOf(named, &S.torque_fit_not_carried);
+    const Eigen::VectorXd t_theta = TorqueTwinTheta(named, &S.torque_fit_not_carried);
     const MotionProblem::Rollout t_ro = P.Simulate(t_theta, Part::kHeldOut);
     std::vector<Eigen::VectorXd> t_loo;
     if (loo)
       for (size_t r = 0; r < P.records(); ++r) {
         const std::vector<Effect>& fx = T.records[r].left_out_effects;
-        t_loo.push_back(ThetaOf(std::vector<Effect>(fx.begin() + static_cast<long>(std::min(params.effects.size(), fx.size())), fx.end()),
+        t_loo.push_back(TorqueTwinTheta(std::vector<Effect>(fx.begin() + static_cast<long>(std::min(params.effects.size(), fx.size())), fx.end()),
                                 &S.torque_fit_not_carried));
       }
     const std::vector<MotionProblem::Rollout> t_loo_ro = P.SimulateEachRecord(t_loo);
@@ -438,8 +595,39 @@ void MotionFit::ScoreTorqueFitTwin() {
         if (loo) S.torque_fit_left_out[j] = Score(ltb[j], lta[j], ltc);
       }
       S.torque_fit_done = true;
+      std::string worse;
+      for (int j = params.one_joint ? 1 : 0; j < 2; ++j)
+        if (S.split[j].rmse_after > kTorqueTwinTolerance * S.torque_fit_split[j].rmse_after)
+          worse += std::string(worse.empty() ? "" : ", ") + "the " + kJoint[j] + " " +
+                   NumberText(S.split[j].rmse_after * 180 / M_PI, 4) + " deg against " +
+                   NumberText(S.torque_fit_split[j].rmse_after * 180 / M_PI, 4);
+      if (!worse.empty())
+        S.torque_fit_why = "the motion fit's twin replays the held-out rows worse than the torque fit's twin (" + worse +
+                           "): " + (floor_note.empty() ? "the torque fit's effects were not put to the plant" : floor_note);
     }
   }
+}
+
+Eigen::VectorXd MotionFit::TorqueTwinTheta(const std::vector<Effect>& fx, std::vector<std::string>* not_carried) const {
+  Eigen::VectorXd x = zero;
+  for (const Effect& e : fx) {
+    if (TorqueValues(P, e, &x)) continue;
+    const std::string label = e.name + " (" + e.joint + ")";
+    if (not_carried && std::find(not_carried->begin(), not_carried->end(), label) == not_carried->end())
+      not_carried->push_back(label);
+  }
+  for (int c = 0; c < n_par; ++c) x[c] = std::clamp(x[c], P.lower(c), P.upper(c));
+  return x;
+}
+
+void MotionFit::HeldOutRms(const MotionProblem::Rollout& ro, double rms[2]) const {
+  double sse[2] = {0, 0}, count = 0;
+  for (size_t r = 0; r < P.records(); ++r) {
+    double a[2], c;
+    P.RecordSse(ro, r, Part::kHeldOut, a, &c);
+    sse[0] += a[0], sse[1] += a[1], count += c;
+  }
+  for (int j = 0; j < 2; ++j) rms[j] = std::sqrt(sse[j] / std::max(count, 1.0));
 }
 
 void MotionFit::FindUnexplained() {
@@ -507,6 +695,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   fit.Rounds();
   fit.ConfirmTorqueNamed();
   fit.HeldOutGate();
+  fit.TorqueTwinFloor();
   fit.Intervals();
   fit.ScoreTwins();
   fit.ListTorqueOnly();

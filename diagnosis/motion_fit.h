@@ -93,11 +93,20 @@
 //     the effect) one Gauss-Newton step from its refined ones on the other records' fit parts
 //     (LeftOutThetas: a record's held-out end may lack the motion an effect shows in); one that passes
 //     neither is dropped (the weakest first) and the rest refined again;
+//  6b. never worse than the torque fit's twin: where the set replays the held-out parts above
+//     kTorqueTwinTolerance times the torque fit's twin's RMS error at a joint, the torque fit's
+//     effects refined, held at its values with the set's others added (those refined), added to the
+//     set (all refined), or at its values: the lowest exact fit-part BIC within the tolerance; the
+//     gate then read against the torque fit's twin; values held stay (step 7 refines the rest);
 //  7. the weights set from the extended twin's misfit (MotionProblem::WeightBy) and the set's values
 //     refined once more under them (step 4's refinement and band probes, from the current values);
 //     95 % intervals from the final Jacobian: cov = s^2 (J'J)^-1, s^2 the fit part's residual variance
-//     inflated by its autocorrelation length; every effect the torque fit names and the motion fit
-//     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings;
+//     inflated by its autocorrelation length; beside them each value's spread across resamples of
+//     the rows of the fit that produced it (motion_spread.cc: kSpreadBootstraps block bootstraps,
+//     fifths left out; the motion objective's one Gauss-Newton step, or the torque fit's least squares
+//     for a value step 6b held); every effect the torque fit names and the motion fit
+//     does not is listed in Diagnosis::torque_only with the held-out simulated-error change it brings
+//     (added to the set, and in the torque fit's twin);
 //     the records left out (simulation.left_out) with the values LeftOutThetas gives at the final
 //     Jacobian; beside them the torque fit's twin on the same rows (SimulationScores::torque_fit_*:
 //     its effects on the held-out parts, its values fitted without each record on that record).
@@ -113,6 +122,7 @@
 // report's header).
 #pragma once
 #include <array>
+#include <cstdint>
 #include <atomic>
 #include <memory>
 #include <string>
@@ -131,6 +141,12 @@ constexpr int kMotionLmIterations = 8;   // Levenberg-Marquardt iterations per r
 constexpr int kMotionScreenIterations = 4;  // rollouts of a candidate's screening fit at most
 constexpr int kMotionBandProbes = 3;  // rounds of a dead band's probes after a refinement at most (step 4)
 constexpr int kMotionExchanges = 3;   // effects exchanged at most (step 5)
+// The motion fit's extended twin replays the held-out rows at most this times the RMS error of the
+// torque fit's twin at each joint, else the torque fit's effects are put in its place (step 6b).
+constexpr double kTorqueTwinTolerance = 1.05;
+// Step 7's resamples of the fit rows: block bootstraps (blocks of a window's rows) and their seed.
+constexpr int kSpreadBootstraps = 200;
+constexpr uint64_t kSpreadSeed = 64;
 
 // `exotwin diagnose --fit motion`: Diagnose (diagnose.h) with opt.fit == DiagnoseFit::kMotion. Throws
 // InputError naming the record for a record the motion fit cannot use: neither a torque reading (a

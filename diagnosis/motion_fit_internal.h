@@ -8,6 +8,7 @@
 //   motion_fit.cc         DiagnoseByMotion and the phases of steps 1, 6, 7 and the scores.
 #pragma once
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,24 @@ std::string ValueText(const MotionProblem& P, const Candidate& cand, const Eigen
 // ListTorqueOnly, ScoreTorqueFitTwin, FindUnexplained, Finish. The members are named as in the
 // method's text (P the problem, T the torque fit, D the diagnosis being filled, theta the current
 // values, at their rollout, chosen the current set).
+// A least squares' normal equations summed per block of rows (A[b], g[b]) and per fifth (As, gs).
+struct BlockGrams {
+  std::vector<Eigen::MatrixXd> A, As;
+  std::vector<Eigen::VectorXd> g, gs;
+  BlockGrams(size_t blocks, Eigen::Index p);
+  // Row x (its columns) with residual e, in block b and fifth f.
+  void Add(const Eigen::VectorXd& x, double e, size_t b, size_t f);
+};
+
+// Step 7's resamples of a least squares (motion_spread.cc): the solution of each of kSpreadBootstraps
+// block bootstraps (as many blocks drawn with replacement as there are, kSpreadSeed) and of the rows
+// with each fifth left out, mapped by `values` to n values (false: not defined there); per value the
+// bootstraps' standard deviation into sd, the least and largest with a fifth left out into lo, hi
+// (NaN: fewer than two bootstraps defined, or no fifth).
+using ValuesOf = std::function<bool(const Eigen::VectorXd& solution, std::vector<double>* v)>;
+void Resample(const BlockGrams& G, size_t n, const ValuesOf& values, std::vector<double>* sd,
+              std::vector<double>* lo, std::vector<double>* hi);
+
 class MotionFit {
  public:
   // Step 1: the records checked, the torque fit (no simulation), the problem, the given twin's rollout.
@@ -129,9 +148,26 @@ class MotionFit {
   void ConfirmTorqueNamed();
   // Step 6: ranges and the exact held-out gate; leaves `at` the extended twin's rollout (both parts).
   void HeldOutGate();
+  // Step 6b: where the torque fit's twin replays the held-out rows better than kTorqueTwinTolerance
+  // times the current set's RMS error at a joint, the torque fit's effects in its place (refined on
+  // the fit part, added to the set, or at the torque fit's values), the gate then read against that
+  // twin.
+  void TorqueTwinFloor();
   // Step 7: the weights of the extended twin's misfit, the values refined under them, the 95 %
   // intervals, D.effects and D.extended.
   void Intervals();
+  // Step 7's spread: each named effect's value one Gauss-Newton step from theta (the final Jacobian
+  // and residual, `last`) on resampled fit rows, a block bootstrap over blocks of a window's rows
+  // (kSpreadBootstraps draws, kSpreadSeed) and each fifth of every record's fit rows left out in turn;
+  // into D.effects' spread_sd, spread_lo, spread_hi.
+  void Spread();
+  // The same for the values step 6b held at the torque fit's: that fit resampled (its least squares on
+  // its candidate columns at its cutoff and weights, the records prepared as its stage 2 does; blocks
+  // as many per record as the motion fit's fit-part windows), each resample's change of a value added
+  // to the value reported. Searched ripples and terms are not among the columns: left out of that fit.
+  void TorqueFitSpread();
+  // Whether every parameter of candidate c is held by step 6b (at the torque fit's value).
+  bool Held(int c) const;
   // The given vs the extended twin on the held-out parts and on every whole record left out
   // (D.records, D.joints, D.left_out, D.simulation), the plotted series.
   void ScoreTwins();
@@ -190,6 +226,11 @@ class MotionFit {
                                                    const std::vector<MotionProblem::Rollout>& ro);
   // The first record's held-out part as plotted: time, measured, given and extended twin's angle.
   void PlottedSeries();
+  // The parameters standing for the effects `fx` at their values, inside the box (the model given's
+  // elsewhere); the effects the plant cannot carry appended to *not_carried (when given) once each.
+  Eigen::VectorXd TorqueTwinTheta(const std::vector<Effect>& fx, std::vector<std::string>* not_carried) const;
+  // Unweighted RMS simulated-angle error per joint of a rollout on the held-out parts, pooled (rad).
+  void HeldOutRms(const MotionProblem::Rollout& ro, double rms[2]) const;
 
  public:
   // The state between the phases.
@@ -226,6 +267,9 @@ class MotionFit {
   Refined last;                      // the last refinement of the chosen set
   bool have_last = false;            // `last` is at theta under the current weights
   std::vector<int> cols;             // the final set's parameters (Intervals)
+  std::vector<int> held;             // step 6b's parameters held at the torque fit's values (Intervals
+                                     // does not move them; Spread does not resample them)
+  std::string floor_note;            // step 6b's outcome in words (SimulationScores::torque_fit_why)
 };
 
 }  // namespace motion

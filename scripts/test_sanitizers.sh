@@ -56,7 +56,7 @@ SWEEPS="$SWEEPS|MotionFit\.HiddenHipBacklashOf20MilliradIsNamedAlone|MotionFit\.
 #   Table5Protocol tests keep that path) and a motion fit (MotionFit's keep it).
 SWEEPS="$SWEEPS|Table5Protocol\.TheHumanSidesStrapIsNamedInTheGaitWithTheTrueAndTheIdentifiedTwin"
 #   The motion fits of real-rig records (each alone, and six together; the same paths on real data).
-SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfSeven"
+SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfEachRecordAloneIsNeverWorseThanTheTorqueFitsTwinAndItsCoulombIsStable"
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitOfSixRecordsKeepsTheRotorInertiaTheSeventhNeeds"
 SWEEPS="$SWEEPS|DiagnoseRealRig\.MotionFitReplaysTheRecordsLeftOutAtLeastAsWellAsTheTorqueFit"
 #   Further sweeps and repeats, each over 8 s in the Release suite (30-90 s here): cli.regress_suite_test

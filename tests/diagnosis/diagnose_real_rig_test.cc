@@ -6,6 +6,7 @@
 // Skipped (with a message) when shared/data is not beside the project.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +15,7 @@
 
 #include "formats/column_map.h"
 #include "diagnosis/diagnose.h"
+#include "diagnosis/motion_fit.h"
 #include "formats/measured_data.h"
 #include "formats/model_file.h"
 #include "diagnosis/replay.h"
@@ -166,38 +168,69 @@ TEST(DiagnoseRealRig, EveryRecordAloneNamesNothingImplausible) {
   }
 }
 
-// The motion fit (diagnose --fit motion) on each record alone (issue 41's target: Coulomb friction, not
-// viscous in its place, named at both joints on at least 6 of the 7 records). Each record's held-out
-// part is 3 s: the fit's rounds linearize at different values and may end on a worse set than an
-// earlier round's; the set of the lowest exact BIC is kept (motion_fit.h step 5). Every Coulomb value
-// inside the makers' scale (the torque fit's test above), and the extended twin moves closer to the rig
-// on every record's held-out part at both joints. Measured: 6 of 7 (hip / knee 0.120 / 0.160, 0.161 /
-// 0.132, 0.150 / 0.134, 0.147 / 0.156, 0.128 / 0.156, 0.085 / 0.167 N m; record 04 a viscous knee, its
-// hip Coulomb dropped by the exact gate). Record 11 (a swing-up after 4 s of small swings) names its
-// hip Coulomb only as the torque fit's effect put to the plant (motion_fit.h step 5: -57 % held-out
-// hip error at the torque fit's 0.145 N m, exact BIC -0.03 -> -8.9 refined); without that step, 5 of 7.
-TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneNamesCoulombAtBothJointsOnSixOfSeven) {
+// The motion fit (diagnose --fit motion) on each record alone. Never worse than the torque fit's twin on
+// the same rows (issue 64, motion_fit.h step 6b): every record's extended twin replays its held-out
+// part within 1.05x the torque fit's twin at both joints, or says why. Coulomb friction, not viscous in
+// its place, at both joints (issue 41), each value's spread across resamples (effects[].spread: the
+// block bootstrap's sd and the values with each fifth of the fit rows left out) within +-35 % of the
+// value of the seven records pooled (the torque fit's, AllSeven: every record's rows at once), and
+// inside the makers' scale. Each record's held-out part is 3 s. Measured: Coulomb at both joints on 5
+// of 7 (hip / knee 0.163 / 0.161, 0.163 / 0.132, 0.150 / 0.134, 0.169 / 0.144, 0.145 / 0.163 N m),
+// each spread inside +-35 %; record 04 names the torque fit's knee Coulomb and rotor inertia, its hip
+// Coulomb removed by the held-out gate (without it the hip replays 5.5 % better); record 05 the torque
+// fit's viscous hip friction (its hip Coulomb, the motion fit's own, replays the hip 1.12x the torque
+// fit's twin, and added to the viscous at its value refines to zero). Before step 6b: 6 of 7 with
+// Coulomb at both joints, 6 of 7 records worse than 1.05x the torque fit's twin (hip 1.11-1.60x,
+// record 03's knee 1.41x).
+TEST(DiagnoseRealRig, MotionFitOfEachRecordAloneIsNeverWorseThanTheTorqueFitsTwinAndItsCoulombIsStable) {
   if (!HaveData()) GTEST_SKIP() << kDir << " not found (shared/data beside the project)";
   const LegParams model = RigModel();
+  const Effect* pooled[2] = {Named(AllSeven(), "coulomb_friction", "hip"), Named(AllSeven(), "coulomb_friction", "knee")};
+  ASSERT_TRUE(pooled[0] && pooled[1]);
   DiagnoseOptions opt;
   opt.fit = DiagnoseFit::kMotion;
-  int both = 0;
+  int both = 0, stable = 0;
   for (const MeasuredData& r : ReadRig()) {
     const Diagnosis d = Diagnose(model, {&r}, opt);
     std::printf("%s\n", r.source.c_str());
     Print(d);
-    const Effect* c[2] = {Named(d, "coulomb_friction", "hip"), Named(d, "coulomb_friction", "knee")};
+    const DiagnosedEffect* c[2] = {nullptr, nullptr};
+    for (const DiagnosedEffect& e : d.effects)
+      for (int j = 0; j < 2; ++j)
+        if (e.effect.name == "coulomb_friction" && e.effect.joint == (j == 0 ? "hip" : "knee")) c[j] = &e;
     both += c[0] && c[1];
-    for (const Effect* e : c)
-      if (e) {
-        EXPECT_LT(e->value, 0.3) << r.source;
-      }
+    bool in = c[0] && c[1];
+    for (int j = 0; j < 2; ++j) {
+      if (!c[j]) continue;
+      const DiagnosedEffect& e = *c[j];
+      EXPECT_LT(e.effect.value, 0.3) << r.source;
+      ASSERT_TRUE(std::isfinite(e.spread_sd) && std::isfinite(e.spread_lo)) << r.source << " joint " << j;
+      const double p = pooled[j]->value, lo = std::min(e.spread_lo, e.effect.value - e.spread_sd),
+                   hi = std::max(e.spread_hi, e.effect.value + e.spread_sd);
+      std::printf("  coulomb %s %.4f, sd %.4f, fifths left out [%.4f, %.4f]: %.0f-%.0f %% of the pooled %.4f\n",
+                  j == 0 ? "hip" : "knee", e.effect.value, e.spread_sd, e.spread_lo, e.spread_hi, 100 * lo / p,
+                  100 * hi / p, p);
+      EXPECT_GE(lo, 0.65 * p) << r.source << " joint " << j;
+      EXPECT_LE(hi, 1.35 * p) << r.source << " joint " << j;
+      in = in && lo >= 0.65 * p && hi <= 1.35 * p;
+    }
+    stable += in;
     ASSERT_TRUE(d.simulation.done) << r.source << ": " << d.simulation.note;
+    ASSERT_TRUE(d.simulation.torque_fit_done) << r.source;
     for (int j = 0; j < 2; ++j) {
       EXPECT_LT(d.simulation.split[j].rmse_after, d.simulation.split[j].rmse_before) << r.source << " joint " << j;
+      std::printf("  %s: held-out %.3f (motion) / %.3f (torque fit's twin) deg\n", j == 0 ? "hip" : "knee",
+                  d.simulation.split[j].rmse_after * 180 / M_PI, d.simulation.torque_fit_split[j].rmse_after * 180 / M_PI);
+      EXPECT_LE(d.simulation.split[j].rmse_after, kTorqueTwinTolerance * d.simulation.torque_fit_split[j].rmse_after)
+          << r.source << " joint " << j << ": " << d.simulation.torque_fit_why;
     }
+    EXPECT_EQ(d.simulation.torque_fit_why.empty(),
+              d.simulation.split[0].rmse_after <= kTorqueTwinTolerance * d.simulation.torque_fit_split[0].rmse_after &&
+                  d.simulation.split[1].rmse_after <= kTorqueTwinTolerance * d.simulation.torque_fit_split[1].rmse_after);
   }
-  EXPECT_GE(both, 6);
+  std::printf("Coulomb at both joints on %d of 7 records, its spread within +-35 %% of the pooled value on %d\n", both, stable);
+  EXPECT_GE(both, 5);
+  EXPECT_EQ(stable, both);
 }
 
 // The motion fit of several records keeps an effect that moves the records left out, not only the
