@@ -799,19 +799,23 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("refinement");
   // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete on the
   // held-out rows or on the fit rows, the search for terms beyond the table at those joints.
-  D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);
-  const std::array<JointCompleteness, 2> on_fit_rows = torque_fit::CompletenessOnFitRows(params, D.extended, recs, opt);
+  // The ceilings wait for the final model: one black box fit for both (torque_fit::FitCeilings).
+  torque_fit::CeilingRows ceiling_rows;
+  std::array<JointCompleteness, 2> on_fit_rows;
+  D.table_model = torque_fit::TestModel(params, D.extended, recs, opt, &ceiling_rows, &on_fit_rows);
   bool incomplete[2];
   for (int j = 0; j < 2; ++j) incomplete[j] = !D.table_model.completeness[j].complete || !on_fit_rows[j].complete;
-  Lap("completeness + ceiling");
+  Lap("completeness");
   const TermSearchResult searched =
-      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};
+      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, DiagnoseThreads(opt), &D) : TermSearchResult{};
   Lap("terms beyond the table");
 
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
   Lap("extended twin");
-  // Stage 6c: the final model's (the table's where the search admitted no term).
-  D.final_model = searched.changed ? torque_fit::AssessModel(params, D.extended, recs, opt) : D.table_model;
+  // Stage 6c: the final model's (the table's where the search admitted no term), and both ceilings.
+  if (searched.changed) D.final_model = torque_fit::TestModel(params, D.extended, recs, opt, &ceiling_rows, nullptr);
+  torque_fit::FitCeilings(ceiling_rows, {&D.table_model, &D.final_model}, opt);
+  if (!searched.changed) D.final_model = D.table_model;
   Lap("final completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)
