@@ -1,5 +1,6 @@
 #include "diagnosis/black_box.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -10,6 +11,10 @@
 #include "core/rng.h"
 
 namespace exotwin {
+
+namespace {
+constexpr Eigen::Index kBlockRows = 1024;  // fit rows whose features are formed at a time
+}  // namespace
 
 Eigen::MatrixXd BlackBox::Features(const Eigen::MatrixXd& X, double length) const {
   const Eigen::Index d = X.cols(), D = W_.rows();
@@ -75,14 +80,21 @@ BlackBox BlackBox::Fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const
     ch.sse.assign(static_cast<size_t>(C), std::numeric_limits<double>::infinity());
     ch.ridge.assign(static_cast<size_t>(C), 0);
     ch.coef.assign(static_cast<size_t>(C), Eigen::VectorXd());
-    const Eigen::MatrixXd Ff = bb.Features(Xf, length), Fv = bb.Features(Xv, length);
-    const Eigen::Index p = Ff.cols();
+    // The fit rows' Gram and moment in blocks of rows (their features are never held whole: memory).
+    const Eigen::MatrixXd Fv = bb.Features(Xv, length);
+    const Eigen::Index p = Fv.cols();
     Eigen::MatrixXd Gf = Eigen::MatrixXd::Zero(p, p), Gv = Eigen::MatrixXd::Zero(p, p);
-    Gf.selfadjointView<Eigen::Lower>().rankUpdate(Ff.transpose());
+    Eigen::MatrixXd hf = Eigen::MatrixXd::Zero(p, C);
+    for (Eigen::Index a = 0; a < Xf.rows(); a += kBlockRows) {
+      const Eigen::Index m = std::min(kBlockRows, Xf.rows() - a);
+      const Eigen::MatrixXd Ff = bb.Features(Xf.middleRows(a, m), length);
+      Gf.selfadjointView<Eigen::Lower>().rankUpdate(Ff.transpose());
+      hf.noalias() += Ff.transpose() * Yf.middleRows(a, m);
+    }
     Gv.selfadjointView<Eigen::Lower>().rankUpdate(Fv.transpose());
     Gf = Gf.selfadjointView<Eigen::Lower>();
     Gv = Gv.selfadjointView<Eigen::Lower>();
-    const Eigen::MatrixXd hf = Ff.transpose() * Yf, hv = Fv.transpose() * Yv;
+    const Eigen::MatrixXd hv = Fv.transpose() * Yv;
     const double diag = (Gf + Gv).diagonal().mean();
     for (double rg : opt.ridges) {
       Eigen::MatrixXd A = Gf;
@@ -125,12 +137,15 @@ Eigen::MatrixXd BlackBox::Predict(const Eigen::MatrixXd& X) const {
   for (Eigen::Index k = 0; k < C; ++k) {
     if (done[static_cast<size_t>(k)]) continue;
     const double length = length_[static_cast<size_t>(k)];
-    const Eigen::MatrixXd F = Features(X, length);  // once for every column of this length scale
-    for (Eigen::Index k2 = k; k2 < C; ++k2)
-      if (length_[static_cast<size_t>(k2)] == length) {
-        out.col(k2) = (F * coef_[static_cast<size_t>(k2)]).array() + y_mean_[k2];
-        done[static_cast<size_t>(k2)] = true;
-      }
+    // The features once for every column of this length scale, in blocks of rows.
+    for (Eigen::Index a = 0; a < X.rows(); a += kBlockRows) {
+      const Eigen::Index m = std::min(kBlockRows, X.rows() - a);
+      const Eigen::MatrixXd F = Features(X.middleRows(a, m), length);
+      for (Eigen::Index k2 = k; k2 < C; ++k2)
+        if (length_[static_cast<size_t>(k2)] == length)
+          out.col(k2).segment(a, m) = (F * coef_[static_cast<size_t>(k2)]).array() + y_mean_[k2];
+    }
+    for (Eigen::Index k2 = k; k2 < C; ++k2) done[static_cast<size_t>(k2)] = done[static_cast<size_t>(k2)] || length_[static_cast<size_t>(k2)] == length;
   }
   return out;
 }

@@ -1,6 +1,7 @@
 #include "diagnosis/diagnose.h"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -736,8 +737,14 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);
     const double cpu = CpuSeconds(ru);
-    std::fprintf(stderr, "diagnose: %-28s %8.3f s (CPU %.3f s), peak %6.1f MB\n", what,
-                 std::chrono::duration<double>(now - clock0).count(), cpu - cpu0, ru.ru_maxrss / 1024.0);
+    long pages = 0, resident = 0;  // the memory held at the stage's end (/proc/self/statm, pages)
+    if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+      if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+      std::fclose(f);
+    }
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s (CPU %.3f s), peak %6.1f MB, held %6.1f MB\n", what,
+                 std::chrono::duration<double>(now - clock0).count(), cpu - cpu0, ru.ru_maxrss / 1024.0,
+                 static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1048576.0);
     clock0 = now;
     cpu0 = cpu;
   };
