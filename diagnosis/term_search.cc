@@ -1,8 +1,10 @@
 #include "diagnosis/term_search.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
+#include <tuple>
 #include <cstdio>
 
 #include <Eigen/Dense>
@@ -123,11 +125,56 @@ struct Screen {
   size_t N = 0;
 };
 
-// The candidate's values on the screening rows of joint j (-expr, weighted, unfiltered).
-Eigen::MatrixXd ScreenColumns(const Screen& sc, int j, const TermCandidate& c, const double w[2]) {
+// Factors' values on the screening rows of one joint (FactorValue; a kSin factor's sin and its cos),
+// by function, signal and inner parameter: a candidate's column is a product of them.
+using FactorKey = std::tuple<int, int, double>;
+using FactorValues = std::map<FactorKey, std::array<std::vector<double>, 2>>;
+FactorKey KeyOf(const TermFactor& f) { return {static_cast<int>(f.fn), static_cast<int>(f.sig), f.p}; }
+
+// The values of every factor of `lib` at joint j, on up to `threads` threads.
+FactorValues ValuesOf(const Screen& sc, int j, const std::vector<TermCandidate>& lib, int threads) {
+  FactorValues v;
+  std::vector<std::pair<TermFactor, std::array<std::vector<double>, 2>*>> todo;
+  for (const TermCandidate& c : lib)
+    for (const TermFactor& f : c.factors)
+      if (!v.count(KeyOf(f))) todo.push_back({f, &v[KeyOf(f)]});
+  ParallelFor(todo.size(), threads, [&](size_t i) {
+    const TermFactor& f = todo[i].first;
+    for (int cosine = 0; cosine < (f.fn == TermFn::kSin ? 2 : 1); ++cosine) {
+      std::vector<double>& x = (*todo[i].second)[static_cast<size_t>(cosine)];
+      x.resize(sc.N);
+      for (size_t k = 0; k < sc.N; ++k) x[k] = FactorValue(f, sc.rows[j][k], cosine == 1);
+    }
+  });
+  return v;
+}
+
+// The candidate's values on the screening rows of joint j (-expr, weighted, unfiltered): the product
+// of its factors' (CandidateValue's), from `known` where it holds them.
+Eigen::MatrixXd ScreenColumns(const Screen& sc, int j, const TermCandidate& c, const double w[2],
+                              const FactorValues* known = nullptr) {
   Eigen::MatrixXd x(static_cast<Eigen::Index>(sc.N), c.Paired() ? 2 : 1);
-  for (Eigen::Index col = 0; col < x.cols(); ++col)
-    for (size_t k = 0; k < sc.N; ++k) x(static_cast<Eigen::Index>(k), col) = -w[j] * CandidateValue(c, sc.rows[j][k], col == 1);
+  for (Eigen::Index col = 0; col < x.cols(); ++col) {
+    std::vector<const std::vector<double>*> f;
+    std::vector<std::vector<double>> own;
+    own.reserve(c.factors.size());
+    for (const TermFactor& fa : c.factors) {
+      const size_t which = col == 1 && fa.fn == TermFn::kSin ? 1 : 0;
+      const auto it = known ? known->find(KeyOf(fa)) : FactorValues::const_iterator();
+      if (known && it != known->end()) {
+        f.push_back(&it->second[which]);
+        continue;
+      }
+      own.emplace_back(sc.N);
+      for (size_t k = 0; k < sc.N; ++k) own.back()[k] = FactorValue(fa, sc.rows[j][k], col == 1);
+      f.push_back(&own.back());
+    }
+    for (size_t k = 0; k < sc.N; ++k) {
+      double v = 1;
+      for (const std::vector<double>* fv : f) v *= (*fv)[k];
+      x(static_cast<Eigen::Index>(k), col) = -w[j] * v;
+    }
+  }
   return x;
 }
 
@@ -205,6 +252,7 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
   using Key = std::pair<int, std::vector<std::pair<int, int>>>;
   std::map<Key, Scored> best;
   std::map<Key, TermScales> scales_of;
+  FactorValues values[2];
   for (int j : joints) {
     TermScales ts;
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, qd2 = 0, cnt = 0;
@@ -220,8 +268,9 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
     ts.q_range = std::max(0.05, hi[j] - lo[j]);
     ts.q_other_range = std::max(0.05, hi[1 - j] - lo[1 - j]);
     const std::vector<TermCandidate> lib = TermLibrary(ts, two_joints);
+    values[j] = ValuesOf(sc, j, lib, threads);
     std::vector<double> gains(lib.size());
-    ParallelFor(lib.size(), threads, [&](size_t i) { gains[i] = ScreenGain(sc, j, ScreenColumns(sc, j, lib[i], w)); });
+    ParallelFor(lib.size(), threads, [&](size_t i) { gains[i] = ScreenGain(sc, j, ScreenColumns(sc, j, lib[i], w, &values[j])); });
     for (size_t i = 0; i < lib.size(); ++i) {
       ++*screened;
       const Key key = std::make_pair(j, ShapeOf(lib[i]));
@@ -243,7 +292,7 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
         TermCandidate c = sd.c;
         for (TermFactor& g : c.factors)
           if (g.fn == f.fn && g.sig == f.sig) g.p = RoundedInner(std::exp(lp));
-        return ScreenGain(sc, sd.joint, ScreenColumns(sc, sd.joint, c, w));
+        return ScreenGain(sc, sd.joint, ScreenColumns(sc, sd.joint, c, w, &values[sd.joint]));
       };
       const double gr = 0.5 * (std::sqrt(5.0) - 1);
       double x1 = b - gr * (b - a), x2 = a + gr * (b - a), g1 = gain(x1), g2 = gain(x2);
