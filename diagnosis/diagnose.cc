@@ -286,6 +286,7 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Re
                                  std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn(), DiagnoseThreads(opt)));
     kins.push_back(&rc.kin);
   }
+  ReturnFreedMemory();  // the columns' record-long temporaries, before the ripple search lays out its own
   std::vector<Eigen::VectorXd> raw;
   const std::vector<Eigen::VectorXd> e = KitchenSinkResiduals(banks);
   for (const ColumnBank& b : banks) raw.push_back(b.r);
@@ -731,7 +732,11 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   rusage ru0{};
   getrusage(RUSAGE_SELF, &ru0);
   double cpu0 = CpuSeconds(ru0);
+  // Every stage's end gives the heap's free pages back (ReturnFreedMemory), so that the next stage's
+  // temporaries take returned pages, not pages on top of what the last one freed: the peak memory
+  // is that of the live vectors.
   auto Lap = [&](const char* what) {
+    ReturnFreedMemory();
     if (!timing) return;
     const auto now = std::chrono::steady_clock::now();
     rusage ru{};
@@ -754,9 +759,8 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const size_t R = records.size();
   D.leave_one_out = R >= 2;
 
-  ReturnFreedMemory();  // what reading the records freed, before the cutoff choice lays out its columns
+  Lap("records read");  // what reading the records freed, before the cutoff choice lays out its columns
   D.cutoff = ResolveCutoff(params, records, opt);
-  ReturnFreedMemory();
   Lap("cutoff choice");
 
   Plant plant(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);
@@ -779,6 +783,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("columns + ripple search");
   FilterMeasured(&recs);
   UseSecantColumns(recs, w, &banks);
+  ReturnFreedMemory();  // the secant columns' record-long temporaries
   if (params.one_joint) KeepJointCandidates(1, &banks);
   // The ceilings and the pooled Grams only read the banks: the two side by side.
   std::vector<CeilingScores> ceilings;
