@@ -15,7 +15,7 @@ namespace exotwin {
 
 struct FitFamily;
 
-inline constexpr size_t kPendingColumns = 2;  // PendingColumns::kPending, and SetColumn's two
+inline constexpr size_t kPendingColumns = 4;  // PendingColumns::kPending, and SetColumn's two
 
 // f(i) for i = 0 .. n - 1 on the machine's cores, each thread a contiguous range: for the loops that
 // evaluate a column on every sample of a record (f writes only sample i's values, into vectors sized
@@ -35,12 +35,12 @@ inline int NewColumn(ColumnBank& b) {
 }
 
 // The bank's low-pass of *xs[0 .. count) in place, then place(k) for each: the signals cut into
-// contiguous groups, one group per thread, each group's non-zero signals interleaved
+// contiguous groups of at least two, one group per thread, each group's non-zero signals interleaved
 // (dsp::FiltFiltInPlace of several: each signal the same bits as filtered alone; the low-pass of zeros
 // is zero) and placed on the group's thread. place(k) must write only what signal k owns.
 template <class Place>
 void FilterAndPlace(const ColumnBank& b, std::vector<double>* const* xs, size_t count, Place place) {
-  const size_t T = std::clamp<size_t>(count, 1, static_cast<size_t>(std::max(1, b.threads)));
+  const size_t T = std::clamp<size_t>(count / 2, 1, static_cast<size_t>(std::max(1, b.threads)));
   ParallelFor(T, static_cast<int>(T), [&](size_t h) {
     const size_t e0 = h * count / T, e1 = (h + 1) * count / T;
     if (b.filter) {
