@@ -1,14 +1,20 @@
 #include "diagnosis/black_box.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
 
+#include "core/parallel_for.h"
 #include "core/rng.h"
 
 namespace exotwin {
+
+namespace {
+constexpr Eigen::Index kBlockRows = 1024;  // fit rows whose features are formed at a time
+}  // namespace
 
 Eigen::MatrixXd BlackBox::Features(const Eigen::MatrixXd& X, double length) const {
   const Eigen::Index d = X.cols(), D = W_.rows();
@@ -54,22 +60,41 @@ BlackBox BlackBox::Fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const
   bb.length_.assign(static_cast<size_t>(C), 0);
   bb.coef_.assign(static_cast<size_t>(C), Eigen::VectorXd());
   std::vector<double> best(static_cast<size_t>(C), std::numeric_limits<double>::infinity());
-  // Fit and validation rows' features per length scale; the Gram of each part.
+  // Fit and validation rows' features per length scale; the Gram of each part. The length scales
+  // on up to opt.threads threads: each one's choice of ridge per column (the first least validation
+  // error in the order of opt.ridges) and its refit, then the first least over the length scales in
+  // their order (the same choice as one loop over both in that order).
   std::vector<Eigen::Index> fit_rows, val_rows;
   for (Eigen::Index i = 0; i < n; ++i) (validation[static_cast<size_t>(i)] ? val_rows : fit_rows).push_back(i);
   const Eigen::MatrixXd Xf = X(fit_rows, Eigen::all), Xv = X(val_rows, Eigen::all);
   const Eigen::MatrixXd Yf = Yc(fit_rows, Eigen::all), Yv = Yc(val_rows, Eigen::all);
   const double dim_scale = std::sqrt(static_cast<double>(d));
-  for (double bw : opt.bandwidths) {
-    const double length = bw * dim_scale;
-    const Eigen::MatrixXd Ff = bb.Features(Xf, length), Fv = bb.Features(Xv, length);
-    const Eigen::Index p = Ff.cols();
+  struct Choice {
+    std::vector<double> sse, ridge;
+    std::vector<Eigen::VectorXd> coef;
+  };
+  std::vector<Choice> per_length(opt.bandwidths.size());
+  ParallelFor(opt.bandwidths.size(), opt.threads, [&](size_t l) {
+    const double length = opt.bandwidths[l] * dim_scale;
+    Choice& ch = per_length[l];
+    ch.sse.assign(static_cast<size_t>(C), std::numeric_limits<double>::infinity());
+    ch.ridge.assign(static_cast<size_t>(C), 0);
+    ch.coef.assign(static_cast<size_t>(C), Eigen::VectorXd());
+    // The fit rows' Gram and moment in blocks of rows (their features are never held whole: memory).
+    const Eigen::MatrixXd Fv = bb.Features(Xv, length);
+    const Eigen::Index p = Fv.cols();
     Eigen::MatrixXd Gf = Eigen::MatrixXd::Zero(p, p), Gv = Eigen::MatrixXd::Zero(p, p);
-    Gf.selfadjointView<Eigen::Lower>().rankUpdate(Ff.transpose());
+    Eigen::MatrixXd hf = Eigen::MatrixXd::Zero(p, C);
+    for (Eigen::Index a = 0; a < Xf.rows(); a += kBlockRows) {
+      const Eigen::Index m = std::min(kBlockRows, Xf.rows() - a);
+      const Eigen::MatrixXd Ff = bb.Features(Xf.middleRows(a, m), length);
+      Gf.selfadjointView<Eigen::Lower>().rankUpdate(Ff.transpose());
+      hf.noalias() += Ff.transpose() * Yf.middleRows(a, m);
+    }
     Gv.selfadjointView<Eigen::Lower>().rankUpdate(Fv.transpose());
     Gf = Gf.selfadjointView<Eigen::Lower>();
     Gv = Gv.selfadjointView<Eigen::Lower>();
-    const Eigen::MatrixXd hf = Ff.transpose() * Yf, hv = Fv.transpose() * Yv;
+    const Eigen::MatrixXd hv = Fv.transpose() * Yv;
     const double diag = (Gf + Gv).diagonal().mean();
     for (double rg : opt.ridges) {
       Eigen::MatrixXd A = Gf;
@@ -78,26 +103,49 @@ BlackBox BlackBox::Fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const
       const Eigen::MatrixXd err = Yv - Fv * c;
       for (Eigen::Index k = 0; k < C; ++k) {
         const double sse = err.col(k).squaredNorm();
-        if (!(sse < best[static_cast<size_t>(k)])) continue;
-        best[static_cast<size_t>(k)] = sse;
-        bb.bandwidth_[static_cast<size_t>(k)] = bw, bb.ridge_[static_cast<size_t>(k)] = rg;
-        bb.length_[static_cast<size_t>(k)] = length;
-        // The refit on every row with this choice.
-        Eigen::MatrixXd All = Gf + Gv;
-        All.diagonal().array() += rg * diag;
-        bb.coef_[static_cast<size_t>(k)] = All.ldlt().solve(hf.col(k) + hv.col(k));
+        if (sse < ch.sse[static_cast<size_t>(k)]) ch.sse[static_cast<size_t>(k)] = sse, ch.ridge[static_cast<size_t>(k)] = rg;
       }
     }
-  }
+    // The refit on every row with each column's choice (one factorization per ridge chosen).
+    for (Eigen::Index k = 0; k < C; ++k) {
+      if (!ch.coef[static_cast<size_t>(k)].size() && std::isfinite(ch.sse[static_cast<size_t>(k)])) {
+        const double rg = ch.ridge[static_cast<size_t>(k)];
+        Eigen::MatrixXd All = Gf + Gv;
+        All.diagonal().array() += rg * diag;
+        const Eigen::LDLT<Eigen::MatrixXd> ldlt(All);
+        for (Eigen::Index k2 = k; k2 < C; ++k2)
+          if (ch.ridge[static_cast<size_t>(k2)] == rg && std::isfinite(ch.sse[static_cast<size_t>(k2)]))
+            ch.coef[static_cast<size_t>(k2)] = ldlt.solve(hf.col(k2) + hv.col(k2));
+      }
+    }
+  });
+  for (size_t l = 0; l < opt.bandwidths.size(); ++l)
+    for (size_t k = 0; k < static_cast<size_t>(C); ++k) {
+      if (!(per_length[l].sse[k] < best[k])) continue;
+      best[k] = per_length[l].sse[k];
+      bb.bandwidth_[k] = opt.bandwidths[l], bb.ridge_[k] = per_length[l].ridge[k];
+      bb.length_[k] = opt.bandwidths[l] * dim_scale;
+      bb.coef_[k] = std::move(per_length[l].coef[k]);
+    }
   return bb;
 }
 
 Eigen::MatrixXd BlackBox::Predict(const Eigen::MatrixXd& X) const {
   const Eigen::Index C = static_cast<Eigen::Index>(coef_.size());
   Eigen::MatrixXd out(X.rows(), C);
+  std::vector<bool> done(static_cast<size_t>(C), false);
   for (Eigen::Index k = 0; k < C; ++k) {
-    const Eigen::MatrixXd F = Features(X, length_[static_cast<size_t>(k)]);
-    out.col(k) = (F * coef_[static_cast<size_t>(k)]).array() + y_mean_[k];
+    if (done[static_cast<size_t>(k)]) continue;
+    const double length = length_[static_cast<size_t>(k)];
+    // The features once for every column of this length scale, in blocks of rows.
+    for (Eigen::Index a = 0; a < X.rows(); a += kBlockRows) {
+      const Eigen::Index m = std::min(kBlockRows, X.rows() - a);
+      const Eigen::MatrixXd F = Features(X.middleRows(a, m), length);
+      for (Eigen::Index k2 = k; k2 < C; ++k2)
+        if (length_[static_cast<size_t>(k2)] == length)
+          out.col(k2).segment(a, m) = (F * coef_[static_cast<size_t>(k2)]).array() + y_mean_[k2];
+    }
+    for (Eigen::Index k2 = k; k2 < C; ++k2) done[static_cast<size_t>(k2)] = done[static_cast<size_t>(k2)] || length_[static_cast<size_t>(k2)] == length;
   }
   return out;
 }

@@ -25,12 +25,14 @@ struct BlackBoxOptions {
   int features = 256;                                    // D, random Fourier features
   std::vector<double> bandwidths = {0.35, 0.7, 1.4};     // l / sqrt(input dimension)
   std::vector<double> ridges = {1e-7, 1e-5, 1e-3, 1e-1, 10};  // lambda / mean diag(Phi' Phi)
+  int threads = 1;  // the length scales fitted side by side (the same bits on any count)
 };
 
 class BlackBox {
  public:
   // Fits every column of Y (rows as X's) on X's rows; rows with validation[i] true choose the length
-  // scale and ridge (at least one row of each kind). Throws std::invalid_argument on mismatched sizes.
+  // scale and ridge (at least one row of each kind). The columns are independent fits sharing the
+  // features and their Gram matrices: several targets on the same rows cost about one. Throws std::invalid_argument on mismatched sizes.
   static BlackBox Fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const std::vector<bool>& validation,
                       const BlackBoxOptions& opt = {});
   // The fitted function at X's rows (inputs as in Fit): one column per column of Y.

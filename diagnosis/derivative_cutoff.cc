@@ -98,7 +98,7 @@ std::vector<RecordBase> RecordBases(const std::vector<const MeasuredData*>& reco
   return base;
 }
 
-constexpr size_t kBatch = 8;  // columns low-passed together (memory: kBatch records)
+constexpr size_t kBatch = 6;  // columns low-passed together (memory: kBatch records)
 
 // A candidate cutoff's rows of one record: the regressor (parallel: from the angles differentiated at
 // DerivativeCutoffHz(fc), each column and the torque low-passed at fc; else differentiated at fc), the

@@ -1,6 +1,7 @@
 #include "diagnosis/diagnose.h"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -287,6 +288,7 @@ std::vector<ColumnBank> CandidateColumns(const LegParams& params, std::vector<Re
                                  std::max<size_t>(2000, opt.max_fit_rows / R), rc.FilterFn(), DiagnoseThreads(opt)));
     kins.push_back(&rc.kin);
   }
+  ReturnFreedMemory();  // the columns' record-long temporaries, before the ripple search lays out its own
   std::vector<Eigen::VectorXd> raw;
   const std::vector<Eigen::VectorXd> e = KitchenSinkResiduals(banks);
   for (const ColumnBank& b : banks) raw.push_back(b.r);
@@ -732,14 +734,24 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   rusage ru0{};
   getrusage(RUSAGE_SELF, &ru0);
   double cpu0 = CpuSeconds(ru0);
+  // Every stage's end gives the heap's free pages back (ReturnFreedMemory), so that the next stage's
+  // temporaries take returned pages, not pages on top of what the last one freed: the peak memory
+  // is that of the live vectors.
   auto Lap = [&](const char* what) {
+    ReturnFreedMemory();
     if (!timing) return;
     const auto now = std::chrono::steady_clock::now();
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);
     const double cpu = CpuSeconds(ru);
-    std::fprintf(stderr, "diagnose: %-28s %8.3f s (CPU %.3f s), peak %6.1f MB\n", what,
-                 std::chrono::duration<double>(now - clock0).count(), cpu - cpu0, ru.ru_maxrss / 1024.0);
+    long pages = 0, resident = 0;  // the memory held at the stage's end (/proc/self/statm, pages)
+    if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+      if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+      std::fclose(f);
+    }
+    std::fprintf(stderr, "diagnose: %-28s %8.3f s (CPU %.3f s), peak %6.1f MB, held %6.1f MB\n", what,
+                 std::chrono::duration<double>(now - clock0).count(), cpu - cpu0, ru.ru_maxrss / 1024.0,
+                 static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1048576.0);
     clock0 = now;
     cpu0 = cpu;
   };
@@ -749,9 +761,8 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const size_t R = records.size();
   D.leave_one_out = R >= 2;
 
-  ReturnFreedMemory();  // what reading the records freed, before the cutoff choice lays out its columns
+  Lap("records read");  // what reading the records freed, before the cutoff choice lays out its columns
   D.cutoff = ResolveCutoff(params, records, opt);
-  ReturnFreedMemory();
   Lap("cutoff choice");
 
   Plant plant(opt.mjcf.empty() ? ExowheelMjcfPath(params.human.has_value()) : opt.mjcf);
@@ -774,6 +785,7 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("columns + ripple search");
   FilterMeasured(&recs);
   UseSecantColumns(recs, w, &banks);
+  ReturnFreedMemory();  // the secant columns' record-long temporaries
   if (params.one_joint) KeepJointCandidates(1, &banks);
   // The ceilings and the pooled Grams only read the banks: the two side by side.
   std::vector<CeilingScores> ceilings;
@@ -801,12 +813,22 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   Lap("refinement");
   // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete on the
   // held-out rows or on the fit rows, the search for terms beyond the table at those joints.
-  D.table_model = torque_fit::AssessModel(params, D.extended, recs, opt);
-  const std::array<JointCompleteness, 2> on_fit_rows = torque_fit::CompletenessOnFitRows(params, D.extended, recs, opt);
+  torque_fit::CeilingRows ceiling_rows;
+  std::array<JointCompleteness, 2> on_fit_rows;
+  D.table_model = torque_fit::TestModel(params, D.extended, recs, opt, &ceiling_rows, &on_fit_rows);
   bool incomplete[2];
+  // The table's ceiling before the search where the residual tests leave a joint complete (it can
+  // start the search there); else it waits for the final model's, one black box fit for both.
+  const int j0 = params.one_joint ? 1 : 0;
+  bool tests_decide = !opt.search_terms;
+  if (opt.search_terms) {
+    tests_decide = true;
+    for (int j = j0; j < 2; ++j) tests_decide = tests_decide && (!D.table_model.completeness[j].complete || !on_fit_rows[j].complete);
+  }
+  if (!tests_decide) torque_fit::FitCeilings(ceiling_rows, {&D.table_model}, opt);
   for (int j = 0; j < 2; ++j) {
     const JointCompleteness& held = D.table_model.completeness[j];
-    const bool ceiling = CeilingLeavesStructure(D.table_model.ceiling[j], held.floor);
+    const bool ceiling = !tests_decide && CeilingLeavesStructure(D.table_model.ceiling[j], held.floor);
     incomplete[j] = opt.search_terms && (!held.complete || !on_fit_rows[j].complete || ceiling);
     if (incomplete[j])
       D.term_search.push_back(std::string(j == 0 ? "hip" : "knee") + ": the table's best model is incomplete (" +
@@ -817,9 +839,9 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
                                                             std::max(1e-9, 100 - D.table_model.ceiling[j].named_pct), 3) + " %; " : "") +
                               "searched)");
   }
-  Lap("completeness + ceiling");
+  Lap("completeness");
   const TermSearchResult searched =
-      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, &D) : TermSearchResult{};
+      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, DiagnoseThreads(opt), &D) : TermSearchResult{};
   Lap("terms beyond the table");
 
   // Each final effect's equivalent reading (FitFamily::equivalent), among its aliases.
@@ -830,8 +852,13 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   }
   ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
   Lap("extended twin");
-  // Stage 6c: the final model's (the table's where the search admitted no term).
-  D.final_model = searched.changed ? torque_fit::AssessModel(params, D.extended, recs, opt) : D.table_model;
+  // Stage 6c: the final model's (the table's where the search admitted no term), and both ceilings.
+  if (searched.changed) D.final_model = torque_fit::TestModel(params, D.extended, recs, opt, &ceiling_rows, nullptr);
+  if (tests_decide || searched.changed) {
+    ModelAssessment again;  // the table's column again where its ceiling was fitted before (one fit)
+    torque_fit::FitCeilings(ceiling_rows, {tests_decide ? &D.table_model : &again, &D.final_model}, opt);
+  }
+  if (!searched.changed) D.final_model = D.table_model;
   Lap("final completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)

@@ -138,11 +138,27 @@ void PrepareRecord(const LegParams& params, const MeasuredData& data, MeasuredDa
 // admitted one, for the final model.
 ModelAssessment AssessModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
                             const DiagnoseOptions& opt);
-// The residual tests of `model` on every record's fit rows [0, split) instead (AssessModel's otherwise):
-// what decides the search for terms beyond the table, so that an effect that fades before the
-// held-out end (a drive warming up) is seen where it acts.
-std::array<JointCompleteness, 2> CompletenessOnFitRows(const LegParams& given, const LegParams& model,
-                                                      const std::vector<Rec>& recs, const DiagnoseOptions& opt);
+// The black box's rows of AssessModel: its inputs on the fit rows (with the validation rows) and on
+// the held-out rows, the model given's residual on the held-out rows, and the residual of every model
+// tested on them (model k: columns 2k (hip) and 2k + 1 (knee) of fit_y and held_y).
+struct CeilingRows {
+  Eigen::MatrixXd fit_x, held_x, held_given, fit_y, held_y;
+  std::vector<bool> validation;
+  int models = 0;
+  bool one_joint = false;
+};
+// AssessModel in two parts, so that the ceilings of several models on the same rows are one black
+// box fit (the table's best model's and the final one's: the inputs are the same, only the
+// residual differs). TestModel: the residual tests; the model's residual appended to *rows (the
+// inputs filled on the first call); with `on_fit_rows`, the residual tests on every record's fit rows
+// [0, split) too (the material floor from those rows): what decides the search for terms beyond the
+// table, so that an effect that fades before the held-out end (a drive warming up) is seen where it
+// acts. FitCeilings: the ceiling of model k of *rows into out[k] (one black box, its output columns
+// fitted independently: the same as one fit per model).
+ModelAssessment TestModel(const LegParams& given, const LegParams& model, const std::vector<Rec>& recs,
+                          const DiagnoseOptions& opt, CeilingRows* rows,
+                          std::array<JointCompleteness, 2>* on_fit_rows);
+void FitCeilings(const CeilingRows& rows, const std::vector<ModelAssessment*>& out, const DiagnoseOptions& opt);
 // Whether the ceiling `c` says the named model leaves structure at a joint by the gates a table
 // effect passes (diagnose_select.h): the black box trained on its residual lowers its held-out sum of
 // squares by at least kMinHeldoutGain, and the part it removes is material (its RMS at least `floor`,

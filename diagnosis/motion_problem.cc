@@ -364,31 +364,38 @@ Eigen::MatrixXd MotionProblem::Jacobian(const Eigen::VectorXd& theta, const Roll
   Eigen::Index rows = 0;
   for (const auto& rp : rec_) rows += static_cast<Eigen::Index>(2 * rp->rows.size());
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, static_cast<Eigen::Index>(cols.size()));
-  std::vector<Eigen::VectorXd> thetas;
   std::vector<double> h(cols.size());
-  for (size_t c = 0; c < cols.size(); ++c) {
-    const int k = cols[c];
-    h[c] = theta[k] + step_[k] <= hi_[k] ? step_[k] : -step_[k];
-    Eigen::VectorXd x = theta;
-    x[k] += h[c];
-    thetas.push_back(x);
-  }
-  std::vector<Rollout> ro = SimulateAll(thetas, part);
-  for (size_t c = 0; c < cols.size(); ++c) {
-    if (!ro[c].ok) {  // the other way
+  // The rollouts a batch of DiagnoseThreads columns at a time, each one's column of J written and the
+  // rollout dropped (every rollout is as large as a column of J: all at once would double J's memory).
+  const size_t batch = static_cast<size_t>(std::max(1, DiagnoseThreads(opt_)));
+  for (size_t c0 = 0; c0 < cols.size(); c0 += batch) {
+    const size_t c1 = std::min(cols.size(), c0 + batch);
+    std::vector<Eigen::VectorXd> thetas;
+    for (size_t c = c0; c < c1; ++c) {
       const int k = cols[c];
-      h[c] = -h[c];
+      h[c] = theta[k] + step_[k] <= hi_[k] ? step_[k] : -step_[k];
       Eigen::VectorXd x = theta;
-      x[k] = std::clamp(x[k] + h[c], lo_[k], hi_[k]);
-      h[c] = x[k] - theta[k];
-      if (h[c] != 0) ro[c] = Simulate(x, part);
-      if (!ro[c].ok || h[c] == 0) continue;
+      x[k] += h[c];
+      thetas.push_back(x);
     }
-    Eigen::Index off = 0;
-    for (size_t r = 0; r < rec_.size(); ++r) {
-      const Eigen::VectorXd d = (ro[c].q[r] - at.q[r]) / h[c];
-      for (Eigen::Index i = 0; i < d.size(); ++i) J(off + i, static_cast<Eigen::Index>(c)) = std::isfinite(d[i]) ? d[i] : 0.0;
-      off += d.size();
+    std::vector<Rollout> ro = SimulateAll(thetas, part);
+    for (size_t c = c0; c < c1; ++c) {
+      Rollout& rc = ro[c - c0];
+      if (!rc.ok) {  // the other way
+        const int k = cols[c];
+        h[c] = -h[c];
+        Eigen::VectorXd x = theta;
+        x[k] = std::clamp(x[k] + h[c], lo_[k], hi_[k]);
+        h[c] = x[k] - theta[k];
+        if (h[c] != 0) rc = Simulate(x, part);
+        if (!rc.ok || h[c] == 0) continue;
+      }
+      Eigen::Index off = 0;
+      for (size_t r = 0; r < rec_.size(); ++r) {
+        const Eigen::VectorXd d = (rc.q[r] - at.q[r]) / h[c];
+        for (Eigen::Index i = 0; i < d.size(); ++i) J(off + i, static_cast<Eigen::Index>(c)) = std::isfinite(d[i]) ? d[i] : 0.0;
+        off += d.size();
+      }
     }
   }
   return J;

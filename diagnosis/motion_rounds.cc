@@ -21,6 +21,7 @@ void MotionFit::Rounds() {
     Grams g;
     Linearize(J, &banks, &g);
     Screen(&J, &banks, &g);
+    J = Eigen::MatrixXd();  // the banks hold the linear model from here (a long record's memory)
     Fit lin;
     SelectionTrace trace;
     chosen = SelectEffects(banks[0], g, P.scale(), opt.max_effects, loo, &lin, &trace);
@@ -68,6 +69,7 @@ Eigen::MatrixXd MotionFit::JacobianAtTheta() {
 }
 
 void MotionFit::Linearize(const Eigen::MatrixXd& J, std::vector<ColumnBank>* banks_out, Grams* g_out) {
+  banks_out->clear();  // a relinearization's old banks (as large as J) gone before the new ones
   std::vector<ColumnBank> banks(P.records());
   Eigen::Index off = 0;
   for (size_t r = 0; r < P.records(); ++r) {

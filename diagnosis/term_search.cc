@@ -1,8 +1,10 @@
 #include "diagnosis/term_search.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
+#include <tuple>
 #include <cstdio>
 
 #include <Eigen/Dense>
@@ -10,6 +12,7 @@
 #include "diagnosis/diagnose_select.h"
 #include "diagnosis/effects.h"
 #include "diagnosis/term_library.h"
+#include "core/parallel_for.h"
 #include "model/effect_families.h"
 #include "model/leg_dynamics.h"
 #include "model/term_expr.h"
@@ -116,21 +119,63 @@ Eigen::MatrixXd ExactColumns(const SearchRec& s, int j, const TermCandidate& c, 
 // The screening rows: a strided subset of every record's train rows, both joints' blocks.
 struct Screen {
   std::vector<std::pair<size_t, size_t>> at;  // (record, fit row) of each screening row
+  std::vector<TermRow> rows[2];               // each one's signals at each joint (RowAt)
   Eigen::MatrixXd Q;     // 2N x q: orthonormal basis of the current model's columns
   Eigen::VectorXd y;     // 2N: the target with the current model projected out
   Eigen::MatrixXd B[2];  // N x b: orthonormal basis of the table's forms at each joint (unweighted)
   size_t N = 0;
 };
 
-// The candidate's values on the screening rows of joint j (-expr, weighted, unfiltered).
-Eigen::MatrixXd ScreenColumns(const std::vector<SearchRec>& S, const Screen& sc, int j, const TermCandidate& c,
-                              const double w[2]) {
-  Eigen::MatrixXd x(static_cast<Eigen::Index>(sc.N), c.Paired() ? 2 : 1);
-  for (Eigen::Index col = 0; col < x.cols(); ++col)
-    for (size_t k = 0; k < sc.N; ++k) {
-      const SearchRec& s = S[sc.at[k].first];
-      x(static_cast<Eigen::Index>(k), col) = -w[j] * CandidateValue(c, RowAt(s, j, s.bank->sample[sc.at[k].second]), col == 1);
+// Factors' values on the screening rows of one joint (FactorValue; a kSin factor's sin and its cos),
+// by function, signal and inner parameter: a candidate's column is a product of them.
+using FactorKey = std::tuple<int, int, double>;
+using FactorValues = std::map<FactorKey, std::array<std::vector<double>, 2>>;
+FactorKey KeyOf(const TermFactor& f) { return {static_cast<int>(f.fn), static_cast<int>(f.sig), f.p}; }
+
+// The values of every factor of `lib` at joint j, on up to `threads` threads.
+FactorValues ValuesOf(const Screen& sc, int j, const std::vector<TermCandidate>& lib, int threads) {
+  FactorValues v;
+  std::vector<std::pair<TermFactor, std::array<std::vector<double>, 2>*>> todo;
+  for (const TermCandidate& c : lib)
+    for (const TermFactor& f : c.factors)
+      if (!v.count(KeyOf(f))) todo.push_back({f, &v[KeyOf(f)]});
+  ParallelFor(todo.size(), threads, [&](size_t i) {
+    const TermFactor& f = todo[i].first;
+    for (int cosine = 0; cosine < (f.fn == TermFn::kSin ? 2 : 1); ++cosine) {
+      std::vector<double>& x = (*todo[i].second)[static_cast<size_t>(cosine)];
+      x.resize(sc.N);
+      for (size_t k = 0; k < sc.N; ++k) x[k] = FactorValue(f, sc.rows[j][k], cosine == 1);
     }
+  });
+  return v;
+}
+
+// The candidate's values on the screening rows of joint j (-expr, weighted, unfiltered): the product
+// of its factors' (CandidateValue's), from `known` where it holds them.
+Eigen::MatrixXd ScreenColumns(const Screen& sc, int j, const TermCandidate& c, const double w[2],
+                              const FactorValues* known = nullptr) {
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(sc.N), c.Paired() ? 2 : 1);
+  for (Eigen::Index col = 0; col < x.cols(); ++col) {
+    std::vector<const std::vector<double>*> f;
+    std::vector<std::vector<double>> own;
+    own.reserve(c.factors.size());
+    for (const TermFactor& fa : c.factors) {
+      const size_t which = col == 1 && fa.fn == TermFn::kSin ? 1 : 0;
+      const auto it = known ? known->find(KeyOf(fa)) : FactorValues::const_iterator();
+      if (known && it != known->end()) {
+        f.push_back(&it->second[which]);
+        continue;
+      }
+      own.emplace_back(sc.N);
+      for (size_t k = 0; k < sc.N; ++k) own.back()[k] = FactorValue(fa, sc.rows[j][k], col == 1);
+      f.push_back(&own.back());
+    }
+    for (size_t k = 0; k < sc.N; ++k) {
+      double v = 1;
+      for (const std::vector<double>* fv : f) v *= (*fv)[k];
+      x(static_cast<Eigen::Index>(k), col) = -w[j] * v;
+    }
+  }
   return x;
 }
 
@@ -171,9 +216,10 @@ Screen MakeScreen(const std::vector<SearchRec>& S, const Eigen::MatrixXd& Zrows,
   // Coulomb friction, inertia, gain): a term is a form the table does not have.
   for (int j = 0; j < 2; ++j) {
     Eigen::MatrixXd B(N, 6);
+    sc.rows[j].resize(sc.N);
     for (Eigen::Index k = 0; k < N; ++k) {
       const SearchRec& s = S[at[k].first];
-      const TermRow r = RowAt(s, j, s.bank->sample[at[k].second]);
+      const TermRow r = sc.rows[j][static_cast<size_t>(k)] = RowAt(s, j, s.bank->sample[at[k].second]);
       const double qd = r.s[1];
       B.row(k) << w[j], w[j] * r.s[0], w[j] * qd, w[j] * (qd > 0 ? 1.0 : (qd < 0 ? -1.0 : 0.0)), w[j] * r.s[2],
           w[j] * r.s[3];
@@ -199,11 +245,15 @@ struct Scored {
 };
 
 // The best of every shape on the screening rows, its inner parameter refined by golden search on
-// log p between its grid neighbours; best first. *screened counts the candidates evaluated.
+// log p between its grid neighbours; best first. *screened counts the candidates evaluated. The
+// candidates' gains, then the shapes' refinements, on up to `threads` threads (the same result on any
+// count: each is a function of its candidate alone, gathered in the library's order).
 std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc, const double w[2], bool two_joints,
-                              const std::vector<int>& joints, size_t* screened) {
-  std::map<std::pair<int, std::vector<std::pair<int, int>>>, Scored> best;
-  std::map<std::pair<int, std::vector<std::pair<int, int>>>, TermScales> scales_of;
+                              const std::vector<int>& joints, int threads, size_t* screened) {
+  using Key = std::pair<int, std::vector<std::pair<int, int>>>;
+  std::map<Key, Scored> best;
+  std::map<Key, TermScales> scales_of;
+  FactorValues values[2];
   for (int j : joints) {
     TermScales ts;
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, qd2 = 0, cnt = 0;
@@ -218,20 +268,24 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
     ts.qd_rms = std::max(1e-3, std::sqrt(qd2 / std::max(cnt, 1.0)));
     ts.q_range = std::max(0.05, hi[j] - lo[j]);
     ts.q_other_range = std::max(0.05, hi[1 - j] - lo[1 - j]);
-    for (const TermCandidate& c : TermLibrary(ts, two_joints)) {
+    const std::vector<TermCandidate> lib = TermLibrary(ts, two_joints);
+    values[j] = ValuesOf(sc, j, lib, threads);
+    std::vector<double> gains(lib.size());
+    ParallelFor(lib.size(), threads, [&](size_t i) { gains[i] = ScreenGain(sc, j, ScreenColumns(sc, j, lib[i], w, &values[j])); });
+    for (size_t i = 0; i < lib.size(); ++i) {
       ++*screened;
-      const double g = ScreenGain(sc, j, ScreenColumns(S, sc, j, c, w));
-      const auto key = std::make_pair(j, ShapeOf(c));
+      const Key key = std::make_pair(j, ShapeOf(lib[i]));
       scales_of[key] = ts;
-      if (g > best[key].gain) best[key] = {j, c, g};
+      if (gains[i] > best[key].gain) best[key] = {j, lib[i], gains[i]};
     }
   }
-  std::vector<Scored> out;
-  for (auto& kv : best) {
-    Scored sd = kv.second;
-    if (!(sd.gain > 0)) continue;
+  std::vector<std::pair<Scored, TermScales>> shapes;
+  for (auto& kv : best)
+    if (kv.second.gain > 0) shapes.push_back({kv.second, scales_of[kv.first]});
+  ParallelFor(shapes.size(), threads, [&](size_t k) {
+    Scored& sd = shapes[k].first;
     for (TermFactor& f : sd.c.factors) {
-      const std::vector<double> grid = InnerGrid(f.fn, scales_of[kv.first]);
+      const std::vector<double> grid = InnerGrid(f.fn, shapes[k].second);
       if (grid.empty()) continue;
       const size_t at = static_cast<size_t>(std::find(grid.begin(), grid.end(), f.p) - grid.begin());
       double a = std::log(grid[at == 0 ? 0 : at - 1]), b = std::log(grid[std::min(at + 1, grid.size() - 1)]);
@@ -239,7 +293,7 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
         TermCandidate c = sd.c;
         for (TermFactor& g : c.factors)
           if (g.fn == f.fn && g.sig == f.sig) g.p = RoundedInner(std::exp(lp));
-        return ScreenGain(sc, sd.joint, ScreenColumns(S, sc, sd.joint, c, w));
+        return ScreenGain(sc, sd.joint, ScreenColumns(sc, sd.joint, c, w, &values[sd.joint]));
       };
       const double gr = 0.5 * (std::sqrt(5.0) - 1);
       double x1 = b - gr * (b - a), x2 = a + gr * (b - a), g1 = gain(x1), g2 = gain(x2);
@@ -253,8 +307,9 @@ std::vector<Scored> ScreenAll(const std::vector<SearchRec>& S, const Screen& sc,
         sd.gain = std::max(g1, g2);
       }
     }
-    out.push_back(sd);
-  }
+  });
+  std::vector<Scored> out;
+  for (auto& sh : shapes) out.push_back(sh.first);
   std::sort(out.begin(), out.end(), [](const Scored& a, const Scored& b) { return a.gain > b.gain; });
   return out;
 }
@@ -436,7 +491,7 @@ std::vector<TermPlot> TermPlots(const SearchRec& s, const Eigen::MatrixXd& model
 
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
                              const std::vector<ColumnBank>& banks, const PhysicalScale& scale,
-                             const bool at_joint[2], Diagnosis* D) {
+                             const bool at_joint[2], int threads, Diagnosis* D) {
   TermSearchResult out;
   const size_t R = recs.size(), K = D->effects.size();
   std::vector<SearchRec> S;
@@ -481,7 +536,7 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
       }
     const Screen sc = MakeScreen(S, Z, y, at, w);
     size_t screened = 0;
-    std::vector<Scored> top = ScreenAll(S, sc, w, !params.one_joint, joints, &screened);
+    std::vector<Scored> top = ScreenAll(S, sc, w, !params.one_joint, joints, threads, &screened);
     if (top.size() > kScreened) top.resize(kScreened);
     if (top.empty()) break;
     // The exact fit of the best: their filtered columns beside the model's.

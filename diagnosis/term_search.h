@@ -43,10 +43,11 @@ struct TermSearchResult {
 // on the records' fit rows (banks[r].sample, .train; their X may be released),
 // with D->effects and D->extended the table's best model (stage 5). Where a term is admitted,
 // rewrites D->effects (the kept table effects refitted, the terms) and D->extended, and appends its
-// steps in words to D->term_search.
+// steps in words to D->term_search. The screening on up to `threads` threads (the same result on any
+// count).
 TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
                              const std::vector<ColumnBank>& banks, const PhysicalScale& scale,
-                             const bool at_joint[2], Diagnosis* D);
+                             const bool at_joint[2], int threads, Diagnosis* D);
 
 }  // namespace torque_fit
 }  // namespace exotwin

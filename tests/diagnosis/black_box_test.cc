@@ -94,5 +94,29 @@ TEST(BlackBox, SameSeedSameBits) {
   EXPECT_THROW(BlackBox::Fit(X, Y, std::vector<bool>(static_cast<size_t>(n), false)), std::invalid_argument);
 }
 
+// Several targets on the same rows (AssessModel's ceilings of two models: one fit) are independent
+// fits: each column as fitted alone, to round-off; the length scales on two threads give the same
+// bits as on one.
+TEST(BlackBox, ColumnsAreIndependentFitsAndThreadsChangeNoBit) {
+  Normal rng(4);
+  const int n = 2000, m = 1000;
+  const Eigen::MatrixXd X = Inputs(rng, n), Xt = Inputs(rng, m);
+  Eigen::MatrixXd Y(n, 3);
+  for (int i = 0; i < n; ++i) Y(i, 0) = F(X, i) + 0.1 * rng.Normal(), Y(i, 1) = rng.Normal(), Y(i, 2) = 0.3 * X(i, 0) * X(i, 0);
+  BlackBoxOptions one, two;
+  two.threads = 2;
+  const BlackBox all = BlackBox::Fit(X, Y, LastQuarter(n), one);
+  const Eigen::MatrixXd P = all.Predict(Xt);
+  for (int k = 0; k < 3; ++k) {
+    const BlackBox alone = BlackBox::Fit(X, Y.col(k), LastQuarter(n), one);
+    EXPECT_EQ(alone.bandwidth(0), all.bandwidth(k)) << k;
+    EXPECT_EQ(alone.ridge(0), all.ridge(k)) << k;
+    const Eigen::MatrixXd Pk = alone.Predict(Xt);
+    EXPECT_LE((Pk.col(0) - P.col(k)).cwiseAbs().maxCoeff(), 1e-9 * (1 + P.col(k).cwiseAbs().maxCoeff())) << k;
+  }
+  const Eigen::MatrixXd P2 = BlackBox::Fit(X, Y, LastQuarter(n), two).Predict(Xt);
+  EXPECT_TRUE((P.array() == P2.array()).all());
+}
+
 }  // namespace
 }  // namespace exotwin
