@@ -153,5 +153,7 @@ namespace exotwin {
 // length (15 columns: cmd_*, ref_*, state and EMG besides the required ones; `run_record` in its JSON).
 nlohmann::ordered_json BenchPredictLong(const BenchConfig& c);
 nlohmann::ordered_json BenchDiagnoseLong(const BenchConfig& c);
+// `diagnose` with stage 5c (completeness, ceilings, the search for terms) against --no-completeness, 60 s.
+nlohmann::ordered_json BenchTermSearch(const BenchConfig& c);
 
 }  // namespace exotwin

@@ -34,12 +34,12 @@ CommandRunner RegisterBench(CLI::App& app) {
   sub->add_option("--repeat", o->repeat, "repetitions per timing, best kept (default 3)");
   sub->add_flag("--quick", o->quick, "small problem sizes (seconds instead of a minute)");
   sub->add_option("--only", o->only, "comma-separated subset: startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                  "predict_long,diagnose_long,link,replay,python,motion_fit");
+                  "predict_long,diagnose_long,term_search,link,replay,python,motion_fit");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     if (o->repeat < 1) throw InputError("--repeat: expected >= 1, got " + std::to_string(o->repeat));
     const std::vector<std::string> all = {"startup", "run", "closed_loop", "render", "identification", "diagnosis", "sweep",
-                                          "predict_long", "diagnose_long", "link", "replay", "python", "motion_fit"};
+                                          "predict_long", "diagnose_long", "term_search", "link", "replay", "python", "motion_fit"};
     std::vector<std::string> selected;
     if (o->only.empty()) selected = all;
     else {
@@ -50,7 +50,7 @@ CommandRunner RegisterBench(CLI::App& app) {
         if (std::find(all.begin(), all.end(), name) == all.end())
           throw InputError("--only: unknown probe '" + name +
                            "', expected a comma-separated subset of startup,run,closed_loop,render,identification,diagnosis,sweep,"
-                           "predict_long,diagnose_long,link,replay,python,motion_fit");
+                           "predict_long,diagnose_long,term_search,link,replay,python,motion_fit");
         selected.push_back(name);
         start = end + 1;
       }
@@ -76,7 +76,7 @@ CommandRunner RegisterBench(CLI::App& app) {
       // render (llvmpipe and encoder threads), `run` (its log writer thread), the sweep and `diagnose`
       // (its cutoff choice, columns and replays on every core; the row says how many) use them all.
       const bool threaded = name == "render" || name == "run" || name == "sweep" || name == "link" || name == "python" ||
-                            name == "motion_fit" || name == "diagnose_long";
+                            name == "motion_fit" || name == "diagnose_long" || name == "term_search";
       const ScopedCpuPin pin(threaded ? -1 : FastestCpu(c.cpus));
       if (name == "startup") j[name] = BenchStartup(c);
       if (name == "run") j[name] = BenchRunCommand(c);
@@ -87,6 +87,7 @@ CommandRunner RegisterBench(CLI::App& app) {
       if (name == "sweep") j[name] = BenchSweep(c);
       if (name == "predict_long") j[name] = BenchPredictLong(c);
       if (name == "diagnose_long") j[name] = BenchDiagnoseLong(c);
+      if (name == "term_search") j[name] = BenchTermSearch(c);
       if (name == "link") j[name] = BenchLink(c);
       if (name == "replay") j[name] = BenchReplay(c);
       if (name == "python") j[name] = BenchPython(c);

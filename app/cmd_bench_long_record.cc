@@ -221,4 +221,44 @@ json BenchDiagnoseLong(const BenchConfig& c) {
   return j;
 }
 
+
+// Issue 63's cost row: `diagnose` on a 60 s record (quick: 20 s) of S1 at 1 kHz holding a form off the
+// table, (0.3 + 0.06 |tau_R|) sgn(qd) at the knee, with stage 5c (the residual tests, the ceilings and
+// the search for terms beyond the table, which names the form) against `diagnose --no-completeness`
+// (the diagnosis without them) on the same record: paired runs, the median of the pairs' ratios.
+json BenchTermSearch(const BenchConfig& c) {
+  GenerateOptions g;
+  g.seed = 1, g.effects = 0, g.duration = c.quick ? 20 : 60, g.rate = 1000;
+  Effect form;
+  form.name = "term", form.joint = "knee", form.value = 0.06, form.expr = "(5 + abs(tau_R)) * sgn(qd)", form.stage = "link";
+  g.terms = {form};
+  const std::string params = DataPath("examples/S1.yaml");
+  const std::string csv = c.scratch + "/term_record.csv";
+  WriteGeneratedCsv(GenerateMeasured(ReadModelFile(params), g), csv, g.seed);
+  std::vector<double> ratios, cpu_ratios;
+  for (int i = 0; i < LongRecordPairs(c); ++i) {
+    const ChildRun off = RunSelf({"diagnose", "--params", params, "--measured", csv, "--out", c.scratch + "/term_off",
+                                  "--no-completeness"});
+    const ChildRun on = RunSelf({"diagnose", "--params", params, "--measured", csv, "--out", c.scratch + "/term_on"});
+    ratios.push_back(on.wall_s / off.wall_s), cpu_ratios.push_back(on.cpu_s / off.cpu_s);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t h = v.size() / 2;
+    return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+  };
+  const double ratio = median(ratios), cpu = median(cpu_ratios);
+  const std::string work = "`diagnose` with its completeness tests, ceilings and search for terms (names the form), " +
+                           std::to_string(static_cast<int>(g.duration)) + " s record holding a form off the table";
+  const std::string detail = "CPU " + NumberText(cpu, 3) + "x; pairs " + NumberText(*std::min_element(ratios.begin(), ratios.end()), 3) +
+                             " .. " + NumberText(*std::max_element(ratios.begin(), ratios.end()), 3) + "x";
+  return json{{"ratio", ratio},
+              {"cpu_ratio", cpu},
+              {"pairs", ratios.size()},
+              {"status", "ok"},
+              {"data_s", g.duration},
+              {"rows", BenchRowsJson({{work, ratio, "x", "the same `diagnose --no-completeness` (paired runs, median)",
+                                       "<= 2x", detail}})}};
+}
+
 }  // namespace exotwin

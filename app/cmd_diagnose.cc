@@ -22,6 +22,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     std::vector<std::string> measured;
     double holdout = 0.3;
     int max_effects = 6;
+    bool no_completeness = false;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand(
@@ -41,6 +42,9 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
   sub->add_option("--fit", o->fit,
                   "torque (default: effects sized on the torque residual) or motion (effects fitted by simulating "
                   "the forward plant on the records, diagnosis/motion_fit.h)");
+  sub->add_flag("--no-completeness", o->no_completeness,
+                "skip the residual tests, the black-box ceilings and the search for terms beyond the table "
+                "(diagnosis.json's completeness and ceiling not assessed)");
   return [sub, o]() -> int {
     if (!*sub) return -1;
     KeepFreedMemoryForReuse();
@@ -52,6 +56,7 @@ CommandRunner RegisterDiagnose(CLI::App& app) {
     opt.cutoff_hz = ParseCutoffOption(o->cutoff, "diagnose --cutoff");
     opt.max_effects = o->max_effects;
     opt.fit = fit;
+    opt.assess = !o->no_completeness;
     std::vector<MeasuredData> data;
     std::string names;
     for (const std::string& m : o->measured) {

@@ -446,6 +446,50 @@ void FindAliases(const ColumnBank& bank, const Grams& g, const PhysicalScale& sc
   }
 }
 
+// Stage 5c's state for stage 6c: the black box's rows, whether the residual tests alone decided the
+// search (the table's ceiling then waits for the final model's: one fit), the search's result.
+struct Stage5c {
+  torque_fit::CeilingRows rows;
+  bool tests_decide = true;
+  TermSearchResult searched;
+};
+
+// Stage 5c: the residual tests of the table's best model (D->table_model) and, where they leave a joint
+// complete, its ceiling, which can start the search there (CeilingLeavesStructure); where it is
+// incomplete, the search for terms beyond the table at those joints (term_search.h).
+Stage5c AssessAndSearch(const LegParams& params, const std::vector<Rec>& recs, const double w[2],
+                        const std::vector<ColumnBank>& banks, const PhysicalScale& scale, const DiagnoseOptions& opt,
+                        Diagnosis* D_out) {
+  Stage5c st;
+  Diagnosis& D = *D_out;
+  std::array<JointCompleteness, 2> on_fit_rows;
+  D.table_model = torque_fit::TestModel(params, D.extended, recs, opt, &st.rows, &on_fit_rows);
+  bool incomplete[2];
+  // The table's ceiling before the search where the residual tests leave a joint complete (it can
+  // start the search there); else it waits for the final model's, one black box fit for both.
+  const int j0 = params.one_joint ? 1 : 0;
+  bool& tests_decide = st.tests_decide;
+  if (opt.search_terms) {
+    for (int j = j0; j < 2; ++j) tests_decide = tests_decide && (!D.table_model.completeness[j].complete || !on_fit_rows[j].complete);
+  }
+  if (!tests_decide) torque_fit::FitCeilings(st.rows, {&D.table_model}, opt);
+  for (int j = 0; j < 2; ++j) {
+    const JointCompleteness& held = D.table_model.completeness[j];
+    const bool ceiling = !tests_decide && CeilingLeavesStructure(D.table_model.ceiling[j], held.floor);
+    incomplete[j] = opt.search_terms && (!held.complete || !on_fit_rows[j].complete || ceiling);
+    if (incomplete[j])
+      D.term_search.push_back(std::string(j == 0 ? "hip" : "knee") + ": the table's best model is incomplete (" +
+                              (!held.complete ? "residual tests on the held-out rows; " : "") +
+                              (!on_fit_rows[j].complete ? "residual tests on the fit rows; " : "") +
+                              (ceiling ? "the black box lowers its held-out error by " +
+                                             NumberText(100 * (D.table_model.ceiling[j].black_box_pct - D.table_model.ceiling[j].named_pct) /
+                                                            std::max(1e-9, 100 - D.table_model.ceiling[j].named_pct), 3) + " %; " : "") +
+                              "searched)");
+  }
+  if (incomplete[0] || incomplete[1]) st.searched = SearchTerms(params, recs, w, banks, scale, incomplete, DiagnoseThreads(opt), &D);
+  return st;
+}
+
 // Stage 6: the extended twin (predict with D->extended) on every record's held-out part: the scores
 // per record and pooled (D->records, D->joints) and the first record's plot series; with several
 // records, each whole record predicted by the effects fitted on the others (D->left_out).
@@ -811,38 +855,10 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
   const std::vector<double> refine_ratio = ExtendAndRefine(params, recs, w, bank, g, f0, chosen, chosen_fit, &D);
   FindAliases(bank, g, scale, chosen, chosen_fit, &D);
   Lap("refinement");
-  // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete on the
-  // held-out rows or on the fit rows, the search for terms beyond the table at those joints.
-  torque_fit::CeilingRows ceiling_rows;
-  std::array<JointCompleteness, 2> on_fit_rows;
-  D.table_model = torque_fit::TestModel(params, D.extended, recs, opt, &ceiling_rows, &on_fit_rows);
-  bool incomplete[2];
-  // The table's ceiling before the search where the residual tests leave a joint complete (it can
-  // start the search there); else it waits for the final model's, one black box fit for both.
-  const int j0 = params.one_joint ? 1 : 0;
-  bool tests_decide = !opt.search_terms;
-  if (opt.search_terms) {
-    tests_decide = true;
-    for (int j = j0; j < 2; ++j) tests_decide = tests_decide && (!D.table_model.completeness[j].complete || !on_fit_rows[j].complete);
-  }
-  if (!tests_decide) torque_fit::FitCeilings(ceiling_rows, {&D.table_model}, opt);
-  for (int j = 0; j < 2; ++j) {
-    const JointCompleteness& held = D.table_model.completeness[j];
-    const bool ceiling = !tests_decide && CeilingLeavesStructure(D.table_model.ceiling[j], held.floor);
-    incomplete[j] = opt.search_terms && (!held.complete || !on_fit_rows[j].complete || ceiling);
-    if (incomplete[j])
-      D.term_search.push_back(std::string(j == 0 ? "hip" : "knee") + ": the table's best model is incomplete (" +
-                              (!held.complete ? "residual tests on the held-out rows; " : "") +
-                              (!on_fit_rows[j].complete ? "residual tests on the fit rows; " : "") +
-                              (ceiling ? "the black box lowers its held-out error by " +
-                                             NumberText(100 * (D.table_model.ceiling[j].black_box_pct - D.table_model.ceiling[j].named_pct) /
-                                                            std::max(1e-9, 100 - D.table_model.ceiling[j].named_pct), 3) + " %; " : "") +
-                              "searched)");
-  }
-  Lap("completeness");
-  const TermSearchResult searched =
-      incomplete[0] || incomplete[1] ? SearchTerms(params, recs, w, banks, scale, incomplete, DiagnoseThreads(opt), &D) : TermSearchResult{};
-  Lap("terms beyond the table");
+  // Stage 5c: the residual tests and ceiling of the table's best model; where it is incomplete, the
+  // search for terms beyond the table at those joints.
+  Stage5c st = opt.assess ? AssessAndSearch(params, recs, w, banks, scale, opt, &D) : Stage5c{};
+  Lap("completeness + terms beyond the table");
 
   // Each final effect's equivalent reading (FitFamily::equivalent), among its aliases.
   for (DiagnosedEffect& de : D.effects) {
@@ -850,15 +866,15 @@ Diagnosis DiagnoseRecords(const LegParams& params, const std::vector<const Measu
     const FitFamily& f = FitFamilyOf(de.effect.name);
     if (f.equivalent && f.equivalent(de, D.effects, &a)) de.aliases.insert(de.aliases.begin(), a);
   }
-  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, searched.left_out, opt, &D);
+  ScoreExtendedTwin(params, recs, bank, g, chosen, refine_ratio, st.searched.left_out, opt, &D);
   Lap("extended twin");
   // Stage 6c: the final model's (the table's where the search admitted no term), and both ceilings.
-  if (searched.changed) D.final_model = torque_fit::TestModel(params, D.extended, recs, opt, &ceiling_rows, nullptr);
-  if (tests_decide || searched.changed) {
+  if (st.searched.changed) D.final_model = torque_fit::TestModel(params, D.extended, recs, opt, &st.rows, nullptr);
+  if (opt.assess && (st.tests_decide || st.searched.changed)) {
     ModelAssessment again;  // the table's column again where its ceiling was fitted before (one fit)
-    torque_fit::FitCeilings(ceiling_rows, {tests_decide ? &D.table_model : &again, &D.final_model}, opt);
+    torque_fit::FitCeilings(st.rows, {st.tests_decide ? &D.table_model : &again, &D.final_model}, opt);
   }
-  if (!searched.changed) D.final_model = D.table_model;
+  if (!st.searched.changed) D.final_model = D.table_model;
   Lap("final completeness + ceiling");
   for (Rec& rc : recs) rc.kin.emg.clear();  // done with: the simulation and the report read no envelope
   for (size_t r = 0; r < R; ++r)

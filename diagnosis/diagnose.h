@@ -240,6 +240,7 @@ struct DiagnoseOptions {
   double cutoff_hz = 0;          // derivative and parallel torque filter, Hz; 0 = chosen from the data
   std::string mjcf;              // MJCF instead of the shipped model
   bool simulate = true;          // step 6b (false: the torque analysis alone)
+  bool assess = true;            // stage 5c, the residual tests and ceilings (and 6c; false: none, `completeness` and `ceiling` not assessed)
   bool search_terms = true;      // stage 5c, the search for terms beyond the table (the motion fit's own torque fit: false)
   double replay_horizon_s = 0.5; // step 6b: restart interval of the forward simulation, s
   double replay_cutoff_hz = kReplayCutoffHz;  // step 6b: filter of the restart state

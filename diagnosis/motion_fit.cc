@@ -704,7 +704,7 @@ Diagnosis DiagnoseByMotion(const LegParams& params, const std::vector<const Meas
   Diagnosis D = fit.Finish();
   // Stage 6c: the torque residual of the motion fit's extended twin on the held-out rows, filtered as
   // the torque fit's at its cutoff (diagnose.h Diagnosis::table_model).
-  D.table_model = torque_fit::AssessModelOnRecords(params, D.extended, records, D.cutoff, opt);
+  if (opt.assess) D.table_model = torque_fit::AssessModelOnRecords(params, D.extended, records, D.cutoff, opt);
   D.final_model = D.table_model;  // the motion fit searches no terms beyond the table
   return D;
 }

@@ -123,6 +123,23 @@ TEST(BenchCli, QuickLongRecordRows) {
   }
 }
 
+// The term search's cost row (issue 63): `diagnose` against `diagnose --no-completeness` on the same
+// record, in pairs; the row's ratio is the pairs' median (no timed assertion). The record's form is
+// named with stage 5c and not without it.
+TEST(BenchCli, QuickTermSearchRow) {
+  const testing::ScopedTempDir tmp("bench_terms");
+  const std::string dir = tmp.path();
+  const RunResult r = RunExotwin("bench --quick --repeat 1 --only term_search --out " + dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream f(dir + "/b.json");
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(f);
+  ASSERT_EQ(j["term_search"]["status"], "ok");
+  EXPECT_EQ(j["term_search"]["pairs"], 1);
+  EXPECT_GT(j["term_search"]["ratio"].get<double>(), 0.0);
+  EXPECT_EQ(j["term_search"]["data_s"], 20);
+  EXPECT_EQ(j["term_search"]["rows"].size(), 1u);
+}
+
 // EXOTWIN_PEAK_FILE: the process's peak resident memory (VmHWM, kB) written at exit.
 TEST(BenchCli, PeakFileHoldsThePeakMemory) {
   const testing::ScopedTempDir tmp("peak");

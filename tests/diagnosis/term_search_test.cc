@@ -201,6 +201,25 @@ TEST(TermSearch, TheCeilingStartsTheSearchWhereTheTestsCannot) {
   EXPECT_GE(share, 95.0);
 }
 
+// Without stage 5c (DiagnoseOptions::assess false, `diagnose --no-completeness`) nothing is tested or
+// searched: the form's record names no term, its completeness is not assessed, its ceiling not done.
+TEST(TermSearch, NoCompletenessSkipsTheTestsAndTheSearch) {
+  const LegParams base = S1();
+  GeneratedData rec = CleanRecord(960, 20);
+  Hide(base, {1}, [](double, double qd, double tau, double) { return (0.3 + 0.06 * std::abs(tau)) * Sgn(qd); },
+       &rec.data);
+  DiagnoseOptions opt = TorqueOnly();
+  opt.assess = false;
+  const Diagnosis d = Diagnose(base, rec.data, opt);
+  for (const auto& e : d.effects) EXPECT_NE(e.effect.name, "term");
+  EXPECT_TRUE(d.term_search.empty());
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_FALSE(d.table_model.completeness[j].assessed);
+    EXPECT_FALSE(d.final_model.ceiling[j].done);
+  }
+  EXPECT_FALSE(d.effects.empty()) << "the table's effects are still named";
+}
+
 TEST(TermSearch, CleanRecordsNameNoTerm) {
   const LegParams base = S1();
   for (uint64_t seed = 1; seed <= 4; ++seed) {
