@@ -16,6 +16,18 @@
 namespace exotwin::testing {
 namespace {
 
+// `exotwin bench --quick --repeat 1 --only <only>`'s JSON; a failed run (exit code not 0) fails the
+// test and returns an empty object.
+nlohmann::ordered_json QuickBench(const std::string& only) {
+  const testing::ScopedTempDir tmp("bench_" + only.substr(0, only.find(',')));
+  const std::string dir = tmp.path();
+  const RunResult r = RunExotwin("bench --quick --repeat 1 --only " + only + " --out " + dir + "/b.json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  if (r.exit_code != 0) return nlohmann::ordered_json::object();
+  std::ifstream f(dir + "/b.json");
+  return nlohmann::ordered_json::parse(f);  // key order as written
+}
+
 TEST(BenchCli, QuickJsonHasRatios) {
   const testing::ScopedTempDir tmp("bench");
   const std::string dir = tmp.path();
@@ -99,13 +111,8 @@ TEST(BenchTable, ScopedCpuPinRestoresTheAffinity) {
 // The long-record rows: ratio against the strtod read of the same file first, the child's peak memory
 // and the start-up's (no timed assertion: the machines are shared).
 TEST(BenchCli, QuickLongRecordRows) {
-  const testing::ScopedTempDir tmp("bench_long");
-  const std::string dir = tmp.path();
-  const RunResult r =
-      RunExotwin("bench --quick --repeat 1 --only predict_long,diagnose_long --out " + dir + "/b.json");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream f(dir + "/b.json");
-  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(f);  // in the file's key order
+  const nlohmann::ordered_json j = QuickBench("predict_long,diagnose_long");
+  ASSERT_FALSE(j.empty());
   for (const char* row : {"predict_long", "diagnose_long"}) {
     SCOPED_TRACE(row);
     ASSERT_EQ(j[row]["status"], "ok");
@@ -124,15 +131,9 @@ TEST(BenchCli, QuickLongRecordRows) {
 }
 
 // The term search's cost row (issue 63): `diagnose` against `diagnose --no-completeness` on the same
-// record, in pairs; the row's ratio is the pairs' median (no timed assertion). The record's form is
-// named with stage 5c and not without it.
+// record, in pairs; the row's ratio is the pairs' median (no timed assertion).
 TEST(BenchCli, QuickTermSearchRow) {
-  const testing::ScopedTempDir tmp("bench_terms");
-  const std::string dir = tmp.path();
-  const RunResult r = RunExotwin("bench --quick --repeat 1 --only term_search --out " + dir + "/b.json");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream f(dir + "/b.json");
-  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(f);
+  const nlohmann::ordered_json j = QuickBench("term_search");
   ASSERT_EQ(j["term_search"]["status"], "ok");
   EXPECT_EQ(j["term_search"]["pairs"], 1);
   EXPECT_GT(j["term_search"]["ratio"].get<double>(), 0.0);
