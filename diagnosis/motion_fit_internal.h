@@ -177,6 +177,8 @@ class MotionFit {
   // Step 5's exchanges on this round's linear model (bank, g), then the friction's form.
   void ExchangeEffects(const ColumnBank& bank, const Grams& g, int round);
   void ExchangeFrictionForm(int round);
+  // Step 5's backward elimination on the exact plant, after the exchanges.
+  void EliminateOnThePlant(int round);
 
   // Step 6 (motion_fit.cc).
   // The first chosen effect whose refined value leaves its range (its index, *why), else -1.

@@ -1,6 +1,6 @@
 // The motion fit's rounds (motion_fit.h "Method", steps 2-5): linearize at the current values, screen
 // the candidates on the plant, select on the linear model, refine the chosen set on the plant; after
-// the last round the exchanges and the torque fit's effects put to the plant.
+// the last round the exchanges, the elimination on the plant and the torque fit's effects put to the plant.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -44,6 +44,7 @@ void MotionFit::Rounds() {
     KeepBestRound(converged);
     ExchangeEffects(banks[0], g_last, round);
     ExchangeFrictionForm(round);
+    EliminateOnThePlant(round);
     break;
   }
 }
@@ -216,8 +217,8 @@ size_t MotionFit::ParameterCount(const std::vector<int>& set) const {
   return k;
 }
 
-// The exchanges of motion_fit.h step 5: a chosen effect replaced by a candidate where the linear
-// model of this round (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the
+// The exchanges of motion_fit.h step 5: a chosen effect replaced by a candidate, or by two while the
+// set is below max_effects, where the linear model of this round (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the
 // swapped set refined from the set's values, the effect taken out, and from the linear fit's: its
 // fit-part BIC lower); kMotionExchanges at most.
 // Forward selection with backward elimination misses a swap when an effect entered early stands in
@@ -229,13 +230,28 @@ void MotionFit::ExchangeEffects(const ColumnBank& bank, const Grams& g, int roun
     double best_bic = cur.bic;
     std::vector<int> best_set;
     Fit best_fit;
+    auto consider = [&](const std::vector<int>& set) {
+      for (size_t a = 0; a < set.size(); ++a)
+        for (size_t b = a + 1; b < set.size(); ++b)
+          if (set[a] == set[b] || Conflicts(cands[static_cast<size_t>(set[a])], cands[static_cast<size_t>(set[b])])) return;
+      const Fit f = FitCols(g, ColumnsOf(bank, set), false);
+      if (f.ok && f.bic < best_bic) best_bic = f.bic, best_set = set, best_fit = f;
+    };
+    const bool pairs = static_cast<int>(chosen.size()) < opt.max_effects;
     for (size_t i = 0; i < chosen.size(); ++i)
       for (size_t c = 0; c < cands.size(); ++c) {
         if (std::find(chosen.begin(), chosen.end(), static_cast<int>(c)) != chosen.end()) continue;
         std::vector<int> set = chosen;
         set[i] = static_cast<int>(c);
-        const Fit f = FitCols(g, ColumnsOf(bank, set), false);
-        if (f.ok && f.bic < best_bic) best_bic = f.bic, best_set = set, best_fit = f;
+        consider(set);
+        // One effect for two: a stand-in that took the share of two effects leaves neither of them
+        // material on its own (a hip gravity error for a hip dead band and Coulomb friction).
+        for (size_t d = c + 1; pairs && d < cands.size(); ++d) {
+          if (std::find(chosen.begin(), chosen.end(), static_cast<int>(d)) != chosen.end()) continue;
+          std::vector<int> two = set;
+          two.push_back(static_cast<int>(d));
+          consider(two);
+        }
       }
     if (best_set.empty()) break;
     Eigen::VectorXd kept = theta, lin = theta;
@@ -258,6 +274,38 @@ void MotionFit::ExchangeEffects(const ColumnBank& bank, const Grams& g, int roun
     if (!rx.ok) break;
     chosen = best_set, theta = rf.theta, at = std::move(rx);
   }
+}
+
+// Backward elimination on the exact plant (motion_fit.h step 5, after the exchanges): each chosen
+// effect taken out and the rest refined from the set's values (step 4's refinement, the effect at 0);
+// the removal of the lowest exact fit-part BIC taken where that BIC is below the set's, repeated. The
+// linear model's elimination (SelectEffects) judges a stand-in where it entered; once an exchange or
+// the friction's form brought in what it stood for (a hip dead band for the sensor gains that took its
+// knocks), only the plant shows that it adds nothing.
+void MotionFit::EliminateOnThePlant(int round) {
+  while (chosen.size() > 1) {
+    const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    double best_bic = bic_now;
+    std::vector<int> best_set;
+    Eigen::VectorXd best_theta;
+    for (size_t i = 0; i < chosen.size(); ++i) {
+      std::vector<int> set = chosen;
+      set.erase(set.begin() + static_cast<long>(i));
+      Eigen::VectorXd x = theta;
+      for (int k : cands[static_cast<size_t>(chosen[i])].cols) x[k] = 0;
+      const Refined rf = Refine(P, ColumnsOf(cand_bank, set), {x}, kMotionLmIterations, false);
+      const double bic = ExactBic(rf.cost, ParameterCount(set));
+      if (std::isfinite(rf.cost) && bic < best_bic) best_bic = bic, best_set = set, best_theta = rf.theta;
+    }
+    if (best_set.empty()) break;
+    MotionProblem::Rollout rx = P.Simulate(best_theta, Part::kBoth);
+    if (!rx.ok) break;
+    D.selection.push_back("round " + std::to_string(round + 1) + ": on the plant " + Labels(P, chosen) + " -> " +
+                          Labels(P, best_set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " +
+                          NumberText(best_bic, 4) + ", taken");
+    chosen = best_set, theta = best_theta, at = std::move(rx);
+  }
+  Charge(kRefinement);
 }
 
 // The torque fit's effects put to the plant (motion_fit.h step 5): each effect the torque fit names
