@@ -41,10 +41,22 @@ void MotionFit::Rounds() {
     if (!repeated) seen.push_back(key);
     previous = chosen;
     if (!repeated && round + 1 < kMotionOuterSteps) continue;
-    KeepBestRound(converged);
-    ExchangeEffects(banks[0], g_last, round);
-    ExchangeFrictionForm(round);
-    EliminateOnThePlant(round);
+    // The last round's set and, where the rounds did not converge, the best round's, each taken
+    // through the exchanges, the friction's form and the elimination; the lower exact BIC stays.
+    Polish(banks[0], round);
+    const std::vector<int> last_set = chosen;
+    const Eigen::VectorXd last_theta = theta;
+    const double last_bic = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    if (!KeepBestRound(converged)) break;
+    Polish(banks[0], round);
+    const double best_bic = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    if (!(last_bic < best_bic)) break;
+    MotionProblem::Rollout rl = P.Simulate(last_theta, Part::kBoth);
+    if (!rl.ok) break;
+    D.selection.push_back("round " + std::to_string(round + 1) + ": the last round's set, after the same, " +
+                          Labels(P, last_set) + " kept: exact BIC " + NumberText(last_bic, 4) + " against " +
+                          NumberText(best_bic, 4));
+    chosen = last_set, theta = last_theta, at = std::move(rl);
     break;
   }
 }
@@ -187,7 +199,13 @@ bool MotionFit::RefineChosen(int round, const ColumnBank& bank, const Fit& lin) 
   return true;
 }
 
-void MotionFit::KeepBestRound(bool converged) {
+void MotionFit::Polish(const ColumnBank& bank, int round) {
+  ExchangeEffects(bank, g_last, round);
+  ExchangeFrictionForm(round);
+  EliminateOnThePlant(round);
+}
+
+bool MotionFit::KeepBestRound(bool converged) {
   size_t best = rounds.size() - 1;
   for (size_t k = 0; !converged && k < rounds.size(); ++k)
     if (ExactBic(rounds[k].cost, ParameterCount(rounds[k].set)) <
@@ -199,11 +217,13 @@ void MotionFit::KeepBestRound(bool converged) {
       D.selection.push_back("round " + std::to_string(best + 1) + "'s set " + Labels(P, rounds[best].set) +
                             " kept: exact BIC " +
                             NumberText(ExactBic(rounds[best].cost, ParameterCount(rounds[best].set)), 4) +
-                            ", the last round's " + Labels(P, chosen) + " " +
+                            ", the last round's " + Labels(P, rounds.back().set) + " " +
                             NumberText(ExactBic(rounds.back().cost, ParameterCount(chosen)), 4));
       chosen = rounds[best].set, theta = rounds[best].theta, at = std::move(rb);
+      return true;
     }
   }
+  return false;
 }
 
 double MotionFit::ExactBic(double cost, size_t k) const {
