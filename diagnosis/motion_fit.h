@@ -82,7 +82,8 @@
 //     from the value of the same power at the joint's RMS speed (c = b qd_rms) and the torque fit's,
 //     taken where the exact fit-part BIC is lower; then backward elimination on the plant: each
 //     chosen effect taken out and the rest refined from the set's values, the removal of the lowest
-//     exact fit-part BIC taken where it is below the set's, repeated (these three on the last round's
+//     exact fit-part BIC taken where it is below the set's or where what the effect adds at its
+//     joint is below the selection's materiality, repeated (these three on the last round's
 //     set and, where an earlier round's set had the lower exact BIC, on that one too: the lower exact
 //     BIC after them stays); then the torque fit's effects put to the plant:
 //     each effect the torque fit names (step 1) that is a candidate and conflicts with no chosen one

@@ -298,32 +298,67 @@ void MotionFit::ExchangeEffects(const ColumnBank& bank, const Grams& g, int roun
 
 // Backward elimination on the exact plant (motion_fit.h step 5, after the exchanges): each chosen
 // effect taken out and the rest refined from the set's values (step 4's refinement, the effect at 0);
-// the removal of the lowest exact fit-part BIC taken where that BIC is below the set's, repeated. The
+// the removal of the lowest exact fit-part BIC taken where that BIC is below the set's or where what
+// the effect adds at its joint on the fit parts is below the selection's materiality (an exchange
+// does not check it), repeated. The
 // linear model's elimination (SelectEffects) judges a stand-in where it entered; once an exchange or
 // the friction's form brought in what it stood for (a hip dead band for the sensor gains that took its
 // knocks), only the plant shows that it adds nothing.
 void MotionFit::EliminateOnThePlant(int round) {
+  // The materiality floor per joint on the fit parts (the selection's, SelectEffects): kMinTorqueShare
+  // of the measured angle's RMS about its mean, squared, times the rows, in the weighted SSE.
+  double floor[2] = {0, 0};
+  for (size_t r = 0; r < P.records(); ++r) {
+    const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
+    for (int j = 0; j < 2; ++j) {
+      std::vector<double> q;
+      for (size_t k = 0; k < mf; ++k) q.push_back(P.measured(r)[static_cast<Eigen::Index>(j * m + k)]);
+      const double s = kMinTorqueShare * RmsAboutMean(q) * P.weight(r, j);
+      floor[j] += s * s * static_cast<double>(q.size());
+    }
+  }
   while (chosen.size() > 1) {
     const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
-    double best_bic = bic_now;
-    std::vector<int> best_set;
-    Eigen::VectorXd best_theta;
+    double sse_now[2];
+    P.Sse(at, Part::kFit, sse_now);
+    std::vector<std::vector<int>> sets;
+    std::vector<Eigen::VectorXd> refined;
+    std::vector<double> bics;
     for (size_t i = 0; i < chosen.size(); ++i) {
       std::vector<int> set = chosen;
       set.erase(set.begin() + static_cast<long>(i));
       Eigen::VectorXd x = theta;
       for (int k : cands[static_cast<size_t>(chosen[i])].cols) x[k] = 0;
       const Refined rf = Refine(P, ColumnsOf(cand_bank, set), {x}, kMotionLmIterations, false);
-      const double bic = ExactBic(rf.cost, ParameterCount(set));
-      if (std::isfinite(rf.cost) && bic < best_bic) best_bic = bic, best_set = set, best_theta = rf.theta;
+      if (!std::isfinite(rf.cost)) continue;
+      sets.push_back(set), refined.push_back(rf.theta), bics.push_back(ExactBic(rf.cost, ParameterCount(set)));
     }
-    if (best_set.empty()) break;
-    MotionProblem::Rollout rx = P.Simulate(best_theta, Part::kBoth);
+    // Taken out where the BIC is lower without it, or where what it adds at its joint is immaterial.
+    const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(refined, Part::kFit);
+    int best = -1;
+    std::string why;
+    for (size_t s = 0; s < sets.size(); ++s) {
+      int out = -1;
+      for (int c : chosen)
+        if (std::find(sets[s].begin(), sets[s].end(), c) == sets[s].end()) out = c;
+      const int j = cands[static_cast<size_t>(out)].joint;
+      double sse[2] = {INFINITY, INFINITY};
+      if (ro[s].ok) P.Sse(ro[s], Part::kFit, sse);
+      const bool lower = bics[s] < bic_now, immaterial = sse[j] - sse_now[j] < floor[j];
+      if ((lower || immaterial) && (best < 0 || bics[s] < bics[static_cast<size_t>(best)])) {
+        best = static_cast<int>(s);
+        why = lower ? "" : " (higher, but what " + cands[static_cast<size_t>(out)].Label() +
+                               " adds at its joint is below the materiality of " + NumberText(100 * kMinTorqueShare) +
+                               " % of the measured angle's RMS)";
+      }
+    }
+    if (best < 0) break;
+    MotionProblem::Rollout rx = P.Simulate(refined[static_cast<size_t>(best)], Part::kBoth);
     if (!rx.ok) break;
     D.selection.push_back("round " + std::to_string(round + 1) + ": on the plant " + Labels(P, chosen) + " -> " +
-                          Labels(P, best_set) + ": exact BIC " + NumberText(bic_now, 4) + " -> " +
-                          NumberText(best_bic, 4) + ", taken");
-    chosen = best_set, theta = best_theta, at = std::move(rx);
+                          Labels(P, sets[static_cast<size_t>(best)]) + ": exact BIC " + NumberText(bic_now, 4) + " -> " +
+                          NumberText(bics[static_cast<size_t>(best)], 4) + why + ", taken");
+    chosen = sets[static_cast<size_t>(best)], theta = refined[static_cast<size_t>(best)], at = std::move(rx);
   }
   Charge(kRefinement);
 }
