@@ -72,14 +72,20 @@
 //     round's set came back (a cycle) or no set repeated, the rounds' refined set of the lowest exact
 //     fit-part BIC stays (a round linearized elsewhere may end on a worse set than an earlier one);
 //     then exchanges (at most
-//     kMotionExchanges): the swap of one chosen effect for one candidate that
+//     kMotionExchanges): the swap of one chosen effect for one candidate, or for two below
+//     max_effects (none of the new set in Conflicts), that
 //     the last round's linear model ranks lowest in BIC, refined on the exact plant (step 4's
 //     refinement from the set's values with the effect taken out and from the linear fit's), taken
 //     where the exact fit-part BIC is lower (stepwise selection keeps an effect that entered early and
 //     stands in for one that only pays once the others are in); then the friction's form: each named
 //     viscous friction exchanged for a Coulomb one at its joint and the other way round, refined
 //     from the value of the same power at the joint's RMS speed (c = b qd_rms) and the torque fit's,
-//     taken where the exact fit-part BIC is lower; then the torque fit's effects put to the plant:
+//     taken where the exact fit-part BIC is lower; then backward elimination on the plant: each
+//     chosen effect taken out and the rest refined from the set's values, the removal of the lowest
+//     exact fit-part BIC taken where it is below the set's or where what the effect adds at its
+//     joint is below the selection's materiality, repeated (these three on the last round's
+//     set and, where an earlier round's set had the lower exact BIC, on that one too: the lower exact
+//     BIC after them stays); then the torque fit's effects put to the plant:
 //     each effect the torque fit names (step 1) that is a candidate and conflicts with no chosen one
 //     (diagnose_select.h Conflicts), added at the torque
 //     fit's value, is refined with the set where it lowers the held-out simulated error at its joint

@@ -204,8 +204,11 @@ class MotionFit {
   // fit's); false where it cannot be simulated (the last round's set kept: the rounds stop).
   bool RefineChosen(int round, const ColumnBank& bank, const Fit& lin);
   // Step 5: after the last round, the rounds' refined set of the lowest exact fit-part BIC (unless
-  // the rounds converged).
-  void KeepBestRound(bool converged);
+  // the rounds converged); true where it is not the last round's.
+  bool KeepBestRound(bool converged);
+  // Step 5's exchanges, the friction's form and the elimination on the plant, on the current set
+  // (the exchanges on the last round's linear model g_last, whose bank is `bank`).
+  void Polish(const ColumnBank& bank, int round);
   // Exact BIC of a fit-part cost (Cost, Part::kFit) with k parameters (the selection's effective
   // sample size).
   double ExactBic(double cost, size_t k) const;
@@ -213,6 +216,8 @@ class MotionFit {
   // Step 5's exchanges on this round's linear model (bank, g), then the friction's form.
   void ExchangeEffects(const ColumnBank& bank, const Grams& g, int round);
   void ExchangeFrictionForm(int round);
+  // Step 5's backward elimination on the exact plant, after the exchanges.
+  void EliminateOnThePlant(int round);
 
   // Step 6 (motion_fit.cc).
   // The first chosen effect whose refined value leaves its range (its index, *why), else -1.

@@ -1,6 +1,6 @@
 // The motion fit's rounds (motion_fit.h "Method", steps 2-5): linearize at the current values, screen
 // the candidates on the plant, select on the linear model, refine the chosen set on the plant; after
-// the last round the exchanges and the torque fit's effects put to the plant.
+// the last round the exchanges, the elimination on the plant and the torque fit's effects put to the plant.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -42,9 +42,22 @@ void MotionFit::Rounds() {
     if (!repeated) seen.push_back(key);
     previous = chosen;
     if (!repeated && round + 1 < kMotionOuterSteps) continue;
-    KeepBestRound(converged);
-    ExchangeEffects(banks[0], g_last, round);
-    ExchangeFrictionForm(round);
+    // The last round's set and, where the rounds did not converge, the best round's, each taken
+    // through the exchanges, the friction's form and the elimination; the lower exact BIC stays.
+    Polish(banks[0], round);
+    const std::vector<int> last_set = chosen;
+    const Eigen::VectorXd last_theta = theta;
+    const double last_bic = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    if (!KeepBestRound(converged)) break;
+    Polish(banks[0], round);
+    const double best_bic = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    if (!(last_bic < best_bic)) break;
+    MotionProblem::Rollout rl = P.Simulate(last_theta, Part::kBoth);
+    if (!rl.ok) break;
+    D.selection.push_back("round " + std::to_string(round + 1) + ": the last round's set, after the same, " +
+                          Labels(P, last_set) + " kept: exact BIC " + NumberText(last_bic, 4) + " against " +
+                          NumberText(best_bic, 4));
+    chosen = last_set, theta = last_theta, at = std::move(rl);
     break;
   }
 }
@@ -188,7 +201,13 @@ bool MotionFit::RefineChosen(int round, const ColumnBank& bank, const Fit& lin) 
   return true;
 }
 
-void MotionFit::KeepBestRound(bool converged) {
+void MotionFit::Polish(const ColumnBank& bank, int round) {
+  ExchangeEffects(bank, g_last, round);
+  ExchangeFrictionForm(round);
+  EliminateOnThePlant(round);
+}
+
+bool MotionFit::KeepBestRound(bool converged) {
   size_t best = rounds.size() - 1;
   for (size_t k = 0; !converged && k < rounds.size(); ++k)
     if (ExactBic(rounds[k].cost, ParameterCount(rounds[k].set)) <
@@ -200,11 +219,13 @@ void MotionFit::KeepBestRound(bool converged) {
       D.selection.push_back("round " + std::to_string(best + 1) + "'s set " + Labels(P, rounds[best].set) +
                             " kept: exact BIC " +
                             NumberText(ExactBic(rounds[best].cost, ParameterCount(rounds[best].set)), 4) +
-                            ", the last round's " + Labels(P, chosen) + " " +
+                            ", the last round's " + Labels(P, rounds.back().set) + " " +
                             NumberText(ExactBic(rounds.back().cost, ParameterCount(chosen)), 4));
       chosen = rounds[best].set, theta = rounds[best].theta, at = std::move(rb);
+      return true;
     }
   }
+  return false;
 }
 
 double MotionFit::ExactBic(double cost, size_t k) const {
@@ -218,8 +239,8 @@ size_t MotionFit::ParameterCount(const std::vector<int>& set) const {
   return k;
 }
 
-// The exchanges of motion_fit.h step 5: a chosen effect replaced by a candidate where the linear
-// model of this round (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the
+// The exchanges of motion_fit.h step 5: a chosen effect replaced by a candidate, or by two while the
+// set is below max_effects, where the linear model of this round (bank, g) ranks the swap lowest in BIC and the exact plant confirms it (the
 // swapped set refined from the set's values, the effect taken out, and from the linear fit's: its
 // fit-part BIC lower); kMotionExchanges at most.
 // Forward selection with backward elimination misses a swap when an effect entered early stands in
@@ -231,13 +252,28 @@ void MotionFit::ExchangeEffects(const ColumnBank& bank, const Grams& g, int roun
     double best_bic = cur.bic;
     std::vector<int> best_set;
     Fit best_fit;
+    auto consider = [&](const std::vector<int>& set) {
+      for (size_t a = 0; a < set.size(); ++a)
+        for (size_t b = a + 1; b < set.size(); ++b)
+          if (set[a] == set[b] || Conflicts(cands[static_cast<size_t>(set[a])], cands[static_cast<size_t>(set[b])])) return;
+      const Fit f = FitCols(g, ColumnsOf(bank, set), false);
+      if (f.ok && f.bic < best_bic) best_bic = f.bic, best_set = set, best_fit = f;
+    };
+    const bool pairs = static_cast<int>(chosen.size()) < opt.max_effects;
     for (size_t i = 0; i < chosen.size(); ++i)
       for (size_t c = 0; c < cands.size(); ++c) {
         if (std::find(chosen.begin(), chosen.end(), static_cast<int>(c)) != chosen.end()) continue;
         std::vector<int> set = chosen;
         set[i] = static_cast<int>(c);
-        const Fit f = FitCols(g, ColumnsOf(bank, set), false);
-        if (f.ok && f.bic < best_bic) best_bic = f.bic, best_set = set, best_fit = f;
+        consider(set);
+        // One effect for two: a stand-in that took the share of two effects leaves neither of them
+        // material on its own (a hip gravity error for a hip dead band and Coulomb friction).
+        for (size_t d = c + 1; pairs && d < cands.size(); ++d) {
+          if (std::find(chosen.begin(), chosen.end(), static_cast<int>(d)) != chosen.end()) continue;
+          std::vector<int> two = set;
+          two.push_back(static_cast<int>(d));
+          consider(two);
+        }
       }
     if (best_set.empty()) break;
     Eigen::VectorXd kept = theta, lin = theta;
@@ -260,6 +296,73 @@ void MotionFit::ExchangeEffects(const ColumnBank& bank, const Grams& g, int roun
     if (!rx.ok) break;
     chosen = best_set, theta = rf.theta, at = std::move(rx);
   }
+}
+
+// Backward elimination on the exact plant (motion_fit.h step 5, after the exchanges): each chosen
+// effect taken out and the rest refined from the set's values (step 4's refinement, the effect at 0);
+// the removal of the lowest exact fit-part BIC taken where that BIC is below the set's or where what
+// the effect adds at its joint on the fit parts is below the selection's materiality (an exchange
+// does not check it), repeated. The
+// linear model's elimination (SelectEffects) judges a stand-in where it entered; once an exchange or
+// the friction's form brought in what it stood for (a hip dead band for the sensor gains that took its
+// knocks), only the plant shows that it adds nothing.
+void MotionFit::EliminateOnThePlant(int round) {
+  // The materiality floor per joint on the fit parts (the selection's, SelectEffects): kMinTorqueShare
+  // of the measured angle's RMS about its mean, squared, times the rows, in the weighted SSE.
+  double floor[2] = {0, 0};
+  for (size_t r = 0; r < P.records(); ++r) {
+    const size_t m = P.rows(r).size(), mf = P.fit_rows(r);
+    for (int j = 0; j < 2; ++j) {
+      std::vector<double> q;
+      for (size_t k = 0; k < mf; ++k) q.push_back(P.measured(r)[static_cast<Eigen::Index>(j * m + k)]);
+      const double s = kMinTorqueShare * RmsAboutMean(q) * P.weight(r, j);
+      floor[j] += s * s * static_cast<double>(q.size());
+    }
+  }
+  while (chosen.size() > 1) {
+    const double bic_now = ExactBic(Cost(P, at, Part::kFit), ParameterCount(chosen));
+    double sse_now[2];
+    P.Sse(at, Part::kFit, sse_now);
+    std::vector<std::vector<int>> sets;
+    std::vector<Eigen::VectorXd> refined;
+    std::vector<double> bics;
+    for (size_t i = 0; i < chosen.size(); ++i) {
+      std::vector<int> set = chosen;
+      set.erase(set.begin() + static_cast<long>(i));
+      Eigen::VectorXd x = theta;
+      for (int k : cands[static_cast<size_t>(chosen[i])].cols) x[k] = 0;
+      const Refined rf = Refine(P, ColumnsOf(cand_bank, set), {x}, kMotionLmIterations, false);
+      if (!std::isfinite(rf.cost)) continue;
+      sets.push_back(set), refined.push_back(rf.theta), bics.push_back(ExactBic(rf.cost, ParameterCount(set)));
+    }
+    // Taken out where the BIC is lower without it, or where what it adds at its joint is immaterial.
+    const std::vector<MotionProblem::Rollout> ro = P.SimulateAll(refined, Part::kFit);
+    int best = -1;
+    std::string why;
+    for (size_t s = 0; s < sets.size(); ++s) {
+      int out = -1;
+      for (int c : chosen)
+        if (std::find(sets[s].begin(), sets[s].end(), c) == sets[s].end()) out = c;
+      const int j = cands[static_cast<size_t>(out)].joint;
+      double sse[2] = {INFINITY, INFINITY};
+      if (ro[s].ok) P.Sse(ro[s], Part::kFit, sse);
+      const bool lower = bics[s] < bic_now, immaterial = sse[j] - sse_now[j] < floor[j];
+      if ((lower || immaterial) && (best < 0 || bics[s] < bics[static_cast<size_t>(best)])) {
+        best = static_cast<int>(s);
+        why = lower ? "" : " (higher, but what " + cands[static_cast<size_t>(out)].Label() +
+                               " adds at its joint is below the materiality of " + NumberText(100 * kMinTorqueShare) +
+                               " % of the measured angle's RMS)";
+      }
+    }
+    if (best < 0) break;
+    MotionProblem::Rollout rx = P.Simulate(refined[static_cast<size_t>(best)], Part::kBoth);
+    if (!rx.ok) break;
+    D.selection.push_back("round " + std::to_string(round + 1) + ": on the plant " + Labels(P, chosen) + " -> " +
+                          Labels(P, sets[static_cast<size_t>(best)]) + ": exact BIC " + NumberText(bic_now, 4) + " -> " +
+                          NumberText(bics[static_cast<size_t>(best)], 4) + why + ", taken");
+    chosen = sets[static_cast<size_t>(best)], theta = refined[static_cast<size_t>(best)], at = std::move(rx);
+  }
+  Charge(kRefinement);
 }
 
 // The torque fit's effects put to the plant (motion_fit.h step 5): each effect the torque fit names
