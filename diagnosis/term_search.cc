@@ -409,6 +409,30 @@ DiagnosedEffect TermEffect(const Term& t, const Eigen::VectorXd& coef, const std
   return d;
 }
 
+// A candidate that acts only near rest at its joint: an even function of the joint's velocity that
+// vanishes with speed (every factor of qd a exp(-(qd / v)^2), at least one). Where a Coulomb friction
+// is named at the joint, such a torque is that friction's sticking phase, whose torque is set-valued
+// (any value within its bound: the plant's friction constraint, a real drive's static friction), not
+// a law of the motion: no term.
+bool StickPhase(const TermCandidate& c) {
+  bool gauss = false;
+  for (const TermFactor& f : c.factors)
+    if (f.sig == TermSignal::kQd) {
+      if (f.fn != TermFn::kGauss) return false;
+      gauss = true;
+    }
+  return gauss;
+}
+
+// Whether a Coulomb friction of the table at joint j is in the current model (its column in `cur`).
+bool CoulombNamed(const Diagnosis& D, const std::vector<int>& cur, int j) {
+  for (int c : cur)
+    if (c < static_cast<int>(D.effects.size()) && D.effects[static_cast<size_t>(c)].effect.name == kCoulombFriction &&
+        EffectJoint(D.effects[static_cast<size_t>(c)].effect) == j)
+      return true;
+  return false;
+}
+
 // Backward elimination: drops, one at a time, the table effect (columns below K of `cur`) that no
 // longer earns the BIC margin or |t| beside the terms and whose absence costs its joint's held-out
 // error less than the selection's gates (kMinHeldoutGain of it or the material floor; tt_te: the
@@ -580,6 +604,12 @@ TermSearchResult SearchTerms(const LegParams& params, const std::vector<Rec>& re
                                Num(-100 * drop_te / std::max(1e-300, now.sse_te_j[j])) + " %, |t| " +
                                Num(TermT(f, cand_cols[i])) + (admissible ? ": admissible" : ""));
       if (!admissible) continue;
+      if (StickPhase(top[i].c) && CoulombNamed(*D, cur, j)) {
+        D->term_search.push_back("not a term: " + CandidateExpr(top[i].c, kJointName[j]) + " (" + kJointName[j] +
+                                 ") acts only near rest, where the named Coulomb friction's torque is set-valued "
+                                 "(sticking: any value within its bound)");
+        continue;
+      }
       gain[i] = drop_te;
     }
     // The table's own forms at a joint compete first (simplest first): a term that one of them
