@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Issue 64 part 3's sweep, by hand (a minute or more per case; the suite's drawn cases are in
-# tests/diagnosis/motion_fit_combination_test.cc): N cases drawn from the ranges with one master seed,
+# tests/diagnosis/motion_rounds_test.cc): N cases drawn from the ranges with one master seed,
 # each a closed-loop run of the shipped gait (S1) on a plant holding a hinge (a dead band, or a knee
 # strap: with a human the plant's strap is the knee's) and a Coulomb friction, then `diagnose --fit
 # motion` (and `--fit torque` for comparison) with the rigid subject model (examples/S1.yaml).
