@@ -154,6 +154,13 @@ const LongRecord& TheRunRecord(const BenchConfig& c) {
   return r;
 }
 
+// The median of paired runs' ratios (at least one).
+double MedianOf(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t h = v.size() / 2;
+  return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+
 json LongRecordRow(const BenchConfig& c, const LongRecord& r, const std::string& command, int pairs) {
   const std::string out = c.scratch + "/long_" + command + (command == "predict" ? ".csv" : "");
   // In pairs, the strtod read then the command: the ratio is the median of the pairs' ratios (a
@@ -172,8 +179,7 @@ json LongRecordRow(const BenchConfig& c, const LongRecord& r, const std::string&
     run.max_rss_mb = rss;
   }
   std::sort(ratios.begin(), ratios.end());
-  const size_t h = ratios.size() / 2;
-  const double ratio = ratios.size() % 2 ? ratios[h] : 0.5 * (ratios[h - 1] + ratios[h]);
+  const double ratio = MedianOf(ratios);
   // `diagnose` runs on every core (diagnosis/diagnose.h DiagnoseThreads), the strtod read on one: the
   // row names the cores, and its CPU seconds over the same floor.
   const bool threaded = command == "diagnose";
@@ -242,12 +248,7 @@ json BenchTermSearch(const BenchConfig& c) {
     const ChildRun on = RunSelf({"diagnose", "--params", params, "--measured", csv, "--out", c.scratch + "/term_on"});
     ratios.push_back(on.wall_s / off.wall_s), cpu_ratios.push_back(on.cpu_s / off.cpu_s);
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t h = v.size() / 2;
-    return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
-  };
-  const double ratio = median(ratios), cpu = median(cpu_ratios);
+  const double ratio = MedianOf(ratios), cpu = MedianOf(cpu_ratios);
   const std::string work = "`diagnose` with its completeness tests, ceilings and search for terms (names the form), " +
                            std::to_string(static_cast<int>(g.duration)) + " s record holding a form off the table";
   const std::string detail = "CPU " + NumberText(cpu, 3) + "x; pairs " + NumberText(*std::min_element(ratios.begin(), ratios.end()), 3) +

@@ -65,6 +65,7 @@ using torque_fit::RangeEdge;
 using torque_fit::RefineRows;
 using torque_fit::UseSecantColumns;
 using torque_fit::SearchTerms;
+using torque_fit::BlackBoxShareOfResidual;
 using torque_fit::CeilingLeavesStructure;
 using torque_fit::TermSearchResult;
 
@@ -482,8 +483,7 @@ Stage5c AssessAndSearch(const LegParams& params, const std::vector<Rec>& recs, c
                               (!held.complete ? "residual tests on the held-out rows; " : "") +
                               (!on_fit_rows[j].complete ? "residual tests on the fit rows; " : "") +
                               (ceiling ? "the black box lowers its held-out error by " +
-                                             NumberText(100 * (D.table_model.ceiling[j].black_box_pct - D.table_model.ceiling[j].named_pct) /
-                                                            std::max(1e-9, 100 - D.table_model.ceiling[j].named_pct), 3) + " %; " : "") +
+                                             NumberText(100 * BlackBoxShareOfResidual(D.table_model.ceiling[j]), 3) + " %; " : "") +
                               "searched)");
   }
   if (incomplete[0] || incomplete[1]) st.searched = SearchTerms(params, recs, w, banks, scale, incomplete, DiagnoseThreads(opt), &D);

@@ -160,11 +160,15 @@ ModelAssessment TestModel(const LegParams& given, const LegParams& model, const 
   return out;
 }
 
+double BlackBoxShareOfResidual(const JointCeiling& c) {
+  const double left = 1 - c.named_pct / 100;  // what the named model leaves of the model given's SSE
+  return c.done && left > 0 ? (c.black_box_pct - c.named_pct) / 100 / left : 0.0;
+}
+
 bool CeilingLeavesStructure(const JointCeiling& c, double floor) {
   if (!c.done) return false;
   const double removed = (c.black_box_pct - c.named_pct) / 100;  // of the model given's held-out SSE
-  const double left = 1 - c.named_pct / 100;                      // what the named model leaves of it
-  return removed >= kMinHeldoutGain * left && c.given_rms * std::sqrt(std::max(0.0, removed)) >= floor;
+  return BlackBoxShareOfResidual(c) >= kMinHeldoutGain && c.given_rms * std::sqrt(std::max(0.0, removed)) >= floor;
 }
 
 void FitCeilings(const CeilingRows& rows, const std::vector<ModelAssessment*>& out, const DiagnoseOptions& opt) {

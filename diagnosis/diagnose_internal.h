@@ -166,6 +166,8 @@ void FitCeilings(const CeilingRows& rows, const std::vector<ModelAssessment*>& o
 // minimum of decimated rows (a short held-out part, a low cutoff) and sees any function of the states,
 // tau_R and their short history.
 bool CeilingLeavesStructure(const JointCeiling& c, double floor);
+// The share of the named model's held-out sum of squares the black box removes (fraction; 0 when not done).
+double BlackBoxShareOfResidual(const JointCeiling& c);
 // The same on the records themselves (the motion fit's): each prepared as stage 2 does at `cutoff`
 // (the torque fit's) with the model given, then AssessModel.
 ModelAssessment AssessModelOnRecords(const LegParams& given, const LegParams& model,

@@ -21,7 +21,7 @@ LegParams WithEffects(const std::string& list) {
   return ParseModelYaml(std::string(kRigid) + "effects: " + list + "\n", "m.yaml");
 }
 // The same with the effects as a block list ("  - {...}\n" lines).
-LegParams Parse(const std::string& effects) { return ParseModelYaml(std::string(kRigid) + "effects:\n" + effects, "m.yaml"); }
+LegParams Parse(const std::string& effects) { return WithEffects("\n" + effects); }
 
 TEST(ModelFile, EachFamilysKeysAreReadByKind) {
   // kAxis: X by default, Y where given.
